@@ -1,0 +1,325 @@
+//! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
+
+use crate::{
+    Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, StepStats, Stats,
+};
+
+/// The integrator's state at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// Time, s.
+    pub t: f64,
+    /// Coordinates (storage, length `n_coords`).
+    pub q: Vec<f64>,
+    /// Velocities (tangent, length `n_dof`).
+    pub v: Vec<f64>,
+    /// Accelerations v̇.
+    pub v_dot: Vec<f64>,
+    /// Generalized-α pseudo-accelerations a.
+    pub a: Vec<f64>,
+    /// Multipliers of the holonomic constraints.
+    pub lambda: Vec<f64>,
+    /// Multipliers of the velocity constraints.
+    pub mu: Vec<f64>,
+}
+
+impl State {
+    /// A state at rest at `q0` with zero accelerations and multipliers, sized for `sys`.
+    ///
+    /// # Panics
+    /// When `q0.len() != sys.n_coords()`.
+    pub fn at_rest<S: ConstrainedSystem + ?Sized>(sys: &S, t: f64, q0: Vec<f64>) -> Self {
+        assert_eq!(q0.len(), sys.n_coords(), "q0 has the wrong length");
+        let n = sys.n_dof();
+        Self {
+            t,
+            q: q0,
+            v: vec![0.0; n],
+            v_dot: vec![0.0; n],
+            a: vec![0.0; n],
+            lambda: vec![0.0; sys.n_holonomic()],
+            mu: vec![0.0; sys.n_velocity_constraints()],
+        }
+    }
+}
+
+/// The generalized-α integrator with its preallocated workspace.
+///
+/// Generic over the linear solver; [`DenseLu`] by default.
+#[derive(Debug)]
+pub struct GenAlpha<L: LinearSolver = DenseLu> {
+    params: IntegratorParams,
+    c: Coefficients,
+    n: usize,
+    n_h: usize,
+    n_v: usize,
+    solver: L,
+    matrix: DenseMatrix,
+    phi_q: DenseMatrix,
+    b_mat: DenseMatrix,
+    phi_q_ready: bool,
+    have_factorization: bool,
+    rhs: Vec<f64>,
+    r: Vec<f64>,
+    phi: Vec<f64>,
+    psi: Vec<f64>,
+    q_n: Vec<f64>,
+    delta: Vec<f64>,
+    hdelta: Vec<f64>,
+    weights: Vec<f64>,
+    stats: Stats,
+}
+
+impl GenAlpha<DenseLu> {
+    /// An integrator with the dense LU solver.
+    pub fn new<S: ConstrainedSystem + ?Sized>(params: IntegratorParams, sys: &S) -> Result<Self, Error> {
+        Self::with_solver(params, sys, DenseLu::default())
+    }
+}
+
+fn inf_norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) })
+}
+
+impl<L: LinearSolver> GenAlpha<L> {
+    /// An integrator with a given linear solver.
+    pub fn with_solver<S: ConstrainedSystem + ?Sized>(params: IntegratorParams, sys: &S, mut solver: L) -> Result<Self, Error> {
+        params.validate()?;
+        let (n, n_h, n_v, n_q) = (sys.n_dof(), sys.n_holonomic(), sys.n_velocity_constraints(), sys.n_coords());
+        let n_all = n + n_h + n_v;
+        solver.set_dimension(n_all);
+        Ok(Self {
+            params,
+            c: params.coefficients(),
+            n,
+            n_h,
+            n_v,
+            solver,
+            matrix: DenseMatrix::zeros(n_all, n_all),
+            phi_q: DenseMatrix::zeros(n_h, n),
+            b_mat: DenseMatrix::zeros(n_v, n),
+            phi_q_ready: false,
+            have_factorization: false,
+            rhs: vec![0.0; n_all],
+            r: vec![0.0; n],
+            phi: vec![0.0; n_h],
+            psi: vec![0.0; n_v],
+            q_n: vec![0.0; n_q],
+            delta: vec![0.0; n],
+            hdelta: vec![0.0; n],
+            weights: (0..n).map(|i| sys.increment_weight(i)).collect(),
+            stats: Stats::default(),
+        })
+    }
+
+    /// Parameters in use.
+    pub fn params(&self) -> &IntegratorParams {
+        &self.params
+    }
+    /// Chung–Hulbert coefficients in use.
+    pub fn coefficients(&self) -> &Coefficients {
+        &self.c
+    }
+    /// Accumulated statistics.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn update_jacobians<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t: f64, q: &[f64]) {
+        if self.n_h > 0 && !(self.phi_q_ready && sys.phi_q_is_constant()) {
+            self.phi_q.fill_zero();
+            sys.phi_q_inplace(t, q, &mut self.phi_q.view());
+            self.phi_q_ready = true;
+        }
+        if self.n_v > 0 {
+            self.b_mat.fill_zero();
+            sys.psi_v_inplace(t, q, &mut self.b_mat.view());
+        }
+    }
+
+    /// Copy Φ_q and B (and their transposes) into the assembled matrix around the K block.
+    fn place_constraint_blocks(&mut self) {
+        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        for j in 0..n {
+            for i in 0..n_h {
+                let x = self.phi_q.get(i, j);
+                *self.matrix.get_mut(n + i, j) = x;
+                *self.matrix.get_mut(j, n + i) = x;
+            }
+            for i in 0..n_v {
+                let x = self.b_mat.get(i, j);
+                *self.matrix.get_mut(n + n_h + i, j) += x;
+                *self.matrix.get_mut(j, n + n_h + i) = x;
+            }
+        }
+    }
+
+    /// Consistent initial accelerations and multipliers:
+    /// `[M Φ_qᵀ Bᵀ; Φ_q 0 0; B 0 0] [v̇; λ; μ] = [−g; −(Φ_q v)_q v; −(B v)_q v]`
+    /// (scleronomic constraints: ∂b/∂t = 0). Sets `a = v̇`.
+    pub fn initialize<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &mut State) -> Result<(), Error> {
+        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        self.update_jacobians(sys, s.t, &s.q);
+        self.matrix.fill_zero();
+        sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));
+        self.place_constraint_blocks();
+        self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })?;
+        self.have_factorization = false; // this is the mass matrix, not the iteration matrix
+        let zeros = vec![0.0; n];
+        sys.residual_inplace(s.t, &s.q, &s.v, &zeros, &mut self.r);
+        for i in 0..n {
+            self.rhs[i] = -self.r[i];
+        }
+        sys.phi_qq_vv_inplace(s.t, &s.q, &s.v, &mut self.phi);
+        for i in 0..n_h {
+            self.rhs[n + i] = -self.phi[i];
+        }
+        if n_v > 0 {
+            let mut psi_q = DenseMatrix::zeros(n_v, n);
+            sys.psi_q_inplace(s.t, &s.q, &s.v, &mut psi_q.view());
+            psi_q.mul_vec_inplace(&s.v, &mut self.psi);
+            for i in 0..n_v {
+                self.rhs[n + n_h + i] = -self.psi[i];
+            }
+        }
+        self.solver.solve_in_place(&mut self.rhs);
+        if !self.rhs.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFinite { t: s.t, iter: 0 });
+        }
+        s.v_dot.copy_from_slice(&self.rhs[..n]);
+        s.a.copy_from_slice(&self.rhs[..n]);
+        s.lambda.copy_from_slice(&self.rhs[n..n + n_h]);
+        s.mu.copy_from_slice(&self.rhs[n + n_h..]);
+        Ok(())
+    }
+
+    /// Advance `s` by one step `dt`. On error `s` is left at the last iterate (for plotting what
+    /// was computed); the caller decides whether to stop.
+    pub fn step<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
+        let c = self.c;
+        let (h, n, n_h, n_v) = (c.h, self.n, self.n_h, self.n_v);
+        let np = self.params.newton;
+        let t1 = s.t + h;
+
+        // Predictor: constant acceleration v̇_{n+1} = v̇_n.
+        self.q_n.copy_from_slice(&s.q);
+        for i in 0..n {
+            let a_n = s.a[i];
+            let a1 = (s.v_dot[i] - c.alpha_m * a_n) / (1.0 - c.alpha_m);
+            self.delta[i] = s.v[i] + h * (0.5 - c.beta) * a_n + h * c.beta * a1;
+            s.v[i] += h * (1.0 - c.gamma) * a_n + h * c.gamma * a1;
+            s.a[i] = a1;
+            self.hdelta[i] = h * self.delta[i];
+        }
+        sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+
+        let mut stats = StepStats::default();
+        let mut prev_inc = f64::INFINITY;
+        let mut fresh = false; // factorisation made at this iterate's matrix
+        let mut inc_norm = f64::INFINITY;
+        let mut res_norm;
+        for iter in 1..=np.max_iter + 1 {
+            // Residuals at the current iterate.
+            self.update_jacobians(sys, t1, &s.q);
+            sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
+            self.stats.n_residual_evals += 1;
+            self.phi_q.add_mul_transpose_vec_inplace(&s.lambda, &mut self.r);
+            self.b_mat.add_mul_transpose_vec_inplace(&s.mu, &mut self.r);
+            sys.phi_inplace(t1, &s.q, &mut self.phi);
+            sys.psi_inplace(t1, &s.q, &s.v, &mut self.psi);
+            res_norm = inf_norm(&self.r) / c.beta_prime;
+            let phi_norm = inf_norm(&self.phi);
+            let psi_norm = inf_norm(&self.psi);
+            stats.residual_norm = res_norm;
+            stats.phi_norm = phi_norm;
+            stats.psi_norm = psi_norm;
+            if !(res_norm.is_finite() && phi_norm.is_finite() && psi_norm.is_finite()) {
+                return Err(Error::NonFinite { t: t1, iter });
+            }
+            if iter > 1 && inc_norm <= 1.0 && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
+                stats.n_newton_iters = iter - 1;
+                s.t = t1;
+                sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
+                self.stats.record(&stats);
+                return Ok(stats);
+            }
+            if iter > np.max_iter {
+                break;
+            }
+            // Decide whether to (re)factorise.
+            let contraction = inc_norm / prev_inc;
+            let need = !np.reuse_factorization
+                || !self.have_factorization
+                || (iter > 1 && contraction > np.max_contraction && !fresh)
+                || (iter > 4 && !fresh);
+            if need {
+                self.assemble(sys, t1, s);
+                self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })?;
+                self.have_factorization = true;
+                stats.n_factorizations += 1;
+                fresh = true;
+            } else {
+                fresh = false;
+            }
+            for i in 0..n {
+                self.rhs[i] = -self.r[i] / c.beta_prime;
+            }
+            for i in 0..n_h {
+                self.rhs[n + i] = -self.phi[i];
+            }
+            for i in 0..n_v {
+                self.rhs[n + n_h + i] = -self.psi[i] / c.gamma_prime;
+            }
+            self.solver.solve_in_place(&mut self.rhs);
+            if !self.rhs.iter().all(|x| x.is_finite()) {
+                return Err(Error::NonFinite { t: t1, iter });
+            }
+            // Update.
+            prev_inc = inc_norm;
+            inc_norm = 0.0;
+            for i in 0..n {
+                let dx = self.rhs[i];
+                self.delta[i] += dx / h;
+                self.hdelta[i] = h * self.delta[i];
+                s.v[i] += c.gamma_prime * dx;
+                s.v_dot[i] += c.beta_prime * dx;
+                s.a[i] += dx / (c.beta * h * h);
+                let w = self.weights[i];
+                let tol = np.atol + np.rtol * (self.hdelta[i] * w).abs();
+                inc_norm = inc_norm.max((dx * w).abs() / tol);
+            }
+            for i in 0..n_h {
+                s.lambda[i] += c.beta_prime * self.rhs[n + i];
+            }
+            for i in 0..n_v {
+                s.mu[i] += c.beta_prime * self.rhs[n + n_h + i];
+            }
+            sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+        }
+        Err(Error::NewtonDiverged {
+            t: t1,
+            iter: np.max_iter,
+            residual_norm: stats.residual_norm,
+            increment_norm: inc_norm,
+            phi_norm: stats.phi_norm,
+            psi_norm: stats.psi_norm,
+        })
+    }
+
+    /// Assemble the scaled iteration matrix at the current iterate.
+    fn assemble<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
+        let c = self.c;
+        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        self.matrix.fill_zero();
+        {
+            let mut k = self.matrix.block(0, 0, n, n);
+            sys.iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, 1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime, &mut k);
+            sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, 1.0 / c.beta_prime, &mut k);
+        }
+        if n_v > 0 {
+            let mut j = self.matrix.block(n + n_h, 0, n_v, n);
+            sys.psi_q_inplace(t1, &s.q, &s.v, &mut j.scaled(1.0 / c.gamma_prime));
+        }
+        self.place_constraint_blocks();
+    }
+}

@@ -1,0 +1,127 @@
+//! Integrator parameters (deserialised straight from case files).
+
+use crate::Error;
+
+/// Newton iteration settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonParams {
+    /// Maximum Newton iterations per step (default 20).
+    pub max_iter: usize,
+    /// Relative tolerance on the increment, against the step's motion `h·|Δq|` (default 1e-8).
+    pub rtol: f64,
+    /// Absolute tolerance on the increment, in the model's coordinate units (default 1e-10).
+    pub atol: f64,
+    /// Absolute tolerance on the holonomic constraints Φ, coordinate units (default 1e-10).
+    pub phi_tol: f64,
+    /// Absolute tolerance on the velocity constraints B v + b, velocity units (default 1e-8).
+    pub psi_tol: f64,
+    /// Reuse the factorisation across iterations and steps while Newton contracts fast
+    /// (modified Newton). Default true.
+    pub reuse_factorization: bool,
+    /// Contraction rate above which a reused factorisation is refreshed (default 0.2).
+    pub max_contraction: f64,
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        Self {
+            max_iter: 20,
+            rtol: 1e-8,
+            atol: 1e-10,
+            phi_tol: 1e-10,
+            psi_tol: 1e-8,
+            reuse_factorization: true,
+            max_contraction: 0.2,
+        }
+    }
+}
+
+/// Generalized-α parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegratorParams {
+    /// Spectral radius at infinite frequency, in [0, 1] (1 = no numerical damping).
+    pub rho_inf: f64,
+    /// Time step, s.
+    pub dt: f64,
+    /// Newton settings.
+    pub newton: NewtonParams,
+}
+
+impl IntegratorParams {
+    /// Parameters with default Newton settings.
+    pub fn new(rho_inf: f64, dt: f64) -> Self {
+        Self { rho_inf, dt, newton: NewtonParams::default() }
+    }
+
+    /// Check ranges; returns an error naming the field.
+    pub fn validate(&self) -> Result<(), Error> {
+        if !(0.0..=1.0).contains(&self.rho_inf) {
+            return Err(Error::InvalidParameter {
+                field: "rho_inf",
+                reason: format!("{} is not in [0, 1]", self.rho_inf),
+            });
+        }
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(Error::InvalidParameter { field: "dt", reason: format!("{} is not a positive number", self.dt) });
+        }
+        let n = &self.newton;
+        if n.max_iter == 0 {
+            return Err(Error::InvalidParameter { field: "newton.max_iter", reason: "must be at least 1".into() });
+        }
+        for (field, v) in [
+            ("newton.rtol", n.rtol),
+            ("newton.atol", n.atol),
+            ("newton.phi_tol", n.phi_tol),
+            ("newton.psi_tol", n.psi_tol),
+            ("newton.max_contraction", n.max_contraction),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidParameter { field, reason: format!("{v} is not a positive number") });
+            }
+        }
+        Ok(())
+    }
+
+    /// The derived Chung–Hulbert coefficients.
+    pub fn coefficients(&self) -> Coefficients {
+        Coefficients::new(self.rho_inf, self.dt)
+    }
+}
+
+/// Chung–Hulbert coefficients and the Newton factors derived from them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients {
+    /// α_m.
+    pub alpha_m: f64,
+    /// α_f.
+    pub alpha_f: f64,
+    /// γ.
+    pub gamma: f64,
+    /// β.
+    pub beta: f64,
+    /// Time step h, s.
+    pub h: f64,
+    /// β′ = (1 − α_m) / (β h² (1 − α_f)): ∂v̇/∂q.
+    pub beta_prime: f64,
+    /// γ′ = γ / (β h): ∂v/∂q.
+    pub gamma_prime: f64,
+}
+
+impl Coefficients {
+    /// Coefficients for spectral radius `rho_inf` and step `h`.
+    pub fn new(rho_inf: f64, h: f64) -> Self {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        let beta = 0.25 * (gamma + 0.5).powi(2);
+        Self {
+            alpha_m,
+            alpha_f,
+            gamma,
+            beta,
+            h,
+            beta_prime: (1.0 - alpha_m) / (beta * h * h * (1.0 - alpha_f)),
+            gamma_prime: gamma / (beta * h),
+        }
+    }
+}

@@ -1,0 +1,40 @@
+//! Work counters.
+
+/// Statistics of one time step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepStats {
+    /// Newton iterations of this step.
+    pub n_newton_iters: usize,
+    /// Factorisations of the iteration matrix in this step.
+    pub n_factorizations: usize,
+    /// Final infinity norm of the scaled dynamic residual.
+    pub residual_norm: f64,
+    /// Final infinity norm of the holonomic constraint residual Φ.
+    pub phi_norm: f64,
+    /// Final infinity norm of the velocity constraint residual B v + b.
+    pub psi_norm: f64,
+}
+
+/// Accumulated statistics of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    /// Accepted steps.
+    pub n_steps: usize,
+    /// Newton iterations, all steps.
+    pub n_newton_iters: usize,
+    /// Largest number of Newton iterations in one step.
+    pub max_newton_iters: usize,
+    /// Numeric factorisations of the iteration matrix.
+    pub n_factorizations: usize,
+    /// Residual evaluations.
+    pub n_residual_evals: usize,
+}
+
+impl Stats {
+    pub(crate) fn record(&mut self, s: &StepStats) {
+        self.n_steps += 1;
+        self.n_newton_iters += s.n_newton_iters;
+        self.max_newton_iters = self.max_newton_iters.max(s.n_newton_iters);
+        self.n_factorizations += s.n_factorizations;
+    }
+}

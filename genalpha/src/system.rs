@@ -1,0 +1,101 @@
+//! The trait a structural model implements.
+
+use crate::MatView;
+
+/// A constrained second-order system
+///
+/// $$ r(q, v, \dot v, t) = M(q)\dot v + g(q, v, t),\qquad \Phi(q) = 0,\qquad \Psi = B(q) v + b(q, t) = 0 $$
+///
+/// (the integrator adds the constraint forces `Φ_qᵀ λ + Bᵀ μ` itself).
+///
+/// Coordinates `q` live in a storage vector of length [`n_coords`](Self::n_coords), which may
+/// exceed the tangent dimension [`n_dof`](Self::n_dof) (unit quaternions). Velocities, accelerations
+/// and every Jacobian column are tangent-space quantities of length `n_dof`. A perturbation of `q`
+/// is `q ∘ exp(δ)`, the model's [`retract_inplace`](Self::retract_inplace); "∂/∂q" below always
+/// means the derivative along that perturbation. For vector coordinates the default additive
+/// retraction makes these plain partial derivatives.
+///
+/// Every method writes into buffers the integrator owns: nothing allocates in the time loop.
+pub trait ConstrainedSystem {
+    /// Length of the stored coordinate vector `q`.
+    fn n_coords(&self) -> usize;
+    /// Tangent dimension: length of `v`, `v_dot` and of the residual.
+    fn n_dof(&self) -> usize;
+    /// Number of holonomic constraint rows Φ(q) = 0.
+    fn n_holonomic(&self) -> usize {
+        0
+    }
+    /// Number of velocity-level constraint rows B(q) v + b = 0.
+    fn n_velocity_constraints(&self) -> usize {
+        0
+    }
+
+    /// `q_out = q ∘ exp(dq)`. Default: `q_out = q + dq` (requires `n_coords == n_dof`).
+    fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
+        for ((o, a), b) in q_out.iter_mut().zip(q).zip(dq) {
+            *o = a + b;
+        }
+    }
+
+    /// `r = M(q) v_dot + g(q, v, t)`: inertial, gyroscopic, internal and (with a minus sign)
+    /// external generalised forces, without constraint forces.
+    fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]);
+
+    /// `k += c_m ∂r/∂v_dot + c_c ∂r/∂v + c_k ∂r/∂q`, an `n_dof × n_dof` view.
+    #[allow(clippy::too_many_arguments)] // the three coefficients are the generalized-α weights
+    fn iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    );
+
+    /// Holonomic constraint residual Φ(q) (length `n_holonomic`).
+    fn phi_inplace(&self, _t: f64, _q: &[f64], _phi: &mut [f64]) {}
+    /// `j += Φ_q`, an `n_holonomic × n_dof` view.
+    fn phi_q_inplace(&self, _t: f64, _q: &[f64], _j: &mut MatView<'_>) {}
+    /// Whether `Φ_q` is constant (ANCF's linear joints): then it is assembled only once.
+    fn phi_q_is_constant(&self) -> bool {
+        false
+    }
+    /// `(Φ_q v)_q v`, the quadratic velocity term of the acceleration-level constraint, used for
+    /// consistent initial accelerations. Default: zero (linear constraints).
+    fn phi_qq_vv_inplace(&self, _t: f64, _q: &[f64], _v: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
+
+    /// Velocity-level constraint residual Ψ = B(q) v + b(q, t) (length `n_velocity_constraints`).
+    fn psi_inplace(&self, _t: f64, _q: &[f64], _v: &[f64], _psi: &mut [f64]) {}
+    /// `j += B(q)`, an `n_velocity_constraints × n_dof` view.
+    fn psi_v_inplace(&self, _t: f64, _q: &[f64], _j: &mut MatView<'_>) {}
+    /// `j += ∂(B(q) v + b)/∂q` at fixed `v`.
+    fn psi_q_inplace(&self, _t: f64, _q: &[f64], _v: &[f64], _j: &mut MatView<'_>) {}
+
+    /// `k += c_k ∂(Φ_qᵀ λ + Bᵀ μ)/∂q` at fixed multipliers. Default: nothing (constant Jacobians).
+    fn constraint_force_tangent_inplace(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _lambda: &[f64],
+        _mu: &[f64],
+        _c_k: f64,
+        _k: &mut MatView<'_>,
+    ) {
+    }
+
+    /// Called after every accepted step: CRV rescaling (with its rate transformation),
+    /// position-level projection, renormalisation. `q`, `v`, `v_dot`, `a` may be changed
+    /// consistently. Default: nothing.
+    fn post_step(&mut self, _t: f64, _q: &mut [f64], _v: &mut [f64], _v_dot: &mut [f64], _a: &mut [f64]) {}
+
+    /// Weight of tangent component `i` in the increment norm: 1 for positions in metres; a
+    /// characteristic length for dimensionless coordinates (slopes, rotations). Default 1.
+    fn increment_weight(&self, _i: usize) -> f64 {
+        1.0
+    }
+}
