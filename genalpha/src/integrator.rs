@@ -1,7 +1,7 @@
 //! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
 
 use crate::{
-    Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, StepStats, Stats,
+    Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, Stats, StepStats,
 };
 
 /// The integrator's state at one instant.
@@ -83,7 +83,11 @@ fn inf_norm(x: &[f64]) -> f64 {
 
 impl<L: LinearSolver> GenAlpha<L> {
     /// An integrator with a given linear solver.
-    pub fn with_solver<S: ConstrainedSystem + ?Sized>(params: IntegratorParams, sys: &S, mut solver: L) -> Result<Self, Error> {
+    pub fn with_solver<S: ConstrainedSystem + ?Sized>(
+        params: IntegratorParams,
+        sys: &S,
+        mut solver: L,
+    ) -> Result<Self, Error> {
         params.validate()?;
         let (n, n_h, n_v, n_q) = (sys.n_dof(), sys.n_holonomic(), sys.n_velocity_constraints(), sys.n_coords());
         let n_all = n + n_h + n_v;
@@ -313,7 +317,16 @@ impl<L: LinearSolver> GenAlpha<L> {
         self.matrix.fill_zero();
         {
             let mut k = self.matrix.block(0, 0, n, n);
-            sys.iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, 1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime, &mut k);
+            sys.iteration_matrix_inplace(
+                t1,
+                &s.q,
+                &s.v,
+                &s.v_dot,
+                1.0,
+                c.gamma_prime / c.beta_prime,
+                1.0 / c.beta_prime,
+                &mut k,
+            );
             sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, 1.0 / c.beta_prime, &mut k);
         }
         if n_v > 0 {

@@ -35,7 +35,7 @@ pub use integrator::{GenAlpha, State};
 pub use linear_solver::{DenseLu, LinearSolver};
 pub use matrix::{DenseMatrix, MatView};
 pub use params::{Coefficients, IntegratorParams, NewtonParams};
-pub use stats::{StepStats, Stats};
+pub use stats::{Stats, StepStats};
 pub use system::ConstrainedSystem;
 
 #[cfg(test)]

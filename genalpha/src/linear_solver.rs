@@ -35,7 +35,13 @@ impl std::fmt::Debug for DenseLu {
 
 impl Default for DenseLu {
     fn default() -> Self {
-        Self { n: 0, lu: Mat::zeros(0, 0), perm: Vec::new(), perm_inv: Vec::new(), buf: MemBuffer::new(StackReq::EMPTY) }
+        Self {
+            n: 0,
+            lu: Mat::zeros(0, 0),
+            perm: Vec::new(),
+            perm_inv: Vec::new(),
+            buf: MemBuffer::new(StackReq::EMPTY),
+        }
     }
 }
 

@@ -123,7 +123,14 @@ impl MatView<'_> {
     }
     /// The same window with every addition multiplied by `s` (on top of the current factor).
     pub fn scaled(&mut self, s: f64) -> MatView<'_> {
-        MatView { m: self.m, row0: self.row0, col0: self.col0, n_rows: self.n_rows, n_cols: self.n_cols, scale: self.scale * s }
+        MatView {
+            m: self.m,
+            row0: self.row0,
+            col0: self.col0,
+            n_rows: self.n_rows,
+            n_cols: self.n_cols,
+            scale: self.scale * s,
+        }
     }
     /// A sub-window at (i0, j0) of this view.
     ///

@@ -62,7 +62,10 @@ impl IntegratorParams {
             });
         }
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(Error::InvalidParameter { field: "dt", reason: format!("{} is not a positive number", self.dt) });
+            return Err(Error::InvalidParameter {
+                field: "dt",
+                reason: format!("{} is not a positive number", self.dt),
+            });
         }
         let n = &self.newton;
         if n.max_iter == 0 {

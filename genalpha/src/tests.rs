@@ -19,7 +19,17 @@ impl ConstrainedSystem for Oscillator {
     fn residual_inplace(&self, _t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
         r[0] = self.m * v_dot[0] + self.k * q[0];
     }
-    fn iteration_matrix_inplace(&self, _t: f64, _q: &[f64], _v: &[f64], _a: &[f64], c_m: f64, _c_c: f64, c_k: f64, k: &mut MatView<'_>) {
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        _a: &[f64],
+        c_m: f64,
+        _c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
         k.add(0, 0, c_m * self.m + c_k * self.k);
     }
 }
@@ -50,7 +60,17 @@ impl ConstrainedSystem for Pendulum {
         r[0] = self.m * v_dot[0];
         r[1] = self.m * v_dot[1] + self.m * self.g;
     }
-    fn iteration_matrix_inplace(&self, _t: f64, _q: &[f64], _v: &[f64], _a: &[f64], c_m: f64, _c_c: f64, _c_k: f64, k: &mut MatView<'_>) {
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        _a: &[f64],
+        c_m: f64,
+        _c_c: f64,
+        _c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
         k.add(0, 0, c_m * self.m);
         k.add(1, 1, c_m * self.m);
     }
@@ -87,7 +107,15 @@ impl ConstrainedSystem for Pendulum {
             j.add(0, 1, v[1]);
         }
     }
-    fn constraint_force_tangent_inplace(&self, _t: f64, _q: &[f64], lambda: &[f64], mu: &[f64], c_k: f64, k: &mut MatView<'_>) {
+    fn constraint_force_tangent_inplace(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        lambda: &[f64],
+        mu: &[f64],
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
         let m = if self.velocity_level { mu[0] } else { lambda[0] };
         if !self.velocity_level {
             k.add(0, 0, c_k * m);
