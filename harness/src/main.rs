@@ -1,1 +1,201 @@
-fn main() {}
+//! `harness`: run both formulations on the case files, compare, report, gate.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use harness::case::{CaseFile, Formulation, Override, json_schema};
+use harness::csv::{to_csv, write_file};
+use harness::driver::{discover, expand_all, run_all, write_reports};
+use harness::gate;
+use harness::report::write_case;
+
+#[derive(Parser)]
+#[command(name = "harness", version, about = "Dual-formulation (ANCF / GEBF) verification harness for flared-hinged wings")]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Which {
+    Ancf,
+    Gebf,
+    Both,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run every case with both formulations; write reports/ (CSV, summary.json, SVG, index.html, summary.md).
+    All {
+        /// Folder of case files.
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value: `[ancf:|gebf:]path=value`, e.g. `t_end=0.5` or `gebf:joints.1.flare_deg=40`.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
+    /// Run one case file.
+    Run {
+        /// Case file.
+        case: PathBuf,
+        /// Formulation(s) to run.
+        #[arg(long, value_enum, default_value = "both")]
+        formulation: Which,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
+    /// Run the gated cases and check their tolerances; exit 1 when any case fails.
+    Gate {
+        /// Case files (default: every case in --cases that declares a gate).
+        files: Vec<PathBuf>,
+        /// Folder of case files.
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
+    /// List the runs the case files expand into.
+    List {
+        /// Folder of case files.
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+    },
+    /// Print the JSON Schema of case files.
+    Schema,
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn real_main() -> Result<ExitCode> {
+    let cli = Cli::parse();
+    match cli.cmd {
+        Cmd::Schema => {
+            use std::io::Write as _;
+            // A closed pipe (`| head`) is not an error worth a panic.
+            let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json_schema())?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::List { cases } => {
+            let (runs, errors) = expand_all(&discover(&cases)?, &[]);
+            for r in &runs {
+                println!(
+                    "{:<48} ancf: {} el/body dt {}  gebf: {} el/body dt {}  t_end {}  gate: {}",
+                    r.name,
+                    r.ancf.ancf.elements_per_body,
+                    r.ancf.ancf.dt,
+                    r.gebf.gebf.elements_per_body,
+                    r.gebf.gebf.dt,
+                    r.ancf.t_end,
+                    if r.ancf.gate.is_some() { "yes" } else { "no" }
+                );
+            }
+            for e in &errors {
+                eprintln!("error: {e}");
+            }
+            Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+        }
+        Cmd::All { cases, out, set } => {
+            let files = discover(&cases)?;
+            let (runs, errors) = expand_all(&files, &set);
+            for e in &errors {
+                eprintln!("error: {e}");
+            }
+            let t0 = std::time::Instant::now();
+            let results = run_all(&runs, &Formulation::ALL, true);
+            let wall = t0.elapsed().as_secs_f64();
+            write_reports(&out, &results).context("writing reports")?;
+            print!("{}", gate::table(&results));
+            let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
+            println!(
+                "{} runs ({} cases x 2 formulations) in {:.2} s wall; {} failed; reports in {}",
+                2 * results.len(),
+                results.len(),
+                wall,
+                failed,
+                out.join("index.html").display()
+            );
+            Ok(if failed == 0 && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+        }
+        Cmd::Run { case, formulation, out, set } => {
+            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
+            let fs: Vec<Formulation> = match formulation {
+                Which::Ancf => vec![Formulation::Ancf],
+                Which::Gebf => vec![Formulation::Gebf],
+                Which::Both => Formulation::ALL.to_vec(),
+            };
+            let results = run_all(&runs, &fs, true);
+            let mut failed = false;
+            for r in &results {
+                let dir = out.join(&r.name);
+                if fs.len() == 2 {
+                    write_case(&dir, r)?;
+                } else {
+                    for run in &r.runs {
+                        write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows))?;
+                    }
+                }
+                for run in &r.runs {
+                    let m = &r.metrics[&run.formulation];
+                    match &run.error {
+                        Some(e) => {
+                            failed = true;
+                            eprintln!("{} {}: FAILED: {e}", r.name, run.formulation);
+                        }
+                        None => println!(
+                            "{} {}: {} steps in {:.1} ms, {:.2} Newton/step, energy drift {:.2e}, max constraint {:.1e} -> {}",
+                            r.name,
+                            run.formulation,
+                            m.n_steps,
+                            1e3 * m.wall_s,
+                            m.newton_per_step,
+                            m.energy_drift,
+                            m.max_constraint_residual,
+                            dir.join(format!("{}.csv", run.formulation)).display()
+                        ),
+                    }
+                }
+                if let Some(p) = &r.pair {
+                    println!("{}: max tip difference ANCF-GEBF {:.3} mm", r.name, 1e3 * p.all.max);
+                }
+            }
+            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
+        Cmd::Gate { files, cases, set } => {
+            let files = if files.is_empty() { discover(&cases)? } else { files };
+            let (runs, errors) = expand_all(&files, &set);
+            for e in &errors {
+                eprintln!("error: {e}");
+            }
+            let gated: Vec<_> = runs.into_iter().filter(|r| r.ancf.gate.is_some()).collect();
+            let results = run_all(&gated, &Formulation::ALL, true);
+            print!("{}", gate::table(&results));
+            let failing: Vec<_> = results.iter().filter(|r| r.status() != "pass").collect();
+            for r in &failing {
+                for l in r.gate_outcome.as_ref().map(|g| g.failed_lines()).unwrap_or_default() {
+                    eprintln!("gate FAILED: {}: {l}", r.name);
+                }
+            }
+            println!("gate: {} of {} cases pass", results.len() - failing.len(), results.len());
+            Ok(if failing.is_empty() && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+        }
+    }
+}

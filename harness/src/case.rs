@@ -1,0 +1,756 @@
+//! Case files: the scene (bodies, joints, gravity), solver settings per formulation, external
+//! references and gate tolerances. JSON deserialises straight into these types; unknown fields
+//! are errors, and [`Case::validate`] names the offending field of every impossible value.
+
+use std::path::{Path, PathBuf};
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use crate::Error;
+
+fn one() -> f64 {
+    1.0
+}
+fn default_rho_inf() -> f64 {
+    0.8
+}
+fn default_x_axis() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn default_y_axis() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// One simulation scene, run with both formulations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Unique name; outputs go to `reports/<name>/`.
+    pub name: String,
+    /// Free text shown in the reports.
+    #[serde(default)]
+    pub description: String,
+    /// Beam bodies, straight in the reference configuration.
+    pub bodies: Vec<Body>,
+    /// Joints between bodies and to ground.
+    pub joints: Vec<Joint>,
+    /// Gravity vector, m/s² (omit for none).
+    #[serde(default)]
+    pub gravity: Option<[f64; 3]>,
+    /// Multiplies every stiffness (EA, GA_y, GA_z, GJ, EI_yy, EI_zz): the paper's `c`. Default 1.
+    #[serde(default = "one")]
+    pub stiffness_scale: f64,
+    /// End time, s.
+    pub t_end: f64,
+    /// Output interval, s (default: every step of the formulation).
+    #[serde(default)]
+    pub output_dt: Option<f64>,
+    /// Name of the flared hinge whose fold angle is the `fold` sensor (default: the first one).
+    #[serde(default)]
+    pub fold_joint: Option<String>,
+    /// ANCF settings.
+    pub ancf: AncfSettings,
+    /// GEBF settings.
+    pub gebf: GebfSettings,
+    /// External reference curves drawn as a third curve and included in the metrics.
+    #[serde(default)]
+    pub references: Vec<Reference>,
+    /// Gate tolerances (omit: the case is reported but not gated).
+    #[serde(default)]
+    pub gate: Option<Gate>,
+    /// Parameter sweep: each entry maps a `--set`-style path (e.g. `stiffness_scale`,
+    /// `joints.1.flare_deg`, `ancf.dt`) to a list of values; the Cartesian product expands into
+    /// named runs `<name>__<key>=<value>…`.
+    #[serde(default)]
+    pub sweep: Vec<SweepAxis>,
+}
+
+/// One sweep dimension.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SweepAxis {
+    /// Dotted path into the case (as for `--set`).
+    pub path: String,
+    /// Values to take.
+    pub values: Vec<Value>,
+}
+
+/// A straight beam body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Name joints refer to.
+    pub name: String,
+    /// Start point, m (global).
+    pub start: [f64; 3],
+    /// Length, m.
+    pub length: f64,
+    /// Beam axis (section x) in global coordinates; normalised. Default +X.
+    #[serde(default = "default_x_axis")]
+    pub x_axis: [f64; 3],
+    /// Section y axis in global coordinates; must be perpendicular to `x_axis`. Default +Y.
+    #[serde(default = "default_y_axis")]
+    pub y_axis: [f64; 3],
+    /// Section properties per unit length.
+    pub section: Section,
+}
+
+/// Cross-section data per unit length (SI). Centre of mass and shear centre on the beam axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Section {
+    /// Mass per length m = ρA, kg/m.
+    pub mass: f64,
+    /// Torsional mass moment of inertia per length ρI_xx, kg·m.
+    pub rho_ixx: f64,
+    /// ρI_yy, kg·m.
+    pub rho_iyy: f64,
+    /// ρI_zz, kg·m.
+    pub rho_izz: f64,
+    /// Axial stiffness EA, N.
+    pub ea: f64,
+    /// Shear stiffness GA_y, N.
+    pub ga_y: f64,
+    /// Shear stiffness GA_z, N.
+    pub ga_z: f64,
+    /// Torsional stiffness GJ, N·m².
+    pub gj: f64,
+    /// Bending stiffness EI_yy, N·m².
+    pub ei_yy: f64,
+    /// Bending stiffness EI_zz, N·m².
+    pub ei_zz: f64,
+}
+
+/// A joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Joint {
+    /// The body's start point pinned to ground; rotation only about a fixed global axis.
+    GroundHinge {
+        /// Optional joint name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Body name.
+        body: String,
+        /// Hinge axis, global (normalised).
+        axis: [f64; 3],
+    },
+    /// Flared hinge from the end of `parent` to the start of `child`, axis
+    /// a = sin β·x + cos β·y in the parent's end section frame.
+    FlaredHinge {
+        /// Optional joint name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Parent body name.
+        parent: String,
+        /// Child body name.
+        child: String,
+        /// Flare angle β, degrees, in [−90, 90].
+        flare_deg: f64,
+    },
+    /// The body's start section clamped to ground.
+    Clamp {
+        /// Optional joint name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Body name.
+        body: String,
+    },
+}
+
+impl Joint {
+    /// The joint's name, if any.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Joint::GroundHinge { name, .. } | Joint::FlaredHinge { name, .. } | Joint::Clamp { name, .. } => {
+                name.as_deref()
+            }
+        }
+    }
+}
+
+/// Newton settings (defaults as genalpha's).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewtonSettings {
+    /// Maximum iterations per step.
+    pub max_iter: usize,
+    /// Relative increment tolerance.
+    pub rtol: f64,
+    /// Absolute increment tolerance (m).
+    pub atol: f64,
+    /// Holonomic constraint tolerance.
+    pub phi_tol: f64,
+    /// Velocity constraint tolerance (m/s).
+    pub psi_tol: f64,
+    /// Reuse factorisations while Newton contracts fast.
+    pub reuse_factorization: bool,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        let d = genalpha::NewtonParams::default();
+        Self {
+            max_iter: d.max_iter,
+            rtol: d.rtol,
+            atol: d.atol,
+            phi_tol: d.phi_tol,
+            psi_tol: d.psi_tol,
+            reuse_factorization: d.reuse_factorization,
+        }
+    }
+}
+
+impl NewtonSettings {
+    /// As genalpha parameters.
+    pub fn to_params(self) -> genalpha::NewtonParams {
+        genalpha::NewtonParams {
+            max_iter: self.max_iter,
+            rtol: self.rtol,
+            atol: self.atol,
+            phi_tol: self.phi_tol,
+            psi_tol: self.psi_tol,
+            reuse_factorization: self.reuse_factorization,
+            ..Default::default()
+        }
+    }
+}
+
+/// ANCF solve path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AncfPath {
+    /// Index-3 DAE with Lagrange multipliers.
+    #[default]
+    Dae,
+    /// Constraints eliminated with the constant velocity transformation B (paper eq. 6–7).
+    Ode,
+}
+
+/// ANCF settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AncfSettings {
+    /// Two-node elements per body.
+    pub elements_per_body: usize,
+    /// Time step, s.
+    pub dt: f64,
+    /// Spectral radius at infinite frequency. Default 0.8.
+    #[serde(default = "default_rho_inf")]
+    pub rho_inf: f64,
+    /// DAE (default) or ODE path.
+    #[serde(default)]
+    pub path: AncfPath,
+    /// Newton settings.
+    #[serde(default)]
+    pub newton: NewtonSettings,
+}
+
+/// GEBF settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GebfSettings {
+    /// Three-node elements per body.
+    pub elements_per_body: usize,
+    /// Time step, s.
+    pub dt: f64,
+    /// Spectral radius at infinite frequency. Default 0.8.
+    #[serde(default = "default_rho_inf")]
+    pub rho_inf: f64,
+    /// Position-level projection of the joints after each step. Default off.
+    #[serde(default)]
+    pub stabilization: bool,
+    /// Newton settings.
+    #[serde(default)]
+    pub newton: NewtonSettings,
+}
+
+/// An external reference curve (CSV with a header; `#` lines are comments).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    /// Legend label.
+    pub label: String,
+    /// CSV path relative to the case file's folder; needs columns `t, tip_x, tip_y, tip_z`.
+    pub file: String,
+    /// The reference at time t + `time_shift` is compared with the run at time t, s (SHARPy's
+    /// zero-acceleration start lags by dt/2: use dt/2).
+    #[serde(default)]
+    pub time_shift: f64,
+    /// Gate: maximum tip distance from this reference, m, per formulation (omit: not gated).
+    #[serde(default)]
+    pub tip_max_m: Option<f64>,
+}
+
+/// Gate tolerances of a case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Gate {
+    /// Why these numbers (refinement study); shown in the reports.
+    #[serde(default)]
+    pub justification: String,
+    /// Windows of the ANCF–GEBF tip difference.
+    pub windows: Vec<GateWindow>,
+    /// Maximum energy drift (max |E − E0 − W_aero| / peak kinetic energy), each formulation.
+    pub energy_drift: f64,
+    /// Maximum position-level constraint residual, each formulation.
+    pub constraint_residual: f64,
+}
+
+/// Tip-difference limits over a time window.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GateWindow {
+    /// Window start, s.
+    pub t_start: f64,
+    /// Window end, s.
+    pub t_end: f64,
+    /// Maximum tip difference |p_ANCF − p_GEBF|, m.
+    pub tip_max_m: f64,
+    /// RMS tip difference, m.
+    pub tip_rms_m: f64,
+}
+
+/// The two structural formulations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    /// Absolute nodal coordinates.
+    Ancf,
+    /// Geometrically exact beam on floating frames.
+    Gebf,
+}
+
+impl Formulation {
+    /// Both, in report order.
+    pub const ALL: [Formulation; 2] = [Formulation::Ancf, Formulation::Gebf];
+    /// Lower-case name used in file names.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Formulation::Ancf => "ancf",
+            Formulation::Gebf => "gebf",
+        }
+    }
+}
+
+impl std::fmt::Display for Formulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// An override `path=value`, optionally for one formulation only (`gebf:path=value`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Override {
+    /// Only for this formulation, or for both.
+    pub only: Option<Formulation>,
+    /// Dotted path (`joints.1.flare_deg`).
+    pub path: String,
+    /// JSON value (a bare word that is not JSON is taken as a string).
+    pub value: Value,
+}
+
+impl std::str::FromStr for Override {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let bad = || Error::Override(format!("`{s}` is not of the form [ancf:|gebf:]path=value"));
+        let (lhs, rhs) = s.split_once('=').ok_or_else(bad)?;
+        let (only, path) = match lhs.split_once(':') {
+            Some(("ancf", p)) => (Some(Formulation::Ancf), p),
+            Some(("gebf", p)) => (Some(Formulation::Gebf), p),
+            Some(_) => return Err(bad()),
+            None => (None, lhs),
+        };
+        if path.is_empty() {
+            return Err(bad());
+        }
+        let value = serde_json::from_str(rhs).unwrap_or_else(|_| Value::String(rhs.to_string()));
+        Ok(Override { only, path: path.to_string(), value })
+    }
+}
+
+/// Set `path` (dotted; numbers index arrays) in a JSON value. The path must exist except for
+/// its last key in an object.
+pub fn set_path(root: &mut Value, path: &str, value: Value) -> Result<(), Error> {
+    let keys: Vec<&str> = path.split('.').collect();
+    let mut cur = root;
+    for (i, key) in keys.iter().enumerate() {
+        let last = i + 1 == keys.len();
+        let here = keys[..=i].join(".");
+        cur = match cur {
+            Value::Object(map) => {
+                if last {
+                    map.insert((*key).to_string(), value);
+                    return Ok(());
+                }
+                map.get_mut(*key).ok_or_else(|| Error::Override(format!("`{here}` does not exist")))?
+            }
+            Value::Array(arr) => {
+                let idx: usize =
+                    key.parse().map_err(|_| Error::Override(format!("`{here}`: `{key}` is not an array index")))?;
+                let len = arr.len();
+                let slot = arr
+                    .get_mut(idx)
+                    .ok_or_else(|| Error::Override(format!("`{here}`: index {idx} out of range (length {len})")))?;
+                if last {
+                    *slot = value;
+                    return Ok(());
+                }
+                slot
+            }
+            _ => return Err(Error::Override(format!("`{here}`: cannot index into a number or string"))),
+        };
+    }
+    Ok(())
+}
+
+/// A case file read from disk, before sweeps and overrides are applied.
+#[derive(Debug, Clone)]
+pub struct CaseFile {
+    /// Path of the file.
+    pub path: PathBuf,
+    /// Raw JSON.
+    pub raw: Value,
+}
+
+impl CaseFile {
+    /// Read and parse JSON (syntax only; the schema is checked per run).
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+        let raw: Value =
+            serde_json::from_str(&text).map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
+        Ok(Self { path: path.to_path_buf(), raw })
+    }
+
+    /// Folder references are resolved against.
+    pub fn dir(&self) -> PathBuf {
+        self.path.parent().map(Path::to_path_buf).unwrap_or_default()
+    }
+
+    /// Expand the sweep and apply overrides; returns one [`Run`] per sweep point.
+    pub fn expand(&self, overrides: &[Override]) -> Result<Vec<RunSpec>, Error> {
+        let file = self.path.display().to_string();
+        let err = |msg: String| Error::Case { file: file.clone(), msg };
+        // Global overrides first (they may change the sweep itself).
+        let mut base = self.raw.clone();
+        for o in overrides.iter().filter(|o| o.only.is_none()) {
+            set_path(&mut base, &o.path, o.value.clone()).map_err(|e| err(e.to_string()))?;
+        }
+        let sweep: Vec<SweepAxis> = match base.get("sweep") {
+            Some(v) => serde_json::from_value(v.clone()).map_err(|e| err(format!("sweep: {e}")))?,
+            None => Vec::new(),
+        };
+        if let Value::Object(m) = &mut base {
+            m.remove("sweep");
+        }
+        let mut points: Vec<Vec<(String, Value)>> = vec![Vec::new()];
+        for (k, axis) in sweep.iter().enumerate() {
+            if axis.values.is_empty() {
+                return Err(err(format!("sweep[{k}].values: empty list")));
+            }
+            points = points
+                .into_iter()
+                .flat_map(|p| {
+                    axis.values.iter().map(move |v| {
+                        let mut q = p.clone();
+                        q.push((axis.path.clone(), v.clone()));
+                        q
+                    })
+                })
+                .collect();
+        }
+        let mut runs = Vec::new();
+        for point in points {
+            let mut raw = base.clone();
+            let mut suffix = String::new();
+            for (path, v) in &point {
+                set_path(&mut raw, path, v.clone()).map_err(|e| err(format!("sweep: {e}")))?;
+                let key = path.rsplit('.').next().unwrap_or(path);
+                let val = match v {
+                    Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                suffix.push_str(&format!("__{key}={val}"));
+            }
+            let mut per = Vec::new();
+            for f in Formulation::ALL {
+                let mut r = raw.clone();
+                for o in overrides.iter().filter(|o| o.only == Some(f)) {
+                    set_path(&mut r, &o.path, o.value.clone()).map_err(|e| err(format!("{f}: {e}")))?;
+                }
+                let mut case = parse_case(&r).map_err(&err)?;
+                case.name.push_str(&suffix);
+                case.validate().map_err(&err)?;
+                per.push(case);
+            }
+            let gebf = per.pop().expect("two formulations");
+            let ancf = per.pop().expect("two formulations");
+            runs.push(RunSpec { name: ancf.name.clone(), dir: self.dir(), ancf, gebf });
+        }
+        Ok(runs)
+    }
+}
+
+/// Deserialize with the path of the offending field in the message.
+pub fn parse_case(raw: &Value) -> Result<Case, String> {
+    serde_path_to_error::deserialize(raw).map_err(|e| {
+        let path = e.path().to_string();
+        if path == "." { e.inner().to_string() } else { format!("{path}: {}", e.inner()) }
+    })
+}
+
+/// One expanded run: the case as each formulation sees it (they differ only under
+/// formulation-specific overrides).
+#[derive(Debug, Clone)]
+pub struct RunSpec {
+    /// Run name (case name plus sweep suffix).
+    pub name: String,
+    /// Folder of the case file (references are relative to it).
+    pub dir: PathBuf,
+    /// The case for ANCF.
+    pub ancf: Case,
+    /// The case for GEBF.
+    pub gebf: Case,
+}
+
+impl RunSpec {
+    /// The case seen by formulation `f`.
+    pub fn case(&self, f: Formulation) -> &Case {
+        match f {
+            Formulation::Ancf => &self.ancf,
+            Formulation::Gebf => &self.gebf,
+        }
+    }
+}
+
+fn finite3(v: &[f64; 3]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn norm3(v: &[f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+impl Case {
+    /// Index of the body called `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Index of the joint whose fold angle is reported.
+    pub fn fold_joint_index(&self) -> Option<usize> {
+        match &self.fold_joint {
+            Some(n) => self.joints.iter().position(|j| j.name() == Some(n.as_str())),
+            None => self.joints.iter().position(|j| matches!(j, Joint::FlaredHinge { .. })),
+        }
+    }
+
+    /// Total length of all bodies, m.
+    pub fn span(&self) -> f64 {
+        self.bodies.iter().map(|b| b.length).sum()
+    }
+
+    /// Check every value; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |f: &str, v: f64| -> Result<(), String> {
+            if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{f}: {v} is not a positive number")) }
+        };
+        let nonneg = |f: &str, v: f64| -> Result<(), String> {
+            if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{f}: {v} is not a non-negative number")) }
+        };
+        if self.name.is_empty() || self.name.contains(['/', '\\']) {
+            return Err(format!("name: `{}` is empty or contains a path separator", self.name));
+        }
+        if self.bodies.is_empty() {
+            return Err("bodies: at least one body is needed".into());
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            let f = |s: &str| format!("bodies[{i}].{s}");
+            if b.name.is_empty() {
+                return Err(f("name: empty"));
+            }
+            if self.bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(f(&format!("name: `{}` is used twice", b.name)));
+            }
+            if !finite3(&b.start) {
+                return Err(f("start: non-finite coordinate"));
+            }
+            pos(&f("length"), b.length)?;
+            if !finite3(&b.x_axis) || norm3(&b.x_axis) < 1e-12 {
+                return Err(f("x_axis: not a finite non-zero vector"));
+            }
+            if !finite3(&b.y_axis) || norm3(&b.y_axis) < 1e-12 {
+                return Err(f("y_axis: not a finite non-zero vector"));
+            }
+            let dot: f64 = (0..3).map(|k| b.x_axis[k] * b.y_axis[k]).sum::<f64>() / (norm3(&b.x_axis) * norm3(&b.y_axis));
+            if dot.abs() > 1e-9 {
+                return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
+            }
+            let s = &b.section;
+            pos(&f("section.mass"), s.mass)?;
+            for (n, v) in [("rho_ixx", s.rho_ixx), ("rho_iyy", s.rho_iyy), ("rho_izz", s.rho_izz)] {
+                nonneg(&f(&format!("section.{n}")), v)?;
+            }
+            for (n, v) in
+                [("ea", s.ea), ("ga_y", s.ga_y), ("ga_z", s.ga_z), ("gj", s.gj), ("ei_yy", s.ei_yy), ("ei_zz", s.ei_zz)]
+            {
+                pos(&f(&format!("section.{n}")), v)?;
+            }
+        }
+        let body = |field: String, name: &str| -> Result<(), String> {
+            if self.body_index(name).is_some() { Ok(()) } else { Err(format!("{field}: no body named `{name}`")) }
+        };
+        for (i, j) in self.joints.iter().enumerate() {
+            match j {
+                Joint::GroundHinge { body: b, axis, .. } => {
+                    body(format!("joints[{i}].body"), b)?;
+                    if !finite3(axis) || norm3(axis) < 1e-12 {
+                        return Err(format!("joints[{i}].axis: not a finite non-zero vector"));
+                    }
+                }
+                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
+                    body(format!("joints[{i}].parent"), parent)?;
+                    body(format!("joints[{i}].child"), child)?;
+                    if parent == child {
+                        return Err(format!("joints[{i}].child: same body as the parent"));
+                    }
+                    if !(flare_deg.is_finite() && (-90.0..=90.0).contains(flare_deg)) {
+                        return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
+                    }
+                }
+                Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
+            }
+        }
+        if let Some(n) = &self.fold_joint {
+            match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
+                Some(Joint::FlaredHinge { .. }) => {}
+                Some(_) => return Err(format!("fold_joint: `{n}` is not a flared hinge")),
+                None => return Err(format!("fold_joint: no joint named `{n}`")),
+            }
+        }
+        if let Some(g) = &self.gravity
+            && !finite3(g)
+        {
+            return Err("gravity: non-finite component".into());
+        }
+        pos("stiffness_scale", self.stiffness_scale)?;
+        pos("t_end", self.t_end)?;
+        if let Some(o) = self.output_dt {
+            pos("output_dt", o)?;
+        }
+        for (f, n, dt, rho) in [
+            ("ancf", self.ancf.elements_per_body, self.ancf.dt, self.ancf.rho_inf),
+            ("gebf", self.gebf.elements_per_body, self.gebf.dt, self.gebf.rho_inf),
+        ] {
+            if n == 0 {
+                return Err(format!("{f}.elements_per_body: must be at least 1"));
+            }
+            pos(&format!("{f}.dt"), dt)?;
+            if !(0.0..=1.0).contains(&rho) {
+                return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
+            }
+        }
+        for (k, r) in self.references.iter().enumerate() {
+            if !r.time_shift.is_finite() {
+                return Err(format!("references[{k}].time_shift: not finite"));
+            }
+            if let Some(t) = r.tip_max_m {
+                pos(&format!("references[{k}].tip_max_m"), t)?;
+            }
+        }
+        if let Some(g) = &self.gate {
+            pos("gate.energy_drift", g.energy_drift)?;
+            pos("gate.constraint_residual", g.constraint_residual)?;
+            for (k, w) in g.windows.iter().enumerate() {
+                if !(w.t_start.is_finite() && w.t_end.is_finite() && w.t_end > w.t_start) {
+                    return Err(format!("gate.windows[{k}]: t_end must exceed t_start"));
+                }
+                pos(&format!("gate.windows[{k}].tip_max_m"), w.tip_max_m)?;
+                pos(&format!("gate.windows[{k}].tip_rms_m"), w.tip_rms_m)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The JSON Schema of a case file, generated from these types.
+pub fn json_schema() -> Value {
+    serde_json::to_value(schemars::schema_for!(Case)).unwrap_or(Value::Null)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn raw() -> Value {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/double_pendulum_c1_beta45.json");
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn paper_case_parses_and_validates() {
+        let c = parse_case(&raw()).unwrap();
+        c.validate().unwrap();
+        assert_eq!(c.fold_joint_index(), Some(1));
+        assert_eq!(c.span(), 1.0);
+    }
+
+    #[test]
+    fn override_syntax() {
+        let o: Override = "gebf:joints.1.flare_deg=40".parse().unwrap();
+        assert_eq!(o.only, Some(Formulation::Gebf));
+        assert_eq!(o.value, json!(40));
+        let o: Override = "ancf.path=ode".parse().unwrap();
+        assert_eq!((o.only, o.value), (None, json!("ode")));
+        assert!("nonsense".parse::<Override>().is_err());
+        assert!("foo:x=1".parse::<Override>().is_err());
+    }
+
+    #[test]
+    fn set_path_reports_missing_keys_and_indices() {
+        let mut v = raw();
+        set_path(&mut v, "joints.1.flare_deg", json!(10)).unwrap();
+        assert_eq!(v["joints"][1]["flare_deg"], json!(10));
+        assert!(set_path(&mut v, "joints.9.flare_deg", json!(1)).unwrap_err().to_string().contains("joints.9"));
+        assert!(set_path(&mut v, "nope.x", json!(1)).unwrap_err().to_string().contains("nope"));
+    }
+
+    #[test]
+    fn sweep_expands_with_formulation_overrides() {
+        let mut v = raw();
+        v["sweep"] = json!([{"path": "stiffness_scale", "values": [1, 0.1]}, {"path": "joints.1.flare_deg", "values": [0, 45, 90]}]);
+        let cf = CaseFile { path: PathBuf::from("cases/x.json"), raw: v };
+        let ov: Override = "gebf:t_end=1".parse().unwrap();
+        let runs = cf.expand(&[ov]).unwrap();
+        assert_eq!(runs.len(), 6);
+        assert_eq!(runs[1].name, "double_pendulum_c1_beta45__stiffness_scale=1__flare_deg=45");
+        assert_eq!(runs[5].ancf.stiffness_scale, 0.1);
+        assert_eq!((runs[0].ancf.t_end, runs[0].gebf.t_end), (2.0, 1.0));
+    }
+
+    #[test]
+    fn validation_names_fields() {
+        let cases: [(&str, Value, &str); 6] = [
+            ("bodies.0.length", json!(-1.0), "bodies[0].length"),
+            ("joints.0.body", json!("ghost"), "joints[0].body"),
+            ("joints.1.flare_deg", json!(120.0), "joints[1].flare_deg"),
+            ("ancf.dt", json!(0.0), "ancf.dt"),
+            ("gebf.rho_inf", json!(1.5), "gebf.rho_inf"),
+            ("bodies.1.y_axis", json!([1.0, 0.0, 0.0]), "bodies[1].y_axis"),
+        ];
+        for (path, value, needle) in cases {
+            let mut v = raw();
+            set_path(&mut v, path, value).unwrap();
+            let c = parse_case(&v).unwrap();
+            let e = c.validate().unwrap_err();
+            assert!(e.contains(needle), "{path}: {e}");
+        }
+        // Non-finite numbers cannot even be written in JSON; a string where a number belongs:
+        let mut v = raw();
+        set_path(&mut v, "bodies.0.section.mass", json!("NaN")).unwrap();
+        assert!(parse_case(&v).unwrap_err().contains("bodies[0].section.mass"));
+    }
+}

@@ -1,0 +1,131 @@
+//! Time-history CSV files: the run output format of DESIGN.md §4 and reading external references.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::Error;
+use crate::run::Row;
+
+/// Column header of a formulation's CSV.
+pub const HEADER: &str =
+    "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,constraint_residual,newton_iterations";
+
+/// Render rows as CSV text.
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut s = String::with_capacity(rows.len() * 180);
+    s.push_str(HEADER);
+    s.push('\n');
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e},{}",
+            r.t,
+            r.tip[0],
+            r.tip[1],
+            r.tip[2],
+            r.fold,
+            r.kinetic,
+            r.elastic,
+            r.potential,
+            r.total,
+            r.constraint_residual,
+            r.newton_iterations
+        );
+    }
+    s
+}
+
+/// A reference time history: times and tip positions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    /// Times, s (increasing).
+    pub t: Vec<f64>,
+    /// Tip positions, m.
+    pub tip: Vec<[f64; 3]>,
+}
+
+/// Read a CSV with a header naming at least `t, tip_x, tip_y, tip_z`; `#` lines are comments.
+pub fn read_curve(path: &Path) -> Result<Curve, Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
+    parse_curve(&text).map_err(|msg| Error::Reference { file, msg })
+}
+
+/// Parse CSV text (see [`read_curve`]).
+pub fn parse_curve(text: &str) -> Result<Curve, String> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
+    let (_, header) = lines.next().ok_or("no header line")?;
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = |name: &str| cols.iter().position(|c| *c == name).ok_or(format!("no column `{name}`"));
+    let (it, ix, iy, iz) = (col("t")?, col("tip_x")?, col("tip_y")?, col("tip_z")?);
+    let mut c = Curve { t: Vec::new(), tip: Vec::new() };
+    for (n, line) in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let get = |i: usize| -> Result<f64, String> {
+            f.get(i)
+                .ok_or(format!("line {}: too few columns", n + 1))?
+                .trim()
+                .parse::<f64>()
+                .map_err(|e| format!("line {}: {e}", n + 1))
+        };
+        let t = get(it)?;
+        if let Some(&last) = c.t.last()
+            && t <= last
+        {
+            return Err(format!("line {}: time {t} does not increase", n + 1));
+        }
+        c.t.push(t);
+        c.tip.push([get(ix)?, get(iy)?, get(iz)?]);
+    }
+    if c.t.is_empty() {
+        return Err("no data rows".into());
+    }
+    Ok(c)
+}
+
+impl Curve {
+    /// Linear interpolation of the tip at time `t`; `None` outside the curve's time range.
+    pub fn tip_at(&self, t: f64) -> Option<[f64; 3]> {
+        let n = self.t.len();
+        if n == 0 || t < self.t[0] - 1e-12 || t > self.t[n - 1] + 1e-12 {
+            return None;
+        }
+        let k = self.t.partition_point(|&x| x < t);
+        if k == 0 {
+            return Some(self.tip[0]);
+        }
+        if k >= n {
+            return Some(self.tip[n - 1]);
+        }
+        let (t0, t1) = (self.t[k - 1], self.t[k]);
+        let w = (t - t0) / (t1 - t0);
+        let (a, b) = (self.tip[k - 1], self.tip[k]);
+        Some([a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])])
+    }
+}
+
+/// Write a file, creating its folder.
+pub fn write_file(path: &Path, contents: &str) -> Result<(), Error> {
+    if let Some(d) = path.parent() {
+        std::fs::create_dir_all(d).map_err(|e| Error::Io(format!("{}: {e}", d.display())))?;
+    }
+    std::fs::write(path, contents).map_err(|e| Error::Io(format!("{}: {e}", path.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_interpolates() {
+        let c = parse_curve("# meta\nt,tip_x,tip_y,tip_z,extra\n0,1,0,0,9\n1,3,2,-2,9\n").unwrap();
+        assert_eq!(c.tip_at(0.5), Some([2.0, 1.0, -1.0]));
+        assert_eq!(c.tip_at(1.5), None);
+    }
+
+    #[test]
+    fn rejects_missing_column_and_bad_number() {
+        assert!(parse_curve("t,tip_x,tip_y\n0,1,2\n").unwrap_err().contains("tip_z"));
+        assert!(parse_curve("t,tip_x,tip_y,tip_z\n0,1,x,2\n").unwrap_err().contains("line 2"));
+    }
+}

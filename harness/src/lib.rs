@@ -1,0 +1,60 @@
+//! # harness — both formulations on every case, compared and reported
+//!
+//! Reads case files ([`case`]), builds the scene for ANCF and for GEBF ([`scene`]), integrates
+//! each with the shared generalized-α integrator ([`run`]), compares them with each other and with
+//! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
+//! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]).
+#![warn(missing_docs)]
+
+pub mod case;
+pub mod csv;
+pub mod driver;
+pub mod gate;
+pub mod metrics;
+pub mod plot;
+pub mod report;
+pub mod run;
+pub mod scene;
+
+/// Errors of the harness library (the binary adds context with anyhow).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A case file is malformed or has an impossible value.
+    #[error("{file}: {msg}")]
+    Case {
+        /// Case file.
+        file: String,
+        /// What is wrong, naming the field.
+        msg: String,
+    },
+    /// A `--set` override is malformed or does not fit the case.
+    #[error("--set: {0}")]
+    Override(String),
+    /// Reading or writing a file failed.
+    #[error("{0}")]
+    Io(String),
+    /// A reference CSV is malformed.
+    #[error("reference {file}: {msg}")]
+    Reference {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        msg: String,
+    },
+    /// Building a model failed.
+    #[error("{formulation} model: {msg}")]
+    Model {
+        /// Which formulation.
+        formulation: case::Formulation,
+        /// The library's message.
+        msg: String,
+    },
+    /// Plotting failed.
+    #[error("plot {file}: {msg}")]
+    Plot {
+        /// The file.
+        file: String,
+        /// What failed.
+        msg: String,
+    },
+}

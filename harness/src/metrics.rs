@@ -1,0 +1,156 @@
+//! Metrics of DESIGN.md §5: tip difference between formulations and against references, energy
+//! drift, constraint residual, speed.
+
+use serde::Serialize;
+
+use crate::csv::Curve;
+use crate::run::{Row, RunOutput};
+
+/// Time history of the tip of a run.
+pub fn tip_curve(rows: &[Row]) -> Curve {
+    let mut c = Curve { t: Vec::with_capacity(rows.len()), tip: Vec::with_capacity(rows.len()) };
+    for r in rows {
+        if c.t.last().is_none_or(|&l| r.t > l) {
+            c.t.push(r.t);
+            c.tip.push(r.tip);
+        }
+    }
+    c
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The distance d(t) = |a(t) − b(t + shift)| sampled at the times of `a` where `b` is defined.
+pub fn tip_difference(a: &Curve, b: &Curve, shift: f64) -> Vec<(f64, f64)> {
+    a.t.iter().zip(&a.tip).filter_map(|(&t, &p)| b.tip_at(t + shift).map(|q| (t, dist(p, q)))).collect()
+}
+
+/// Max and RMS of a sampled difference over a window.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct DiffStats {
+    /// Maximum, m.
+    pub max: f64,
+    /// Root mean square, m.
+    pub rms: f64,
+    /// Time of the maximum, s.
+    pub t_max: f64,
+    /// Samples used.
+    pub n: usize,
+}
+
+/// Statistics of `d` restricted to `t_start ≤ t ≤ t_end`.
+pub fn window_stats(d: &[(f64, f64)], t_start: f64, t_end: f64) -> DiffStats {
+    let mut s = DiffStats::default();
+    let mut sum = 0.0;
+    for &(t, x) in d.iter().filter(|(t, _)| *t >= t_start - 1e-12 && *t <= t_end + 1e-12) {
+        if x > s.max || s.n == 0 {
+            s.max = x;
+            s.t_max = t;
+        }
+        sum += x * x;
+        s.n += 1;
+    }
+    s.rms = if s.n > 0 { (sum / s.n as f64).sqrt() } else { f64::NAN };
+    if s.n == 0 {
+        s.max = f64::NAN;
+    }
+    s
+}
+
+/// Per-formulation metrics.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FormulationMetrics {
+    /// Wall time, s.
+    pub wall_s: f64,
+    /// Steps taken.
+    pub n_steps: usize,
+    /// Steps per second.
+    pub steps_per_s: f64,
+    /// Newton iterations in total.
+    pub n_newton_iters: usize,
+    /// Mean Newton iterations per step.
+    pub newton_per_step: f64,
+    /// Most Newton iterations in one step.
+    pub max_newton_iters: usize,
+    /// Factorisations of the iteration matrix.
+    pub n_factorizations: usize,
+    /// Tangent dimension.
+    pub n_dof: usize,
+    /// Last time reached, s.
+    pub t_reached: f64,
+    /// max |E(t) − E(0)| / max kinetic energy.
+    pub energy_drift: f64,
+    /// Peak kinetic energy, J.
+    pub peak_kinetic: f64,
+    /// Largest position-level constraint residual.
+    pub max_constraint_residual: f64,
+    /// Error that stopped the run.
+    pub error: Option<String>,
+}
+
+impl FormulationMetrics {
+    /// Metrics of one run.
+    pub fn of(run: &RunOutput) -> Self {
+        let e0 = run.rows.first().map_or(0.0, |r| r.total);
+        let peak = run.rows.iter().map(|r| r.kinetic).fold(0.0, f64::max);
+        let drift = run.rows.iter().map(|r| (r.total - e0).abs()).fold(0.0, f64::max);
+        Self {
+            wall_s: run.wall_s,
+            n_steps: run.stats.n_steps,
+            steps_per_s: if run.wall_s > 0.0 { run.stats.n_steps as f64 / run.wall_s } else { 0.0 },
+            n_newton_iters: run.stats.n_newton_iters,
+            newton_per_step: run.stats.n_newton_iters as f64 / run.stats.n_steps.max(1) as f64,
+            max_newton_iters: run.stats.max_newton_iters,
+            n_factorizations: run.stats.n_factorizations,
+            n_dof: run.n_dof,
+            t_reached: run.rows.last().map_or(0.0, |r| r.t),
+            energy_drift: if peak > 0.0 { drift / peak } else { drift },
+            peak_kinetic: peak,
+            max_constraint_residual: run.rows.iter().map(|r| r.constraint_residual).fold(0.0, f64::max),
+            error: run.error.clone(),
+        }
+    }
+}
+
+/// ANCF–GEBF tip difference.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairMetrics {
+    /// Over the whole common time range.
+    pub all: DiffStats,
+    /// Over t ≤ 1 s.
+    pub first_second: DiffStats,
+    /// `all.max` divided by the span.
+    pub max_over_span: f64,
+    /// `all.rms` divided by the span.
+    pub rms_over_span: f64,
+}
+
+impl PairMetrics {
+    /// Compare two runs.
+    pub fn of(a: &RunOutput, b: &RunOutput, span: f64) -> (Self, Vec<(f64, f64)>) {
+        let d = tip_difference(&tip_curve(&a.rows), &tip_curve(&b.rows), 0.0);
+        let all = window_stats(&d, f64::NEG_INFINITY, f64::INFINITY);
+        let m = Self {
+            all,
+            first_second: window_stats(&d, f64::NEG_INFINITY, 1.0),
+            max_over_span: all.max / span,
+            rms_over_span: all.rms / span,
+        };
+        (m, d)
+    }
+}
+
+/// A formulation against an external reference.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceMetrics {
+    /// Reference label.
+    pub label: String,
+    /// Formulation compared.
+    pub formulation: crate::case::Formulation,
+    /// Tip distance statistics.
+    pub diff: DiffStats,
+    /// Gate limit if any, m.
+    pub tip_max_m: Option<f64>,
+}

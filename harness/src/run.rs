@@ -1,0 +1,154 @@
+//! Integrating one formulation of one case and recording the sensors of DESIGN.md §3.
+
+use std::time::Instant;
+
+use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, State, Stats};
+use serde::Serialize;
+
+use crate::case::Formulation;
+
+/// Energies, J.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Energies {
+    /// Kinetic energy T.
+    pub kinetic: f64,
+    /// Elastic energy U.
+    pub elastic: f64,
+    /// Gravitational potential V (zero in the reference configuration).
+    pub potential: f64,
+}
+
+/// What the harness needs from a structural model beyond the integrator's trait: its initial
+/// state and the sensors. Implemented in [`crate::scene`] for both formulations.
+pub trait Structure: ConstrainedSystem {
+    /// Reference configuration at rest.
+    fn initial_state(&self) -> State;
+    /// Tip position (centroid of the last body's free end), m.
+    fn tip(&self, q: &[f64]) -> [f64; 3];
+    /// Fold angle of the sensor joint, rad (NaN without one).
+    fn fold(&self, q: &[f64]) -> f64;
+    /// Energies.
+    fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
+    /// Position-level joint violation (gap in m and axis misalignment in rad, Euclidean norm).
+    fn constraint_residual(&self, q: &[f64]) -> f64;
+}
+
+/// One output row (the CSV columns).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Row {
+    /// Time, s.
+    pub t: f64,
+    /// Tip position, m.
+    pub tip: [f64; 3],
+    /// Fold angle, rad.
+    pub fold: f64,
+    /// Kinetic energy, J.
+    pub kinetic: f64,
+    /// Elastic energy, J.
+    pub elastic: f64,
+    /// Gravitational potential, J.
+    pub potential: f64,
+    /// Total energy, J.
+    pub total: f64,
+    /// Position-level constraint residual.
+    pub constraint_residual: f64,
+    /// Newton iterations of the step that reached this row.
+    pub newton_iterations: usize,
+}
+
+/// Solver settings of one run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunSettings {
+    /// Integrator parameters.
+    pub params: IntegratorParams,
+    /// End time, s.
+    pub t_end: f64,
+    /// Output interval, s (None: every step).
+    pub output_dt: Option<f64>,
+}
+
+/// Outcome of one run: what was computed, even when it failed part-way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Recorded rows.
+    pub rows: Vec<Row>,
+    /// Wall time of model set-up plus the time loop, s.
+    pub wall_s: f64,
+    /// Integrator counters.
+    pub stats: Stats,
+    /// Tangent dimension of the model.
+    pub n_dof: usize,
+    /// Why the run stopped early, if it did.
+    pub error: Option<String>,
+}
+
+impl RunOutput {
+    /// A run that could not even start.
+    pub fn failed(formulation: Formulation, error: String) -> Self {
+        Self { formulation, rows: Vec::new(), wall_s: 0.0, stats: Stats::default(), n_dof: 0, error: Some(error) }
+    }
+}
+
+fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize) -> Row {
+    let e = model.energies(&s.q, &s.v);
+    Row {
+        t: s.t,
+        tip: model.tip(&s.q),
+        fold: model.fold(&s.q),
+        kinetic: e.kinetic,
+        elastic: e.elastic,
+        potential: e.potential,
+        total: e.kinetic + e.elastic + e.potential,
+        constraint_residual: model.constraint_residual(&s.q),
+        newton_iterations,
+    }
+}
+
+/// Integrate `model` from its reference state to `t_end`, recording rows.
+/// A Newton failure ends the run with `error` set and the rows computed so far.
+pub fn simulate<S: Structure + ?Sized>(formulation: Formulation, model: &mut S, settings: &RunSettings) -> RunOutput {
+    let start = Instant::now();
+    let mut out = RunOutput {
+        formulation,
+        rows: Vec::new(),
+        wall_s: 0.0,
+        stats: Stats::default(),
+        n_dof: model.n_dof(),
+        error: None,
+    };
+    let dt = settings.params.dt;
+    let n_steps = (settings.t_end / dt - 1e-9).ceil().max(0.0) as usize;
+    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    out.rows.reserve(n_steps / every + 2);
+    let mut ga = match GenAlpha::new(settings.params, model) {
+        Ok(g) => g,
+        Err(e) => {
+            out.error = Some(e.to_string());
+            return out;
+        }
+    };
+    let mut s = model.initial_state();
+    if let Err(e) = ga.initialize(model, &mut s) {
+        out.error = Some(format!("initial accelerations: {e}"));
+        return out;
+    }
+    out.rows.push(row(model, &s, 0));
+    for k in 1..=n_steps {
+        match ga.step(model, &mut s) {
+            Ok(st) => {
+                if k % every == 0 || k == n_steps {
+                    out.rows.push(row(model, &s, st.n_newton_iters));
+                }
+            }
+            Err(e) => {
+                out.error = Some(format!("step {k}: {e}"));
+                break;
+            }
+        }
+    }
+    out.stats = *ga.stats();
+    out.wall_s = start.elapsed().as_secs_f64();
+    out
+}

@@ -1,0 +1,220 @@
+//! Building each formulation's model from a case, and the [`Structure`] impls that expose the
+//! sensors of both through one interface.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::Error;
+use crate::case::{AncfPath, Case, Formulation, Joint};
+use crate::run::{Energies, RunOutput, RunSettings, Structure, simulate};
+
+fn unit(v: [f64; 3]) -> Vector3<f64> {
+    Vector3::from(v).normalize()
+}
+
+/// Section frame of a body: columns x (beam axis), y, z = x × y.
+fn frame(x: [f64; 3], y: [f64; 3]) -> Matrix3<f64> {
+    let x = unit(x);
+    let y = unit(y);
+    Matrix3::from_columns(&[x, y, x.cross(&y)])
+}
+
+/// Bodies and joints in a formulation crate's own spec types (both crates share the shape).
+macro_rules! specs {
+    ($krate:ident, $case:expr, $n_el:expr) => {{
+        let case: &Case = $case;
+        let c = case.stiffness_scale;
+        let bodies: Vec<$krate::BodySpec> = case
+            .bodies
+            .iter()
+            .map(|b| $krate::BodySpec {
+                name: b.name.clone(),
+                start: Vector3::from(b.start),
+                length: b.length,
+                frame: frame(b.x_axis, b.y_axis),
+                section: $krate::Section {
+                    mass: b.section.mass,
+                    rho_ixx: b.section.rho_ixx,
+                    rho_iyy: b.section.rho_iyy,
+                    rho_izz: b.section.rho_izz,
+                    ea: c * b.section.ea,
+                    ga_y: c * b.section.ga_y,
+                    ga_z: c * b.section.ga_z,
+                    gj: c * b.section.gj,
+                    ei_yy: c * b.section.ei_yy,
+                    ei_zz: c * b.section.ei_zz,
+                },
+                n_elements: $n_el,
+            })
+            .collect();
+        let idx = |n: &str| case.body_index(n).unwrap_or(usize::MAX);
+        let joints: Vec<$krate::JointSpec> = case
+            .joints
+            .iter()
+            .map(|j| match j {
+                Joint::GroundHinge { body, axis, .. } => {
+                    $krate::JointSpec::GroundHinge { body: idx(body), axis: unit(*axis) }
+                }
+                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
+                    $krate::JointSpec::FlaredHinge { parent: idx(parent), child: idx(child), beta: flare_deg.to_radians() }
+                }
+                Joint::Clamp { body, .. } => $krate::JointSpec::Clamp { body: idx(body) },
+            })
+            .collect();
+        let gravity = case.gravity.map(Vector3::from).unwrap_or_else(Vector3::zeros);
+        (bodies, joints, gravity)
+    }};
+}
+
+/// A model with its fold-sensor joint.
+pub struct Sensed<M> {
+    /// The model.
+    pub model: M,
+    /// Joint index of the fold sensor.
+    pub fold_joint: Option<usize>,
+}
+
+macro_rules! forward_system {
+    ($t:ty) => {
+        impl genalpha::ConstrainedSystem for Sensed<$t> {
+            fn n_coords(&self) -> usize {
+                self.model.n_coords()
+            }
+            fn n_dof(&self) -> usize {
+                self.model.n_dof()
+            }
+            fn n_holonomic(&self) -> usize {
+                self.model.n_holonomic()
+            }
+            fn n_velocity_constraints(&self) -> usize {
+                self.model.n_velocity_constraints()
+            }
+            fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
+                self.model.retract_inplace(q, dq, q_out)
+            }
+            fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+                self.model.residual_inplace(t, q, v, v_dot, r)
+            }
+            fn iteration_matrix_inplace(
+                &self,
+                t: f64,
+                q: &[f64],
+                v: &[f64],
+                v_dot: &[f64],
+                c_m: f64,
+                c_c: f64,
+                c_k: f64,
+                k: &mut genalpha::MatView<'_>,
+            ) {
+                self.model.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k)
+            }
+            fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+                self.model.phi_inplace(t, q, phi)
+            }
+            fn phi_q_inplace(&self, t: f64, q: &[f64], j: &mut genalpha::MatView<'_>) {
+                self.model.phi_q_inplace(t, q, j)
+            }
+            fn phi_q_is_constant(&self) -> bool {
+                self.model.phi_q_is_constant()
+            }
+            fn phi_qq_vv_inplace(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+                self.model.phi_qq_vv_inplace(t, q, v, out)
+            }
+            fn psi_inplace(&self, t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
+                self.model.psi_inplace(t, q, v, psi)
+            }
+            fn psi_v_inplace(&self, t: f64, q: &[f64], j: &mut genalpha::MatView<'_>) {
+                self.model.psi_v_inplace(t, q, j)
+            }
+            fn psi_q_inplace(&self, t: f64, q: &[f64], v: &[f64], j: &mut genalpha::MatView<'_>) {
+                self.model.psi_q_inplace(t, q, v, j)
+            }
+            fn constraint_force_tangent_inplace(
+                &self,
+                t: f64,
+                q: &[f64],
+                lambda: &[f64],
+                mu: &[f64],
+                c_k: f64,
+                k: &mut genalpha::MatView<'_>,
+            ) {
+                self.model.constraint_force_tangent_inplace(t, q, lambda, mu, c_k, k)
+            }
+            fn post_step(&mut self, t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
+                self.model.post_step(t, q, v, v_dot, a)
+            }
+            fn increment_weight(&self, i: usize) -> f64 {
+                self.model.increment_weight(i)
+            }
+        }
+    };
+}
+
+macro_rules! structure {
+    ($t:ty) => {
+        forward_system!($t);
+        impl Structure for Sensed<$t> {
+            fn initial_state(&self) -> genalpha::State {
+                self.model.initial_state()
+            }
+            fn tip(&self, q: &[f64]) -> [f64; 3] {
+                self.model.tip_position(q).into()
+            }
+            fn fold(&self, q: &[f64]) -> f64 {
+                self.fold_joint.and_then(|j| self.model.fold_angle(q, j).ok()).unwrap_or(f64::NAN)
+            }
+            fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
+                let e = self.model.energies(q, v);
+                Energies { kinetic: e.kinetic, elastic: e.elastic, potential: e.potential }
+            }
+            fn constraint_residual(&self, q: &[f64]) -> f64 {
+                self.model.constraint_residual(q)
+            }
+        }
+    };
+}
+
+structure!(ancf::Model);
+structure!(ancf::ReducedModel);
+structure!(gebf::Model);
+
+fn settings(case: &Case, f: Formulation) -> RunSettings {
+    let (dt, rho, newton) = match f {
+        Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton),
+        Formulation::Gebf => (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton),
+    };
+    let mut params = genalpha::IntegratorParams::new(rho, dt);
+    params.newton = newton.to_params();
+    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt }
+}
+
+/// Build the ANCF model of a case (DAE path).
+pub fn build_ancf(case: &Case) -> Result<ancf::Model, Error> {
+    let (bodies, joints, gravity) = specs!(ancf, case, case.ancf.elements_per_body);
+    ancf::Model::new(&bodies, &joints, gravity, ancf::Options::default())
+        .map_err(|e| Error::Model { formulation: Formulation::Ancf, msg: e.to_string() })
+}
+
+/// Build the GEBF model of a case.
+pub fn build_gebf(case: &Case) -> Result<gebf::Model, Error> {
+    let (bodies, joints, gravity) = specs!(gebf, case, case.gebf.elements_per_body);
+    let options = gebf::Options { stabilization: case.gebf.stabilization, ..Default::default() };
+    gebf::Model::new(&bodies, &joints, gravity, options)
+        .map_err(|e| Error::Model { formulation: Formulation::Gebf, msg: e.to_string() })
+}
+
+/// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot
+/// be built gives a failed [`RunOutput`] with the reason.
+pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
+    let s = settings(case, f);
+    let fold_joint = case.fold_joint_index();
+    let built = match f {
+        Formulation::Ancf => build_ancf(case).and_then(|model| match case.ancf.path {
+            AncfPath::Dae => Ok(simulate(f, &mut Sensed { model, fold_joint }, &s)),
+            AncfPath::Ode => ancf::ReducedModel::new(model)
+                .map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s))
+                .map_err(|e| Error::Model { formulation: f, msg: e.to_string() }),
+        }),
+        Formulation::Gebf => build_gebf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
+    };
+    built.unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
+}
