@@ -60,6 +60,9 @@ pub struct Case {
     /// Gate tolerances (omit: the case is reported but not gated).
     #[serde(default)]
     pub gate: Option<Gate>,
+    /// `harness all` also runs the refinement ladders of this case (`harness converge`).
+    #[serde(default)]
+    pub converge: bool,
     /// Parameter sweep: each entry maps a `--set`-style path (e.g. `stiffness_scale`,
     /// `joints.1.flare_deg`, `ancf.dt`) to a list of values; the Cartesian product expands into
     /// named runs `<name>__<key>=<value>…`.
@@ -282,6 +285,10 @@ pub struct Reference {
     /// Gate: maximum tip distance from this reference, m, per formulation (omit: not gated).
     #[serde(default)]
     pub tip_max_m: Option<f64>,
+    /// The reference is converged (its own error far below the formulations' at the case's
+    /// settings): convergence studies measure the diagonal ladder against it.
+    #[serde(default)]
+    pub converged: bool,
 }
 
 /// Gate tolerances of a case.

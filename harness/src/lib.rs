@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod case;
+pub mod converge;
 pub mod csv;
 pub mod driver;
 pub mod gate;
@@ -15,6 +16,7 @@ pub mod plot;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod stress;
 
 /// Errors of the harness library (the binary adds context with anyhow).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use harness::case::{CaseFile, Formulation, Override, json_schema};
 use harness::csv::{to_csv, write_file};
 use harness::driver::{discover, expand_all, run_all, write_reports};
-use harness::gate;
+use harness::{converge, gate, stress};
 use harness::report::write_case;
 
 #[derive(Parser)]
@@ -62,6 +62,29 @@ enum Cmd {
         #[arg(long, default_value = "cases")]
         cases: PathBuf,
         /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
+    /// Refinement ladders (time, space, both) for each formulation: error against wall time.
+    Converge {
+        /// Case file.
+        case: PathBuf,
+        /// Output folder (writes `<out>/converge/<case>/`).
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
+    /// The stress matrix (c × β × dt × rho_inf) on a base case, for both formulations.
+    Stress {
+        /// Base case file.
+        #[arg(default_value = "cases/double_pendulum_c1_beta45.json")]
+        case: PathBuf,
+        /// Output folder (writes `<out>/stress/`).
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a base-case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
@@ -178,6 +201,42 @@ fn real_main() -> Result<ExitCode> {
                 }
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
+        Cmd::Converge { case, out, set } => {
+            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
+            for spec in &runs {
+                let r = converge::converge(spec, true)?;
+                let dir = out.join("converge").join(&spec.name);
+                converge::write(&dir, &r)?;
+                for o in &r.orders {
+                    let ord: Vec<String> = o.orders.iter().map(|x| format!("{x:.2}")).collect();
+                    println!(
+                        "{} {} {:<8} observed orders [{}], truth error estimate {:.2e} m",
+                        spec.name,
+                        o.formulation,
+                        format!("{:?}", o.ladder).to_lowercase(),
+                        ord.join(", "),
+                        o.truth_error_estimate_m
+                    );
+                }
+                println!("wrote {}", dir.display());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Stress { case, out, set } => {
+            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
+            let base = runs.first().context("the base case expands into no run")?;
+            let axes = stress::Axes::default();
+            let t0 = std::time::Instant::now();
+            let cells = stress::run(base, &axes, true);
+            let dir = out.join("stress");
+            stress::write(&dir, &axes, &cells)?;
+            for f in Formulation::ALL {
+                let (ok, n) = stress::survival(&cells, f);
+                println!("{f}: {ok} of {n} cells reach t_end");
+            }
+            println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Gate { files, cases, set } => {
             let files = if files.is_empty() { discover(&cases)? } else { files };

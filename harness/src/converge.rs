@@ -1,0 +1,298 @@
+//! Refinement ladders and work-precision diagrams (speed against error).
+//!
+//! For each formulation three ladders are run from the case's own settings (n elements per body,
+//! time step h):
+//! * **time**: n fixed, h·{2, 1, ½, ¼} against h/8;
+//! * **space**: h/4 fixed, elements n·{½, 1, 2} (at least 1) against 4n;
+//! * **diagonal** (work-precision): (n·2ᵏ, h/2ᵏ), k = 0..2, against the finest rung k = 3, or
+//!   against an external reference marked `converged` in the case file.
+//!
+//! Error of a rung = max over time of the tip distance to its truth. Observed orders come from
+//! successive rungs (`log2(e_k / e_{k+1})` for halving ratios), and a Richardson estimate of the
+//! truth's own error is reported from the last two rungs.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::Error;
+use crate::case::{Formulation, RunSpec};
+use crate::csv::{Curve, read_curve, write_file};
+use crate::metrics::{tip_curve, tip_difference, window_stats};
+use crate::plot::{Panel, Series, colors, panels_svg};
+use crate::run::RunOutput;
+use crate::scene::run_formulation;
+
+/// Which ladder a rung belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ladder {
+    /// Time step refined at fixed elements.
+    Time,
+    /// Elements refined at a fixed small step.
+    Space,
+    /// Both refined together.
+    Diagonal,
+}
+
+impl Ladder {
+    fn as_str(self) -> &'static str {
+        match self {
+            Ladder::Time => "time",
+            Ladder::Space => "space",
+            Ladder::Diagonal => "diagonal",
+        }
+    }
+}
+
+/// One rung of a ladder.
+#[derive(Debug, Clone, Serialize)]
+pub struct Rung {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Ladder.
+    pub ladder: Ladder,
+    /// Elements per body.
+    pub elements: usize,
+    /// Time step, s.
+    pub dt: f64,
+    /// Whether this rung is the ladder's truth.
+    pub is_truth: bool,
+    /// Wall time, s.
+    pub wall_s: f64,
+    /// Steps taken.
+    pub n_steps: usize,
+    /// Max tip distance to the ladder's truth, m (NaN for the truth itself or a failed run).
+    pub error_m: f64,
+    /// What the error is measured against.
+    pub against: String,
+    /// Failure, if any.
+    pub failure: Option<String>,
+}
+
+/// Observed convergence order of one ladder.
+#[derive(Debug, Clone, Serialize)]
+pub struct Order {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Ladder.
+    pub ladder: Ladder,
+    /// Orders between successive rungs (refinement ratio 2).
+    pub orders: Vec<f64>,
+    /// Richardson estimate of the truth rung's own error, m.
+    pub truth_error_estimate_m: f64,
+}
+
+/// Result of a convergence study.
+#[derive(Debug, Clone, Serialize)]
+pub struct ConvergeResult {
+    /// Run name.
+    pub name: String,
+    /// All rungs.
+    pub rungs: Vec<Rung>,
+    /// Observed orders.
+    pub orders: Vec<Order>,
+}
+
+fn rung_spec(spec: &RunSpec, f: Formulation, elements: usize, dt: f64) -> crate::case::Case {
+    let mut c = spec.case(f).clone();
+    match f {
+        Formulation::Ancf => {
+            c.ancf.elements_per_body = elements;
+            c.ancf.dt = dt;
+        }
+        Formulation::Gebf => {
+            c.gebf.elements_per_body = elements;
+            c.gebf.dt = dt;
+        }
+    }
+    // Common output grid: the coarsest step of the study, so that every rung is sampled alike.
+    c.output_dt = None;
+    c.gate = None;
+    c
+}
+
+fn max_distance(a: &RunOutput, truth: &Curve) -> f64 {
+    let d = tip_difference(&tip_curve(&a.rows), truth, 0.0);
+    window_stats(&d, f64::NEG_INFINITY, f64::INFINITY).max
+}
+
+/// Plan of one study: (formulation, ladder, elements, dt, is_truth).
+fn plan(spec: &RunSpec) -> Vec<(Formulation, Ladder, usize, f64, bool)> {
+    let mut p = Vec::new();
+    for f in Formulation::ALL {
+        let c = spec.case(f);
+        let (n, h) = match f {
+            Formulation::Ancf => (c.ancf.elements_per_body, c.ancf.dt),
+            Formulation::Gebf => (c.gebf.elements_per_body, c.gebf.dt),
+        };
+        for (k, m) in [2.0, 1.0, 0.5, 0.25, 0.125].into_iter().enumerate() {
+            p.push((f, Ladder::Time, n, h * m, k == 4));
+        }
+        let mut space: Vec<usize> = vec![(n / 2).max(1), n, 2 * n, 4 * n];
+        space.dedup();
+        let last = space.len() - 1;
+        for (k, e) in space.into_iter().enumerate() {
+            p.push((f, Ladder::Space, e, h / 4.0, k == last));
+        }
+        for k in 0..4u32 {
+            let s = 2usize.pow(k);
+            p.push((f, Ladder::Diagonal, n * s, h / s as f64, k == 3));
+        }
+    }
+    p
+}
+
+/// Run the three ladders of both formulations (rayon over rungs).
+pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error> {
+    let plan = plan(spec);
+    // A converged external reference, if the case names one.
+    let case = &spec.ancf;
+    let external: Option<(String, Curve)> = match case.references.iter().find(|r| r.converged) {
+        Some(r) => Some((r.label.clone(), read_curve(&spec.dir.join(&r.file))?)),
+        None => None,
+    };
+    let bar = if progress { indicatif::ProgressBar::new(plan.len() as u64) } else { indicatif::ProgressBar::hidden() };
+    // Most expensive first so the two cores stay busy to the end.
+    let mut order: Vec<usize> = (0..plan.len()).collect();
+    order.sort_by(|&a, &b| {
+        let cost = |i: usize| plan[i].2 as f64 / plan[i].3;
+        cost(b).total_cmp(&cost(a))
+    });
+    let mut outs: Vec<(usize, RunOutput)> = order
+        .par_iter()
+        .map(|&i| {
+            let (f, _, e, dt, _) = plan[i];
+            let out = run_formulation(&rung_spec(spec, f, e, dt), f);
+            bar.inc(1);
+            (i, out)
+        })
+        .collect();
+    bar.finish_and_clear();
+    outs.sort_by_key(|x| x.0);
+    let outs: Vec<RunOutput> = outs.into_iter().map(|x| x.1).collect();
+
+    let mut rungs = Vec::new();
+    let mut orders = Vec::new();
+    for f in Formulation::ALL {
+        for ladder in [Ladder::Time, Ladder::Space, Ladder::Diagonal] {
+            let idx: Vec<usize> = (0..plan.len()).filter(|&i| plan[i].0 == f && plan[i].1 == ladder).collect();
+            let truth_i = *idx.iter().find(|&&i| plan[i].4).expect("every ladder has a truth");
+            let own_truth = tip_curve(&outs[truth_i].rows);
+            let use_external = ladder == Ladder::Diagonal && external.is_some();
+            let (against, truth) = match (&external, use_external) {
+                (Some((label, c)), true) => (label.clone(), c),
+                _ => (format!("{} rung ({} el, dt {:.3e})", f, plan[truth_i].2, plan[truth_i].3), &own_truth),
+            };
+            let mut errs = Vec::new();
+            for &i in &idx {
+                let (_, _, e, dt, is_truth) = plan[i];
+                let o = &outs[i];
+                let error_m = if o.error.is_some() || (is_truth && !use_external) {
+                    f64::NAN
+                } else {
+                    max_distance(o, truth)
+                };
+                if !is_truth || use_external {
+                    errs.push(error_m);
+                }
+                rungs.push(Rung {
+                    formulation: f,
+                    ladder,
+                    elements: e,
+                    dt,
+                    is_truth: is_truth && !use_external,
+                    wall_s: o.wall_s,
+                    n_steps: o.stats.n_steps,
+                    error_m,
+                    against: against.clone(),
+                    failure: o.error.clone(),
+                });
+            }
+            // Orders from successive rungs with ratio 2 (the space ladder's first step may not be 2).
+            let obs: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+            let p_last = obs.iter().rev().find(|x| x.is_finite()).copied().unwrap_or(f64::NAN);
+            let last = errs.iter().rev().find(|x| x.is_finite()).copied().unwrap_or(f64::NAN);
+            orders.push(Order {
+                formulation: f,
+                ladder,
+                orders: obs,
+                truth_error_estimate_m: last / (2f64.powf(p_last) - 1.0).max(1e-12),
+            });
+        }
+    }
+    Ok(ConvergeResult { name: spec.name.clone(), rungs, orders })
+}
+
+/// Write `converge.csv`, `converge.json`, `work_precision.svg` and `convergence.svg` into `dir`.
+pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
+    let mut csv = String::from("formulation,ladder,elements_per_body,dt,is_truth,wall_s,n_steps,error_m,against,failure\n");
+    for g in &r.rungs {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:.6e},{},{:.6},{},{:.6e},\"{}\",\"{}\"",
+            g.formulation,
+            g.ladder.as_str(),
+            g.elements,
+            g.dt,
+            g.is_truth,
+            g.wall_s,
+            g.n_steps,
+            g.error_m,
+            g.against,
+            g.failure.clone().unwrap_or_default().replace('"', "'")
+        );
+    }
+    write_file(&dir.join("converge.csv"), &csv)?;
+    write_file(&dir.join("converge.json"), &serde_json::to_string_pretty(r).map_err(|e| Error::Io(e.to_string()))?)?;
+    let color = |f: Formulation, k: usize| match f {
+        Formulation::Ancf => [colors::ANCF, colors::EXTRA[0], colors::REFS[1]][k],
+        Formulation::Gebf => [colors::GEBF, colors::EXTRA[3], colors::REFS[3]][k],
+    };
+    let series = |x: &dyn Fn(&Rung) -> f64, ladders: &[Ladder]| -> Vec<Series> {
+        let mut v = Vec::new();
+        for f in Formulation::ALL {
+            for (k, &l) in ladders.iter().enumerate() {
+                let pts: Vec<(f64, f64)> = r
+                    .rungs
+                    .iter()
+                    .filter(|g| g.formulation == f && g.ladder == l && g.error_m.is_finite() && g.error_m > 0.0)
+                    .map(|g| (x(g).log10(), g.error_m))
+                    .collect();
+                if !pts.is_empty() {
+                    v.push(Series {
+                        label: format!("{} {}", f.as_str().to_uppercase(), l.as_str()),
+                        color: color(f, k),
+                        points: pts,
+                    });
+                }
+            }
+        }
+        v
+    };
+    let wp = Panel {
+        title: format!("{} — work-precision", r.name),
+        x_label: "log10 wall time [s]".into(),
+        y_label: "max tip error [m]".into(),
+        log_y: true,
+        series: series(&|g| g.wall_s.max(1e-6), &[Ladder::Diagonal, Ladder::Time, Ladder::Space]),
+    };
+    panels_svg(&dir.join("work_precision.svg"), &[wp], 1, (900, 480))?;
+    let t = Panel {
+        title: format!("{} — error against time step", r.name),
+        x_label: "log10 dt [s]".into(),
+        y_label: "max tip error [m]".into(),
+        log_y: true,
+        series: series(&|g| g.dt, &[Ladder::Time]),
+    };
+    let s = Panel {
+        title: format!("{} — error against elements per body", r.name),
+        x_label: "log10 elements per body [-]".into(),
+        y_label: "max tip error [m]".into(),
+        log_y: true,
+        series: series(&|g| g.elements as f64, &[Ladder::Space]),
+    };
+    panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (600, 420))
+}

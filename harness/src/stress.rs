@@ -1,0 +1,220 @@
+//! The stress matrix: where each formulation survives on hard cases.
+//!
+//! Cells are the product of stiffness scale c, flare angle β, time-step factor (× the case's dt)
+//! and rho_inf, applied to a base case (the paper's double pendulum). Each cell records success or
+//! the failure (time and reason), Newton statistics, energy drift and constraint drift. Extra
+//! single runs (e.g. a 20 s pendulum) are listed beside the matrix.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use plotters::prelude::*;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::Error;
+use crate::case::{Case, Formulation, Joint, RunSpec};
+use crate::csv::write_file;
+use crate::metrics::FormulationMetrics;
+use crate::scene::run_formulation;
+
+/// The axes of the matrix.
+#[derive(Debug, Clone, Serialize)]
+pub struct Axes {
+    /// Stiffness scales c.
+    pub c: Vec<f64>,
+    /// Flare angles β, degrees.
+    pub beta_deg: Vec<f64>,
+    /// Multiples of the case's time step.
+    pub dt_factor: Vec<f64>,
+    /// Spectral radii.
+    pub rho_inf: Vec<f64>,
+}
+
+impl Default for Axes {
+    fn default() -> Self {
+        Self {
+            c: vec![1.0, 0.1, 0.01, 0.001],
+            beta_deg: vec![0.0, 10.0, 45.0, 80.0, 89.0, 90.0],
+            dt_factor: vec![1.0, 2.0, 5.0],
+            rho_inf: vec![0.6, 0.8, 0.9, 1.0],
+        }
+    }
+}
+
+/// One cell.
+#[derive(Debug, Clone, Serialize)]
+pub struct Cell {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Stiffness scale.
+    pub c: f64,
+    /// Flare angle, degrees.
+    pub beta_deg: f64,
+    /// Time-step factor.
+    pub dt_factor: f64,
+    /// Spectral radius.
+    pub rho_inf: f64,
+    /// Metrics of the run (incl. failure and the time reached).
+    pub metrics: FormulationMetrics,
+}
+
+impl Cell {
+    /// Whether the run reached its end time.
+    pub fn ok(&self) -> bool {
+        self.metrics.error.is_none()
+    }
+}
+
+/// Make the case of one cell.
+fn cell_case(base: &Case, c: f64, beta: f64, dt_factor: f64, rho: f64) -> Case {
+    let mut k = base.clone();
+    k.stiffness_scale = c;
+    for j in &mut k.joints {
+        if let Joint::FlaredHinge { flare_deg, .. } = j {
+            *flare_deg = beta;
+        }
+    }
+    k.ancf.dt *= dt_factor;
+    k.gebf.dt *= dt_factor;
+    k.ancf.rho_inf = rho;
+    k.gebf.rho_inf = rho;
+    k.gate = None;
+    k.references.clear();
+    // Coarser output keeps memory small; metrics only need the sampled history.
+    k.output_dt = Some(0.01_f64.max(k.ancf.dt.max(k.gebf.dt)));
+    k
+}
+
+/// Run the matrix on `base` (rayon over cells).
+pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
+    let mut jobs = Vec::new();
+    for f in Formulation::ALL {
+        for &c in &axes.c {
+            for &b in &axes.beta_deg {
+                for &d in &axes.dt_factor {
+                    for &r in &axes.rho_inf {
+                        jobs.push((f, c, b, d, r));
+                    }
+                }
+            }
+        }
+    }
+    let bar = if progress { indicatif::ProgressBar::new(jobs.len() as u64) } else { indicatif::ProgressBar::hidden() };
+    let cells = jobs
+        .par_iter()
+        .map(|&(f, c, b, d, r)| {
+            let case = cell_case(base.case(f), c, b, d, r);
+            let out = run_formulation(&case, f);
+            bar.inc(1);
+            Cell { formulation: f, c, beta_deg: b, dt_factor: d, rho_inf: r, metrics: FormulationMetrics::of(&out) }
+        })
+        .collect();
+    bar.finish_and_clear();
+    cells
+}
+
+/// Write `stress.csv`, `stress.json` and one heat map per formulation (`stress_<f>.svg`).
+pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
+    let mut csv = String::from(
+        "formulation,c,beta_deg,dt_factor,rho_inf,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure\n",
+    );
+    for k in cells {
+        let m = &k.metrics;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.4},\"{}\"",
+            k.formulation,
+            k.c,
+            k.beta_deg,
+            k.dt_factor,
+            k.rho_inf,
+            k.ok(),
+            m.t_reached,
+            m.newton_per_step,
+            m.max_newton_iters,
+            m.energy_drift,
+            m.max_constraint_residual,
+            m.wall_s,
+            m.error.clone().unwrap_or_default().replace('"', "'")
+        );
+    }
+    write_file(&dir.join("stress.csv"), &csv)?;
+    write_file(&dir.join("stress.json"), &serde_json::to_string_pretty(cells).map_err(|e| Error::Io(e.to_string()))?)?;
+    for f in Formulation::ALL {
+        heat_map(&dir.join(format!("stress_{f}.svg")), axes, cells, f)?;
+    }
+    Ok(())
+}
+
+/// Colour of a cell: red = failed, orange = energy drift > 10 %, yellow > 1 %, green otherwise.
+fn cell_color(k: &Cell) -> RGBColor {
+    if !k.ok() {
+        RGBColor(214, 39, 40)
+    } else if !(k.metrics.energy_drift <= 0.1) {
+        RGBColor(255, 160, 60)
+    } else if k.metrics.energy_drift > 0.01 {
+        RGBColor(240, 220, 80)
+    } else {
+        RGBColor(90, 180, 90)
+    }
+}
+
+fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<(), Error> {
+    let err = |m: String| Error::Plot { file: path.display().to_string(), msg: m };
+    let rows: Vec<(f64, f64)> = axes.c.iter().flat_map(|&c| axes.beta_deg.iter().map(move |&b| (c, b))).collect();
+    let cols: Vec<(f64, f64)> =
+        axes.dt_factor.iter().flat_map(|&d| axes.rho_inf.iter().map(move |&r| (d, r))).collect();
+    let (cw, ch, left, top) = (74i32, 26i32, 150i32, 90i32);
+    let w = (left + cw * cols.len() as i32 + 20) as u32;
+    let h = (top + ch * rows.len() as i32 + 70) as u32;
+    let root = SVGBackend::new(path, (w, h)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let txt = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), ("sans-serif", size).into_font());
+    let title = format!(
+        "Stress matrix, {}: cell = (c, β) row × (dt factor, ρ∞) column; text = Newton/step or failure time [s]",
+        f.as_str().to_uppercase()
+    );
+    root.draw(&txt(&title, 10, 8, 15)).map_err(|e| err(e.to_string()))?;
+    for (j, (d, r)) in cols.iter().enumerate() {
+        let x = left + cw * j as i32 + 4;
+        root.draw(&txt(&format!("dt×{d}"), x, top - 40, 13)).map_err(|e| err(e.to_string()))?;
+        root.draw(&txt(&format!("ρ∞ {r}"), x, top - 22, 13)).map_err(|e| err(e.to_string()))?;
+    }
+    for (i, (c, b)) in rows.iter().enumerate() {
+        let y = top + ch * i as i32;
+        root.draw(&txt(&format!("c {c}, β {b}°"), 8, y + 6, 13)).map_err(|e| err(e.to_string()))?;
+        for (j, (d, r)) in cols.iter().enumerate() {
+            let x = left + cw * j as i32;
+            let Some(k) = cells
+                .iter()
+                .find(|k| k.formulation == f && k.c == *c && k.beta_deg == *b && k.dt_factor == *d && k.rho_inf == *r)
+            else {
+                continue;
+            };
+            root.draw(&Rectangle::new([(x, y), (x + cw - 2, y + ch - 2)], cell_color(k).filled()))
+                .map_err(|e| err(e.to_string()))?;
+            let label = if k.ok() { format!("{:.1}", k.metrics.newton_per_step) } else { format!("✗{:.2}", k.metrics.t_reached) };
+            root.draw(&txt(&label, x + 6, y + 6, 12)).map_err(|e| err(e.to_string()))?;
+        }
+    }
+    let ly = top + ch * rows.len() as i32 + 16;
+    let legend = [
+        (RGBColor(90, 180, 90), "ok, drift ≤ 1 %"),
+        (RGBColor(240, 220, 80), "ok, drift ≤ 10 %"),
+        (RGBColor(255, 160, 60), "ok, drift > 10 %"),
+        (RGBColor(214, 39, 40), "failed (time reached)"),
+    ];
+    for (n, (col, s)) in legend.iter().enumerate() {
+        let x = 10 + 200 * n as i32;
+        root.draw(&Rectangle::new([(x, ly), (x + 16, ly + 14)], col.filled())).map_err(|e| err(e.to_string()))?;
+        root.draw(&txt(s, x + 22, ly, 13)).map_err(|e| err(e.to_string()))?;
+    }
+    root.present().map_err(|e| err(e.to_string()))
+}
+
+/// Count of successful cells per formulation.
+pub fn survival(cells: &[Cell], f: Formulation) -> (usize, usize) {
+    let of_f: Vec<&Cell> = cells.iter().filter(|k| k.formulation == f).collect();
+    (of_f.iter().filter(|k| k.ok()).count(), of_f.len())
+}
