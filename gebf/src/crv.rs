@@ -1,0 +1,448 @@
+//! Cartesian rotation vectors (CRV): rotation matrix, tangential operator and its derivatives.
+//!
+//! A CRV `psi = phi·n` (|n| = 1) describes the rotation by `phi` about `n`:
+//!
+//! $$ C(\psi) = \exp(\tilde\psi) = I + \frac{\sin\phi}{\phi}\tilde\psi + \frac{1-\cos\phi}{\phi^2}\tilde\psi^2 .$$
+//!
+//! In the beam, `C(psi) = C^{AB}` maps section (B) components to body-frame (A) components.
+//! The tangential operator gives the angular velocity in B, `Omega = T(psi) psi_dot`:
+//!
+//! $$ T(\psi) = I + \alpha(s)\,\tilde\psi + \beta(s)\,\tilde\psi^2,\quad
+//!    \alpha = \frac{\cos\phi - 1}{\phi^2},\quad \beta = \frac{\phi - \sin\phi}{\phi^3},\quad s = \phi^2 .$$
+//!
+//! The beam tangents need the first and second derivatives of `T(psi) a` with respect to `psi`;
+//! they are written in terms of the s-derivatives of `alpha` and `beta`, which are evaluated by
+//! their Taylor series for `phi < 1` (no cancellation near `psi = 0`) and in closed form above.
+//! `T` is singular at `|psi| = 2πk`, k ≥ 1; [`rescale`] maps a CRV past π back to the
+//! equivalent one of norm below π, and [`rescale_rates`] transforms its rate consistently.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// 3-vector of f64.
+pub type V3 = Vector3<f64>;
+/// 3×3 matrix of f64.
+pub type M3 = Matrix3<f64>;
+
+/// The skew-symmetric (cross-product) matrix: `skew(a) b = a × b`.
+#[inline]
+pub fn skew(a: &V3) -> M3 {
+    M3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+}
+
+/// The axial vector of the skew-symmetric part of `m`: `axial(skew(a)) = a`.
+#[inline]
+pub fn axial(m: &M3) -> V3 {
+    V3::new(0.5 * (m[(2, 1)] - m[(1, 2)]), 0.5 * (m[(0, 2)] - m[(2, 0)]), 0.5 * (m[(1, 0)] - m[(0, 1)]))
+}
+
+/// Below this angle (rad) the series expansions are used.
+const SERIES_LIMIT: f64 = 1.0;
+/// Number of Taylor terms: the remainder at `phi = 1` is below 1e-25.
+const N_TERMS: usize = 12;
+
+/// Taylor coefficients of α(s) = Σ (−1)^{k+1} s^k/(2k+2)! (`sign = -1`, `offset = 2`) and
+/// β(s) = Σ (−1)^k s^k/(2k+3)! (`sign = 1`, `offset = 3`), differentiated `deriv` times in s.
+const fn series(sign: f64, offset: usize, deriv: usize) -> [f64; N_TERMS] {
+    let mut out = [0.0; N_TERMS];
+    let mut k = 0;
+    while k < N_TERMS {
+        let n = k + deriv; // index of the original term
+        let mut f = 1.0;
+        let mut i = 2;
+        while i <= 2 * n + offset {
+            f *= i as f64;
+            i += 1;
+        }
+        let mut c = if n % 2 == 0 { sign / f } else { -sign / f };
+        let mut d = 0;
+        while d < deriv {
+            c *= (n - d) as f64;
+            d += 1;
+        }
+        out[k] = c;
+        k += 1;
+    }
+    out
+}
+
+const SERIES_A: [f64; N_TERMS] = series(-1.0, 2, 0);
+const SERIES_DA: [f64; N_TERMS] = series(-1.0, 2, 1);
+const SERIES_DDA: [f64; N_TERMS] = series(-1.0, 2, 2);
+const SERIES_B: [f64; N_TERMS] = series(1.0, 3, 0);
+const SERIES_DB: [f64; N_TERMS] = series(1.0, 3, 1);
+const SERIES_DDB: [f64; N_TERMS] = series(1.0, 3, 2);
+
+#[inline]
+fn horner(c: &[f64; N_TERMS], s: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, ck| acc * s + ck)
+}
+
+/// Scalar coefficients of `T(psi) = I + a·psĩ + b·psĩ²` and their first and second derivatives
+/// with respect to `s = |psi|²`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TangentCoefficients {
+    /// α(s) = (cos φ − 1)/φ².
+    pub a: f64,
+    /// β(s) = (φ − sin φ)/φ³.
+    pub b: f64,
+    /// dα/ds.
+    pub da: f64,
+    /// dβ/ds.
+    pub db: f64,
+    /// d²α/ds².
+    pub dda: f64,
+    /// d²β/ds².
+    pub ddb: f64,
+}
+
+impl TangentCoefficients {
+    /// Coefficients at the CRV `psi`.
+    pub fn new(psi: &V3) -> Self {
+        let s = psi.norm_squared();
+        let phi = s.sqrt();
+        if phi < SERIES_LIMIT {
+            // α = Σ (−1)^{k+1} s^k/(2k+2)!,  β = Σ (−1)^k s^k/(2k+3)!
+            Self {
+                a: horner(&SERIES_A, s),
+                b: horner(&SERIES_B, s),
+                da: horner(&SERIES_DA, s),
+                db: horner(&SERIES_DB, s),
+                dda: horner(&SERIES_DDA, s),
+                ddb: horner(&SERIES_DDB, s),
+            }
+        } else {
+            let (sn, c) = phi.sin_cos();
+            let p2 = s;
+            let p3 = p2 * phi;
+            let p4 = p2 * p2;
+            let p5 = p4 * phi;
+            let p6 = p4 * p2;
+            let p7 = p6 * phi;
+            Self {
+                a: (c - 1.0) / p2,
+                b: (phi - sn) / p3,
+                da: -sn / (2.0 * p3) - (c - 1.0) / p4,
+                db: -1.0 / p4 - c / (2.0 * p4) + 1.5 * sn / p5,
+                dda: -c / (4.0 * p4) + 1.25 * sn / p5 + 2.0 * (c - 1.0) / p6,
+                ddb: 2.0 / p6 + sn / (4.0 * p5) + 1.75 * c / p6 - 3.75 * sn / p7,
+            }
+        }
+    }
+}
+
+/// Rotation matrix `C(psi) = exp(psĩ)` (C^{AB} for a nodal CRV).
+pub fn rotation_matrix(psi: &V3) -> M3 {
+    let s = psi.norm_squared();
+    let phi = s.sqrt();
+    // sin φ/φ and (1 − cos φ)/φ² with series near zero.
+    let (c1, c2) = if phi < 1e-4 {
+        (1.0 - s / 6.0 + s * s / 120.0, 0.5 - s / 24.0 + s * s / 720.0)
+    } else {
+        (phi.sin() / phi, (1.0 - phi.cos()) / s)
+    };
+    let k = skew(psi);
+    M3::identity() + k * c1 + k * k * c2
+}
+
+/// The CRV of a rotation matrix, with norm in [0, π] (logarithm of SO(3)).
+///
+/// Goes through the unit quaternion so that it stays accurate near π.
+pub fn from_rotation_matrix(c: &M3) -> V3 {
+    crate::quaternion::Quaternion::from_rotation_matrix(c).to_crv()
+}
+
+/// Tangential operator `T(psi)`: `Omega_B = T(psi) psi_dot`.
+pub fn tangent(psi: &V3) -> M3 {
+    let k = TangentCoefficients::new(psi);
+    tangent_with(psi, &k, 1.0)
+}
+
+/// `T_σ = I + σ α psĩ + β psĩ²` (σ = 1: T, σ = −1: Tᵀ).
+fn tangent_with(psi: &V3, k: &TangentCoefficients, sigma: f64) -> M3 {
+    let p = skew(psi);
+    M3::identity() + p * (sigma * k.a) + p * p * k.b
+}
+
+/// Inverse of the tangential operator, `T(psi)⁻¹ = I + ½ psĩ + c(φ) psĩ²` with
+/// `c = (1 − (φ/2) cot(φ/2))/φ²` (singular at φ = 2π).
+pub fn tangent_inverse(psi: &V3) -> M3 {
+    let s = psi.norm_squared();
+    let phi = s.sqrt();
+    let c = if phi < 1e-2 {
+        1.0 / 12.0 + s / 720.0 + s * s / 30240.0
+    } else {
+        let h = 0.5 * phi;
+        (1.0 - h * h.cos() / h.sin()) / s
+    };
+    let p = skew(psi);
+    M3::identity() + p * 0.5 + p * p * c
+}
+
+/// Directional derivative of `T_σ` along `b`: `Σ_j b_j ∂T_σ/∂psi_j`.
+fn tangent_dir_with(psi: &V3, k: &TangentCoefficients, sigma: f64, b: &V3) -> M3 {
+    let p = skew(psi);
+    let bt = skew(b);
+    let pb = psi.dot(b);
+    bt * (sigma * k.a) + p * (2.0 * sigma * k.da * pb) + (bt * p + p * bt) * k.b + p * p * (2.0 * k.db * pb)
+}
+
+/// Jacobian `∂(T_σ(psi) a)/∂psi`.
+fn tangent_jacobian_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3) -> M3 {
+    let pa = psi.cross(a);
+    let ppa = psi.cross(&pa);
+    let psa = psi.dot(a);
+    skew(a) * (-sigma * k.a)
+        + pa * psi.transpose() * (2.0 * sigma * k.da)
+        + (M3::identity() * psa + psi * a.transpose() - a * psi.transpose() * 2.0) * k.b
+        + ppa * psi.transpose() * (2.0 * k.db)
+}
+
+/// `∂/∂psi [ (Σ_j b_j ∂T_σ/∂psi_j) a ]`: second derivative of `T_σ a` contracted with `b` on one
+/// derivative index.
+fn tangent_second_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3, b: &V3) -> M3 {
+    let i3 = M3::identity();
+    let pa = psi.cross(a);
+    let ppa = psi.cross(&pa);
+    let psa = psi.dot(a);
+    let psb = psi.dot(b);
+    let ab = a.dot(b);
+    let pt = psi.transpose();
+    let t1 = a.cross(b) * pt * (-2.0 * sigma * k.da);
+    let t2 = (pa * pt * (2.0 * k.dda * psb) + (skew(a) * (-psb) + pa * b.transpose()) * k.da) * (2.0 * sigma);
+    let lin = b * psa + psi * ab - a * (2.0 * psb);
+    let t3 = lin * pt * (2.0 * k.db) + (b * a.transpose() + i3 * ab - a * b.transpose() * 2.0) * k.b;
+    let t4 = (ppa * pt * (2.0 * k.ddb * psb)
+        + ((i3 * psa + psi * a.transpose() - a * pt * 2.0) * psb + ppa * b.transpose()) * k.db)
+        * 2.0;
+    t1 + t2 + t3 + t4
+}
+
+/// The tangential operator and its derivatives at one CRV, sharing the scalar coefficients.
+#[derive(Debug, Clone, Copy)]
+pub struct Tangent {
+    /// The CRV.
+    pub psi: V3,
+    /// Scalar coefficients.
+    pub k: TangentCoefficients,
+    /// `T(psi)`.
+    pub t: M3,
+}
+
+impl Tangent {
+    /// Evaluate at `psi`.
+    pub fn new(psi: &V3) -> Self {
+        let k = TangentCoefficients::new(psi);
+        Self { psi: *psi, k, t: tangent_with(psi, &k, 1.0) }
+    }
+    /// `dT[b] = Σ_j b_j ∂T/∂psi_j`, so that `dT[b] a = ∂(T a)/∂psi · b`.
+    pub fn dir(&self, b: &V3) -> M3 {
+        tangent_dir_with(&self.psi, &self.k, 1.0, b)
+    }
+    /// `∂(T a)/∂psi`.
+    pub fn jac(&self, a: &V3) -> M3 {
+        tangent_jacobian_with(&self.psi, &self.k, 1.0, a)
+    }
+    /// `∂(Tᵀ b)/∂psi`.
+    pub fn jac_t(&self, b: &V3) -> M3 {
+        tangent_jacobian_with(&self.psi, &self.k, -1.0, b)
+    }
+    /// `∂/∂psi [dT[b] a]` (a, b fixed).
+    pub fn second(&self, a: &V3, b: &V3) -> M3 {
+        tangent_second_with(&self.psi, &self.k, 1.0, a, b)
+    }
+    /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar `mᵀ T(psi) a` (symmetric).
+    pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
+        let mut h = M3::zeros();
+        for j in 0..3 {
+            // Row j: mᵀ ∂/∂psi (dT[e_j] a).
+            let s = tangent_second_with(&self.psi, &self.k, 1.0, a, &V3::ith(j, 1.0));
+            let row = m.transpose() * s;
+            h.set_row(j, &row);
+        }
+        h
+    }
+}
+
+/// `∂(T(psi) a)/∂psi`.
+pub fn tangent_jacobian(psi: &V3, a: &V3) -> M3 {
+    Tangent::new(psi).jac(a)
+}
+
+/// `∂(T(psi)ᵀ b)/∂psi`.
+pub fn tangent_transpose_jacobian(psi: &V3, b: &V3) -> M3 {
+    Tangent::new(psi).jac_t(b)
+}
+
+/// If `|psi| > π`, the equivalent CRV `psi (1 − 2πk/|psi|)` with norm in [0, π] (same rotation);
+/// otherwise `None`.
+pub fn rescale(psi: &V3) -> Option<V3> {
+    let phi = psi.norm();
+    if phi <= std::f64::consts::PI || !phi.is_finite() {
+        return None;
+    }
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let k = ((phi + std::f64::consts::PI) / two_pi).floor();
+    Some(psi * (1.0 - two_pi * k / phi))
+}
+
+/// Rate of a rescaled CRV: the same angular velocity `T(psi_new) psi_dot_new = T(psi_old) psi_dot_old`.
+pub fn rescale_rates(psi_old: &V3, psi_new: &V3, psi_dot_old: &V3) -> V3 {
+    tangent_inverse(psi_new) * (tangent(psi_old) * psi_dot_old)
+}
+
+/// Second rate of a rescaled CRV: the same angular acceleration
+/// `T psi_ddot + dT[psi_dot] psi_dot` in both parametrisations.
+pub fn rescale_accelerations(psi_old: &V3, psi_new: &V3, psi_dot_old: &V3, psi_dot_new: &V3, psi_ddot_old: &V3) -> V3 {
+    let to = Tangent::new(psi_old);
+    let tn = Tangent::new(psi_new);
+    let omega_dot = to.t * psi_ddot_old + to.dir(psi_dot_old) * psi_dot_old;
+    tangent_inverse(psi_new) * (omega_dot - tn.dir(psi_dot_new) * psi_dot_new)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use std::f64::consts::PI;
+
+    fn samples() -> Vec<V3> {
+        vec![
+            V3::zeros(),
+            V3::new(1e-9, -2e-9, 0.5e-9),
+            V3::new(1e-3, 2e-3, -1e-3),
+            V3::new(0.3, -0.2, 0.4),
+            V3::new(0.6, 0.7, -0.2), // φ ≈ 0.94 (series side)
+            V3::new(0.6, 0.7, -0.45), // φ ≈ 1.03 (closed-form side)
+            V3::new(1.2, -0.8, 2.0),
+            V3::new(0.0, 0.0, PI - 1e-6),
+            V3::new(1.5, 1.5, 2.0).normalize() * (PI - 1e-3),
+            V3::new(-1.0, 2.0, 0.5).normalize() * 4.5,
+        ]
+    }
+
+    fn fd_jac(f: impl Fn(&V3) -> V3, psi: &V3) -> M3 {
+        let h = 1e-6;
+        let mut j = M3::zeros();
+        for c in 0..3 {
+            let d = V3::ith(c, h);
+            j.set_column(c, &((f(&(psi + d)) - f(&(psi - d))) / (2.0 * h)));
+        }
+        j
+    }
+
+    #[test]
+    fn coefficients_continuous_at_series_limit() {
+        let lo = TangentCoefficients::new(&V3::new(SERIES_LIMIT * (1.0 - 1e-12), 0.0, 0.0));
+        let hi = TangentCoefficients::new(&V3::new(SERIES_LIMIT * (1.0 + 1e-12), 0.0, 0.0));
+        assert_relative_eq!(lo.a, hi.a, max_relative = 1e-11);
+        assert_relative_eq!(lo.b, hi.b, max_relative = 1e-11);
+        assert_relative_eq!(lo.da, hi.da, max_relative = 1e-10);
+        assert_relative_eq!(lo.db, hi.db, max_relative = 1e-10);
+        assert_relative_eq!(lo.dda, hi.dda, max_relative = 1e-9);
+        assert_relative_eq!(lo.ddb, hi.ddb, max_relative = 1e-9);
+    }
+
+    #[test]
+    fn coefficient_derivatives_match_finite_differences() {
+        for phi in [0.3, 0.9, 1.1, 2.5, 3.1, 5.0] {
+            let s = phi * phi;
+            let at = |s: f64| TangentCoefficients::new(&V3::new(s.sqrt(), 0.0, 0.0));
+            let h = 1e-6;
+            let (p, m, c) = (at(s + h), at(s - h), at(s));
+            assert_relative_eq!(c.da, (p.a - m.a) / (2.0 * h), max_relative = 1e-7);
+            assert_relative_eq!(c.db, (p.b - m.b) / (2.0 * h), max_relative = 1e-7);
+            assert_relative_eq!(c.dda, (p.da - m.da) / (2.0 * h), max_relative = 1e-6);
+            assert_relative_eq!(c.ddb, (p.db - m.db) / (2.0 * h), max_relative = 1e-6);
+        }
+    }
+
+    #[test]
+    fn rotation_matrix_is_orthonormal_and_round_trips() {
+        for psi in samples() {
+            let c = rotation_matrix(&psi);
+            assert_relative_eq!(c.transpose() * c, M3::identity(), epsilon = 1e-14);
+            assert_relative_eq!(c.determinant(), 1.0, epsilon = 1e-14);
+            if psi.norm() <= PI {
+                assert_relative_eq!(from_rotation_matrix(&c), psi, epsilon = 1e-9);
+            } else {
+                let r = rescale(&psi).unwrap();
+                assert!(r.norm() <= PI);
+                assert_relative_eq!(rotation_matrix(&r), c, epsilon = 1e-13);
+                assert_relative_eq!(from_rotation_matrix(&c), r, epsilon = 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn tangent_gives_body_angular_velocity() {
+        // Cᵀ dC/dt = (T psi_dot)~ along psi(t) = psi + t psi_dot.
+        let dpsi = V3::new(0.3, -0.7, 0.2);
+        for psi in samples() {
+            let h = 1e-6;
+            let dc = (rotation_matrix(&(psi + dpsi * h)) - rotation_matrix(&(psi - dpsi * h))) / (2.0 * h);
+            let w = rotation_matrix(&psi).transpose() * dc;
+            assert_relative_eq!(axial(&w), tangent(&psi) * dpsi, epsilon = 1e-8);
+        }
+    }
+
+    #[test]
+    fn tangent_inverse_inverts() {
+        for psi in samples() {
+            let t = tangent(&psi);
+            assert_relative_eq!(tangent_inverse(&psi) * t, M3::identity(), epsilon = 1e-10);
+        }
+    }
+
+    #[test]
+    fn tangent_jacobians_match_finite_differences() {
+        let a = V3::new(0.4, -1.3, 0.8);
+        let b = V3::new(-0.6, 0.2, 1.1);
+        for psi in samples() {
+            let t = Tangent::new(&psi);
+            let scale = 1.0 + t.jac(&a).norm();
+            let fd = fd_jac(|p| tangent(p) * a, &psi);
+            assert!((t.jac(&a) - fd).norm() < 1e-8 * scale, "jac at {psi:?}");
+            let fd = fd_jac(|p| tangent(p).transpose() * b, &psi);
+            assert!((t.jac_t(&b) - fd).norm() < 1e-8 * scale, "jac_t at {psi:?}");
+            // dT[b] a = jac(a) b
+            assert_relative_eq!(t.dir(&b) * a, t.jac(&a) * b, epsilon = 1e-13 * scale);
+            // Second derivative: ∂/∂psi [dT[b] a].
+            let fd = fd_jac(|p| Tangent::new(p).dir(&b) * a, &psi);
+            let an = t.second(&a, &b);
+            assert!((an - fd).norm() < 1e-7 * (1.0 + an.norm()), "second at {psi:?}: {an} vs {fd}");
+            // Hessian of bᵀ T a.
+            let fd = fd_jac(|p| Tangent::new(p).jac(&a).transpose() * b, &psi);
+            let an = t.hessian(&a, &b);
+            assert!((an - fd).norm() < 1e-7 * (1.0 + an.norm()), "hessian at {psi:?}");
+            assert_relative_eq!(an, an.transpose(), epsilon = 1e-12 * (1.0 + an.norm()));
+        }
+    }
+
+    #[test]
+    fn rescale_keeps_rotation_rate_and_acceleration() {
+        let psi = V3::new(1.0, -2.0, 2.5).normalize() * (PI + 0.2);
+        let psi_dot = V3::new(0.3, 0.1, -0.5);
+        let psi_ddot = V3::new(-0.2, 0.4, 0.7);
+        let new = rescale(&psi).unwrap();
+        assert_relative_eq!(new.norm(), PI - 0.2, epsilon = 1e-12);
+        let new_dot = rescale_rates(&psi, &new, &psi_dot);
+        // Same path of rotations: C(psi(t)) = C(psi_new(t)) to first order.
+        let h = 1e-6;
+        let c_old = rotation_matrix(&(psi + psi_dot * h));
+        let c_new = rotation_matrix(&(new + new_dot * h));
+        assert_relative_eq!(c_old, c_new, epsilon = 1e-11);
+        // Second order: compare the angular accelerations.
+        let new_ddot = rescale_accelerations(&psi, &new, &psi_dot, &new_dot, &psi_ddot);
+        let om = |p: &V3, d: &V3, dd: &V3, t: f64| {
+            let pt = p + d * t + dd * (0.5 * t * t);
+            tangent(&pt) * (d + dd * t)
+        };
+        let a_old = (om(&psi, &psi_dot, &psi_ddot, h) - om(&psi, &psi_dot, &psi_ddot, -h)) / (2.0 * h);
+        let a_new = (om(&new, &new_dot, &new_ddot, h) - om(&new, &new_dot, &new_ddot, -h)) / (2.0 * h);
+        assert_relative_eq!(a_old, a_new, epsilon = 1e-7);
+        assert!(rescale(&V3::new(0.0, 3.0, 0.0)).is_none());
+        // Multiples of 2π fold back too.
+        let far = V3::new(0.0, 0.0, 4.0 * PI + 0.5);
+        assert_relative_eq!(rescale(&far).unwrap(), V3::new(0.0, 0.0, 0.5), epsilon = 1e-12);
+    }
+}
