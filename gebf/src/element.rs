@@ -1,0 +1,162 @@
+//! The three-node quadratic element: shape functions, Gauss rules, the gathered nodal state,
+//! and the element-local numbering of unknowns.
+//!
+//! Local unknowns (24): node k = 0, 1, 2 at `6k` as `(R, psi)`, then the body frame's
+//! `v_A` at 18 and `omega_A` at 21. Positions and CRVs are interpolated with the same
+//! quadratic Lagrange functions of `ξ ∈ [−1, 1]` (nodes at −1, 0, 1), `s = (1 + ξ) L_e / 2`.
+
+use crate::body::Body;
+use crate::crv::V3;
+use nalgebra::{SMatrix, SVector};
+
+/// Element-local vector.
+pub(crate) type Vec24 = SVector<f64, 24>;
+/// Element-local matrix.
+pub(crate) type Mat24 = SMatrix<f64, 24, 24>;
+
+/// Offset of the frame velocity `v_A` in the local numbering.
+pub(crate) const V_OFF: usize = 18;
+/// Offset of the frame angular velocity `omega_A` in the local numbering.
+pub(crate) const W_OFF: usize = 21;
+
+/// A Gauss rule on [−1, 1]: (abscissa, weight).
+pub(crate) fn gauss_rule(n: usize) -> &'static [(f64, f64)] {
+    const G1: [(f64, f64); 1] = [(0.0, 2.0)];
+    // 1/√3 and √(3/5) written out (not const-evaluable).
+    const G2: [(f64, f64); 2] = [(-0.577_350_269_189_625_8, 1.0), (0.577_350_269_189_625_8, 1.0)];
+    const G3: [(f64, f64); 3] =
+        [(-0.774_596_669_241_483_4, 5.0 / 9.0), (0.0, 8.0 / 9.0), (0.774_596_669_241_483_4, 5.0 / 9.0)];
+    match n {
+        1 => &G1,
+        2 => &G2,
+        _ => &G3,
+    }
+}
+
+/// Shape functions and their derivatives with respect to `s` at `ξ` for element length `le`.
+#[inline]
+pub(crate) fn shape(xi: f64, le: f64) -> ([f64; 3], [f64; 3]) {
+    let n = [0.5 * xi * (xi - 1.0), 1.0 - xi * xi, 0.5 * xi * (xi + 1.0)];
+    let j = 2.0 / le;
+    let dn = [(xi - 0.5) * j, -2.0 * xi * j, (xi + 0.5) * j];
+    (n, dn)
+}
+
+/// Interpolate a nodal field.
+#[inline]
+pub(crate) fn interp(n: &[f64; 3], x: &[V3; 3]) -> V3 {
+    x[0] * n[0] + x[1] * n[1] + x[2] * n[2]
+}
+
+/// The state of one element gathered from the global vectors.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ElementState {
+    /// Nodal positions R in A, m.
+    pub r: [V3; 3],
+    /// Nodal CRVs psi (B relative to A).
+    pub psi: [V3; 3],
+    /// Nodal velocities R_dot.
+    pub rd: [V3; 3],
+    /// Nodal CRV rates psi_dot.
+    pub psid: [V3; 3],
+    /// Nodal accelerations R_ddot.
+    pub rdd: [V3; 3],
+    /// Nodal CRV second rates psi_ddot.
+    pub psidd: [V3; 3],
+    /// Frame velocity v_A (A components).
+    pub v: V3,
+    /// Frame angular velocity omega_A (A components).
+    pub w: V3,
+    /// Frame acceleration v_A_dot.
+    pub vd: V3,
+    /// Frame angular acceleration omega_A_dot.
+    pub wd: V3,
+}
+
+impl ElementState {
+    /// Gather element `e` of `body`. `v`, `v_dot` may be `None` (treated as zero).
+    pub fn gather(body: &Body, e: usize, q: &[f64], v: Option<&[f64]>, v_dot: Option<&[f64]>) -> Self {
+        let mut s = Self::default();
+        for k in 0..3 {
+            let i = 2 * e + k;
+            (s.r[k], s.psi[k]) = body.node_state(q, i);
+            if let Some(v) = v {
+                (s.rd[k], s.psid[k]) = body.node_rates(v, i);
+            }
+            if let Some(a) = v_dot {
+                (s.rdd[k], s.psidd[k]) = body.node_rates(a, i);
+            }
+        }
+        if let Some(v) = v {
+            (s.v, s.w) = body.frame_rates(v);
+        }
+        if let Some(a) = v_dot {
+            (s.vd, s.wd) = body.frame_rates(a);
+        }
+        s
+    }
+}
+
+/// Global tangent index of each local 3-block (8 blocks: node k R, node k psi, v_A, omega_A);
+/// `None` for the clamped node 0.
+pub(crate) fn local_blocks(body: &Body, e: usize) -> [Option<usize>; 8] {
+    let mut b = [None; 8];
+    for k in 0..3 {
+        if let Some(d) = body.node_dof(2 * e + k) {
+            b[2 * k] = Some(d);
+            b[2 * k + 1] = Some(d + 3);
+        }
+    }
+    b[6] = Some(body.frame_dof());
+    b[7] = Some(body.frame_dof() + 3);
+    b
+}
+
+/// Add a 3-vector into a local vector at `off`.
+#[inline]
+pub(crate) fn add3(v: &mut Vec24, off: usize, x: &V3) {
+    v[off] += x.x;
+    v[off + 1] += x.y;
+    v[off + 2] += x.z;
+}
+
+/// Add a 3×3 block into a local matrix at (i, j).
+#[inline]
+pub(crate) fn add33(m: &mut Mat24, i: usize, j: usize, x: &crate::crv::M3) {
+    let mut b = m.fixed_view_mut::<3, 3>(i, j);
+    b += x;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn shape_functions_partition_unity_and_interpolate_lines() {
+        let le = 0.7;
+        for xi in [-1.0, -0.3, 0.0, 0.45, 1.0] {
+            let (n, dn) = shape(xi, le);
+            assert_relative_eq!(n.iter().sum::<f64>(), 1.0, epsilon = 1e-15);
+            assert_relative_eq!(dn.iter().sum::<f64>(), 0.0, epsilon = 1e-14);
+            // s at the nodes: 0, le/2, le  → interpolation of s is exact, ds/ds = 1.
+            let s_nodes = [0.0, 0.5 * le, le];
+            let s: f64 = n.iter().zip(&s_nodes).map(|(a, b)| a * b).sum();
+            let ds: f64 = dn.iter().zip(&s_nodes).map(|(a, b)| a * b).sum();
+            assert_relative_eq!(s, 0.5 * (1.0 + xi) * le, epsilon = 1e-15);
+            assert_relative_eq!(ds, 1.0, epsilon = 1e-14);
+        }
+    }
+
+    #[test]
+    fn gauss_rules_integrate_polynomials() {
+        for (n, deg) in [(1usize, 1u32), (2, 3), (3, 5)] {
+            let rule = gauss_rule(n);
+            for p in 0..=deg {
+                let num: f64 = rule.iter().map(|(x, w)| w * x.powi(p as i32)).sum();
+                let exact = if p % 2 == 1 { 0.0 } else { 2.0 / (p as f64 + 1.0) };
+                assert_relative_eq!(num, exact, epsilon = 1e-15);
+            }
+        }
+    }
+}

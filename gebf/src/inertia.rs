@@ -1,0 +1,133 @@
+//! Inertial forces of a beam element in its moving frame A, with the configuration-dependent
+//! mass matrix, the gyroscopic matrix and the inertial stiffness.
+//!
+//! At a point of the beam axis, with `W = v_A + R_dot + omega_A × R` (velocity in A) and the
+//! section angular velocity in B `Omega = T(psi) psi_dot + C^{BA} omega_A`, the kinetic energy is
+//! `½ ∫ (m |W|² + Omegaᵀ J Omega) ds`. The inertial forces follow from d'Alembert's principle:
+//!
+//! * linear: `f = m (v_A_dot + R_ddot + omega_A_dot × R + 2 omega_A × R_dot + omega_A × (v_A + omega_A × R))`
+//!   (the acceleration of the point in A components), virtual displacement
+//!   `δr = δr_A + δR + δθ_A × R` → rows `R_k: N_k f`, `v_A: f`, `omega_A: R × f`;
+//! * angular: `h = J Omega_dot + Omega × J Omega` with
+//!   `Omega_dot = T psi_ddot + dT[psi_dot] psi_dot + (C^{BA} omega_A) × (T psi_dot) + C^{BA} omega_A_dot`,
+//!   virtual rotation `δθ_B = T δpsi + C^{BA} δθ_A` → rows `psi_k: N_k Tᵀ h`, `omega_A: C^{AB} h`.
+//!
+//! Nothing here depends on the frame's position or orientation (gravity is in `gravity.rs`).
+//! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
+
+use crate::Section;
+use crate::crv::{M3, Tangent, rotation_matrix, skew};
+use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
+
+/// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MatrixCoefficients {
+    pub c_m: f64,
+    pub c_c: f64,
+    pub c_k: f64,
+}
+
+/// Add the inertial forces of one element to `res` (and their weighted tangent to `mat`);
+/// returns the kinetic energy of the element, J.
+pub(crate) fn add_inertia(
+    st: &ElementState,
+    le: f64,
+    sec: &Section,
+    res: &mut Vec24,
+    mut mat: Option<(&mut Mat24, MatrixCoefficients)>,
+) -> f64 {
+    let m = sec.mass;
+    let jd = sec.inertia();
+    let j = M3::from_diagonal(&jd);
+    let i3 = M3::identity();
+    let mut kinetic = 0.0;
+    for &(xi, wgt) in gauss_rule(3) {
+        let (n, _) = shape(xi, le);
+        let wt = 0.5 * le * wgt;
+        let r = interp(&n, &st.r);
+        let rd = interp(&n, &st.rd);
+        let rdd = interp(&n, &st.rdd);
+        let psi = interp(&n, &st.psi);
+        let psid = interp(&n, &st.psid);
+        let psidd = interp(&n, &st.psidd);
+        let (v, w, vd, wd) = (st.v, st.w, st.vd, st.wd);
+
+        // Translation.
+        let w0 = v + w.cross(&r);
+        let vel = w0 + rd;
+        let f = (vd + rdd + wd.cross(&r) + w.cross(&rd) * 2.0 + w.cross(&w0)) * m;
+        let rf = r.cross(&f);
+        // Rotation.
+        let tg = Tangent::new(&psi);
+        let t = tg.t;
+        let cba = rotation_matrix(&psi).transpose();
+        let om_r = t * psid;
+        let cw = cba * w;
+        let om = om_r + cw;
+        let jom = jd.component_mul(&om);
+        let dtp = tg.dir(&psid);
+        let om_d = t * psidd + dtp * psid + cw.cross(&om_r) + cba * wd;
+        let h = jd.component_mul(&om_d) + om.cross(&jom);
+        kinetic += 0.5 * wt * (m * vel.norm_squared() + om.dot(&jom));
+
+        let tth = t.transpose() * h;
+        for k in 0..3 {
+            add3(res, 6 * k, &(f * (wt * n[k])));
+            add3(res, 6 * k + 3, &(tth * (wt * n[k])));
+        }
+        add3(res, V_OFF, &(f * wt));
+        add3(res, W_OFF, &((rf + cba.transpose() * h) * wt));
+
+        if let Some((mm, c)) = mat.as_mut() {
+            let c = *c;
+            let wt_ = wt;
+            let rt = skew(&r);
+            let wt3 = skew(&w);
+            // Linear part: columns (per node: × n_l).
+            let l_r = i3 * (c.c_m * m) + wt3 * (2.0 * m * c.c_c) + (skew(&wd) + wt3 * wt3) * (m * c.c_k);
+            let l_v = i3 * (c.c_m * m) + wt3 * (m * c.c_c);
+            let l_w = rt * (-m * c.c_m) + (skew(&rd) * 2.0 + skew(&w0) + wt3 * rt) * (-m * c.c_c);
+            // Angular part.
+            let x = skew(&om) * j - skew(&jom);
+            let cwt = skew(&cw);
+            let omr_t = skew(&om_r);
+            let d_psid = tg.jac(&psid);
+            let dom_dpsi = d_psid + cwt * t;
+            let domd_dpsi = tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt * t
+                + skew(&(cba * wd)) * t;
+            let domd_dpsid = dtp + d_psid + cwt * t;
+            let h_psi = j * t * c.c_m + (j * domd_dpsid + x * t) * c.c_c + (j * domd_dpsi + x * dom_dpsi) * c.c_k;
+            let h_w = j * cba * c.c_m + (j * (-omr_t * cba) + x * cba) * c.c_c;
+            let tt = t.transpose();
+            let ct = cba.transpose();
+            let geo_psi_row = tg.jac_t(&h) * c.c_k; // ∂(Tᵀh)/∂psi at fixed h
+            let geo_w_row = -(ct * skew(&h) * t) * c.c_k; // ∂(C^{AB} h)/∂psi at fixed h
+            let geo_rf = -skew(&f) * c.c_k; // ∂(R × f)/∂R at fixed f
+
+            let a_rr = l_r;
+            let a_pp = tt * h_psi + geo_psi_row;
+            let a_wp = ct * h_psi + geo_w_row;
+            let a_pw = tt * h_w;
+            for k in 0..3 {
+                let nk = n[k] * wt_;
+                for l in 0..3 {
+                    let nkl = nk * n[l];
+                    add33(mm, 6 * k, 6 * l, &(a_rr * nkl));
+                    add33(mm, 6 * k + 3, 6 * l + 3, &(a_pp * nkl));
+                }
+                add33(mm, 6 * k, V_OFF, &(l_v * nk));
+                add33(mm, 6 * k, W_OFF, &(l_w * nk));
+                add33(mm, 6 * k + 3, W_OFF, &(a_pw * nk));
+                // Frame rows, node columns.
+                add33(mm, V_OFF, 6 * k, &(l_r * nk));
+                add33(mm, W_OFF, 6 * k, &((rt * l_r + geo_rf) * nk));
+                add33(mm, W_OFF, 6 * k + 3, &(a_wp * nk));
+            }
+            add33(mm, V_OFF, V_OFF, &(l_v * wt_));
+            add33(mm, V_OFF, W_OFF, &(l_w * wt_));
+            add33(mm, W_OFF, V_OFF, &(rt * l_v * wt_));
+            add33(mm, W_OFF, W_OFF, &((rt * l_w + ct * h_w) * wt_));
+        }
+    }
+    kinetic
+}

@@ -1,0 +1,571 @@
+//! The multibody GEBF model: bodies with floating frames, joints, gravity, nodal loads; the
+//! [`genalpha::ConstrainedSystem`] implementation and the sensors of the harness API.
+
+use crate::body::Body;
+use crate::clamp::Clamp;
+use crate::crv::{M3, V3, rotation_matrix};
+use crate::element::{ElementState, Mat24, Vec24, local_blocks};
+use crate::flared_hinge::FlaredHinge;
+use crate::gravity::{add_gravity, potential};
+use crate::ground_hinge::GroundHinge;
+use crate::inertia::{MatrixCoefficients, add_inertia};
+use crate::joint::Joint;
+use crate::loads::{NodalLoad, add_load, add_load_tangent};
+use crate::quaternion::Quaternion;
+use crate::stiffness::add_elastic;
+use crate::{BodySpec, Error, JointSpec, Options};
+use genalpha::{ConstrainedSystem, MatView, State};
+use nalgebra::Vector3;
+
+/// Energies in J. potential = −∫ m g·(r − r_ref) ds (zero in the reference configuration).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy, J.
+    pub kinetic: f64,
+    /// Elastic strain energy, J.
+    pub elastic: f64,
+    /// Gravitational potential energy, J.
+    pub potential: f64,
+}
+
+impl Energies {
+    /// kinetic + elastic + potential, J.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.potential
+    }
+}
+
+/// The GEBF multibody model. Implements [`genalpha::ConstrainedSystem`].
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub(crate) bodies: Vec<Body>,
+    pub(crate) joints: Vec<Joint>,
+    /// First velocity-constraint row of each joint.
+    joint_row: Vec<usize>,
+    /// Joint indices, parents before children (for the projection).
+    projection_order: Vec<usize>,
+    pub(crate) gravity: V3,
+    options: Options,
+    n_dof: usize,
+    n_coords: usize,
+    n_rows: usize,
+    /// Nodal loads per body and node.
+    loads: Vec<Vec<NodalLoad>>,
+    n_loaded: usize,
+    /// Factor on gravity and nodal loads (load stepping in statics).
+    pub(crate) load_scale: f64,
+}
+
+fn check_body(field: String, b: usize, n_bodies: usize) -> Result<(), Error> {
+    if b >= n_bodies { Err(Error::NoSuchBody { field, body: b, n_bodies }) } else { Ok(()) }
+}
+
+impl Model {
+    /// Validates everything and returns an [`Error`] naming the field.
+    pub fn new(bodies: &[BodySpec], joints: &[JointSpec], gravity: Vector3<f64>, options: Options) -> Result<Model, Error> {
+        if bodies.is_empty() {
+            return Err(Error::ZeroCount { field: "bodies".into() });
+        }
+        for (i, b) in bodies.iter().enumerate() {
+            b.validate(i)?;
+        }
+        for (k, g) in gravity.iter().enumerate() {
+            if !g.is_finite() {
+                return Err(Error::NotFinite { field: format!("gravity[{k}]"), value: *g });
+            }
+        }
+        options.validate()?;
+        let (mut dof, mut coord) = (0, 0);
+        let mut bs = Vec::with_capacity(bodies.len());
+        for spec in bodies {
+            let b = Body::new(spec, dof, coord);
+            dof += b.n_dof();
+            coord += b.n_coords();
+            bs.push(b);
+        }
+        let nb = bodies.len();
+        // Which joint attaches each body at its start, and each body's parent.
+        let mut attached: Vec<Option<usize>> = vec![None; nb];
+        let mut parent: Vec<Option<usize>> = vec![None; nb];
+        let mut js = Vec::with_capacity(joints.len());
+        for (j, spec) in joints.iter().enumerate() {
+            let (body, joint) = match spec {
+                JointSpec::GroundHinge { body, axis } => {
+                    check_body(format!("joints[{j}].body"), *body, nb)?;
+                    for (k, a) in axis.iter().enumerate() {
+                        if !a.is_finite() {
+                            return Err(Error::NotFinite { field: format!("joints[{j}].axis[{k}]"), value: *a });
+                        }
+                    }
+                    if axis.norm() == 0.0 {
+                        return Err(Error::ZeroAxis { field: format!("joints[{j}].axis") });
+                    }
+                    (*body, Joint::Ground(GroundHinge::new(*body, axis, &bs[*body])))
+                }
+                JointSpec::Clamp { body } => {
+                    check_body(format!("joints[{j}].body"), *body, nb)?;
+                    (*body, Joint::Clamp(Clamp { body: *body }))
+                }
+                JointSpec::FlaredHinge { parent: p, child: c, beta } => {
+                    check_body(format!("joints[{j}].parent"), *p, nb)?;
+                    check_body(format!("joints[{j}].child"), *c, nb)?;
+                    if p == c {
+                        return Err(Error::SelfJoint { joint: j, body: *p });
+                    }
+                    if !beta.is_finite() {
+                        return Err(Error::NotFinite { field: format!("joints[{j}].beta"), value: *beta });
+                    }
+                    let half_pi = std::f64::consts::FRAC_PI_2;
+                    if beta.abs() > half_pi * (1.0 + 1e-12) {
+                        return Err(Error::OutOfRange {
+                            field: format!("joints[{j}].beta"),
+                            value: *beta,
+                            min: -half_pi,
+                            max: half_pi,
+                        });
+                    }
+                    let end = bodies[*p].start + bodies[*p].frame.column(0) * bodies[*p].length;
+                    let gap = (bodies[*c].start - end).norm();
+                    if gap > 1e-9 * bodies[*p].length.max(bodies[*c].length) {
+                        return Err(Error::JointGap { field: format!("joints[{j}].child"), gap });
+                    }
+                    parent[*c] = Some(*p);
+                    (*c, Joint::Flared(FlaredHinge::new(*p, *c, *beta, &bs[*p], &bs[*c])))
+                }
+            };
+            if let Some(other) = attached[body] {
+                let field = match spec {
+                    JointSpec::FlaredHinge { .. } => format!("joints[{j}].child"),
+                    _ => format!("joints[{j}].body"),
+                };
+                return Err(Error::DoublyAttached { field, body, other });
+            }
+            attached[body] = Some(j);
+            js.push(joint);
+        }
+        // Depth of every body along its parents (detects loops).
+        let mut depth = vec![0usize; nb];
+        for (b, d) in depth.iter_mut().enumerate() {
+            let mut cur = b;
+            let mut n = 0;
+            while let Some(p) = parent[cur] {
+                n += 1;
+                cur = p;
+                if n > nb {
+                    return Err(Error::JointLoop { joint: attached[b].unwrap_or(0) });
+                }
+            }
+            *d = n;
+        }
+        let joint_body: Vec<usize> = joints
+            .iter()
+            .map(|s| match s {
+                JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } => *body,
+                JointSpec::FlaredHinge { child, .. } => *child,
+            })
+            .collect();
+        let mut projection_order: Vec<usize> = (0..js.len()).collect();
+        projection_order.sort_by_key(|&j| depth[joint_body[j]]);
+        let mut joint_row = Vec::with_capacity(js.len());
+        let mut rows = 0;
+        for j in &js {
+            joint_row.push(rows);
+            rows += j.n_rows();
+        }
+        let loads = bs.iter().map(|b| vec![NodalLoad::default(); b.n_nodes()]).collect();
+        Ok(Model {
+            bodies: bs,
+            joints: js,
+            joint_row,
+            projection_order,
+            gravity,
+            options,
+            n_dof: dof,
+            n_coords: coord,
+            n_rows: rows,
+            loads,
+            n_loaded: 0,
+            load_scale: 1.0,
+        })
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &Options {
+        &self.options
+    }
+
+    /// Switch the position-level stabilisation on or off.
+    pub fn set_stabilization(&mut self, on: bool) {
+        self.options.stabilization = on;
+    }
+
+    /// The undeformed reference configuration at rest, sized for genalpha (q, zero v, ...).
+    pub fn initial_state(&self) -> State {
+        State::at_rest(self, 0.0, self.reference_coordinates())
+    }
+
+    /// The storage vector `q` of the reference configuration.
+    pub fn reference_coordinates(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.n_coords];
+        for b in &self.bodies {
+            for i in 1..b.n_nodes() {
+                let k = b.node_coord(i).expect("i ≥ 1");
+                q[k..k + 3].copy_from_slice(b.node_ref(i).as_slice());
+            }
+            let f = b.frame_coord();
+            q[f..f + 3].copy_from_slice(b.start.as_slice());
+            b.quat0.write_to(&mut q[f + 3..f + 7]);
+        }
+        q
+    }
+
+    /// Number of bodies.
+    pub fn n_bodies(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Number of nodes of body `body` (including its node 0 at the frame origin).
+    ///
+    /// # Panics
+    /// When `body` is out of range.
+    pub fn n_nodes(&self, body: usize) -> usize {
+        self.bodies[body].n_nodes()
+    }
+
+    /// Total length of all bodies (m).
+    pub fn span(&self) -> f64 {
+        self.bodies.iter().map(|b| b.length).sum()
+    }
+
+    /// Arc length of node `node` of `body` from the body's start in the reference, m.
+    pub fn node_arc_length(&self, body: usize, node: usize) -> Result<f64, Error> {
+        self.check_node(body, node)?;
+        Ok(self.bodies[body].node_ref(node).x)
+    }
+
+    fn check_node(&self, body: usize, node: usize) -> Result<(), Error> {
+        let nb = self.bodies.len();
+        check_body("body".into(), body, nb)?;
+        let n_nodes = self.bodies[body].n_nodes();
+        if node >= n_nodes {
+            return Err(Error::NoSuchNode { body, node, n_nodes });
+        }
+        Ok(())
+    }
+
+    /// Frame origin `r_A` (global, m) and orientation `C^{GA}` of body `body`.
+    ///
+    /// # Panics
+    /// When `body` is out of range or `q` is too short.
+    pub fn body_frame(&self, q: &[f64], body: usize) -> (Vector3<f64>, M3) {
+        let (r, chi) = self.bodies[body].frame_state(q);
+        (r, chi.to_rotation_matrix())
+    }
+
+    /// Global position of a node, m.
+    pub fn node_position(&self, q: &[f64], body: usize, node: usize) -> Result<Vector3<f64>, Error> {
+        self.check_node(body, node)?;
+        let b = &self.bodies[body];
+        let (r, chi) = b.frame_state(q);
+        let (ri, _) = b.node_state(q, node);
+        Ok(r + chi.rotate(&ri))
+    }
+
+    /// Section frame of a node, `C^{GB}`: columns = section x (beam axis), y, z in global
+    /// components.
+    pub fn node_frame(&self, q: &[f64], body: usize, node: usize) -> Result<M3, Error> {
+        self.check_node(body, node)?;
+        let b = &self.bodies[body];
+        let (_, chi) = b.frame_state(q);
+        let (_, psi) = b.node_state(q, node);
+        Ok(chi.to_rotation_matrix() * rotation_matrix(&psi))
+    }
+
+    /// Global velocity of a node, m/s: `C^{GA}(v_A + R_dot + omega_A × R)`.
+    pub fn node_velocity(&self, q: &[f64], v: &[f64], body: usize, node: usize) -> Result<Vector3<f64>, Error> {
+        self.check_node(body, node)?;
+        let b = &self.bodies[body];
+        let (_, chi) = b.frame_state(q);
+        let (ri, _) = b.node_state(q, node);
+        let (rd, _) = b.node_rates(v, node);
+        let (va, wa) = b.frame_rates(v);
+        Ok(chi.rotate(&(va + rd + wa.cross(&ri))))
+    }
+
+    /// Global angular velocity of a node's section, rad/s: `C^{GB}(T psi_dot + C^{BA} omega_A)`.
+    pub fn node_angular_velocity(&self, q: &[f64], v: &[f64], body: usize, node: usize) -> Result<Vector3<f64>, Error> {
+        self.check_node(body, node)?;
+        let b = &self.bodies[body];
+        let (_, chi) = b.frame_state(q);
+        let (_, psi) = b.node_state(q, node);
+        let (_, psid) = b.node_rates(v, node);
+        let (_, wa) = b.frame_rates(v);
+        let c = rotation_matrix(&psi);
+        Ok(chi.rotate(&(c * (crate::crv::tangent(&psi) * psid) + wa)))
+    }
+
+    /// Apply (replace) a nodal load: force and moment in global components, held fixed until
+    /// changed. This is the hook for the aerodynamic coupling: set the loads of the current
+    /// step before calling `GenAlpha::step`. The power of the loads is
+    /// `Σ F·node_velocity + M·node_angular_velocity`.
+    pub fn set_nodal_load(&mut self, body: usize, node: usize, load: NodalLoad) -> Result<(), Error> {
+        self.check_node(body, node)?;
+        for (k, x) in load.force.iter().chain(load.moment.iter()).enumerate() {
+            if !x.is_finite() {
+                return Err(Error::NotFinite { field: format!("load[{k}]"), value: *x });
+            }
+        }
+        self.loads[body][node] = load;
+        self.n_loaded = self.loads.iter().flatten().filter(|l| !l.is_zero()).count();
+        Ok(())
+    }
+
+    /// The load currently applied at a node.
+    pub fn nodal_load(&self, body: usize, node: usize) -> Result<NodalLoad, Error> {
+        self.check_node(body, node)?;
+        Ok(self.loads[body][node])
+    }
+
+    /// Remove all nodal loads.
+    pub fn clear_nodal_loads(&mut self) {
+        self.loads.iter_mut().flatten().for_each(|l| *l = NodalLoad::default());
+        self.n_loaded = 0;
+    }
+
+    /// Centroid of the free end section of the last body (global, m).
+    pub fn tip_position(&self, q: &[f64]) -> Vector3<f64> {
+        let b = self.bodies.len() - 1;
+        let n = self.bodies[b].n_nodes() - 1;
+        let body = &self.bodies[b];
+        let (r, chi) = body.frame_state(q);
+        let (ri, _) = body.node_state(q, n);
+        r + chi.rotate(&ri)
+    }
+
+    /// Fold angle θ (rad) of joint `joint` (must be a FlaredHinge):
+    /// `R_rel = C^{GB_n}ᵀ C^{GA_child}` divided by its reference value; with `a' = −a`,
+    /// `n1 = z ⟂ a'` and `n2 = a' × n1`, `θ = atan2(n2·(R_rel n1), n1·(R_rel n1))`.
+    pub fn fold_angle(&self, q: &[f64], joint: usize) -> Result<f64, Error> {
+        match self.joints.get(joint) {
+            None => Err(Error::NoSuchJoint { joint, n_joints: self.joints.len() }),
+            Some(Joint::Flared(h)) => Ok(h.fold_angle(&self.bodies, q)),
+            Some(_) => Err(Error::NotAFlaredHinge { joint }),
+        }
+    }
+
+    /// Kinetic, elastic and gravitational potential energy.
+    pub fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
+        let mut e = Energies::default();
+        let mut res = Vec24::zeros();
+        for b in &self.bodies {
+            let (r_a, chi) = b.frame_state(q);
+            let c_ga = chi.to_rotation_matrix();
+            for el in 0..b.n_elements {
+                let st = ElementState::gather(b, el, q, Some(v), None);
+                e.kinetic += add_inertia(&st, b.le, &b.section, &mut res, None);
+                e.elastic += add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
+                e.potential += potential(&st, b, el, &self.gravity, &r_a, &c_ga);
+            }
+        }
+        e
+    }
+
+    /// Position-level joint violation: the Euclidean norm, over all joints, of (position gap in
+    /// m, axis misalignment angle in rad [for clamps: the full relative rotation angle]).
+    pub fn constraint_residual(&self, q: &[f64]) -> f64 {
+        self.joint_violations(q).iter().map(|(g, a)| g * g + a * a).sum::<f64>().sqrt()
+    }
+
+    /// Per joint: (position gap, m; axis misalignment angle, rad).
+    pub fn joint_violations(&self, q: &[f64]) -> Vec<(f64, f64)> {
+        self.joints.iter().map(|j| j.violation(&self.bodies, q)).collect()
+    }
+
+    /// Largest nodal CRV norm (rad). The nodal rotations are relative to the body frame; the
+    /// tangential operator is singular at 2π, so this should stay well below that.
+    pub fn max_nodal_rotation(&self, q: &[f64]) -> f64 {
+        let mut m: f64 = 0.0;
+        for b in &self.bodies {
+            for i in 1..b.n_nodes() {
+                m = m.max(b.node_state(q, i).1.norm());
+            }
+        }
+        m
+    }
+
+    fn gravity_in_frame(&self, b: &Body, q: &[f64]) -> V3 {
+        let (_, chi) = b.frame_state(q);
+        chi.conjugate().rotate(&self.gravity) * self.load_scale
+    }
+}
+
+impl ConstrainedSystem for Model {
+    fn n_coords(&self) -> usize {
+        self.n_coords
+    }
+
+    fn n_dof(&self) -> usize {
+        self.n_dof
+    }
+
+    fn n_velocity_constraints(&self) -> usize {
+        self.n_rows
+    }
+
+    /// Nodal coordinates are updated additively. A frame is updated on SE(3)-like lines:
+    /// `χ ← χ ⊗ exp(δθ/2)` and `r_A ← r_A + C^{GA}(χ ⊗ exp(δθ/4)) δr`, i.e. the translation
+    /// increment (in A) is rotated to global with the orientation at the *midpoint* of the
+    /// rotation increment. The integrator calls this with `δ = h Δ`, `Δ` the step's mean
+    /// velocity to O(h²); since `∫ C^{GA} v_A dt = h C^{GA}(t_{n+½}) v_A(t_{n+½}) + O(h³)`
+    /// and the midpoint orientation is `C^{GA}_n exp(h Δω/2) + O(h³)`, the frame position keeps
+    /// the second-order accuracy of the rest of the scheme (a test checks the observed order).
+    /// Rotating with the start orientation instead would make it first order.
+    fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
+        for b in &self.bodies {
+            let (c0, d0) = (b.coord0, b.dof0);
+            let nn = 12 * b.n_elements;
+            for k in 0..nn {
+                q_out[c0 + k] = q[c0 + k] + dq[d0 + k];
+            }
+            let fc = b.frame_coord();
+            let fd = b.frame_dof();
+            let dr = V3::new(dq[fd], dq[fd + 1], dq[fd + 2]);
+            let dth = V3::new(dq[fd + 3], dq[fd + 4], dq[fd + 5]);
+            let chi = Quaternion::from_slice(&q[fc + 3..fc + 7]);
+            let mid = chi.mul(&Quaternion::from_rotation_vector(&(dth * 0.5)));
+            let r = V3::new(q[fc], q[fc + 1], q[fc + 2]) + mid.rotate(&dr);
+            q_out[fc..fc + 3].copy_from_slice(r.as_slice());
+            chi.retract(&dth).write_to(&mut q_out[fc + 3..fc + 7]);
+        }
+    }
+
+    fn residual_inplace(&self, _t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        r.iter_mut().for_each(|x| *x = 0.0);
+        let mut res = Vec24::zeros();
+        for b in &self.bodies {
+            let g_a = self.gravity_in_frame(b, q);
+            for e in 0..b.n_elements {
+                res.fill(0.0);
+                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
+                add_inertia(&st, b.le, &b.section, &mut res, None);
+                add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
+                add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
+                for (blk, g) in local_blocks(b, e).iter().enumerate() {
+                    if let Some(g) = g {
+                        for c in 0..3 {
+                            r[g + c] += res[3 * blk + c];
+                        }
+                    }
+                }
+            }
+        }
+        if self.n_loaded > 0 {
+            for (bi, b) in self.bodies.iter().enumerate() {
+                for (i, l) in self.loads[bi].iter().enumerate() {
+                    if !l.is_zero() {
+                        add_load(b, i, l, self.load_scale, q, r);
+                    }
+                }
+            }
+        }
+    }
+
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        let mut res = Vec24::zeros();
+        let mut mat = Mat24::zeros();
+        let coeffs = MatrixCoefficients { c_m, c_c, c_k };
+        for b in &self.bodies {
+            let g_a = self.gravity_in_frame(b, q);
+            for e in 0..b.n_elements {
+                mat.fill(0.0);
+                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
+                add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
+                if c_k != 0.0 {
+                    add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut mat, c_k)));
+                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
+                }
+                let blocks = local_blocks(b, e);
+                for (bi, gi) in blocks.iter().enumerate() {
+                    let Some(gi) = gi else { continue };
+                    for (bj, gj) in blocks.iter().enumerate() {
+                        let Some(gj) = gj else { continue };
+                        let blk: M3 = mat.fixed_view::<3, 3>(3 * bi, 3 * bj).into_owned();
+                        k.add_block::<3, 3>(*gi, *gj, &blk);
+                    }
+                }
+            }
+        }
+        if self.n_loaded > 0 && c_k != 0.0 {
+            for (bi, b) in self.bodies.iter().enumerate() {
+                for (i, l) in self.loads[bi].iter().enumerate() {
+                    if !l.is_zero() {
+                        add_load_tangent(b, i, l, self.load_scale, q, c_k, k);
+                    }
+                }
+            }
+        }
+    }
+
+    fn psi_inplace(&self, _t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
+        for (j, row) in self.joints.iter().zip(&self.joint_row) {
+            j.psi(&self.bodies, q, v, &mut psi[*row..*row + j.n_rows()]);
+        }
+    }
+
+    fn psi_v_inplace(&self, _t: f64, q: &[f64], m: &mut MatView<'_>) {
+        for (j, row) in self.joints.iter().zip(&self.joint_row) {
+            j.add_b(&self.bodies, q, m, *row);
+        }
+    }
+
+    fn psi_q_inplace(&self, _t: f64, q: &[f64], v: &[f64], m: &mut MatView<'_>) {
+        for (j, row) in self.joints.iter().zip(&self.joint_row) {
+            j.add_psi_q(&self.bodies, q, v, m, *row);
+        }
+    }
+
+    fn constraint_force_tangent_inplace(
+        &self,
+        _t: f64,
+        q: &[f64],
+        _lambda: &[f64],
+        mu: &[f64],
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        for (j, row) in self.joints.iter().zip(&self.joint_row) {
+            j.add_force_tangent(&self.bodies, q, &mu[*row..*row + j.n_rows()], c_k, k);
+        }
+    }
+
+    fn post_step(&mut self, _t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
+        if self.options.stabilization {
+            for &j in &self.projection_order {
+                self.joints[j].project(&self.bodies, q, [&mut *v, &mut *v_dot, &mut *a]);
+            }
+        }
+    }
+
+    /// Positions in m weigh 1; rotations weigh the body length (a rotation δ moves the far end
+    /// of the body by about L·δ).
+    fn increment_weight(&self, i: usize) -> f64 {
+        for b in &self.bodies {
+            if i < b.dof0 + b.n_dof() {
+                let k = i - b.dof0;
+                let is_rotation = (k % 6) >= 3;
+                return if is_rotation { b.length } else { 1.0 };
+            }
+        }
+        1.0
+    }
+}

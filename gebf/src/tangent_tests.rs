@@ -1,0 +1,353 @@
+//! Every analytic tangent against central finite differences of its residual at random states.
+//!
+//! Element level: the inertial forces (mass, gyroscopic and inertial-stiffness parts), the
+//! elastic forces and gravity, each on its own so that no term hides behind a larger one.
+//! Model level: the full iteration matrix (including nodal loads), the joint Jacobian `B`,
+//! `∂(B v)/∂q` and `∂(Bᵀ mu)/∂q`, all derivatives with respect to `q` taken along the model's
+//! retraction. Tolerance: relative error below 1e-6 (max-norm of the difference over the
+//! max-norm of the matrix).
+
+use crate::crv::{M3, V3, rotation_matrix};
+use crate::element::{ElementState, Mat24, Vec24};
+use crate::gravity::add_gravity;
+use crate::inertia::{MatrixCoefficients, add_inertia};
+use crate::stiffness::add_elastic;
+use crate::{BodySpec, JointSpec, Model, NodalLoad, Options, Section};
+use genalpha::{ConstrainedSystem, DenseMatrix};
+use proptest::prelude::*;
+
+const H: f64 = 1e-6;
+const TOL: f64 = 1e-6;
+
+/// A section with all properties of order one, so that every term of the tangent matters.
+fn unit_section() -> Section {
+    Section {
+        mass: 1.3,
+        rho_ixx: 0.5,
+        rho_iyy: 0.2,
+        rho_izz: 0.35,
+        ea: 7.0,
+        ga_y: 3.0,
+        ga_z: 4.0,
+        gj: 1.5,
+        ei_yy: 2.0,
+        ei_zz: 2.5,
+    }
+}
+
+fn rel_err(a: &Mat24, b: &Mat24) -> f64 {
+    (a - b).amax() / a.amax().max(1e-300)
+}
+
+/// A deterministic pseudo-random generator (tests must be reproducible).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+    fn v3(&mut self, s: f64) -> V3 {
+        V3::new(self.next() * s, self.next() * s, self.next() * s)
+    }
+}
+
+fn random_state(rng: &mut Lcg, le: f64, rot: f64) -> ElementState {
+    let mut s = ElementState::default();
+    for k in 0..3 {
+        s.r[k] = V3::new(0.3 + 0.5 * le * k as f64, 0.0, 0.0) + rng.v3(0.1);
+        s.psi[k] = rng.v3(rot);
+        s.rd[k] = rng.v3(1.0);
+        s.psid[k] = rng.v3(1.0);
+        s.rdd[k] = rng.v3(1.0);
+        s.psidd[k] = rng.v3(1.0);
+    }
+    s.v = rng.v3(1.0);
+    s.w = rng.v3(1.0);
+    s.vd = rng.v3(1.0);
+    s.wd = rng.v3(1.0);
+    s
+}
+
+#[derive(Clone, Copy)]
+enum Slot {
+    Q,
+    V,
+    A,
+}
+
+/// The field of `s` that local unknown block `blk` of `slot` lives in (None: frame position,
+/// or frame rotation in the `q` slot, which only acts through `g_a`).
+fn field(s: &mut ElementState, slot: Slot, blk: usize) -> Option<&mut V3> {
+    match (slot, blk) {
+        (Slot::Q, b) if b < 6 => Some(if b % 2 == 0 { &mut s.r[b / 2] } else { &mut s.psi[b / 2] }),
+        (Slot::V, b) if b < 6 => Some(if b % 2 == 0 { &mut s.rd[b / 2] } else { &mut s.psid[b / 2] }),
+        (Slot::A, b) if b < 6 => Some(if b % 2 == 0 { &mut s.rdd[b / 2] } else { &mut s.psidd[b / 2] }),
+        (Slot::V, 6) => Some(&mut s.v),
+        (Slot::V, 7) => Some(&mut s.w),
+        (Slot::A, 6) => Some(&mut s.vd),
+        (Slot::A, 7) => Some(&mut s.wd),
+        _ => None,
+    }
+}
+
+/// Perturb local unknown `j` of the given slot by `h`; for `q`, frame rotations rotate `g_a`
+/// (C^{AG} ← exp(−δθ̃) C^{AG}) and frame translations change nothing.
+fn perturbed(st: &ElementState, g_a: &V3, slot: Slot, j: usize, h: f64) -> (ElementState, V3) {
+    let mut s = *st;
+    let mut g = *g_a;
+    let (blk, c) = (j / 3, j % 3);
+    if let Some(x) = field(&mut s, slot, blk) {
+        x[c] += h;
+    } else if let (Slot::Q, 7) = (slot, blk) {
+        g = rotation_matrix(&(-V3::ith(c, h))) * g;
+    }
+    (s, g)
+}
+
+fn fd_matrix(f: impl Fn(&ElementState, &V3) -> Vec24, st: &ElementState, g_a: &V3, slot: Slot) -> Mat24 {
+    let mut m = Mat24::zeros();
+    for j in 0..24 {
+        let (sp, gp) = perturbed(st, g_a, slot, j, H);
+        let (sm, gm) = perturbed(st, g_a, slot, j, -H);
+        m.set_column(j, &((f(&sp, &gp) - f(&sm, &gm)) / (2.0 * H)));
+    }
+    m
+}
+
+fn check_element(seed: u64, rot: f64) {
+    let mut rng = Lcg(seed);
+    let le = 0.8;
+    let sec = unit_section();
+    let st = random_state(&mut rng, le, rot);
+    let g_a = rng.v3(2.0);
+    let inertia = |s: &ElementState, _g: &V3| {
+        let mut r = Vec24::zeros();
+        add_inertia(s, le, &sec, &mut r, None);
+        r
+    };
+    let elastic = |s: &ElementState, _g: &V3| {
+        let mut r = Vec24::zeros();
+        add_elastic(s, le, &sec, 2, &mut r, None);
+        r
+    };
+    let gravity = |s: &ElementState, g: &V3| {
+        let mut r = Vec24::zeros();
+        add_gravity(s, le, sec.mass, g, &mut r, None);
+        r
+    };
+    for (slot, c) in [(Slot::A, [1.0, 0.0, 0.0]), (Slot::V, [0.0, 1.0, 0.0]), (Slot::Q, [0.0, 0.0, 1.0])] {
+        let mut an = Mat24::zeros();
+        let mut r = Vec24::zeros();
+        let coeffs = MatrixCoefficients { c_m: c[0], c_c: c[1], c_k: c[2] };
+        add_inertia(&st, le, &sec, &mut r, Some((&mut an, coeffs)));
+        let fd = fd_matrix(inertia, &st, &g_a, slot);
+        let e = rel_err(&an, &fd);
+        assert!(e < TOL, "inertia tangent (seed {seed}, slot {}) rel err {e:.2e}", c.iter().position(|x| *x == 1.0).unwrap());
+    }
+    let mut an = Mat24::zeros();
+    let mut r = Vec24::zeros();
+    add_elastic(&st, le, &sec, 2, &mut r, Some((&mut an, 1.0)));
+    let e = rel_err(&an, &fd_matrix(elastic, &st, &g_a, Slot::Q));
+    assert!(e < TOL, "elastic tangent (seed {seed}) rel err {e:.2e}");
+    assert!((an - an.transpose()).amax() < 1e-9 * an.amax(), "elastic tangent not symmetric");
+    let mut an = Mat24::zeros();
+    add_gravity(&st, le, sec.mass, &g_a, &mut r, Some((&mut an, 1.0)));
+    let e = rel_err(&an, &fd_matrix(gravity, &st, &g_a, Slot::Q));
+    assert!(e < TOL, "gravity tangent (seed {seed}) rel err {e:.2e}");
+}
+
+#[test]
+fn element_tangents_match_finite_differences() {
+    for seed in 1..6 {
+        check_element(seed, 0.6);
+    }
+}
+
+#[test]
+fn element_tangents_near_zero_rotation() {
+    check_element(11, 1e-7);
+}
+
+#[test]
+fn element_tangents_at_large_rotation() {
+    // Nodal CRVs up to ~2.6 rad, i.e. close to π.
+    check_element(23, 1.5);
+}
+
+#[test]
+fn mass_matrix_is_symmetric_positive_definite() {
+    let mut rng = Lcg(5);
+    let sec = unit_section();
+    let st = random_state(&mut rng, 0.8, 0.8);
+    let mut m = Mat24::zeros();
+    let mut r = Vec24::zeros();
+    add_inertia(&st, 0.8, &sec, &mut r, Some((&mut m, MatrixCoefficients { c_m: 1.0, c_c: 0.0, c_k: 0.0 })));
+    assert!((m - m.transpose()).amax() < 1e-13 * m.amax());
+    // The element alone with its frame: 24 unknowns, 3 nodes × 6 + 6 frame dofs — the frame
+    // motion duplicates a rigid motion of the nodes, so M is positive semi-definite with a
+    // 6-dimensional null space; check v̇ᵀ M v̇ ≥ 0 on random vectors.
+    for _ in 0..20 {
+        let x = nalgebra::SVector::<f64, 24>::from_fn(|_, _| rng.next());
+        assert!(x.dot(&(m * x)) >= -1e-12);
+    }
+}
+
+/// A two-body flared pendulum with a third free body hanging off the second: covers the ground
+/// hinge, two flared hinges and nodal loads at a random state.
+fn random_model(rng: &mut Lcg, beta: f64) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let sec = unit_section();
+    let f1 = rotation_matrix(&V3::new(0.1, -0.2, 0.3));
+    let f2 = rotation_matrix(&V3::new(-0.3, 0.2, 0.4));
+    let f3 = rotation_matrix(&V3::new(0.5, 0.1, -0.2));
+    let s1 = V3::new(0.1, 0.2, -0.1);
+    let s2 = s1 + f1.column(0) * 1.1;
+    let s3 = s2 + f2.column(0) * 0.9;
+    let body = |name: &str, start: V3, frame: M3, l: f64, n: usize| BodySpec {
+        name: name.into(),
+        start,
+        length: l,
+        frame,
+        section: sec,
+        n_elements: n,
+    };
+    let bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
+    let joints = vec![
+        JointSpec::GroundHinge { body: 0, axis: V3::new(0.2, 1.0, 0.1) },
+        JointSpec::FlaredHinge { parent: 0, child: 1, beta },
+        JointSpec::FlaredHinge { parent: 1, child: 2, beta: -0.3 },
+    ];
+    let mut model = Model::new(&bodies, &joints, V3::new(0.5, -1.0, -9.8), Options::default()).unwrap();
+    model.set_nodal_load(1, 4, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
+    model.set_nodal_load(2, 0, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
+    model.set_nodal_load(0, 3, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
+    let n = model.n_dof();
+    let q0 = model.reference_coordinates();
+    // Random configuration: a random tangent increment from the reference.
+    let dq: Vec<f64> = (0..n).map(|_| rng.next() * 0.3).collect();
+    let mut q = q0.clone();
+    model.retract_inplace(&q0, &dq, &mut q);
+    let v: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+    let a: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+    let mu: Vec<f64> = (0..model.n_velocity_constraints()).map(|_| rng.next() * 3.0).collect();
+    (model, q, v, a, mu)
+}
+
+fn dense_rel_err(an: &DenseMatrix, fd: &DenseMatrix) -> f64 {
+    let mut diff: f64 = 0.0;
+    let mut scale: f64 = 0.0;
+    for j in 0..an.n_cols() {
+        for i in 0..an.n_rows() {
+            diff = diff.max((an.get(i, j) - fd.get(i, j)).abs());
+            scale = scale.max(an.get(i, j).abs());
+        }
+    }
+    diff / scale
+}
+
+/// Finite-difference Jacobian of `f` with respect to `q` along the retraction.
+fn fd_q(model: &Model, q: &[f64], n_out: usize, f: impl Fn(&[f64], &mut [f64])) -> DenseMatrix {
+    let n = model.n_dof();
+    let mut m = DenseMatrix::zeros(n_out, n);
+    let (mut qp, mut qm) = (q.to_vec(), q.to_vec());
+    let (mut rp, mut rm) = (vec![0.0; n_out], vec![0.0; n_out]);
+    let mut d = vec![0.0; n];
+    for j in 0..n {
+        d[j] = H;
+        model.retract_inplace(q, &d, &mut qp);
+        d[j] = -H;
+        model.retract_inplace(q, &d, &mut qm);
+        d[j] = 0.0;
+        f(&qp, &mut rp);
+        f(&qm, &mut rm);
+        for i in 0..n_out {
+            *m.get_mut(i, j) = (rp[i] - rm[i]) / (2.0 * H);
+        }
+    }
+    m
+}
+
+fn fd_x(n_in: usize, x: &[f64], n_out: usize, f: impl Fn(&[f64], &mut [f64])) -> DenseMatrix {
+    let mut m = DenseMatrix::zeros(n_out, n_in);
+    let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+    let (mut rp, mut rm) = (vec![0.0; n_out], vec![0.0; n_out]);
+    for j in 0..n_in {
+        xp[j] += H;
+        xm[j] -= H;
+        f(&xp, &mut rp);
+        f(&xm, &mut rm);
+        xp[j] = x[j];
+        xm[j] = x[j];
+        for i in 0..n_out {
+            *m.get_mut(i, j) = (rp[i] - rm[i]) / (2.0 * H);
+        }
+    }
+    m
+}
+
+fn check_model(seed: u64, beta: f64) {
+    let mut rng = Lcg(seed);
+    let (model, q, v, a, mu) = random_model(&mut rng, beta);
+    let n = model.n_dof();
+    let nc = model.n_velocity_constraints();
+    // Iteration matrix: each coefficient separately.
+    for (which, c) in [(0, [1.0, 0.0, 0.0]), (1, [0.0, 1.0, 0.0]), (2, [0.0, 0.0, 1.0])] {
+        let mut an = DenseMatrix::zeros(n, n);
+        model.iteration_matrix_inplace(0.0, &q, &v, &a, c[0], c[1], c[2], &mut an.view());
+        let fd = match which {
+            0 => fd_x(n, &a, n, |x, r| model.residual_inplace(0.0, &q, &v, x, r)),
+            1 => fd_x(n, &v, n, |x, r| model.residual_inplace(0.0, &q, x, &a, r)),
+            _ => fd_q(&model, &q, n, |x, r| model.residual_inplace(0.0, x, &v, &a, r)),
+        };
+        let e = dense_rel_err(&an, &fd);
+        assert!(e < TOL, "model iteration matrix part {which} (seed {seed}): rel err {e:.2e}");
+    }
+    // B = ∂psi/∂v.
+    let mut b = DenseMatrix::zeros(nc, n);
+    model.psi_v_inplace(0.0, &q, &mut b.view());
+    let fd = fd_x(n, &v, nc, |x, r| model.psi_inplace(0.0, &q, x, r));
+    let e = dense_rel_err(&b, &fd);
+    assert!(e < TOL, "B (seed {seed}): rel err {e:.2e}");
+    // psi = B v exactly (scleronomic).
+    let mut psi = vec![0.0; nc];
+    model.psi_inplace(0.0, &q, &v, &mut psi);
+    let mut bv = vec![0.0; nc];
+    b.mul_vec_inplace(&v, &mut bv);
+    for (x, y) in psi.iter().zip(&bv) {
+        assert!((x - y).abs() < 1e-12 * (1.0 + x.abs()));
+    }
+    // ∂(B v)/∂q.
+    let mut an = DenseMatrix::zeros(nc, n);
+    model.psi_q_inplace(0.0, &q, &v, &mut an.view());
+    let fd = fd_q(&model, &q, nc, |x, r| model.psi_inplace(0.0, x, &v, r));
+    let e = dense_rel_err(&an, &fd);
+    assert!(e < TOL, "psi_q (seed {seed}): rel err {e:.2e}");
+    // ∂(Bᵀ mu)/∂q.
+    let mut an = DenseMatrix::zeros(n, n);
+    model.constraint_force_tangent_inplace(0.0, &q, &[], &mu, 1.0, &mut an.view());
+    let fd = fd_q(&model, &q, n, |x, r| {
+        let mut bm = DenseMatrix::zeros(nc, n);
+        model.psi_v_inplace(0.0, x, &mut bm.view());
+        r.iter_mut().for_each(|y| *y = 0.0);
+        bm.add_mul_transpose_vec_inplace(&mu, r);
+    });
+    let e = dense_rel_err(&an, &fd);
+    assert!(e < TOL, "constraint force tangent (seed {seed}): rel err {e:.2e}");
+}
+
+#[test]
+fn model_tangents_match_finite_differences() {
+    check_model(3, 0.7);
+}
+
+#[test]
+fn model_tangents_at_ninety_degree_flare() {
+    check_model(8, std::f64::consts::FRAC_PI_2);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    #[test]
+    fn element_tangents_random_states(seed in 100u64..100_000, rot in 0.0f64..1.2) {
+        check_element(seed, rot);
+    }
+}
