@@ -1,1 +1,46 @@
-//! placeholder
+//! # ancf — absolute nodal coordinate beams with linear joints
+//!
+//! Two-node beam elements with the nodal coordinates `e_k = [r, r_x, r_y, r_z]` (12 per node,
+//! 24 per element; THEORY §A), a constant mass matrix, an elastic force from beam strains written
+//! as quadratic forms of the coordinates (exact analytic tangent), and joints that are *linear*
+//! in the coordinates (ground hinge, flared hinge of paper eq. 5, clamp). Equations of motion:
+//!
+//! $$ M \ddot q + f_{el}(q) - Q + \Phi_q^T \lambda = 0,\qquad \Phi(q) = \Phi_q q - c = 0 $$
+//!
+//! (index-3 DAE, constant `M` and `Φ_q`), or, eliminating the joints with the constant velocity
+//! transformation `q = B z + q_p`, `Φ_q B = 0` (paper eq. 6–7),
+//!
+//! $$ B^T M B\, \ddot z + B^T\big(f_{el}(B z + q_p) - Q\big) = 0 . $$
+//!
+//! [`Model`] implements [`genalpha::ConstrainedSystem`] in either form ([`Options::path`]).
+//! Elastic energy (THEORY §A.3), with reference values subtracted:
+//!
+//! $$ U = \tfrac12\int_0^L \big[EA\,\varepsilon^2 + GA_y\gamma_y^2 + GA_z\gamma_z^2 + GJ K_1^2
+//!      + EI_{yy} K_2^2 + EI_{zz} K_3^2\big] dx + \text{section penalties}. $$
+//!
+//! Units SI; global frame as in DESIGN §3.
+#![warn(missing_docs)]
+
+pub mod elastic_force;
+pub mod element;
+mod error;
+pub mod frame;
+mod joint;
+mod loads;
+pub mod mass;
+pub mod modal;
+mod model;
+pub mod reduction;
+pub mod samples;
+pub mod shape;
+mod spec;
+pub mod statics;
+pub mod strain;
+
+pub use error::Error;
+pub use joint::ConstraintRow;
+pub use loads::PointLoad;
+pub use modal::{Mode, ModeKind};
+pub use model::{Energies, Model};
+pub use spec::{BodySpec, Curvature, JointSpec, Options, Section, SolvePath};
+pub use strain::StrainKind;

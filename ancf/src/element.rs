@@ -1,0 +1,65 @@
+//! The precomputed two-node element of one body: length, constant mass, integration points.
+//!
+//! All elements of a body share length and section, so one [`Element`] serves them all;
+//! it is built once at model construction. Forces and tangents are in
+//! [`elastic_force`](crate::elastic_force).
+
+use crate::mass::{element_mass, nonzeros};
+use crate::shape::N_BLOCKS;
+use crate::strain::{IntegrationPoint, integration_points};
+use crate::{Curvature, Section};
+
+/// The element kernel shared by all elements of one body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Element {
+    /// Element length l, m.
+    pub l: f64,
+    /// Scalar mass factor `m̄` (`M_e = m̄ ⊗ I₃`), kg.
+    pub mass: [[f64; N_BLOCKS]; N_BLOCKS],
+    /// Non-zeros of `mass`.
+    pub mass_nz: Vec<(usize, usize, f64)>,
+    /// Integration points with their sampled strains.
+    pub points: Vec<IntegrationPoint>,
+    /// Mass per unit length, kg/m (for gravity and point loads).
+    pub mass_per_length: f64,
+}
+
+impl Element {
+    /// Build the kernel for elements of length `l`.
+    pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64) -> Self {
+        let (d_yy, d_zz) = section.slope_inertias();
+        let mass = element_mass(section.mass, d_yy, d_zz, l);
+        Self {
+            l,
+            mass_nz: nonzeros(&mass),
+            mass,
+            points: integration_points(l, section, curvature, penalty_factor),
+            mass_per_length: section.mass,
+        }
+    }
+
+    /// `out += c · M_e · x` for 24-vectors.
+    #[inline]
+    pub fn add_mass_times(&self, c: f64, x: &[f64], out: &mut [f64]) {
+        for &(a, b, m) in &self.mass_nz {
+            let cm = c * m;
+            out[3 * a] += cm * x[3 * b];
+            out[3 * a + 1] += cm * x[3 * b + 1];
+            out[3 * a + 2] += cm * x[3 * b + 2];
+        }
+    }
+
+    /// Generalized gravity force of one element, `∫ m S_cᵀ g dx` (24 numbers).
+    pub fn gravity_force(&self, g: [f64; 3]) -> [f64; 24] {
+        let (m, l) = (self.mass_per_length, self.l);
+        // ∫ h dx = (l/2, l²/12, l/2, −l²/12)
+        let w = [(0, 0.5 * l), (1, l * l / 12.0), (4, 0.5 * l), (5, -l * l / 12.0)];
+        let mut f = [0.0; 24];
+        for (b, x) in w {
+            for i in 0..3 {
+                f[3 * b + i] = m * x * g[i];
+            }
+        }
+        f
+    }
+}

@@ -1,0 +1,146 @@
+//! Joints as linear equations in the nodal coordinates (paper eq. 5, THEORY §A.5).
+//!
+//! * Ground hinge about the fixed unit axis `n`: `r = r₀` and `Σ_b α_b r_b = n` at the body's
+//!   start node, with `α = F₀ᵀ n` the axis in the body's reference section frame and
+//!   `r_b ∈ {r_x, r_y, r_z}`.
+//! * Flared hinge: `r^P = r^C` and `a^P = a^C` with `a^P = sin β r^P_x + cos β r^P_y` at the
+//!   parent's end and `a^C = Σ_b α^C_b r^C_b`, `α^C = F₀_Cᵀ F₀_P (sin β, cos β, 0)` at the child's
+//!   start (for collinear bodies with equal frames simply `sin β r^C_x + cos β r^C_y`). Full
+//!   rank for every β in [−90°, 90°]; the sixth equation also equalises the axis stretch.
+//! * Clamp: `r = r₀`, `r_y = y₀`, `r_z = z₀` at the start node: the section's position and
+//!   orientation are fixed, the centreline slope `r_x` stays free (axial and shear strain at
+//!   the root are not suppressed).
+//!
+//! All equations are `Σ c_j q_j = rhs` with constant coefficients: `Φ_q` is built once.
+
+use crate::frame::{angle_between, rotation_angle, section_frame};
+use crate::model::Body;
+use crate::{JointSpec, shape::NODE_DOF};
+use nalgebra::{Matrix3, Vector3};
+
+/// One linear constraint equation `Σ c_j q_j − rhs = 0`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintRow {
+    /// `(full coordinate index, coefficient)`.
+    pub entries: Vec<(usize, f64)>,
+    /// Right-hand side.
+    pub rhs: f64,
+    /// Index of the joint this row belongs to.
+    pub joint: usize,
+}
+
+impl ConstraintRow {
+    /// Φ of this row at `q`.
+    #[inline]
+    pub fn value(&self, q: &[f64]) -> f64 {
+        self.entries.iter().map(|&(j, c)| c * q[j]).sum::<f64>() - self.rhs
+    }
+}
+
+/// A joint with its precomputed data.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Joint {
+    Ground { body: usize, axis: Vector3<f64>, alpha: Vector3<f64>, r0: Vector3<f64> },
+    Flared { parent: usize, child: usize, alpha_p: Vector3<f64>, alpha_c: Vector3<f64>, rel0: Matrix3<f64> },
+    Clamp { body: usize, r0: Vector3<f64>, frame0: Matrix3<f64> },
+}
+
+/// 3-vector block `b` (0 r, 1 r_x, 2 r_y, 3 r_z) of node `node` of `body`.
+pub(crate) fn node_vector(body: &Body, q: &[f64], node: usize, block: usize) -> Vector3<f64> {
+    let i = body.offset + NODE_DOF * node + 3 * block;
+    Vector3::new(q[i], q[i + 1], q[i + 2])
+}
+
+fn axis_vector(body: &Body, q: &[f64], node: usize, alpha: &Vector3<f64>) -> Vector3<f64> {
+    (1..4).map(|b| node_vector(body, q, node, b) * alpha[b - 1]).sum()
+}
+
+impl Joint {
+    pub(crate) fn new(spec: &JointSpec, bodies: &[Body]) -> Self {
+        match *spec {
+            JointSpec::GroundHinge { body, axis } => {
+                let b = &bodies[body];
+                let axis = axis.normalize();
+                Joint::Ground { body, axis, alpha: b.spec.frame.transpose() * axis, r0: b.spec.start }
+            }
+            JointSpec::FlaredHinge { parent, child, beta } => {
+                let (fp, fc) = (bodies[parent].spec.frame, bodies[child].spec.frame);
+                let alpha_p = Vector3::new(beta.sin(), beta.cos(), 0.0);
+                let alpha_c = fc.transpose() * (fp * alpha_p);
+                Joint::Flared { parent, child, alpha_p, alpha_c, rel0: fp.transpose() * fc }
+            }
+            JointSpec::Clamp { body } => {
+                let b = &bodies[body];
+                Joint::Clamp { body, r0: b.spec.start, frame0: b.spec.frame }
+            }
+        }
+    }
+
+    /// The constraint equations of this joint (index `j`).
+    pub(crate) fn rows(&self, j: usize, bodies: &[Body]) -> Vec<ConstraintRow> {
+        let dof = |body: usize, node: usize, block: usize, i: usize| bodies[body].offset + NODE_DOF * node + 3 * block + i;
+        let mut rows = Vec::new();
+        match self {
+            Joint::Ground { body, axis, alpha, r0 } => {
+                for i in 0..3 {
+                    rows.push(ConstraintRow { entries: vec![(dof(*body, 0, 0, i), 1.0)], rhs: r0[i], joint: j });
+                }
+                for i in 0..3 {
+                    let entries =
+                        (1..4).filter(|&b| alpha[b - 1] != 0.0).map(|b| (dof(*body, 0, b, i), alpha[b - 1])).collect();
+                    rows.push(ConstraintRow { entries, rhs: axis[i], joint: j });
+                }
+            }
+            Joint::Flared { parent, child, alpha_p, alpha_c, .. } => {
+                let pe = bodies[*parent].n_nodes - 1;
+                for i in 0..3 {
+                    rows.push(ConstraintRow {
+                        entries: vec![(dof(*parent, pe, 0, i), 1.0), (dof(*child, 0, 0, i), -1.0)],
+                        rhs: 0.0,
+                        joint: j,
+                    });
+                }
+                for i in 0..3 {
+                    let mut entries: Vec<(usize, f64)> = (1..4)
+                        .filter(|&b| alpha_p[b - 1] != 0.0)
+                        .map(|b| (dof(*parent, pe, b, i), alpha_p[b - 1]))
+                        .collect();
+                    entries.extend(
+                        (1..4).filter(|&b| alpha_c[b - 1] != 0.0).map(|b| (dof(*child, 0, b, i), -alpha_c[b - 1])),
+                    );
+                    rows.push(ConstraintRow { entries, rhs: 0.0, joint: j });
+                }
+            }
+            Joint::Clamp { body, r0, frame0 } => {
+                for (block, target) in [(0, *r0), (2, frame0.column(1).into()), (3, frame0.column(2).into())] {
+                    let target: Vector3<f64> = target;
+                    for i in 0..3 {
+                        rows.push(ConstraintRow { entries: vec![(dof(*body, 0, block, i), 1.0)], rhs: target[i], joint: j });
+                    }
+                }
+            }
+        }
+        rows
+    }
+
+    /// (position gap in m, axis misalignment angle in rad) — for clamps the full rotation angle.
+    pub(crate) fn violation(&self, bodies: &[Body], q: &[f64]) -> (f64, f64) {
+        match self {
+            Joint::Ground { body, axis, alpha, r0 } => {
+                let b = &bodies[*body];
+                ((node_vector(b, q, 0, 0) - r0).norm(), angle_between(&axis_vector(b, q, 0, alpha), axis))
+            }
+            Joint::Flared { parent, child, alpha_p, alpha_c, .. } => {
+                let (p, c) = (&bodies[*parent], &bodies[*child]);
+                let pe = p.n_nodes - 1;
+                let gap = (node_vector(p, q, pe, 0) - node_vector(c, q, 0, 0)).norm();
+                (gap, angle_between(&axis_vector(p, q, pe, alpha_p), &axis_vector(c, q, 0, alpha_c)))
+            }
+            Joint::Clamp { body, r0, frame0 } => {
+                let b = &bodies[*body];
+                let f = section_frame(&node_vector(b, q, 0, 2), &node_vector(b, q, 0, 3));
+                ((node_vector(b, q, 0, 0) - r0).norm(), rotation_angle(&(f * frame0.transpose())))
+            }
+        }
+    }
+}

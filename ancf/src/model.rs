@@ -1,0 +1,671 @@
+//! The assembled multibody model: bodies of two-node elements, linear joints, loads, and its
+//! two presentations to the integrator (index-3 DAE or reduced ODE).
+
+use crate::element::Element;
+use crate::elastic_force::ElementMatrix;
+use crate::frame::{fold_angle, section_frame};
+use crate::joint::{ConstraintRow, Joint, node_vector};
+use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
+use crate::reduction::Reduction;
+use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
+use crate::spec::finite;
+use crate::{BodySpec, Error, JointSpec, Options, SolvePath};
+use genalpha::{ConstrainedSystem, MatView, State};
+use nalgebra::{Matrix3, Vector3};
+use std::cell::RefCell;
+
+/// A body with its place in the global coordinate vector.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Body {
+    pub spec: BodySpec,
+    /// First global coordinate of the body.
+    pub offset: usize,
+    pub n_nodes: usize,
+    pub element: Element,
+}
+
+impl Body {
+    pub(crate) fn n_elements(&self) -> usize {
+        self.n_nodes - 1
+    }
+}
+
+/// Energies in J. `potential = −∫ m g·(r − r_ref) ds` (zero in the reference configuration).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy ½ q̇ᵀ M q̇, J.
+    pub kinetic: f64,
+    /// Elastic energy including the cross-section penalty terms, J.
+    pub elastic: f64,
+    /// Gravitational potential energy relative to the reference configuration, J.
+    pub potential: f64,
+}
+
+impl Energies {
+    /// T + U + V, J.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.potential
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Workspace {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    r: Vec<f64>,
+}
+
+/// The ANCF multibody model. Implements [`genalpha::ConstrainedSystem`] in the form chosen by
+/// [`Options::path`]:
+///
+/// * [`SolvePath::Dae`]: `q` = all nodal coordinates, `M q̈ + f_el(q) − Q + Φ_qᵀ λ = 0`,
+///   `Φ(q) = Φ_q q − c = 0` with the constant `Φ_q`.
+/// * [`SolvePath::Ode`]: `q` = the independent coordinates `z`, `q_full = B z + q_p`,
+///   `BᵀMB z̈ + Bᵀ(f_el − Q) = 0`.
+///
+/// Every method taking `q` (or `v`) expects the vector of the chosen form, as the integrator
+/// holds it.
+#[derive(Debug)]
+pub struct Model {
+    pub(crate) bodies: Vec<Body>,
+    joints: Vec<Joint>,
+    rows: Vec<ConstraintRow>,
+    pub(crate) reduction: Reduction,
+    options: Options,
+    gravity: Vector3<f64>,
+    n_full: usize,
+    q_ref: Vec<f64>,
+    gravity_force: Vec<f64>,
+    point_force: Vec<f64>,
+    moments: Vec<(Station, Vector3<f64>)>,
+    load_factor: f64,
+    weights: Vec<f64>,
+    /// Per element (bodies in order): z index of its first coordinate when all 24 are
+    /// independent and hence contiguous in z.
+    element_z: Vec<Option<usize>>,
+    work: RefCell<Workspace>,
+    sensor: RefCell<(Vec<f64>, Vec<f64>)>,
+}
+
+impl Model {
+    /// Validate the scene and build the model (constant mass, element kernels, constraint
+    /// equations, elimination basis). Errors name the offending field.
+    pub fn new(bodies: &[BodySpec], joints: &[JointSpec], gravity: Vector3<f64>, options: Options) -> Result<Model, Error> {
+        if bodies.is_empty() {
+            return Err(Error::NoBodies);
+        }
+        for (i, b) in bodies.iter().enumerate() {
+            b.validate(i)?;
+        }
+        for (j, s) in joints.iter().enumerate() {
+            s.validate(j, bodies)?;
+        }
+        for (k, g) in gravity.iter().enumerate() {
+            finite(&format!("gravity[{k}]"), *g)?;
+        }
+        options.validate()?;
+
+        let mut offset = 0;
+        let bodies: Vec<Body> = bodies
+            .iter()
+            .map(|spec| {
+                let l = spec.length / spec.n_elements as f64;
+                let b = Body {
+                    spec: spec.clone(),
+                    offset,
+                    n_nodes: spec.n_elements + 1,
+                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor),
+                };
+                offset += NODE_DOF * b.n_nodes;
+                b
+            })
+            .collect();
+        let n_full = offset;
+
+        let mut q_ref = vec![0.0; n_full];
+        let mut weights = vec![1.0; n_full];
+        for b in &bodies {
+            let f = b.spec.frame;
+            for n in 0..b.n_nodes {
+                let i = b.offset + NODE_DOF * n;
+                let r = b.spec.start + f.column(0) * (n as f64 * b.element.l);
+                for k in 0..3 {
+                    q_ref[i + k] = r[k];
+                    q_ref[i + 3 + k] = f[(k, 0)];
+                    q_ref[i + 6 + k] = f[(k, 1)];
+                    q_ref[i + 9 + k] = f[(k, 2)];
+                }
+                weights[i + 3..i + 12].iter_mut().for_each(|w| *w = b.element.l);
+            }
+        }
+
+        let joint_list: Vec<Joint> = joints.iter().map(|s| Joint::new(s, &bodies)).collect();
+        let rows: Vec<ConstraintRow> = joint_list.iter().enumerate().flat_map(|(j, jt)| jt.rows(j, &bodies)).collect();
+        let reduction = Reduction::new(&rows, n_full)?;
+
+        let mut gravity_force = vec![0.0; n_full];
+        let g = [gravity.x, gravity.y, gravity.z];
+        for b in &bodies {
+            let fe = b.element.gravity_force(g);
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                for (x, y) in gravity_force[first..first + ELEMENT_DOF].iter_mut().zip(&fe) {
+                    *x += y;
+                }
+            }
+        }
+
+        let mut element_z = Vec::new();
+        for b in &bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                let z0 = reduction.z_of(first);
+                let contiguous = z0.is_some_and(|z0| (0..ELEMENT_DOF).all(|a| reduction.z_of(first + a) == Some(z0 + a)));
+                element_z.push(if contiguous { z0 } else { None });
+            }
+        }
+
+        let n_red = reduction.n_reduced();
+        Ok(Model {
+            bodies,
+            joints: joint_list,
+            rows,
+            reduction,
+            options,
+            gravity,
+            n_full,
+            q_ref,
+            gravity_force,
+            point_force: vec![0.0; n_full],
+            moments: Vec::new(),
+            load_factor: 1.0,
+            weights,
+            element_z,
+            work: RefCell::new(Workspace { q: vec![0.0; n_full], v: vec![0.0; n_full], r: vec![0.0; n_full] }),
+            sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
+        })
+    }
+
+    /// The options the model was built with.
+    pub fn options(&self) -> &Options {
+        &self.options
+    }
+    /// Gravity vector, m/s².
+    pub fn gravity(&self) -> Vector3<f64> {
+        self.gravity
+    }
+    /// Number of nodal coordinates (12 per node).
+    pub fn n_full_coords(&self) -> usize {
+        self.n_full
+    }
+    /// Number of independent coordinates of the ODE form.
+    pub fn n_reduced_coords(&self) -> usize {
+        self.reduction.n_reduced()
+    }
+    /// Number of joint equations.
+    pub fn n_constraint_rows(&self) -> usize {
+        self.rows.len()
+    }
+    /// Number of bodies.
+    pub fn n_bodies(&self) -> usize {
+        self.bodies.len()
+    }
+    /// Number of joints.
+    pub fn n_joints(&self) -> usize {
+        self.joints.len()
+    }
+    /// The body specifications.
+    pub fn body_spec(&self, body: usize) -> Option<&BodySpec> {
+        self.bodies.get(body).map(|b| &b.spec)
+    }
+    /// Total length of all bodies (m).
+    pub fn span(&self) -> f64 {
+        self.bodies.iter().map(|b| b.spec.length).sum()
+    }
+    /// Reference nodal coordinates (full form).
+    pub fn reference_coordinates(&self) -> &[f64] {
+        &self.q_ref
+    }
+
+    /// The undeformed reference configuration at rest, sized for genalpha.
+    pub fn initial_state(&self) -> State {
+        let q0 = match self.options.path {
+            SolvePath::Dae => self.q_ref.clone(),
+            SolvePath::Ode => self.reduction.restrict(&self.q_ref),
+        };
+        State::at_rest(self, 0.0, q0)
+    }
+
+    /// Full nodal coordinates from the model's coordinate vector (identity on the DAE path,
+    /// `B z + q_p` on the ODE path).
+    ///
+    /// # Panics
+    /// When the lengths do not match the model.
+    pub fn full_coordinates_inplace(&self, q: &[f64], out: &mut [f64]) {
+        assert_eq!(out.len(), self.n_full, "full coordinate buffer has the wrong length");
+        match self.options.path {
+            SolvePath::Dae => out.copy_from_slice(q),
+            SolvePath::Ode => self.reduction.expand_inplace(q, out),
+        }
+    }
+    /// Full nodal velocities from the model's velocity vector.
+    ///
+    /// # Panics
+    /// When the lengths do not match the model.
+    pub fn full_velocities_inplace(&self, v: &[f64], out: &mut [f64]) {
+        assert_eq!(out.len(), self.n_full, "full velocity buffer has the wrong length");
+        match self.options.path {
+            SolvePath::Dae => out.copy_from_slice(v),
+            SolvePath::Ode => self.reduction.expand_rate_inplace(v, out),
+        }
+    }
+    /// Allocating form of [`full_coordinates_inplace`](Self::full_coordinates_inplace).
+    pub fn full_coordinates(&self, q: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_full];
+        self.full_coordinates_inplace(q, &mut out);
+        out
+    }
+
+    /// Run `f` on the full coordinates of `q` without allocating.
+    fn with_full<R>(&self, q: &[f64], f: impl FnOnce(&[f64]) -> R) -> R {
+        match self.options.path {
+            SolvePath::Dae => f(q),
+            SolvePath::Ode => {
+                let mut s = self.sensor.borrow_mut();
+                self.reduction.expand_inplace(q, &mut s.0);
+                f(&s.0)
+            }
+        }
+    }
+
+    /// Centroid of the free end section of the last body (global, m).
+    pub fn tip_position(&self, q: &[f64]) -> Vector3<f64> {
+        self.with_full(q, |q| {
+            let b = self.bodies.last().expect("a model has at least one body");
+            node_vector(b, q, b.n_nodes - 1, 0)
+        })
+    }
+
+    /// Fold angle θ (rad) of joint `joint`, which must be a flared hinge: the rotation of the
+    /// child's start section frame relative to the parent's end section frame (reference
+    /// value removed) about `−a`; θ > 0 lifts the child's free end toward +z of the parent's
+    /// section for β < 90°.
+    pub fn fold_angle(&self, q: &[f64], joint: usize) -> Result<f64, Error> {
+        let jt = self.joints.get(joint).ok_or(Error::NoSuchJoint { joint, n_joints: self.joints.len() })?;
+        let Joint::Flared { parent, child, alpha_p, rel0, .. } = jt else {
+            return Err(Error::NotAFlaredHinge { joint });
+        };
+        Ok(self.with_full(q, |q| {
+            let (p, c) = (&self.bodies[*parent], &self.bodies[*child]);
+            let pe = p.n_nodes - 1;
+            let rp = section_frame(&node_vector(p, q, pe, 2), &node_vector(p, q, pe, 3));
+            let rc = section_frame(&node_vector(c, q, 0, 2), &node_vector(c, q, 0, 3));
+            fold_angle(&(rp.transpose() * rc * rel0.transpose()), alpha_p)
+        }))
+    }
+
+    /// Kinetic, elastic and gravitational potential energy.
+    pub fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
+        let mut s = self.sensor.borrow_mut();
+        let (qf, vf) = &mut *s;
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, &mut vf[..self.n_full]);
+        let mut e = Energies::default();
+        let mut mv = [0.0; ELEMENT_DOF];
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                let range = first..first + ELEMENT_DOF;
+                mv.iter_mut().for_each(|x| *x = 0.0);
+                b.element.add_mass_times(1.0, &vf[range.clone()], &mut mv);
+                e.kinetic += 0.5 * mv.iter().zip(&vf[range.clone()]).map(|(a, b)| a * b).sum::<f64>();
+                e.elastic += b.element.elastic_energy(&qf[range]);
+            }
+        }
+        e.potential = -self.gravity_force.iter().zip(qf.iter().zip(&self.q_ref)).map(|(g, (q, q0))| g * (q - q0)).sum::<f64>();
+        e
+    }
+
+    /// Position-level joint violation: the Euclidean norm over all joints of (position gap in m,
+    /// axis misalignment angle in rad; for clamps the full relative rotation angle).
+    pub fn constraint_residual(&self, q: &[f64]) -> f64 {
+        self.with_full(q, |q| {
+            self.joints
+                .iter()
+                .map(|j| {
+                    let (gap, angle) = j.violation(&self.bodies, q);
+                    gap * gap + angle * angle
+                })
+                .sum::<f64>()
+                .sqrt()
+        })
+    }
+
+    fn check_station(&self, field: &str, body: usize, s: f64) -> Result<&Body, Error> {
+        let b = self.bodies.get(body).ok_or(Error::NoSuchBody {
+            field: format!("{field}.body"),
+            body,
+            n_bodies: self.bodies.len(),
+        })?;
+        finite(&format!("{field}.s"), s)?;
+        let len = b.spec.length;
+        if s < -1e-12 * len || s > len * (1.0 + 1e-12) {
+            return Err(Error::ArclengthOutOfRange { field: format!("{field}.s"), s, length: len });
+        }
+        Ok(b)
+    }
+
+    /// Position (global, m) of the material point with section coordinates (y, z) at arclength
+    /// `s` of `body`: `S(x, y, z) q`.
+    pub fn material_point(&self, q: &[f64], body: usize, s: f64, y: f64, z: f64) -> Result<Vector3<f64>, Error> {
+        let b = self.check_station("station", body, s)?;
+        let st = locate(b, s);
+        Ok(self.with_full(q, |q| {
+            let w = point_weights(st.xi, st.l, y, z);
+            (0..8).map(|k| Vector3::new(q[st.first + 3 * k], q[st.first + 3 * k + 1], q[st.first + 3 * k + 2]) * w[k]).sum()
+        }))
+    }
+
+    /// Velocity (global, m/s) of the material point (s, y, z) of `body`: `S(x, y, z) q̇`.
+    pub fn material_velocity(&self, v: &[f64], body: usize, s: f64, y: f64, z: f64) -> Result<Vector3<f64>, Error> {
+        let b = self.check_station("station", body, s)?;
+        let st = locate(b, s);
+        let mut sens = self.sensor.borrow_mut();
+        let vf = &mut sens.1[..self.n_full];
+        self.full_velocities_inplace(v, vf);
+        let w = point_weights(st.xi, st.l, y, z);
+        Ok((0..8).map(|k| Vector3::new(vf[st.first + 3 * k], vf[st.first + 3 * k + 1], vf[st.first + 3 * k + 2]) * w[k]).sum())
+    }
+
+    /// Axis point (global, m) and orthonormalised section frame (columns x, y, z) at arclength
+    /// `s` of `body`.
+    pub fn section_frame(&self, q: &[f64], body: usize, s: f64) -> Result<(Vector3<f64>, Matrix3<f64>), Error> {
+        let b = self.check_station("station", body, s)?;
+        let st = locate(b, s);
+        Ok(self.with_full(q, |q| {
+            let w = point_weights(st.xi, st.l, 0.0, 0.0);
+            let v = |k: usize| Vector3::new(q[st.first + 3 * k], q[st.first + 3 * k + 1], q[st.first + 3 * k + 2]);
+            let r: Vector3<f64> = (0..8).map(|k| v(k) * w[k]).sum();
+            let ry = v(2) * (1.0 - st.xi) + v(6) * st.xi;
+            let rz = v(3) * (1.0 - st.xi) + v(7) * st.xi;
+            (r, section_frame(&ry, &rz))
+        }))
+    }
+
+    /// Replace the point loads. Forces are dead loads at material points (constant generalized
+    /// forces); moments are fixed global vectors acting on the section (configuration-dependent,
+    /// with their tangent). Does not allocate once the moment list has reached its size.
+    /// On error the previous loads are kept.
+    pub fn set_point_loads(&mut self, loads: &[PointLoad]) -> Result<(), Error> {
+        for (i, p) in loads.iter().enumerate() {
+            let field = format!("loads[{i}]");
+            self.check_station(&field, p.body, p.s)?;
+            for (name, x) in [("y", p.y), ("z", p.z)] {
+                finite(&format!("{field}.{name}"), x)?;
+            }
+            for k in 0..3 {
+                finite(&format!("{field}.force[{k}]"), p.force[k])?;
+                finite(&format!("{field}.moment[{k}]"), p.moment[k])?;
+            }
+        }
+        self.point_force.iter_mut().for_each(|x| *x = 0.0);
+        self.moments.clear();
+        for p in loads {
+            let st = locate(&self.bodies[p.body], p.s);
+            if p.force != Vector3::zeros() {
+                add_point_force(st, p.y, p.z, &p.force, &mut self.point_force);
+            }
+            if p.moment != Vector3::zeros() {
+                self.moments.push((st, p.moment));
+            }
+        }
+        Ok(())
+    }
+
+    /// Factor on all external loads (gravity and point loads), 1 by default; the static solver
+    /// ramps it.
+    pub fn set_load_factor(&mut self, factor: f64) {
+        self.load_factor = factor;
+    }
+    /// The current load factor.
+    pub fn load_factor(&self) -> f64 {
+        self.load_factor
+    }
+
+    /// Increment weight of full coordinate `i` (1 for positions, the element length for slopes).
+    pub(crate) fn full_weight(&self, i: usize) -> f64 {
+        self.weights[i]
+    }
+
+    /// Constraint equations (full coordinates).
+    pub(crate) fn rows(&self) -> &[ConstraintRow] {
+        &self.rows
+    }
+
+    /// `r = M v̇ + f_el(q) − λ_load (Q_g + Q_F + Q_M(q))` on full coordinates.
+    pub(crate) fn full_residual(&self, q: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        let lf = self.load_factor;
+        for ((ri, g), p) in r.iter_mut().zip(&self.gravity_force).zip(&self.point_force) {
+            *ri = -lf * (g + p);
+        }
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                let range = first..first + ELEMENT_DOF;
+                let out = &mut r[range.clone()];
+                b.element.add_mass_times(1.0, &v_dot[range.clone()], out);
+                b.element.add_elastic_force(&q[range], out);
+            }
+        }
+        if !self.moments.is_empty() {
+            // r −= λ Q_M: accumulate with the sign flipped through a negated moment.
+            for (st, m) in &self.moments {
+                add_moment_force(*st, &(-lf * m), q, r);
+            }
+        }
+    }
+
+    /// Elastic energy of full coordinates `q`.
+    pub(crate) fn elastic_energy_full(&self, q: &[f64]) -> f64 {
+        let mut u = 0.0;
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                u += b.element.elastic_energy(&q[first..first + ELEMENT_DOF]);
+            }
+        }
+        u
+    }
+
+    /// `k += c_m M + c_k ∂r/∂q` at full coordinates `q`, written through the chosen form.
+    fn add_iteration_matrix(&self, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
+        let mut ke = ElementMatrix::zeros();
+        let mut e_index = 0;
+        for b in &self.bodies {
+            for el in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * el;
+                ke.fill(0.0);
+                if c_m != 0.0 {
+                    for &(a, bb, m) in &b.element.mass_nz {
+                        for i in 0..3 {
+                            ke[(3 * a + i, 3 * bb + i)] += c_m * m;
+                        }
+                    }
+                }
+                if c_k != 0.0 {
+                    b.element.add_elastic_tangent(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
+                }
+                self.scatter_element(first, self.element_z[e_index], &ke, k);
+                e_index += 1;
+            }
+        }
+        if c_k != 0.0 {
+            let lf = self.load_factor;
+            for (st, m) in &self.moments {
+                moment_tangent(*st, m, q, c_k * lf, |i, j, blk| self.scatter_block(i, j, blk, k));
+            }
+        }
+    }
+
+    fn scatter_element(&self, first: usize, z_first: Option<usize>, ke: &ElementMatrix, k: &mut MatView<'_>) {
+        match (self.options.path, z_first) {
+            (SolvePath::Dae, _) => k.add_block(first, first, ke),
+            (SolvePath::Ode, Some(z)) => k.add_block(z, z, ke),
+            (SolvePath::Ode, None) => {
+                for a in 0..ELEMENT_DOF {
+                    let ra = self.reduction.row(first + a);
+                    if ra.is_empty() {
+                        continue;
+                    }
+                    for bb in 0..ELEMENT_DOF {
+                        let x = ke[(a, bb)];
+                        if x == 0.0 {
+                            continue;
+                        }
+                        for &(za, ca) in ra {
+                            for &(zb, cb) in self.reduction.row(first + bb) {
+                                k.add(za, zb, ca * cb * x);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn scatter_block(&self, i0: usize, j0: usize, blk: &Matrix3<f64>, k: &mut MatView<'_>) {
+        match self.options.path {
+            SolvePath::Dae => k.add_block(i0, j0, blk),
+            SolvePath::Ode => {
+                for a in 0..3 {
+                    for bb in 0..3 {
+                        for &(za, ca) in self.reduction.row(i0 + a) {
+                            for &(zb, cb) in self.reduction.row(j0 + bb) {
+                                k.add(za, zb, ca * cb * blk[(a, bb)]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Assemble `c_m M + c_k K_t` on full coordinates into a dense column-major matrix
+    /// (DAE layout regardless of the path; used by the static solver and the modal analysis).
+    pub(crate) fn assemble_full_inplace(&self, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
+        let mut ke = ElementMatrix::zeros();
+        for b in &self.bodies {
+            for el in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * el;
+                ke.fill(0.0);
+                for &(a, bb, m) in &b.element.mass_nz {
+                    for i in 0..3 {
+                        ke[(3 * a + i, 3 * bb + i)] += c_m * m;
+                    }
+                }
+                b.element.add_elastic_tangent(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
+                k.add_block(first, first, &ke);
+            }
+        }
+        let lf = self.load_factor;
+        for (st, m) in &self.moments {
+            moment_tangent(*st, m, q, c_k * lf, |i, j, blk| k.add_block(i, j, blk));
+        }
+    }
+
+    /// Elastic energy by strain kind for full coordinates `q` (J, indexed by `StrainKind`).
+    pub(crate) fn elastic_energy_by_kind_full(&self, q: &[f64]) -> [f64; crate::strain::N_STRAINS] {
+        let mut u = [0.0; crate::strain::N_STRAINS];
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                for (x, y) in u.iter_mut().zip(b.element.elastic_energy_by_kind(&q[first..first + ELEMENT_DOF])) {
+                    *x += y;
+                }
+            }
+        }
+        u
+    }
+}
+
+impl ConstrainedSystem for Model {
+    fn n_coords(&self) -> usize {
+        self.n_dof()
+    }
+    fn n_dof(&self) -> usize {
+        match self.options.path {
+            SolvePath::Dae => self.n_full,
+            SolvePath::Ode => self.reduction.n_reduced(),
+        }
+    }
+    fn n_holonomic(&self) -> usize {
+        match self.options.path {
+            SolvePath::Dae => self.rows.len(),
+            SolvePath::Ode => 0,
+        }
+    }
+
+    fn residual_inplace(&self, _t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        match self.options.path {
+            SolvePath::Dae => self.full_residual(q, v_dot, r),
+            SolvePath::Ode => {
+                let mut w = self.work.borrow_mut();
+                let Workspace { q: qf, v: af, r: rf } = &mut *w;
+                self.reduction.expand_inplace(q, qf);
+                self.reduction.expand_rate_inplace(v_dot, af);
+                self.full_residual(qf, af, rf);
+                self.reduction.project_inplace(rf, r);
+            }
+        }
+    }
+
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        q: &[f64],
+        _v: &[f64],
+        _v_dot: &[f64],
+        c_m: f64,
+        _c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        match self.options.path {
+            SolvePath::Dae => self.add_iteration_matrix(q, c_m, c_k, k),
+            SolvePath::Ode => {
+                let mut w = self.work.borrow_mut();
+                self.reduction.expand_inplace(q, &mut w.q);
+                self.add_iteration_matrix(&w.q, c_m, c_k, k);
+            }
+        }
+    }
+
+    fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {
+        if self.options.path == SolvePath::Dae {
+            for (p, row) in phi.iter_mut().zip(&self.rows) {
+                *p = row.value(q);
+            }
+        }
+    }
+
+    fn phi_q_inplace(&self, _t: f64, _q: &[f64], j: &mut MatView<'_>) {
+        if self.options.path == SolvePath::Dae {
+            for (i, row) in self.rows.iter().enumerate() {
+                for &(col, c) in &row.entries {
+                    j.add(i, col, c);
+                }
+            }
+        }
+    }
+
+    fn phi_q_is_constant(&self) -> bool {
+        true
+    }
+
+    fn increment_weight(&self, i: usize) -> f64 {
+        match self.options.path {
+            SolvePath::Dae => self.weights[i],
+            SolvePath::Ode => self.weights[self.reduction.full_of(i)],
+        }
+    }
+}
