@@ -1,1 +1,75 @@
-//! placeholder
+//! # uvlm — unsteady vortex-lattice aerodynamics for the flared-hinge wing harness
+//!
+//! The crate knows nothing of beams: it takes a lattice geometry (and its motion) and returns
+//! circulations and loads.
+//!
+//! ## Model
+//! A lifting surface is a structured lattice of vortex rings (see [`lattice`]): grid column `j`
+//! is generated from a [`SpanStation`] (section frame + chord), the rings are the grid panels
+//! shifted a quarter panel downstream along the grid lines, collocation points sit at the ring
+//! centroids. The non-penetration condition at every collocation point `c` with normal `n`,
+//!
+//! $$ \big(V_\infty + u_{ind}(c) - \dot x_c\big)\cdot n = 0, $$
+//!
+//! gives the linear system `A Γ = −(V∞ − ẋ_c + u_wake)·n` for the ring circulations, with
+//! the Biot–Savart law of straight segments ([`biot_savart`]) evaluated once per shared edge with
+//! its net circulation. The Kutta condition is implicit: the newest wake ring row carries the
+//! trailing-edge circulation (steady solves use semi-infinite legs along the free stream).
+//! The wake ([`Wake`]) is a ring buffer of rows shed every step, convected with the free stream
+//! (prescribed) or the local velocity (free), truncated after `n_wake_rows` rows, optionally
+//! closed by semi-infinite legs. Loads ([`Loads`]) are Joukowski forces per segment plus
+//! ρ·A·n·dΓ/dt per ring (eq. 16 of Otsuka, Cheng & Palacios 2024), as nodal forces on the ring
+//! nodes. Symmetry and ground planes are modelled by image vortices ([`ImagePlane`]).
+//!
+//! ## Coupling API
+//! ```
+//! use uvlm::{Lattice, Uvlm, UvlmParams, samples::FlaredWing};
+//! # fn main() -> Result<(), uvlm::UvlmError> {
+//! let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+//! // 1. Build a lattice from span stations (origin, section frame, chord, le_offset) + hinge column.
+//! let lattice = Lattice::from_stations(wing.spec(), &wing.stations(0.0))?;
+//! let mut uvlm = Uvlm::new(lattice, UvlmParams::new(0.0889, [0.0, -25.0, 0.0]))?;
+//! for step in 1..=3 {
+//!     // 2. Each step: move the stations (positions, frames, optionally velocities) ...
+//!     let fold = 0.01 * step as f64;
+//!     uvlm.update_stations(&wing.stations(fold), None)?;
+//!     // 3. ... advance one unsteady step ...
+//!     let loads = uvlm.step(0.01)?;
+//!     // 4. ... and lump the nodal forces to the stations: force + moment about each origin.
+//!     let origins: Vec<[f64; 3]> = wing.stations(fold).iter().map(|s| s.origin.into()).collect();
+//!     let (mut f, mut m) = (vec![[0.0; 3]; origins.len()], vec![[0.0; 3]; origins.len()]);
+//!     loads.column_loads_inplace(&origins, &mut f, &mut m);
+//!     assert!(f.iter().all(|v| v.iter().all(|x| x.is_finite())));
+//! }
+//! # Ok(()) }
+//! ```
+//! [`Uvlm::solve_steady`] gives the steady solution (a ring VLM); [`Uvlm::prefill_wake`] then
+//! starts an unsteady run from it instead of impulsively.
+#![warn(missing_docs)]
+
+mod aic;
+pub mod biot_savart;
+mod dense_lu;
+mod error;
+pub mod images;
+mod induce;
+pub mod lattice;
+mod loads;
+mod params;
+pub mod samples;
+mod solver;
+mod station;
+mod stats;
+mod wake;
+
+pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
+pub use error::{Result, UvlmError};
+pub use images::ImagePlane;
+pub use induce::{Points, induced_velocity};
+pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
+pub use loads::{Loads, lift_drag_of};
+pub use params::{PARALLEL_MIN_PAIRS, Parallel, UvlmParams, WakeConvection};
+pub use solver::Uvlm;
+pub use station::{SpanStation, StationVelocity};
+pub use stats::Stats;
+pub use wake::Wake;

@@ -1,0 +1,278 @@
+//! The bound system: unit-strength filaments of the lattice (each shared edge once, with its
+//! ring incidences), the aerodynamic influence coefficient (AIC) matrix and the known wake.
+//!
+//! Unknowns are the bound ring circulations Γ. The newest wake ring row carries the circulation
+//! of the trailing-edge rings (implicit Kutta condition, `Γ_w0 = Γ_TE`), so its filaments belong
+//! to the trailing-edge unknowns and the trailing-edge segment (net strength Γ_w0 − Γ_TE = 0)
+//! disappears; in a steady solve the wake is a set of semi-infinite legs from the trailing-edge
+//! nodes along the free stream, again tied to the trailing-edge unknowns. Edge net strengths
+//! (segment directions along increasing indices):
+//! spanwise `(i, j)→(i, j+1)`: `Γ(i, j) − Γ(i−1, j)`; chordwise `(i, j)→(i+1, j)`:
+//! `Γ(i, j−1) − Γ(i, j)`. The AIC row of collocation point `c_p` is
+//!
+//! $$ A_{pr} = \sum_{f \ni r} s_{fr}\, u_f(c_p)\cdot n_p ,$$
+//!
+//! with `s_fr = ±1` the incidence of filament `f` on ring `r` (image copies included).
+
+use crate::biot_savart::{CoreModel, Filaments, LANES, NodeBlock, fill_block, influence_block, load_lanes};
+use crate::images::{ImagePlane, append_images, copy_signs};
+use crate::induce::{Points, use_threads};
+use crate::lattice::Lattice;
+use crate::params::Parallel;
+use crate::wake::Wake;
+use rayon::prelude::*;
+use std::cell::RefCell;
+
+const NONE: u32 = u32::MAX;
+
+thread_local! {
+    static BLOCK: RefCell<NodeBlock> = RefCell::new(NodeBlock::default());
+}
+
+/// How the bound system ends at the trailing edge.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum TrailingEdge<'a> {
+    /// Newest wake ring row (its downstream nodes are the wake's detached row 0).
+    Unsteady(&'a Wake),
+    /// Semi-infinite legs along the unit vector.
+    Steady([f64; 3]),
+}
+
+/// Unit-strength bound filaments with incidences.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct BoundSystem {
+    /// Filaments (image copies appended); strengths are unit × copy sign until
+    /// [`BoundSystem::set_strengths`] is called.
+    pub(crate) fil: Filaments,
+    inc: Vec<[(u32, f64); 2]>,
+    n_base_seg: usize,
+    n_base_leg: usize,
+    /// The first `n_lattice_seg` base segments are lattice edges (they carry loads).
+    pub(crate) n_lattice_seg: usize,
+    n_copies: usize,
+    n_planes: usize,
+    base_gamma: Vec<f64>,
+}
+
+impl BoundSystem {
+    /// Rebuild for the current lattice geometry. Does not allocate once warm.
+    pub(crate) fn build(&mut self, lat: &Lattice, te: TrailingEdge<'_>, core: &CoreModel, planes: &[ImagePlane]) {
+        let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
+        let nc = n + 1;
+        let fil = &mut self.fil;
+        fil.clear();
+        self.inc.clear();
+        for p in lat.ring_nodes() {
+            fil.push_node(*p);
+        }
+        let ring = |i: usize, j: usize| (i * n + j) as u32;
+        let node = |i: usize, j: usize| (i * nc + j) as u32;
+        // Spanwise lattice edges, rows 0..M−1.
+        for i in 0..m {
+            for j in 0..n {
+                fil.push_segment(node(i, j), node(i, j + 1), 1.0, core);
+                let prev = if i > 0 { (ring(i - 1, j), -1.0) } else { (NONE, 0.0) };
+                self.inc.push([(ring(i, j), 1.0), prev]);
+            }
+        }
+        // Chordwise lattice edges.
+        for i in 0..m {
+            for j in 0..nc {
+                fil.push_segment(node(i, j), node(i + 1, j), 1.0, core);
+                let right = if j < n { (ring(i, j), -1.0) } else { (NONE, 0.0) };
+                let left = if j > 0 { (ring(i, j - 1), 1.0) } else { (NONE, 0.0) };
+                self.inc.push([right, left]);
+            }
+        }
+        self.n_lattice_seg = fil.n_segments();
+        let te_ring = |j: usize| ring(m - 1, j);
+        match te {
+            TrailingEdge::Unsteady(wake) => {
+                let base = fil.n_nodes() as u32;
+                for j in 0..nc {
+                    fil.push_node(wake.node(0, j));
+                }
+                // Downstream edge of wake ring 0: w(j)→w(j+1) carries −Γ_w0 = −Γ_TE.
+                for j in 0..n {
+                    fil.push_segment(base + j as u32, base + j as u32 + 1, 1.0, core);
+                    self.inc.push([(te_ring(j), -1.0), (NONE, 0.0)]);
+                }
+                // Chordwise legs of wake ring 0: TE(j)→w(j).
+                for j in 0..nc {
+                    fil.push_segment(node(m, j), base + j as u32, 1.0, core);
+                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
+                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
+                    self.inc.push([right, left]);
+                }
+            }
+            TrailingEdge::Steady(dir) => {
+                for j in 0..nc {
+                    let len = {
+                        let (a, b) = (lat.ring_nodes()[node(m - 1, j) as usize], lat.ring_nodes()[node(m, j) as usize]);
+                        ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+                    };
+                    fil.push_leg(node(m, j), dir, 1.0, core, len);
+                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
+                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
+                    self.inc.push([right, left]);
+                }
+            }
+        }
+        self.n_base_seg = fil.n_segments();
+        self.n_base_leg = fil.n_legs();
+        self.n_planes = planes.len();
+        self.n_copies = copy_signs(planes.len()).len();
+        append_images(fil, planes);
+    }
+
+    /// Total number of filaments (with images).
+    pub(crate) fn n_filaments(&self) -> usize {
+        self.fil.n_filaments()
+    }
+
+    /// Base filament index and copy sign of total filament `f` (segments first, then legs).
+    #[inline]
+    fn base_of(&self, f: usize) -> (usize, usize) {
+        let ns = self.n_base_seg * self.n_copies;
+        if f < ns {
+            (f % self.n_base_seg, f / self.n_base_seg)
+        } else {
+            let l = f - ns;
+            (self.n_base_seg + l % self.n_base_leg, l / self.n_base_leg)
+        }
+    }
+
+    /// Net strength of base filament `b` for ring circulations `gamma`.
+    #[inline]
+    fn net(&self, b: usize, gamma: &[f64]) -> f64 {
+        self.inc[b].iter().filter(|(r, _)| *r != NONE).map(|(r, s)| s * gamma[*r as usize]).sum()
+    }
+
+    /// Net circulation of lattice segment `s` (`s < n_lattice_seg`).
+    pub(crate) fn lattice_segment_gamma(&self, s: usize) -> f64 {
+        self.base_gamma[s]
+    }
+
+    /// Put the net strengths of the ring circulations on every filament (images with their sign).
+    pub(crate) fn set_strengths(&mut self, gamma: &[f64]) {
+        let nb = self.n_base_seg + self.n_base_leg;
+        self.base_gamma.clear();
+        for b in 0..nb {
+            let g = self.net(b, gamma);
+            self.base_gamma.push(g);
+        }
+        for (c, &sign) in copy_signs(self.n_planes).iter().enumerate() {
+            for b in 0..self.n_base_seg {
+                self.fil.set_segment_gamma(c * self.n_base_seg + b, sign * self.base_gamma[b]);
+            }
+            for b in 0..self.n_base_leg {
+                self.fil.set_leg_gamma(c * self.n_base_leg + b, sign * self.base_gamma[self.n_base_seg + b]);
+            }
+        }
+    }
+
+    /// Assemble the row-major `n_rings × n_rings` AIC at the collocation points `col` with
+    /// normals `nrm` (SoA). Returns the number of point–filament pairs evaluated.
+    pub(crate) fn assemble_aic(
+        &self,
+        col: &Points,
+        nrm: &Points,
+        aic: &mut [f64],
+        parallel: Parallel,
+        blk: &mut NodeBlock,
+    ) -> u64 {
+        let n = col.len();
+        assert_eq!(aic.len(), n * n, "assemble_aic: dimension");
+        let nf = self.n_filaments();
+        let pairs = n.div_ceil(LANES) * LANES * nf;
+        let work = |b: usize, rows: &mut [f64], blk: &mut NodeBlock| {
+            let (px, py, pz) = (load_lanes(&col.x, b), load_lanes(&col.y, b), load_lanes(&col.z, b));
+            let (nx, ny, nz) = (load_lanes(&nrm.x, b), load_lanes(&nrm.y, b), load_lanes(&nrm.z, b));
+            fill_block(&self.fil, &px, &py, &pz, blk);
+            influence_block(&self.fil, blk, &nx, &ny, &nz);
+            rows.fill(0.0);
+            let n_rows = rows.len() / n;
+            for f in 0..nf {
+                let (b, _) = self.base_of(f);
+                let v = &blk.infl[f];
+                for &(r, s) in &self.inc[b] {
+                    if r == NONE {
+                        continue;
+                    }
+                    for (l, vl) in v.iter().enumerate().take(n_rows) {
+                        rows[l * n + r as usize] += s * vl;
+                    }
+                }
+            }
+        };
+        if use_threads(parallel, pairs) {
+            aic.par_chunks_mut(LANES * n).enumerate().for_each(|(b, rows)| {
+                BLOCK.with(|cell| work(b, rows, &mut cell.borrow_mut()));
+            });
+        } else {
+            for (b, rows) in aic.chunks_mut(LANES * n).enumerate() {
+                work(b, rows, blk);
+            }
+        }
+        pairs as u64
+    }
+}
+
+/// Build the known part of the wake: ring rows ≥ 1 (row 0 belongs to the bound system), with
+/// net strengths, optional closure legs along `closure_dir`, and images. Segments of exactly zero
+/// net strength are skipped.
+pub(crate) fn build_known_wake(
+    fil: &mut Filaments,
+    wake: &Wake,
+    closure_dir: Option<[f64; 3]>,
+    core: &CoreModel,
+    planes: &[ImagePlane],
+) {
+    fil.clear();
+    let len = wake.n_rows();
+    let n = wake.n_spanwise();
+    let nc = n + 1;
+    for r in 0..len {
+        for j in 0..nc {
+            fil.push_node(wake.node(r, j));
+        }
+    }
+    let node = |r: usize, j: usize| (r * nc + j) as u32;
+    let closed = closure_dir.is_some() && len >= 2;
+    let g = |r: usize, j: isize| -> f64 {
+        if r < len && j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 }
+    };
+    for r in 0..len {
+        // Spanwise edge at detached row r: +Γ(r+1) − Γ(r) (the −Γ(0) part is in the bound system).
+        for j in 0..n {
+            let down = g(r + 1, j as isize);
+            let up = if r >= 1 && !(closed && r == len - 1) { g(r, j as isize) } else { 0.0 };
+            let s = down - up;
+            if s != 0.0 {
+                fil.push_segment(node(r, j), node(r, j + 1), s, core);
+            }
+        }
+        // Chordwise legs of ring r ≥ 1: (r−1, j)→(r, j).
+        if r >= 1 {
+            for j in 0..nc {
+                let s = g(r, j as isize - 1) - g(r, j as isize);
+                if s != 0.0 {
+                    fil.push_segment(node(r - 1, j), node(r, j), s, core);
+                }
+            }
+        }
+    }
+    if closed && let Some(dir) = closure_dir {
+        let r = len - 1;
+        for j in 0..nc {
+            let s = g(r, j as isize - 1) - g(r, j as isize);
+            if s != 0.0 {
+                let a = wake.node(r, j);
+                let b = wake.node(r - 1, j);
+                let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                fil.push_leg(node(r, j), dir, s, core, l);
+            }
+        }
+    }
+    append_images(fil, planes);
+}

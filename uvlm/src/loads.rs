@@ -1,0 +1,183 @@
+//! Aerodynamic loads on the lattice nodes.
+//!
+//! Steady part — Joukowski per lattice segment (Simpson, Palacios & Murua 2013), at the segment
+//! midpoint with the local relative velocity:
+//!
+//! $$ f_s = \rho\,\Gamma_s\,\big(V_\infty + u_{ind}(x_s) - \dot x_s\big)\times(x_B - x_A),$$
+//!
+//! `Γ_s` the segment's net circulation, split ½–½ to its end nodes. Unsteady part (eq. 16 of
+//! Otsuka, Cheng & Palacios 2024; Katz & Plotkin §13.12):
+//!
+//! $$ f_r = \rho\,A_r\,n_r\,\frac{d\Gamma_r}{dt}, $$
+//!
+//! split ¼ to each ring corner. The nodal forces therefore sum exactly to the panel loads, and a
+//! structure can lump them to its stations as force + moment about the station origin.
+
+use crate::aic::BoundSystem;
+use crate::lattice::Lattice;
+
+/// Loads of the last solve, on the vortex-ring nodes of the lattice.
+#[derive(Debug, Clone, Default)]
+pub struct Loads {
+    /// Force on every ring node (index `i·(N+1) + j`, as [`Lattice::ring_nodes`]), N.
+    pub nodal: Vec<[f64; 3]>,
+    /// Force on every spanwise strip (panel column `j`), N: its spanwise edges, half of its two
+    /// chordwise edges and the unsteady terms of its rings.
+    pub strip: Vec<[f64; 3]>,
+    /// Sum of the Joukowski (steady) segment forces, N.
+    pub total_steady: [f64; 3],
+    /// Sum of the unsteady ρ·A·n·dΓ/dt terms, N.
+    pub total_unsteady: [f64; 3],
+    /// Application points of `nodal` (copy of the ring nodes), m.
+    pub positions: Vec<[f64; 3]>,
+}
+
+impl Loads {
+    /// Total force, N.
+    pub fn total_force(&self) -> [f64; 3] {
+        let (a, b) = (self.total_steady, self.total_unsteady);
+        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+    }
+
+    /// Total moment about `p`, N·m.
+    pub fn moment_about(&self, p: [f64; 3]) -> [f64; 3] {
+        let mut m = [0.0; 3];
+        for (x, f) in self.positions.iter().zip(&self.nodal) {
+            let r = [x[0] - p[0], x[1] - p[1], x[2] - p[2]];
+            m[0] += r[1] * f[2] - r[2] * f[1];
+            m[1] += r[2] * f[0] - r[0] * f[2];
+            m[2] += r[0] * f[1] - r[1] * f[0];
+        }
+        m
+    }
+
+    /// Lift and drag, N: drag along the free stream, lift along `v̂ × ŝ` where `ŝ` is
+    /// `span_dir` made perpendicular to the free stream.
+    pub fn lift_drag(&self, v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f64) {
+        let f = self.total_force();
+        let (l, d) = lift_drag_of(f, v_inf, span_dir);
+        (l, d)
+    }
+
+    /// Lump the nodal forces of every grid column `j` to the point `origins[j]`: force and moment
+    /// about that point (the rigid-arm, virtual-work consistent transfer). Does not allocate.
+    ///
+    /// # Panics
+    /// If the slices do not have one entry per grid column.
+    pub fn column_loads_inplace(&self, origins: &[[f64; 3]], force: &mut [[f64; 3]], moment: &mut [[f64; 3]]) {
+        let nc = origins.len();
+        assert!(force.len() == nc && moment.len() == nc, "column_loads_inplace: length mismatch");
+        assert_eq!(self.nodal.len() % nc, 0, "column_loads_inplace: origins do not match the lattice");
+        force.fill([0.0; 3]);
+        moment.fill([0.0; 3]);
+        for (k, (x, f)) in self.positions.iter().zip(&self.nodal).enumerate() {
+            let j = k % nc;
+            let o = origins[j];
+            let r = [x[0] - o[0], x[1] - o[1], x[2] - o[2]];
+            for q in 0..3 {
+                force[j][q] += f[q];
+            }
+            moment[j][0] += r[1] * f[2] - r[2] * f[1];
+            moment[j][1] += r[2] * f[0] - r[0] * f[2];
+            moment[j][2] += r[0] * f[1] - r[1] * f[0];
+        }
+    }
+}
+
+/// Lift (⊥ free stream, along v̂ × ŝ) and drag (along v̂) components of a force.
+pub fn lift_drag_of(f: [f64; 3], v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f64) {
+    let vn = (v_inf[0].powi(2) + v_inf[1].powi(2) + v_inf[2].powi(2)).sqrt();
+    let v = [v_inf[0] / vn, v_inf[1] / vn, v_inf[2] / vn];
+    let sd = span_dir[0] * v[0] + span_dir[1] * v[1] + span_dir[2] * v[2];
+    let s = [span_dir[0] - sd * v[0], span_dir[1] - sd * v[1], span_dir[2] - sd * v[2]];
+    let l = [v[1] * s[2] - v[2] * s[1], v[2] * s[0] - v[0] * s[2], v[0] * s[1] - v[1] * s[0]];
+    let ln = (l[0].powi(2) + l[1].powi(2) + l[2].powi(2)).sqrt();
+    let lift = (f[0] * l[0] + f[1] * l[1] + f[2] * l[2]) / ln;
+    let drag = f[0] * v[0] + f[1] * v[1] + f[2] * v[2];
+    (lift, drag)
+}
+
+/// Fill `loads` from the solved bound system. `u_mid[s]` is the induced velocity at the midpoint
+/// of lattice segment `s`; `gamma_dot` the ring circulation rates (None: steady).
+pub(crate) fn compute_loads(
+    loads: &mut Loads,
+    lat: &Lattice,
+    bs: &BoundSystem,
+    u_mid: &[[f64; 3]],
+    gamma_dot: Option<&[f64]>,
+    rho: f64,
+    v_inf: [f64; 3],
+) {
+    let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
+    let nc = n + 1;
+    let nodes = lat.ring_nodes();
+    let vel = lat.ring_velocities();
+    loads.nodal.clear();
+    loads.nodal.resize(nodes.len(), [0.0; 3]);
+    loads.strip.clear();
+    loads.strip.resize(n, [0.0; 3]);
+    loads.positions.clear();
+    loads.positions.extend_from_slice(nodes);
+    let mut tot = [0.0; 3];
+    for s in 0..bs.n_lattice_seg {
+        let g = bs.lattice_segment_gamma(s);
+        if g == 0.0 {
+            continue;
+        }
+        let (a, b) = bs.fil.segment_nodes(s);
+        let (a, b) = (a as usize, b as usize);
+        let dl = [nodes[b][0] - nodes[a][0], nodes[b][1] - nodes[a][1], nodes[b][2] - nodes[a][2]];
+        let mut v = [0.0; 3];
+        for q in 0..3 {
+            v[q] = v_inf[q] + u_mid[s][q] - 0.5 * (vel[a][q] + vel[b][q]);
+        }
+        let f = [
+            rho * g * (v[1] * dl[2] - v[2] * dl[1]),
+            rho * g * (v[2] * dl[0] - v[0] * dl[2]),
+            rho * g * (v[0] * dl[1] - v[1] * dl[0]),
+        ];
+        for q in 0..3 {
+            loads.nodal[a][q] += 0.5 * f[q];
+            loads.nodal[b][q] += 0.5 * f[q];
+            tot[q] += f[q];
+        }
+        if s < m * n {
+            let j = s % n;
+            for q in 0..3 {
+                loads.strip[j][q] += f[q];
+            }
+        } else {
+            let j = (s - m * n) % nc;
+            let share = if j == 0 || j == n { 1.0 } else { 0.5 };
+            for jj in [j.wrapping_sub(1), j] {
+                if jj < n {
+                    for q in 0..3 {
+                        loads.strip[jj][q] += share * f[q];
+                    }
+                }
+            }
+        }
+    }
+    loads.total_steady = tot;
+    let mut tu = [0.0; 3];
+    if let Some(gd) = gamma_dot {
+        for i in 0..m {
+            for j in 0..n {
+                let r = lat.ring_index(i, j);
+                let c = rho * lat.areas()[r] * gd[r];
+                let nr = lat.normals()[r];
+                let f = [c * nr[0], c * nr[1], c * nr[2]];
+                for k in lat.ring_corners(i, j) {
+                    for q in 0..3 {
+                        loads.nodal[k][q] += 0.25 * f[q];
+                    }
+                }
+                for q in 0..3 {
+                    loads.strip[j][q] += f[q];
+                    tu[q] += f[q];
+                }
+            }
+        }
+    }
+    loads.total_unsteady = tu;
+}

@@ -1,0 +1,131 @@
+//! Solver parameters (plain serde structs; case JSON deserialises straight into them).
+
+use crate::biot_savart::CoreModel;
+use crate::error::{Result, UvlmError};
+use crate::images::{ImagePlane, validate_planes};
+use serde::{Deserialize, Serialize};
+
+/// How the wake nodes move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WakeConvection {
+    /// Convected with the free stream (SHARPy `convection_scheme = 2`, Ptera `prescribed_wake`).
+    #[default]
+    Prescribed,
+    /// Convected with the local velocity (free stream + induced), forward Euler.
+    Free,
+}
+
+/// Threading policy of the Biot–Savart evaluations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Parallel {
+    /// Always one thread.
+    Off,
+    /// rayon over point blocks when an evaluation has at least [`PARALLEL_MIN_PAIRS`]
+    /// point–filament pairs per available thread (and more than one thread exists).
+    #[default]
+    Auto,
+}
+
+/// Work per thread below which [`Parallel::Auto`] stays sequential (point–filament pairs).
+pub const PARALLEL_MIN_PAIRS: usize = 100_000;
+
+/// Parameters of the UVLM solver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UvlmParams {
+    /// Air density ρ, kg/m³.
+    pub rho: f64,
+    /// Free-stream (wind) velocity in the global frame, m/s.
+    pub v_inf: [f64; 3],
+    /// Maximum number of wake ring rows kept (truncation), ≥ 1. Default 40.
+    #[serde(default = "default_wake_rows")]
+    pub n_wake_rows: usize,
+    /// Wake convection. Default prescribed.
+    #[serde(default)]
+    pub wake_convection: WakeConvection,
+    /// Close the truncated wake by semi-infinite trailing legs along the free stream from the last
+    /// row (instead of a closing spanwise segment). Default false (SHARPy / paper set-up).
+    #[serde(default)]
+    pub wake_closure: bool,
+    /// Core of the bound filaments (and of the newest wake ring, which belongs to the
+    /// trailing-edge unknowns). Default: 1e-6 m cut-off.
+    #[serde(default)]
+    pub bound_core: CoreModel,
+    /// Core of the wake filaments (rows ≥ 2 and closure legs). Default: 1e-6 m cut-off; a Scully
+    /// core of 5–10 % of the segment length is advisable for free wakes.
+    #[serde(default)]
+    pub wake_core: CoreModel,
+    /// Image planes (symmetry and/or ground), at most two, perpendicular.
+    #[serde(default)]
+    pub images: Vec<ImagePlane>,
+    /// Include the unsteady load term ρ·A·n·dΓ/dt. Default true.
+    #[serde(default = "default_true")]
+    pub unsteady_term: bool,
+    /// Threading of the Biot–Savart kernels. Default auto.
+    #[serde(default)]
+    pub parallel: Parallel,
+}
+
+fn default_wake_rows() -> usize {
+    40
+}
+fn default_true() -> bool {
+    true
+}
+
+impl UvlmParams {
+    /// Defaults for a given density and free stream.
+    pub fn new(rho: f64, v_inf: [f64; 3]) -> Self {
+        Self {
+            rho,
+            v_inf,
+            n_wake_rows: 40,
+            wake_convection: WakeConvection::Prescribed,
+            wake_closure: false,
+            bound_core: CoreModel::default(),
+            wake_core: CoreModel::default(),
+            images: Vec::new(),
+            unsteady_term: true,
+            parallel: Parallel::Auto,
+        }
+    }
+
+    /// Check every value.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.rho.is_finite() && self.rho > 0.0) {
+            return Err(UvlmError::InvalidParameter { field: "rho", value: self.rho });
+        }
+        if let Some(v) = self.v_inf.iter().find(|v| !v.is_finite()) {
+            return Err(UvlmError::InvalidParameter { field: "v_inf", value: *v });
+        }
+        if self.n_wake_rows == 0 {
+            return Err(UvlmError::InvalidParameter { field: "n_wake_rows", value: 0.0 });
+        }
+        for (field, c) in [("bound_core", self.bound_core), ("wake_core", self.wake_core)] {
+            let p = c.parameter();
+            if !(p.is_finite() && p >= 0.0) {
+                return Err(UvlmError::InvalidParameter { field, value: p });
+            }
+        }
+        validate_planes(&self.images)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_round_trip_and_unknown_fields() {
+        let json = r#"{"rho": 0.0889, "v_inf": [0, -25, 0], "wake_core": {"model": "scully", "fraction": 0.05}}"#;
+        let p: UvlmParams = serde_json::from_str(json).unwrap();
+        assert_eq!(p.n_wake_rows, 40);
+        assert_eq!(p.wake_core, CoreModel::Scully { fraction: 0.05 });
+        assert!(p.validate().is_ok());
+        assert!(serde_json::from_str::<UvlmParams>(r#"{"rho": 1, "v_inf": [1,0,0], "wake_rows": 3}"#).is_err());
+        let bad = UvlmParams { rho: -1.0, ..p };
+        assert!(matches!(bad.validate(), Err(UvlmError::InvalidParameter { field: "rho", .. })));
+    }
+}

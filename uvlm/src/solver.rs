@@ -1,0 +1,395 @@
+//! The UVLM solver: steady solve and unsteady time steps on one lattice with its wake.
+
+use crate::aic::{BoundSystem, TrailingEdge, build_known_wake};
+use crate::biot_savart::{Filaments, NodeBlock};
+use crate::dense_lu::DenseLu;
+use crate::error::{Result, UvlmError};
+use crate::induce::{Points, induced_velocity_inplace};
+use crate::lattice::Lattice;
+use crate::loads::{Loads, compute_loads};
+use crate::params::{UvlmParams, WakeConvection};
+use crate::station::{SpanStation, StationVelocity};
+use crate::stats::Stats;
+use crate::wake::Wake;
+use std::time::Instant;
+
+/// Which trailing-edge model the current AIC was built for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Steady,
+    Unsteady,
+}
+
+/// A UVLM solver owning its lattice, wake, circulations, work buffers and loads.
+///
+/// Per unsteady step ([`Uvlm::step`]), with the lattice already moved to the new time:
+/// 1. convect the wake (free stream, or free stream + induced velocity for a free wake);
+/// 2. shed a row: the previous trailing-edge ring row, convected, becomes the downstream edge of
+///    the newest wake ring (truncating the oldest row when full);
+/// 3. assemble the AIC (bound rings + newest wake ring, implicit Kutta) unless the geometry is
+///    bitwise unchanged, then factorise;
+/// 4. right-hand side `−(V∞ − ẋ_c + u_wake(c))·n`, solve for Γ, set the newest wake row to Γ_TE;
+/// 5. loads: Joukowski per segment + ρ·A·n·dΓ/dt (backward differences, first order on the first
+///    step, second order after).
+#[derive(Debug)]
+pub struct Uvlm {
+    params: UvlmParams,
+    lattice: Lattice,
+    wake: Wake,
+    gamma: Vec<f64>,
+    gamma_prev: Vec<f64>,
+    gamma_prev2: Vec<f64>,
+    gamma_dot: Vec<f64>,
+    n_history: usize,
+    prev_te: Vec<[f64; 3]>,
+    bound: BoundSystem,
+    bound_mode: Option<Mode>,
+    has_solution: bool,
+    known: Filaments,
+    lu: DenseLu,
+    aic: Vec<f64>,
+    rhs: Vec<f64>,
+    aic_key: Option<(Mode, u64)>,
+    row0: Vec<[f64; 3]>,
+    col: Points,
+    nrm: Points,
+    mid: Points,
+    wpts: Points,
+    u_col: Vec<[f64; 3]>,
+    u_mid: Vec<[f64; 3]>,
+    u_wake: Vec<[f64; 3]>,
+    row_buf: Vec<[f64; 3]>,
+    gamma_row: Vec<f64>,
+    blk: NodeBlock,
+    loads: Loads,
+    stats: Stats,
+}
+
+impl Uvlm {
+    /// A solver for `lattice` with an empty wake (impulsive start).
+    pub fn new(lattice: Lattice, params: UvlmParams) -> Result<Self> {
+        params.validate()?;
+        let nr = lattice.n_rings();
+        let n = lattice.n_spanwise();
+        let m = lattice.n_chordwise();
+        let wake = Wake::new(n, params.n_wake_rows);
+        let prev_te = (0..=n).map(|j| lattice.ring_nodes()[lattice.node_index(m, j)]).collect();
+        Ok(Self {
+            wake,
+            gamma: vec![0.0; nr],
+            gamma_prev: vec![0.0; nr],
+            gamma_prev2: vec![0.0; nr],
+            gamma_dot: vec![0.0; nr],
+            n_history: 0,
+            prev_te,
+            bound: BoundSystem::default(),
+            bound_mode: None,
+            has_solution: false,
+            known: Filaments::default(),
+            lu: DenseLu::new(nr),
+            aic: vec![0.0; nr * nr],
+            rhs: vec![0.0; nr],
+            aic_key: None,
+            row0: vec![[0.0; 3]; n + 1],
+            col: Points::default(),
+            nrm: Points::default(),
+            mid: Points::default(),
+            wpts: Points::default(),
+            u_col: vec![[0.0; 3]; nr],
+            u_mid: Vec::new(),
+            u_wake: Vec::new(),
+            row_buf: vec![[0.0; 3]; n + 1],
+            gamma_row: vec![0.0; n],
+            blk: NodeBlock::default(),
+            loads: Loads::default(),
+            stats: Stats::default(),
+            lattice,
+            params,
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &UvlmParams {
+        &self.params
+    }
+    /// The lattice (current geometry).
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+    /// The wake.
+    pub fn wake(&self) -> &Wake {
+        &self.wake
+    }
+    /// Bound ring circulations Γ (index `i·N + j`), m²/s.
+    pub fn gamma(&self) -> &[f64] {
+        &self.gamma
+    }
+    /// dΓ/dt of the last step (zero after a steady solve), m²/s².
+    pub fn gamma_dot(&self) -> &[f64] {
+        &self.gamma_dot
+    }
+    /// Loads of the last solve.
+    pub fn loads(&self) -> &Loads {
+        &self.loads
+    }
+    /// Work counters.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// Move the lattice to new station frames and velocities (see [`Lattice::update_stations`]).
+    pub fn update_stations(&mut self, stations: &[SpanStation], velocities: Option<&[StationVelocity]>) -> Result<()> {
+        self.lattice.update_stations(stations, velocities)
+    }
+
+    /// Set the grid nodes and velocities directly (see [`Lattice::set_grid`]).
+    pub fn set_grid(&mut self, positions: &[[f64; 3]], velocities: &[[f64; 3]]) -> Result<()> {
+        self.lattice.set_grid(positions, velocities)
+    }
+
+    /// Unit free-stream direction (error if the free stream is zero).
+    fn stream_dir(&self) -> Result<[f64; 3]> {
+        let v = self.params.v_inf;
+        let vn = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if vn > 0.0 { Ok([v[0] / vn, v[1] / vn, v[2] / vn]) } else { Err(UvlmError::InvalidParameter { field: "v_inf", value: 0.0 }) }
+    }
+
+    /// Collocation points and normals into SoA buffers.
+    fn load_collocation(&mut self) {
+        self.col.clear();
+        self.nrm.clear();
+        for (c, n) in self.lattice.collocation().iter().zip(self.lattice.normals()) {
+            self.col.push(*c);
+            self.nrm.push(*n);
+        }
+    }
+
+    /// Build (if needed) and factorise the AIC for `mode`.
+    fn prepare_aic(&mut self, mode: Mode) -> Result<()> {
+        let key = (mode, self.lattice.version());
+        let n = self.lattice.n_spanwise();
+        let row0_same = match mode {
+            Mode::Steady => true,
+            Mode::Unsteady => (0..=n).all(|j| self.wake.node(0, j) == self.row0[j]),
+        };
+        if self.aic_key == Some(key) && row0_same && self.bound_mode == Some(mode) {
+            return Ok(());
+        }
+        let te = match mode {
+            Mode::Steady => TrailingEdge::Steady(self.stream_dir()?),
+            Mode::Unsteady => {
+                for j in 0..=n {
+                    self.row0[j] = self.wake.node(0, j);
+                }
+                TrailingEdge::Unsteady(&self.wake)
+            }
+        };
+        self.bound.build(&self.lattice, te, &self.params.bound_core, &self.params.images);
+        self.bound_mode = Some(mode);
+        self.load_collocation();
+        self.stats.n_pair_evaluations +=
+            self.bound.assemble_aic(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blk);
+        self.stats.n_aic_builds += 1;
+        self.aic_key = None;
+        self.lu.factorize_row_major(&self.aic).map_err(|pivot| UvlmError::SingularAic { pivot })?;
+        self.stats.n_factorizations += 1;
+        self.aic_key = Some(key);
+        Ok(())
+    }
+
+    /// Solve for Γ with the current AIC: rhs = −(V∞ − ẋ_c + u_known(c))·n.
+    fn solve_gamma(&mut self, with_known_wake: bool) -> Result<()> {
+        self.load_collocation();
+        let nr = self.lattice.n_rings();
+        if with_known_wake {
+            self.stats.n_pair_evaluations += induced_velocity_inplace(
+                &[&self.known],
+                &self.col,
+                &mut self.u_col,
+                self.params.parallel,
+                &mut self.blk,
+            );
+        } else {
+            self.u_col.fill([0.0; 3]);
+        }
+        let v = self.params.v_inf;
+        let cv = self.lattice.collocation_velocities();
+        let nrm = self.lattice.normals();
+        for r in 0..nr {
+            let mut s = 0.0;
+            for q in 0..3 {
+                s += (v[q] - cv[r][q] + self.u_col[r][q]) * nrm[r][q];
+            }
+            self.rhs[r] = -s;
+        }
+        self.gamma.copy_from_slice(&self.rhs);
+        self.lu.solve_in_place(&mut self.gamma);
+        if !self.gamma.iter().all(|g| g.is_finite()) {
+            return Err(UvlmError::NonFiniteSolution { step: self.stats.n_steps });
+        }
+        self.bound.set_strengths(&self.gamma);
+        self.has_solution = true;
+        Ok(())
+    }
+
+    /// Induced velocity at the lattice segment midpoints (bound + known wake) and the loads.
+    fn update_loads(&mut self, with_known_wake: bool, unsteady: bool) {
+        self.mid.clear();
+        for s in 0..self.bound.n_lattice_seg {
+            let (a, b) = self.bound.fil.segment_nodes(s);
+            let (pa, pb) = (self.bound.fil.node(a as usize), self.bound.fil.node(b as usize));
+            self.mid.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])]);
+        }
+        self.u_mid.resize(self.mid.len(), [0.0; 3]);
+        let pairs = if with_known_wake {
+            induced_velocity_inplace(&[&self.bound.fil, &self.known], &self.mid, &mut self.u_mid, self.params.parallel, &mut self.blk)
+        } else {
+            induced_velocity_inplace(&[&self.bound.fil], &self.mid, &mut self.u_mid, self.params.parallel, &mut self.blk)
+        };
+        self.stats.n_pair_evaluations += pairs;
+        let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
+        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.u_mid, gd, self.params.rho, self.params.v_inf);
+    }
+
+    /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM).
+    /// Does not touch the wake or the unsteady history.
+    pub fn solve_steady(&mut self) -> Result<&Loads> {
+        let t0 = Instant::now();
+        self.prepare_aic(Mode::Steady)?;
+        self.solve_gamma(false)?;
+        self.gamma_dot.fill(0.0);
+        self.update_loads(false, false);
+        self.stats.n_steady_solves += 1;
+        self.stats.wall_time += t0.elapsed().as_secs_f64();
+        Ok(&self.loads)
+    }
+
+    /// Replace the wake by the steady wake of the current Γ for time step `dt`: `n_wake_rows`
+    /// straight rows convected with the free stream, every row carrying Γ_TE, and make the
+    /// current Γ the unsteady history (dΓ/dt = 0). Call after [`Uvlm::solve_steady`] to start
+    /// an unsteady run from a converged state instead of impulsively.
+    pub fn prefill_wake(&mut self, dt: f64) -> Result<()> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(UvlmError::InvalidParameter { field: "dt", value: dt });
+        }
+        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
+        let v = self.params.v_inf;
+        for j in 0..=n {
+            self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
+        }
+        for j in 0..n {
+            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
+        }
+        self.wake.clear();
+        for r in (0..self.wake.capacity()).rev() {
+            let k = (r + 1) as f64 * dt;
+            for j in 0..=n {
+                let p = self.prev_te[j];
+                self.row_buf[j] = [p[0] + k * v[0], p[1] + k * v[1], p[2] + k * v[2]];
+            }
+            self.wake.push_front(&self.row_buf, &self.gamma_row);
+        }
+        self.gamma_prev.copy_from_slice(&self.gamma);
+        self.gamma_prev2.copy_from_slice(&self.gamma);
+        self.n_history = 2;
+        self.bound_mode = None;
+        self.aic_key = None;
+        Ok(())
+    }
+
+    /// Convect the wake and the previous trailing-edge row over `dt`.
+    fn convect(&mut self, dt: f64) {
+        let v = self.params.v_inf;
+        let free = self.params.wake_convection == WakeConvection::Free
+            && self.has_solution
+            && self.bound_mode == Some(Mode::Unsteady);
+        if !free {
+            let d = [v[0] * dt, v[1] * dt, v[2] * dt];
+            self.wake.translate(d);
+            for p in &mut self.prev_te {
+                for q in 0..3 {
+                    p[q] += d[q];
+                }
+            }
+            return;
+        }
+        let n = self.lattice.n_spanwise();
+        self.wpts.clear();
+        for r in 0..self.wake.n_rows() {
+            for j in 0..=n {
+                self.wpts.push(self.wake.node(r, j));
+            }
+        }
+        for p in &self.prev_te {
+            self.wpts.push(*p);
+        }
+        self.u_wake.resize(self.wpts.len(), [0.0; 3]);
+        self.stats.n_pair_evaluations += induced_velocity_inplace(
+            &[&self.bound.fil, &self.known],
+            &self.wpts,
+            &mut self.u_wake,
+            self.params.parallel,
+            &mut self.blk,
+        );
+        let mut k = 0;
+        for r in 0..self.wake.n_rows() {
+            for j in 0..=n {
+                let u = self.u_wake[k];
+                self.wake.displace(r, j, [(v[0] + u[0]) * dt, (v[1] + u[1]) * dt, (v[2] + u[2]) * dt]);
+                k += 1;
+            }
+        }
+        for p in &mut self.prev_te {
+            let u = self.u_wake[k];
+            for q in 0..3 {
+                p[q] += (v[q] + u[q]) * dt;
+            }
+            k += 1;
+        }
+    }
+
+    /// Advance one time step of length `dt` (s). The lattice must already be at the new time.
+    pub fn step(&mut self, dt: f64) -> Result<&Loads> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(UvlmError::InvalidParameter { field: "dt", value: dt });
+        }
+        let t0 = Instant::now();
+        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
+        // 1–2. Convect, then shed the previous trailing edge as the newest wake row.
+        self.convect(dt);
+        for j in 0..n {
+            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
+        }
+        self.wake.push_front(&self.prev_te, &self.gamma_row);
+        // 3. AIC.
+        self.prepare_aic(Mode::Unsteady)?;
+        // 4. Known wake (rows ≥ 1), solve, implicit Kutta.
+        let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
+        build_known_wake(&mut self.known, &self.wake, closure, &self.params.wake_core, &self.params.images);
+        self.solve_gamma(true)?;
+        for j in 0..n {
+            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
+        }
+        self.wake.set_gamma_row(0, &self.gamma_row);
+        // 5. dΓ/dt and loads.
+        let nr = self.gamma.len();
+        for r in 0..nr {
+            self.gamma_dot[r] = if self.n_history >= 2 {
+                (3.0 * self.gamma[r] - 4.0 * self.gamma_prev[r] + self.gamma_prev2[r]) / (2.0 * dt)
+            } else {
+                (self.gamma[r] - self.gamma_prev[r]) / dt
+            };
+        }
+        self.update_loads(true, true);
+        // History.
+        std::mem::swap(&mut self.gamma_prev2, &mut self.gamma_prev);
+        self.gamma_prev.copy_from_slice(&self.gamma);
+        self.n_history += 1;
+        for j in 0..=n {
+            self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
+        }
+        self.stats.n_steps += 1;
+        self.stats.wall_time += t0.elapsed().as_secs_f64();
+        Ok(&self.loads)
+    }
+}
