@@ -1,11 +1,12 @@
 //! The bound system: unit-strength filaments of the lattice (each shared edge once, with its
 //! ring incidences), the aerodynamic influence coefficient (AIC) matrix and the known wake.
 //!
-//! Unknowns are the bound ring circulations Γ. The newest wake ring row carries the circulation
-//! of the trailing-edge rings (implicit Kutta condition, `Γ_w0 = Γ_TE`), so its filaments belong
-//! to the trailing-edge unknowns and the trailing-edge segment (net strength Γ_w0 − Γ_TE = 0)
-//! disappears; in a steady solve the wake is a set of semi-infinite legs from the trailing-edge
-//! nodes along the free stream, again tied to the trailing-edge unknowns. Edge net strengths
+//! Unknowns are the bound ring circulations Γ. Unsteady solves use the explicit Kutta condition
+//! (as SHARPy and Ptera Software): each step the trailing-edge circulation of the previous step
+//! is shed into a new wake row, so the whole wake is known and the trailing-edge edge of the rings
+//! is a bound filament of net strength Γ_w0 − Γ_TE (which carries the circulation shed during the
+//! step). Steady solves close the rings with semi-infinite legs from the trailing-edge nodes along
+//! the free stream (the trailing-edge edge then cancels). Edge net strengths
 //! (segment directions along increasing indices):
 //! spanwise `(i, j)→(i, j+1)`: `Γ(i, j) − Γ(i−1, j)`; chordwise `(i, j)→(i+1, j)`:
 //! `Γ(i, j−1) − Γ(i, j)`. The AIC row of collocation point `c_p` is
@@ -31,10 +32,12 @@ thread_local! {
 
 /// How the bound system ends at the trailing edge.
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum TrailingEdge<'a> {
-    /// Newest wake ring row (its downstream nodes are the wake's detached row 0).
-    Unsteady(&'a Wake),
-    /// Semi-infinite legs along the unit vector.
+pub(crate) enum TrailingEdge {
+    /// Unsteady: the trailing-edge spanwise edge of the rings is a bound filament; the wake
+    /// (explicit Kutta condition, rows carrying the circulations shed at earlier steps) is known.
+    Unsteady,
+    /// Steady: semi-infinite legs along the unit vector carry the trailing-edge circulations
+    /// (the trailing-edge spanwise edge cancels).
     Steady([f64; 3]),
 }
 
@@ -56,7 +59,7 @@ pub(crate) struct BoundSystem {
 
 impl BoundSystem {
     /// Rebuild for the current lattice geometry. Does not allocate once warm.
-    pub(crate) fn build(&mut self, lat: &Lattice, te: TrailingEdge<'_>, core: &CoreModel, planes: &[ImagePlane]) {
+    pub(crate) fn build(&mut self, lat: &Lattice, te: TrailingEdge, core: &CoreModel, planes: &[ImagePlane]) {
         let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
         let nc = n + 1;
         let fil = &mut self.fil;
@@ -67,10 +70,20 @@ impl BoundSystem {
         }
         let ring = |i: usize, j: usize| (i * n + j) as u32;
         let node = |i: usize, j: usize| (i * nc + j) as u32;
+        let nodes = lat.ring_nodes();
+        let dist = |a: u32, b: u32| {
+            let (p, q) = (nodes[a as usize], nodes[b as usize]);
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        };
+        // Local chordwise panel length of a spanwise edge at node row i, column j..j+1.
+        let chord_scale = |i: usize, j: usize| {
+            let (r0, r1) = if i < m { (i, i + 1) } else { (i - 1, i) };
+            0.5 * (dist(node(r0, j), node(r1, j)) + dist(node(r0, j + 1), node(r1, j + 1)))
+        };
         // Spanwise lattice edges, rows 0..M−1.
         for i in 0..m {
             for j in 0..n {
-                fil.push_segment(node(i, j), node(i, j + 1), 1.0, core);
+                fil.push_segment_scaled(node(i, j), node(i, j + 1), 1.0, core, chord_scale(i, j));
                 let prev = if i > 0 { (ring(i - 1, j), -1.0) } else { (NONE, 0.0) };
                 self.inc.push([(ring(i, j), 1.0), prev]);
             }
@@ -87,23 +100,13 @@ impl BoundSystem {
         self.n_lattice_seg = fil.n_segments();
         let te_ring = |j: usize| ring(m - 1, j);
         match te {
-            TrailingEdge::Unsteady(wake) => {
-                let base = fil.n_nodes() as u32;
-                for j in 0..nc {
-                    fil.push_node(wake.node(0, j));
-                }
-                // Downstream edge of wake ring 0: w(j)→w(j+1) carries −Γ_w0 = −Γ_TE.
+            TrailingEdge::Unsteady => {
+                // Trailing-edge edge (M, j)→(M, j+1): −Γ_TE (the shed row's +Γ_w0 is in the known wake).
                 for j in 0..n {
-                    fil.push_segment(base + j as u32, base + j as u32 + 1, 1.0, core);
+                    fil.push_segment_scaled(node(m, j), node(m, j + 1), 1.0, core, chord_scale(m, j));
                     self.inc.push([(te_ring(j), -1.0), (NONE, 0.0)]);
                 }
-                // Chordwise legs of wake ring 0: TE(j)→w(j).
-                for j in 0..nc {
-                    fil.push_segment(node(m, j), base + j as u32, 1.0, core);
-                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
-                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
-                    self.inc.push([right, left]);
-                }
+                self.n_lattice_seg = fil.n_segments();
             }
             TrailingEdge::Steady(dir) => {
                 for j in 0..nc {
@@ -218,59 +221,77 @@ impl BoundSystem {
     }
 }
 
-/// Build the known part of the wake: ring rows ≥ 1 (row 0 belongs to the bound system), with
-/// net strengths, optional closure legs along `closure_dir`, and images. Segments of exactly zero
-/// net strength are skipped.
+/// Build the known wake: every wake ring row with its shed circulation (explicit Kutta
+/// condition), net strengths per edge, optional closure legs along `closure_dir`, and images.
+/// Node row 0 is the trailing-edge ring row `te` (the upstream edge of the newest wake row, +Γ_w0),
+/// node row `r + 1` the wake's detached row `r`. Segments of exactly zero net strength are skipped.
+/// The spanwise edge on the trailing edge coincides with the bound trailing-edge edge and takes
+/// the bound core `te_core`, so that the two cancel exactly at steady state.
 pub(crate) fn build_known_wake(
     fil: &mut Filaments,
+    te: &[[f64; 3]],
     wake: &Wake,
     closure_dir: Option<[f64; 3]>,
     core: &CoreModel,
+    te_core: &CoreModel,
     planes: &[ImagePlane],
 ) {
     fil.clear();
     let len = wake.n_rows();
     let n = wake.n_spanwise();
     let nc = n + 1;
+    if len == 0 {
+        return;
+    }
+    for p in te {
+        fil.push_node(*p);
+    }
     for r in 0..len {
         for j in 0..nc {
             fil.push_node(wake.node(r, j));
         }
     }
-    let node = |r: usize, j: usize| (r * nc + j) as u32;
-    let closed = closure_dir.is_some() && len >= 2;
-    let g = |r: usize, j: isize| -> f64 {
-        if r < len && j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 }
+    // Node row k: 0 = trailing edge, k ≥ 1 = detached row k − 1.
+    let node = |k: usize, j: usize| (k * nc + j) as u32;
+    let closed = closure_dir.is_some();
+    let g = |r: isize, j: isize| -> f64 {
+        if r >= 0 && (r as usize) < len && j >= 0 && (j as usize) < n { wake.gamma(r as usize, j as usize) } else { 0.0 }
     };
-    for r in 0..len {
-        // Spanwise edge at detached row r: +Γ(r+1) − Γ(r) (the −Γ(0) part is in the bound system).
+    for k in 0..=len {
+        // Spanwise edge at node row k: upstream edge of ring k (+Γ_k), downstream edge of ring k − 1 (−Γ_{k−1}).
+        let r = k as isize;
         for j in 0..n {
-            let down = g(r + 1, j as isize);
-            let up = if r >= 1 && !(closed && r == len - 1) { g(r, j as isize) } else { 0.0 };
-            let s = down - up;
+            let up = if closed && k == len { 0.0 } else { g(r - 1, j as isize) };
+            let s = g(r, j as isize) - up;
             if s != 0.0 {
-                fil.push_segment(node(r, j), node(r, j + 1), s, core);
+                let (k0, k1) = if k < len { (k, k + 1) } else { (k - 1, k) };
+                let d = |a: u32, b: u32| {
+                    let (p, q) = (fil.node(a as usize), fil.node(b as usize));
+                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+                };
+                let scale = 0.5 * (d(node(k0, j), node(k1, j)) + d(node(k0, j + 1), node(k1, j + 1)));
+                let c = if k == 0 { te_core } else { core };
+                fil.push_segment_scaled(node(k, j), node(k, j + 1), s, c, scale);
             }
         }
-        // Chordwise legs of ring r ≥ 1: (r−1, j)→(r, j).
-        if r >= 1 {
+        // Chordwise legs of ring k − 1: (k−1, j)→(k, j).
+        if k >= 1 {
             for j in 0..nc {
-                let s = g(r, j as isize - 1) - g(r, j as isize);
+                let s = g(r - 1, j as isize - 1) - g(r - 1, j as isize);
                 if s != 0.0 {
-                    fil.push_segment(node(r - 1, j), node(r, j), s, core);
+                    fil.push_segment(node(k - 1, j), node(k, j), s, core);
                 }
             }
         }
     }
-    if closed && let Some(dir) = closure_dir {
-        let r = len - 1;
+    if let Some(dir) = closure_dir {
+        let r = len as isize - 1;
         for j in 0..nc {
             let s = g(r, j as isize - 1) - g(r, j as isize);
             if s != 0.0 {
-                let a = wake.node(r, j);
-                let b = wake.node(r - 1, j);
+                let (a, b) = (fil.node(node(len, j) as usize), fil.node(node(len - 1, j) as usize));
                 let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-                fil.push_leg(node(r, j), dir, s, core, l);
+                fil.push_leg(node(len, j), dir, s, core, l);
             }
         }
     }

@@ -37,8 +37,10 @@ pub enum CoreModel {
         /// Cut-off distance from the filament axis, m (≥ 0).
         radius: f64,
     },
-    /// Scully (Vatistas n = 1) core whose radius is `fraction` × the segment's own length, so the
-    /// core shrinks with the mesh and the discrete model converges to the inviscid limit.
+    /// Scully (Vatistas n = 1) core whose radius is `fraction` × the local chordwise panel length
+    /// (a chordwise segment's own length; for a spanwise segment the length of the adjacent
+    /// chordwise edge), so the core shrinks with the mesh and the discrete model converges to the
+    /// inviscid limit.
     Scully {
         /// Core radius over segment length, dimensionless (≥ 0).
         fraction: f64,
@@ -67,14 +69,15 @@ impl CoreModel {
         }
     }
 
-    /// Per-segment kernel constants `(core2, cut2)` for a segment of squared length `len2`:
-    /// the term added to |r₁×r₂|² and the threshold below which the induction is zeroed.
+    /// Per-segment kernel constants `(core2, cut2)` for a segment of squared length `len2` whose
+    /// local panel length is `scale`: the term added to |r₁×r₂|² and the threshold below which
+    /// the induction is zeroed.
     #[inline]
-    pub fn coefficients(&self, len2: f64) -> (f64, f64) {
+    pub fn coefficients(&self, len2: f64, scale: f64) -> (f64, f64) {
         let guard = TINY_REL2 * len2 * len2;
         match *self {
             CoreModel::CutOff { radius } => (0.0, (radius * radius * len2).max(guard)),
-            CoreModel::Scully { fraction } => (fraction * fraction * len2 * len2, guard),
+            CoreModel::Scully { fraction } => (fraction * fraction * scale * scale * len2, guard),
             CoreModel::ScullyRadius { radius } => (radius * radius * len2, guard),
         }
     }
@@ -91,10 +94,11 @@ impl CoreModel {
     }
 }
 
-/// Velocity induced at `p` by the segment `a → b` of circulation `gamma` (scalar reference kernel).
+/// Velocity induced at `p` by the segment `a → b` of circulation `gamma` (scalar reference
+/// kernel; a [`CoreModel::Scully`] core is sized from the segment's own length).
 pub fn segment_velocity(p: [f64; 3], a: [f64; 3], b: [f64; 3], gamma: f64, core: CoreModel) -> [f64; 3] {
     let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
-    let (core2, cut2) = core.coefficients(len2);
+    let (core2, cut2) = core.coefficients(len2, len2.sqrt());
     let r1 = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
     let r2 = [p[0] - b[0], p[1] - b[1], p[2] - b[2]];
     let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
@@ -220,11 +224,20 @@ impl Filaments {
         (self.x.len() - 1) as u32
     }
 
-    /// Append the segment `a → b` of circulation `gamma` with the given core.
+    /// Append the segment `a → b` of circulation `gamma` with the given core, sized (for
+    /// [`CoreModel::Scully`]) from the segment's own length.
     pub fn push_segment(&mut self, a: u32, b: u32, gamma: f64, core: &CoreModel) {
         let (pa, pb) = (self.node(a as usize), self.node(b as usize));
+        let len = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt();
+        self.push_segment_scaled(a, b, gamma, core, len);
+    }
+
+    /// Append the segment `a → b` of circulation `gamma` with the given core sized from the local
+    /// panel length `scale`, m.
+    pub fn push_segment_scaled(&mut self, a: u32, b: u32, gamma: f64, core: &CoreModel, scale: f64) {
+        let (pa, pb) = (self.node(a as usize), self.node(b as usize));
         let len2 = (pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2);
-        let (core2, cut2) = core.coefficients(len2);
+        let (core2, cut2) = core.coefficients(len2, scale);
         self.seg_a.push(a);
         self.seg_b.push(b);
         self.seg_g.push(gamma * INV_FOUR_PI);
@@ -558,7 +571,7 @@ mod tests {
             }
         }
         // Inside the Scully core the velocity grows linearly from the axis: u(h) ≈ Γ h/(2π rc²)
-        // for a long segment.
+        // for a long segment (core sized from its own length here).
         let rc = 0.1 * 2e3;
         let h = 1e-3;
         let u = segment_velocity([0.0, h, 0.0], [-1e3, 0.0, 0.0], [1e3, 0.0, 0.0], 1.0, CoreModel::Scully { fraction: 0.1 });

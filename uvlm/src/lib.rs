@@ -13,8 +13,9 @@
 //!
 //! gives the linear system `A Γ = −(V∞ − ẋ_c + u_wake)·n` for the ring circulations, with
 //! the Biot–Savart law of straight segments ([`biot_savart`]) evaluated once per shared edge with
-//! its net circulation. The Kutta condition is implicit: the newest wake ring row carries the
-//! trailing-edge circulation (steady solves use semi-infinite legs along the free stream).
+//! its net circulation. The Kutta condition is explicit (as SHARPy): every step the trailing-edge
+//! circulation is shed into a new wake row; steady solves close the rings by semi-infinite legs
+//! along the free stream.
 //! The wake ([`Wake`]) is a ring buffer of rows shed every step, convected with the free stream
 //! (prescribed) or the local velocity (free), truncated after `n_wake_rows` rows, optionally
 //! closed by semi-infinite legs. Loads ([`Loads`]) are Joukowski forces per segment plus

@@ -5,7 +5,9 @@
 //!
 //! $$ f_s = \rho\,\Gamma_s\,\big(V_\infty + u_{ind}(x_s) - \dot x_s\big)\times(x_B - x_A),$$
 //!
-//! `Γ_s` the segment's net circulation, split ½–½ to its end nodes. Unsteady part (eq. 16 of
+//! `Γ_s` the segment's net circulation, split ½–½ to its end nodes. The trailing-edge segment
+//! (net strength Γ_w0 − Γ_TE, the circulation shed during the step) is skipped by default, as in
+//! SHARPy, or included, as in Ptera Software (`te_segment_force`). Unsteady part (eq. 16 of
 //! Otsuka, Cheng & Palacios 2024; Katz & Plotkin §13.12):
 //!
 //! $$ f_r = \rho\,A_r\,n_r\,\frac{d\Gamma_r}{dt}, $$
@@ -105,6 +107,7 @@ pub(crate) fn compute_loads(
     bs: &BoundSystem,
     u_mid: &[[f64; 3]],
     gamma_dot: Option<&[f64]>,
+    te_segment_force: bool,
     rho: f64,
     v_inf: [f64; 3],
 ) {
@@ -121,7 +124,8 @@ pub(crate) fn compute_loads(
     let mut tot = [0.0; 3];
     for s in 0..bs.n_lattice_seg {
         let g = bs.lattice_segment_gamma(s);
-        if g == 0.0 {
+        let te_row = s >= m * n + m * nc;
+        if g == 0.0 || (te_row && !te_segment_force) {
             continue;
         }
         let (a, b) = bs.fil.segment_nodes(s);
@@ -141,8 +145,8 @@ pub(crate) fn compute_loads(
             loads.nodal[b][q] += 0.5 * f[q];
             tot[q] += f[q];
         }
-        if s < m * n {
-            let j = s % n;
+        if s < m * n || te_row {
+            let j = (s - if te_row { m * n + m * nc } else { 0 }) % n;
             for q in 0..3 {
                 loads.strip[j][q] += f[q];
             }

@@ -60,6 +60,10 @@ pub struct UvlmParams {
     /// Image planes (symmetry and/or ground), at most two, perpendicular.
     #[serde(default)]
     pub images: Vec<ImagePlane>,
+    /// Apply the Joukowski force to the trailing-edge segment (net strength Γ_w0 − Γ_TE) as
+    /// Ptera Software does; default false (SHARPy: the segment is skipped). Zero at steady state.
+    #[serde(default)]
+    pub te_segment_force: bool,
     /// Include the unsteady load term ρ·A·n·dΓ/dt. Default true.
     #[serde(default = "default_true")]
     pub unsteady_term: bool,
@@ -87,6 +91,7 @@ impl UvlmParams {
             bound_core: CoreModel::default(),
             wake_core: CoreModel::default(),
             images: Vec::new(),
+            te_segment_force: false,
             unsteady_term: true,
             parallel: Parallel::Auto,
         }

@@ -24,11 +24,11 @@ enum Mode {
 ///
 /// Per unsteady step ([`Uvlm::step`]), with the lattice already moved to the new time:
 /// 1. convect the wake (free stream, or free stream + induced velocity for a free wake);
-/// 2. shed a row: the previous trailing-edge ring row, convected, becomes the downstream edge of
-///    the newest wake ring (truncating the oldest row when full);
-/// 3. assemble the AIC (bound rings + newest wake ring, implicit Kutta) unless the geometry is
-///    bitwise unchanged, then factorise;
-/// 4. right-hand side `−(V∞ − ẋ_c + u_wake(c))·n`, solve for Γ, set the newest wake row to Γ_TE;
+/// 2. shed a row (explicit Kutta condition): the previous trailing-edge ring row, convected,
+///    becomes the downstream edge of the newest wake ring, which carries the trailing-edge
+///    circulation of the previous step (the oldest row is dropped when the buffer is full);
+/// 3. assemble and factorise the AIC of the bound rings unless the lattice is unchanged;
+/// 4. right-hand side `−(V∞ − ẋ_c + u_wake(c))·n`, solve for Γ;
 /// 5. loads: Joukowski per segment + ρ·A·n·dΓ/dt (backward differences, first order on the first
 ///    step, second order after).
 #[derive(Debug)]
@@ -50,7 +50,6 @@ pub struct Uvlm {
     aic: Vec<f64>,
     rhs: Vec<f64>,
     aic_key: Option<(Mode, u64)>,
-    row0: Vec<[f64; 3]>,
     col: Points,
     nrm: Points,
     mid: Points,
@@ -90,7 +89,6 @@ impl Uvlm {
             aic: vec![0.0; nr * nr],
             rhs: vec![0.0; nr],
             aic_key: None,
-            row0: vec![[0.0; 3]; n + 1],
             col: Points::default(),
             nrm: Points::default(),
             mid: Points::default(),
@@ -167,22 +165,12 @@ impl Uvlm {
     /// Build (if needed) and factorise the AIC for `mode`.
     fn prepare_aic(&mut self, mode: Mode) -> Result<()> {
         let key = (mode, self.lattice.version());
-        let n = self.lattice.n_spanwise();
-        let row0_same = match mode {
-            Mode::Steady => true,
-            Mode::Unsteady => (0..=n).all(|j| self.wake.node(0, j) == self.row0[j]),
-        };
-        if self.aic_key == Some(key) && row0_same && self.bound_mode == Some(mode) {
+        if self.aic_key == Some(key) && self.bound_mode == Some(mode) {
             return Ok(());
         }
         let te = match mode {
             Mode::Steady => TrailingEdge::Steady(self.stream_dir()?),
-            Mode::Unsteady => {
-                for j in 0..=n {
-                    self.row0[j] = self.wake.node(0, j);
-                }
-                TrailingEdge::Unsteady(&self.wake)
-            }
+            Mode::Unsteady => TrailingEdge::Unsteady,
         };
         self.bound.build(&self.lattice, te, &self.params.bound_core, &self.params.images);
         self.bound_mode = Some(mode);
@@ -248,7 +236,16 @@ impl Uvlm {
         };
         self.stats.n_pair_evaluations += pairs;
         let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
-        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.u_mid, gd, self.params.rho, self.params.v_inf);
+        compute_loads(
+            &mut self.loads,
+            &self.lattice,
+            &self.bound,
+            &self.u_mid,
+            gd,
+            self.params.te_segment_force,
+            self.params.rho,
+            self.params.v_inf,
+        );
     }
 
     /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM).
@@ -365,12 +362,18 @@ impl Uvlm {
         self.prepare_aic(Mode::Unsteady)?;
         // 4. Known wake (rows ≥ 1), solve, implicit Kutta.
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
-        build_known_wake(&mut self.known, &self.wake, closure, &self.params.wake_core, &self.params.images);
+        let nc = n + 1;
+        let te = &self.lattice.ring_nodes()[m * nc..];
+        build_known_wake(
+            &mut self.known,
+            te,
+            &self.wake,
+            closure,
+            &self.params.wake_core,
+            &self.params.bound_core,
+            &self.params.images,
+        );
         self.solve_gamma(true)?;
-        for j in 0..n {
-            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
-        }
-        self.wake.set_gamma_row(0, &self.gamma_row);
         // 5. dΓ/dt and loads.
         let nr = self.gamma.len();
         for r in 0..nr {
