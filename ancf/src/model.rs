@@ -573,8 +573,13 @@ impl Model {
         }
     }
 
-    /// Elastic energy by strain kind for full coordinates `q` (J, indexed by `StrainKind`).
-    pub(crate) fn elastic_energy_by_kind_full(&self, q: &[f64]) -> [f64; crate::strain::N_STRAINS] {
+    /// Elastic energy split by strain kind (J, indexed by `StrainKind as usize`): shows how much
+    /// sits in the cross-section penalties and the shear.
+    pub fn elastic_energy_by_kind(&self, q: &[f64]) -> [f64; crate::strain::N_STRAINS] {
+        self.with_full(q, |q| self.elastic_energy_by_kind_full(q))
+    }
+
+    fn elastic_energy_by_kind_full(&self, q: &[f64]) -> [f64; crate::strain::N_STRAINS] {
         let mut u = [0.0; crate::strain::N_STRAINS];
         for b in &self.bodies {
             for k in 0..b.n_elements() {
