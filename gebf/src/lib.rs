@@ -43,7 +43,9 @@ mod loads;
 mod model;
 mod options;
 pub mod quaternion;
+pub mod samples;
 mod section;
+pub mod simulate;
 mod stiffness;
 
 pub use body::BodySpec;

@@ -353,6 +353,11 @@ impl Model {
         }
     }
 
+    /// Indices (into the joint list) of the flared hinges.
+    pub fn flared_hinges(&self) -> Vec<usize> {
+        self.joints.iter().enumerate().filter(|(_, j)| matches!(j, Joint::Flared(_))).map(|(i, _)| i).collect()
+    }
+
     /// Kinetic, elastic and gravitational potential energy.
     pub fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
         let mut e = Energies::default();

@@ -67,6 +67,11 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     delta: Vec<f64>,
     hdelta: Vec<f64>,
     weights: Vec<f64>,
+    /// State at the start of the current attempt (for retrying a failed step in halves).
+    backup: State,
+    /// The predictor of the current attempt (for restarting Newton with a fresh matrix).
+    predictor: State,
+    predictor_delta: Vec<f64>,
     stats: Stats,
 }
 
@@ -75,6 +80,16 @@ impl GenAlpha<DenseLu> {
     pub fn new<S: ConstrainedSystem + ?Sized>(params: IntegratorParams, sys: &S) -> Result<Self, Error> {
         Self::with_solver(params, sys, DenseLu::default())
     }
+}
+
+fn copy_state(from: &State, to: &mut State) {
+    to.t = from.t;
+    to.q.copy_from_slice(&from.q);
+    to.v.copy_from_slice(&from.v);
+    to.v_dot.copy_from_slice(&from.v_dot);
+    to.a.copy_from_slice(&from.a);
+    to.lambda.copy_from_slice(&from.lambda);
+    to.mu.copy_from_slice(&from.mu);
 }
 
 fn inf_norm(x: &[f64]) -> f64 {
@@ -112,6 +127,25 @@ impl<L: LinearSolver> GenAlpha<L> {
             delta: vec![0.0; n],
             hdelta: vec![0.0; n],
             weights: (0..n).map(|i| sys.increment_weight(i)).collect(),
+            backup: State {
+                t: 0.0,
+                q: vec![0.0; n_q],
+                v: vec![0.0; n],
+                v_dot: vec![0.0; n],
+                a: vec![0.0; n],
+                lambda: vec![0.0; n_h],
+                mu: vec![0.0; n_v],
+            },
+            predictor: State {
+                t: 0.0,
+                q: vec![0.0; n_q],
+                v: vec![0.0; n],
+                v_dot: vec![0.0; n],
+                a: vec![0.0; n],
+                lambda: vec![0.0; n_h],
+                mu: vec![0.0; n_v],
+            },
+            predictor_delta: vec![0.0; n],
             stats: Stats::default(),
         })
     }
@@ -197,9 +231,58 @@ impl<L: LinearSolver> GenAlpha<L> {
         Ok(())
     }
 
-    /// Advance `s` by one step `dt`. On error `s` is left at the last iterate (for plotting what
-    /// was computed); the caller decides whether to stop.
+    /// Advance `s` by one step `dt`. If Newton fails, the step is retried as two half steps
+    /// (recursively, up to `newton.max_step_halvings` deep). On error `s` is left at the last
+    /// iterate (for plotting what was computed); the caller decides whether to stop.
     pub fn step<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
+        let h = self.params.dt;
+        let out = self.advance(sys, s, h, 0);
+        if self.c.h != h {
+            self.set_step_size(h);
+        }
+        let st = out?;
+        self.stats.record(&st);
+        Ok(st)
+    }
+
+    fn set_step_size(&mut self, h: f64) {
+        self.c = Coefficients::new(self.params.rho_inf, h);
+        self.have_factorization = false; // the matrix depends on h
+    }
+
+    /// One step of size `h`, halved recursively on Newton failure.
+    fn advance<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        s: &mut State,
+        h: f64,
+        depth: usize,
+    ) -> Result<StepStats, Error> {
+        if self.c.h != h {
+            self.set_step_size(h);
+        }
+        let retry = depth < self.params.newton.max_step_halvings;
+        if retry {
+            copy_state(s, &mut self.backup);
+        }
+        match self.attempt(sys, s) {
+            Ok(st) => return Ok(st),
+            Err(e) if !retry || matches!(e, Error::InvalidParameter { .. }) => return Err(e),
+            Err(_) => {}
+        }
+        copy_state(&self.backup, s);
+        let a = self.advance(sys, s, 0.5 * h, depth + 1)?;
+        let b = self.advance(sys, s, 0.5 * h, depth + 1)?;
+        Ok(StepStats {
+            n_newton_iters: a.n_newton_iters + b.n_newton_iters,
+            n_factorizations: a.n_factorizations + b.n_factorizations,
+            n_substeps: a.n_substeps + b.n_substeps,
+            ..b
+        })
+    }
+
+    /// One Newton solve for a step of the current size `self.c.h`.
+    fn attempt<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
         let c = self.c;
         let (h, n, n_h, n_v) = (c.h, self.n, self.n_h, self.n_v);
         let np = self.params.newton;
@@ -216,10 +299,16 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.hdelta[i] = h * self.delta[i];
         }
         sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+        let keep_predictor = np.reuse_factorization;
+        if keep_predictor {
+            copy_state(s, &mut self.predictor);
+            self.predictor_delta.copy_from_slice(&self.delta);
+        }
 
-        let mut stats = StepStats::default();
+        let mut stats = StepStats { n_substeps: 1, ..StepStats::default() };
         let mut prev_inc = f64::INFINITY;
         let mut fresh = false; // factorisation made at this iterate's matrix
+        let mut factorized_this_step = false;
         let mut inc_norm = f64::INFINITY;
         let mut res_norm;
         for iter in 1..=np.max_iter + 1 {
@@ -244,7 +333,6 @@ impl<L: LinearSolver> GenAlpha<L> {
                 stats.n_newton_iters = iter - 1;
                 s.t = t1;
                 sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
-                self.stats.record(&stats);
                 return Ok(stats);
             }
             if iter > np.max_iter {
@@ -252,6 +340,19 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
             // Decide whether to (re)factorise.
             let contraction = inc_norm / prev_inc;
+            if keep_predictor && contraction > 1.0 && !factorized_this_step {
+                // Diverging with a matrix from an earlier step: the iterate may already be
+                // spoiled, so restart from the predictor with a fresh matrix.
+                copy_state(&self.predictor, s);
+                self.delta.copy_from_slice(&self.predictor_delta);
+                for i in 0..n {
+                    self.hdelta[i] = h * self.delta[i];
+                }
+                self.have_factorization = false;
+                inc_norm = f64::INFINITY;
+                prev_inc = f64::INFINITY;
+                continue;
+            }
             let need = !np.reuse_factorization
                 || !self.have_factorization
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
@@ -262,6 +363,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.have_factorization = true;
                 stats.n_factorizations += 1;
                 fresh = true;
+                factorized_this_step = true;
             } else {
                 fresh = false;
             }

@@ -20,6 +20,11 @@ pub struct NewtonParams {
     pub reuse_factorization: bool,
     /// Contraction rate above which a reused factorisation is refreshed (default 0.2).
     pub max_contraction: f64,
+    /// When Newton fails on a step (divergence, non-finite values, singular matrix), the step
+    /// is retried as two half steps, recursively, at most this many times deep (default 4:
+    /// down to dt/16). 0 turns the retry off. A successful run without failures is unaffected;
+    /// the halvings are counted in [`Stats::n_step_halvings`](crate::Stats).
+    pub max_step_halvings: usize,
 }
 
 impl Default for NewtonParams {
@@ -32,6 +37,7 @@ impl Default for NewtonParams {
             psi_tol: 1e-8,
             reuse_factorization: true,
             max_contraction: 0.2,
+            max_step_halvings: 4,
         }
     }
 }

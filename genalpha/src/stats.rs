@@ -13,6 +13,8 @@ pub struct StepStats {
     pub phi_norm: f64,
     /// Final infinity norm of the velocity constraint residual B v + b.
     pub psi_norm: f64,
+    /// Sub-steps the step was completed in (1 unless Newton failed and the step was halved).
+    pub n_substeps: usize,
 }
 
 /// Accumulated statistics of a run.
@@ -28,10 +30,14 @@ pub struct Stats {
     pub n_factorizations: usize,
     /// Residual evaluations.
     pub n_residual_evals: usize,
+    /// Steps that were retried as two half steps after a Newton failure (each halving at any
+    /// depth counts once).
+    pub n_step_halvings: usize,
 }
 
 impl Stats {
     pub(crate) fn record(&mut self, s: &StepStats) {
+        self.n_step_halvings += s.n_substeps.saturating_sub(1);
         self.n_steps += 1;
         self.n_newton_iters += s.n_newton_iters;
         self.max_newton_iters = self.max_newton_iters.max(s.n_newton_iters);

@@ -220,3 +220,36 @@ fn invalid_parameters_name_the_field() {
     let e = GenAlpha::new(IntegratorParams::new(0.9, -1.0), &sys).unwrap_err();
     assert!(e.to_string().contains("dt"));
 }
+
+/// A pendulum whose Newton iteration is made to fail at one step size: `max_iter` is too small
+/// for some full steps but enough for half steps; those steps must be retried in halves, reach the
+/// right time and keep the constraint; with retries off the same run fails.
+#[test]
+fn failed_step_is_retried_in_halves() {
+    let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: false };
+    let mut p = IntegratorParams::new(0.9, 0.02);
+    p.newton.max_iter = 2;
+    p.newton.reuse_factorization = false;
+    let mut ga = GenAlpha::new(p, &sys).unwrap();
+    let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+    ga.initialize(&sys, &mut s).unwrap();
+    let mut halved = 0;
+    for _ in 0..10 {
+        let st = ga.step(&mut sys, &mut s).unwrap();
+        assert!(st.n_substeps >= 1);
+        halved += st.n_substeps - 1;
+    }
+    assert_relative_eq!(s.t, 0.2, epsilon = 1e-12);
+    assert!(halved > 0, "the test needs at least one halving");
+    assert_eq!(ga.stats().n_step_halvings, halved);
+    let phi = 0.5 * (s.q[0] * s.q[0] + s.q[1] * s.q[1] - 1.0);
+    assert!(phi.abs() < 1e-9, "phi = {phi}");
+    // Without retries the same run fails.
+    let mut p0 = p;
+    p0.newton.max_step_halvings = 0;
+    let mut ga = GenAlpha::new(p0, &sys).unwrap();
+    let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+    ga.initialize(&sys, &mut s).unwrap();
+    let failed = (0..10).any(|_| ga.step(&mut sys, &mut s).is_err());
+    assert!(failed);
+}
