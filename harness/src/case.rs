@@ -426,8 +426,8 @@ impl CaseFile {
     /// Read and parse JSON (syntax only; the schema is checked per run).
     pub fn read(path: &Path) -> Result<Self, Error> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-        let raw: Value =
-            serde_json::from_str(&text).map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
+        let raw: Value = serde_json::from_str(&text)
+            .map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
         Ok(Self { path: path.to_path_buf(), raw })
     }
 
@@ -591,7 +591,8 @@ impl Case {
             if !finite3(&b.y_axis) || norm3(&b.y_axis) < 1e-12 {
                 return Err(f("y_axis: not a finite non-zero vector"));
             }
-            let dot: f64 = (0..3).map(|k| b.x_axis[k] * b.y_axis[k]).sum::<f64>() / (norm3(&b.x_axis) * norm3(&b.y_axis));
+            let dot: f64 =
+                (0..3).map(|k| b.x_axis[k] * b.y_axis[k]).sum::<f64>() / (norm3(&b.x_axis) * norm3(&b.y_axis));
             if dot.abs() > 1e-9 {
                 return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
             }

@@ -190,11 +190,8 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
             for &i in &idx {
                 let (_, _, e, dt, is_truth) = plan[i];
                 let o = &outs[i];
-                let error_m = if o.error.is_some() || (is_truth && !use_external) {
-                    f64::NAN
-                } else {
-                    max_distance(o, truth)
-                };
+                let error_m =
+                    if o.error.is_some() || (is_truth && !use_external) { f64::NAN } else { max_distance(o, truth) };
                 if !is_truth || use_external {
                     errs.push(error_m);
                 }
@@ -228,7 +225,8 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
 
 /// Write `converge.csv`, `converge.json`, `work_precision.svg` and `convergence.svg` into `dir`.
 pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
-    let mut csv = String::from("formulation,ladder,elements_per_body,dt,is_truth,wall_s,n_steps,error_m,against,failure\n");
+    let mut csv =
+        String::from("formulation,ladder,elements_per_body,dt,is_truth,wall_s,n_steps,error_m,against,failure\n");
     for g in &r.rungs {
         let _ = writeln!(
             csv,

@@ -47,7 +47,8 @@ pub struct Curve {
 /// Read a CSV with a header naming at least `t, tip_x, tip_y, tip_z`; `#` lines are comments.
 pub fn read_curve(path: &Path) -> Result<Curve, Error> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
     parse_curve(&text).map_err(|msg| Error::Reference { file, msg })
 }
 

@@ -36,7 +36,9 @@ impl GateOutcome {
     /// The failed checks and failures, one line each.
     pub fn failed_lines(&self) -> Vec<String> {
         let mut v: Vec<String> = self.failures.clone();
-        v.extend(self.checks.iter().filter(|c| !c.pass).map(|c| format!("{} = {:.4e} > {:.4e}", c.metric, c.value, c.limit)));
+        v.extend(
+            self.checks.iter().filter(|c| !c.pass).map(|c| format!("{} = {:.4e} > {:.4e}", c.metric, c.value, c.limit)),
+        );
         v
     }
 }
@@ -62,7 +64,11 @@ pub fn evaluate(r: &CaseResult) -> Option<GateOutcome> {
     for f in Formulation::ALL {
         if let Some(m) = r.metrics.get(&f) {
             out.checks.push(check(format!("{f}.energy_drift"), m.energy_drift, gate.energy_drift));
-            out.checks.push(check(format!("{f}.constraint_residual"), m.max_constraint_residual, gate.constraint_residual));
+            out.checks.push(check(
+                format!("{f}.constraint_residual"),
+                m.max_constraint_residual,
+                gate.constraint_residual,
+            ));
         }
     }
     for rm in &r.references {

@@ -9,11 +9,15 @@ use clap::{Parser, Subcommand, ValueEnum};
 use harness::case::{CaseFile, Formulation, Override, json_schema};
 use harness::csv::{to_csv, write_file};
 use harness::driver::{discover, expand_all, run_all, write_reports};
-use harness::{converge, gate, stress};
 use harness::report::write_case;
+use harness::{converge, gate, stress};
 
 #[derive(Parser)]
-#[command(name = "harness", version, about = "Dual-formulation (ANCF / GEBF) verification harness for flared-hinged wings")]
+#[command(
+    name = "harness",
+    version,
+    about = "Dual-formulation (ANCF / GEBF) verification harness for flared-hinged wings"
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,

@@ -49,7 +49,8 @@ pub mod colors {
 }
 
 fn finite_range(it: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    let (lo, hi) = it.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) =
+        it.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     (lo <= hi).then_some((lo, hi))
 }
 
@@ -70,11 +71,7 @@ where
     let xs = finite_range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
     let (x0, x1) = xs.map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
     let mut chart = ChartBuilder::on(area);
-    chart
-        .caption(&p.title, ("sans-serif", 18))
-        .margin(8)
-        .x_label_area_size(40)
-        .y_label_area_size(78);
+    chart.caption(&p.title, ("sans-serif", 18)).margin(8).x_label_area_size(40).y_label_area_size(78);
     let label_style = ("sans-serif", 14);
     if p.log_y {
         let ys = finite_range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1).filter(|v| *v > 0.0)));

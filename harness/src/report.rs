@@ -204,11 +204,8 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     panels_svg(&dir.join("tip.svg"), &tip_panels, 1, (900, 300))?;
 
     // Differences: ANCF–GEBF and each formulation against each reference.
-    let mut diff = vec![Series {
-        label: "|ANCF − GEBF|".into(),
-        color: colors::EXTRA[2],
-        points: r.pair_diff.clone(),
-    }];
+    let mut diff =
+        vec![Series { label: "|ANCF − GEBF|".into(), color: colors::EXTRA[2], points: r.pair_diff.clone() }];
     for (i, (lab, c, shift)) in r.reference_curves.iter().enumerate() {
         for run in r.runs.iter().filter(|x| !x.rows.is_empty()) {
             diff.push(Series {
@@ -430,7 +427,11 @@ pub fn index_html(results: &[CaseResult]) -> String {
     for row in table_rows(results) {
         s.push_str("<tr>");
         for (i, c) in row.iter().enumerate() {
-            let class = if i == 10 { format!(" class=\"{}\"", if c == "pass" { "pass" } else { "fail" }) } else { String::new() };
+            let class = if i == 10 {
+                format!(" class=\"{}\"", if c == "pass" { "pass" } else { "fail" })
+            } else {
+                String::new()
+            };
             let cell = if i == 0 { format!("<a href=\"#{0}\">{0}</a>", esc(c)) } else { esc(c) };
             let _ = write!(s, "<td{class}>{cell}</td>");
         }
@@ -438,7 +439,13 @@ pub fn index_html(results: &[CaseResult]) -> String {
     }
     s.push_str("</table>\n");
     for r in results {
-        let _ = write!(s, "<h2 id=\"{0}\">{0} <span class=\"{1}\">[{1}]</span></h2>\n<p>{2}</p>\n", esc(&r.name), r.status(), esc(&r.description));
+        let _ = write!(
+            s,
+            "<h2 id=\"{0}\">{0} <span class=\"{1}\">[{1}]</span></h2>\n<p>{2}</p>\n",
+            esc(&r.name),
+            r.status(),
+            esc(&r.description)
+        );
         for run in &r.runs {
             if let Some(e) = &run.error {
                 let _ = writeln!(s, "<p class=\"fail\">{}: {}</p>", run.formulation, esc(e));
@@ -455,7 +462,14 @@ pub fn index_html(results: &[CaseResult]) -> String {
             esc(&r.name)
         );
         for (file, caption) in PLOTS {
-            let _ = writeln!(s, "<figure><img src=\"{}/{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>", esc(&r.name), file, caption, caption);
+            let _ = writeln!(
+                s,
+                "<figure><img src=\"{}/{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
+                esc(&r.name),
+                file,
+                caption,
+                caption
+            );
         }
     }
     s.push_str("</body></html>\n");

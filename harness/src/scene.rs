@@ -54,9 +54,11 @@ macro_rules! specs {
                 Joint::GroundHinge { body, axis, .. } => {
                     $krate::JointSpec::GroundHinge { body: idx(body), axis: unit(*axis) }
                 }
-                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
-                    $krate::JointSpec::FlaredHinge { parent: idx(parent), child: idx(child), beta: flare_deg.to_radians() }
-                }
+                Joint::FlaredHinge { parent, child, flare_deg, .. } => $krate::JointSpec::FlaredHinge {
+                    parent: idx(parent),
+                    child: idx(child),
+                    beta: flare_deg.to_radians(),
+                },
                 Joint::Clamp { body, .. } => $krate::JointSpec::Clamp { body: idx(body) },
             })
             .collect();
@@ -174,7 +176,6 @@ macro_rules! structure {
 }
 
 structure!(ancf::Model);
-structure!(ancf::ReducedModel);
 structure!(gebf::Model);
 
 fn settings(case: &Case, f: Formulation) -> RunSettings {
@@ -187,10 +188,14 @@ fn settings(case: &Case, f: Formulation) -> RunSettings {
     RunSettings { params, t_end: case.t_end, output_dt: case.output_dt }
 }
 
-/// Build the ANCF model of a case (DAE path).
+/// Build the ANCF model of a case (DAE or ODE path as the case says).
 pub fn build_ancf(case: &Case) -> Result<ancf::Model, Error> {
     let (bodies, joints, gravity) = specs!(ancf, case, case.ancf.elements_per_body);
-    ancf::Model::new(&bodies, &joints, gravity, ancf::Options::default())
+    let path = match case.ancf.path {
+        AncfPath::Dae => ancf::SolvePath::Dae,
+        AncfPath::Ode => ancf::SolvePath::Ode,
+    };
+    ancf::Model::new(&bodies, &joints, gravity, ancf::Options { path, ..Default::default() })
         .map_err(|e| Error::Model { formulation: Formulation::Ancf, msg: e.to_string() })
 }
 
@@ -208,12 +213,7 @@ pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
     let s = settings(case, f);
     let fold_joint = case.fold_joint_index();
     let built = match f {
-        Formulation::Ancf => build_ancf(case).and_then(|model| match case.ancf.path {
-            AncfPath::Dae => Ok(simulate(f, &mut Sensed { model, fold_joint }, &s)),
-            AncfPath::Ode => ancf::ReducedModel::new(model)
-                .map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s))
-                .map_err(|e| Error::Model { formulation: f, msg: e.to_string() }),
-        }),
+        Formulation::Ancf => build_ancf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
         Formulation::Gebf => build_gebf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
     };
     built.unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))

@@ -194,7 +194,11 @@ fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<
             };
             root.draw(&Rectangle::new([(x, y), (x + cw - 2, y + ch - 2)], cell_color(k).filled()))
                 .map_err(|e| err(e.to_string()))?;
-            let label = if k.ok() { format!("{:.1}", k.metrics.newton_per_step) } else { format!("✗{:.2}", k.metrics.t_reached) };
+            let label = if k.ok() {
+                format!("{:.1}", k.metrics.newton_per_step)
+            } else {
+                format!("✗{:.2}", k.metrics.t_reached)
+            };
             root.draw(&txt(&label, x + 6, y + 6, 12)).map_err(|e| err(e.to_string()))?;
         }
     }
