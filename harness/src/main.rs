@@ -43,6 +43,9 @@ enum Cmd {
         /// Override a case value: `[ancf:|gebf:]path=value`, e.g. `t_end=0.5` or `gebf:joints.1.flare_deg=40`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        /// Skip the refinement ladders and the stress matrix (cases only).
+        #[arg(long)]
+        quick: bool,
     },
     /// Run one case file.
     Run {
@@ -140,7 +143,7 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
         }
-        Cmd::All { cases, out, set } => {
+        Cmd::All { cases, out, set, quick } => {
             let files = discover(&cases)?;
             let (runs, errors) = expand_all(&files, &set);
             for e in &errors {
@@ -149,6 +152,27 @@ fn real_main() -> Result<ExitCode> {
             let t0 = std::time::Instant::now();
             let results = run_all(&runs, &Formulation::ALL, true);
             let wall = t0.elapsed().as_secs_f64();
+            if !quick {
+                for spec in runs.iter().filter(|r| r.ancf.converge) {
+                    let t = std::time::Instant::now();
+                    let r = converge::converge(spec, true)?;
+                    converge::write(&out.join("converge").join(&spec.name), &r)?;
+                    println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+                }
+                let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
+                if let Some(base) = base {
+                    let t = std::time::Instant::now();
+                    let spec = CaseFile::read(base).and_then(|c| c.expand(&set))?;
+                    let axes = stress::Axes::default();
+                    let cells = stress::run(&spec[0], &axes, true);
+                    stress::write(&out.join("stress"), &axes, &cells)?;
+                    for f in Formulation::ALL {
+                        let (ok, n) = stress::survival(&cells, f);
+                        println!("stress {f}: {ok} of {n} cells reach t_end");
+                    }
+                    println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
+                }
+            }
             write_reports(&out, &results).context("writing reports")?;
             print!("{}", gate::table(&results));
             let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();

@@ -410,8 +410,41 @@ fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
+/// HTML section for the studies found on disk under `out`: `converge/<case>/` and `stress/`.
+pub fn studies_html(out: &Path) -> String {
+    let mut s = String::new();
+    let conv = out.join("converge");
+    let mut names: Vec<String> = std::fs::read_dir(&conv)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter(|e| e.path().join("work_precision.svg").exists())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    if !names.is_empty() {
+        s.push_str("<h2 id=\"converge\">Speed against error: refinement ladders</h2>\n<p>Each formulation refined in time (fixed elements), in space (small fixed step) and in both (diagonal); error = max tip distance to the ladder's truth (finest rung, or a converged external reference). Tables: <code>converge.csv</code>.</p>\n");
+        for n in &names {
+            let _ = writeln!(
+                s,
+                "<h3>{0}</h3><p><a href=\"converge/{0}/converge.csv\">converge.csv</a></p><figure><img src=\"converge/{0}/work_precision.svg\" alt=\"work-precision {0}\"><figcaption>Work-precision: max tip error against wall time</figcaption></figure><figure><img src=\"converge/{0}/convergence.svg\" alt=\"convergence {0}\"><figcaption>Error against time step and against elements per body</figcaption></figure>",
+                esc(n)
+            );
+        }
+    }
+    if out.join("stress/stress_ancf.svg").exists() {
+        s.push_str("<h2 id=\"stress\">Stability on hard cases: the stress matrix</h2>\n<p><a href=\"stress/stress.csv\">stress.csv</a></p>\n");
+        for f in Formulation::ALL {
+            let _ = writeln!(s, "<figure><img src=\"stress/stress_{f}.svg\" alt=\"stress {f}\"><figcaption>Stress matrix, {f}</figcaption></figure>");
+        }
+    }
+    s
+}
+
 /// `reports/index.html`: static page with the table and every plot (no JavaScript).
-pub fn index_html(results: &[CaseResult]) -> String {
+/// `studies` is extra HTML appended after the cases (see [`studies_html`]).
+pub fn index_html(results: &[CaseResult], studies: &str) -> String {
     let mut s = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Flared-hinge verification harness</title>\n\
          <style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse;font-size:13px}\
@@ -472,6 +505,7 @@ pub fn index_html(results: &[CaseResult]) -> String {
             );
         }
     }
+    s.push_str(studies);
     s.push_str("</body></html>\n");
     s
 }
