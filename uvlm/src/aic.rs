@@ -52,6 +52,8 @@ pub(crate) struct BoundSystem {
     n_base_leg: usize,
     /// The first `n_lattice_seg` base segments are lattice edges (they carry loads).
     pub(crate) n_lattice_seg: usize,
+    /// The last `n_te_seg` lattice segments are the trailing-edge edge (unsteady mode only).
+    pub(crate) n_te_seg: usize,
     n_copies: usize,
     n_planes: usize,
     base_gamma: Vec<f64>,
@@ -98,6 +100,7 @@ impl BoundSystem {
             }
         }
         self.n_lattice_seg = fil.n_segments();
+        self.n_te_seg = 0;
         let te_ring = |j: usize| ring(m - 1, j);
         match te {
             TrailingEdge::Unsteady => {
@@ -107,6 +110,7 @@ impl BoundSystem {
                     self.inc.push([(te_ring(j), -1.0), (NONE, 0.0)]);
                 }
                 self.n_lattice_seg = fil.n_segments();
+                self.n_te_seg = n;
             }
             TrailingEdge::Steady(dir) => {
                 for j in 0..nc {
@@ -255,7 +259,11 @@ pub(crate) fn build_known_wake(
     let node = |k: usize, j: usize| (k * nc + j) as u32;
     let closed = closure_dir.is_some();
     let g = |r: isize, j: isize| -> f64 {
-        if r >= 0 && (r as usize) < len && j >= 0 && (j as usize) < n { wake.gamma(r as usize, j as usize) } else { 0.0 }
+        if r >= 0 && (r as usize) < len && j >= 0 && (j as usize) < n {
+            wake.gamma(r as usize, j as usize)
+        } else {
+            0.0
+        }
     };
     for k in 0..=len {
         // Spanwise edge at node row k: upstream edge of ring k (+Γ_k), downstream edge of ring k − 1 (−Γ_{k−1}).

@@ -75,7 +75,9 @@ pub enum UvlmError {
         area: f64,
     },
     /// A panel is non-convex, folded over or too skewed (smallest corner angle below the limit).
-    #[error("over-skewed panel (row {row}, column {column}): smallest corner angle {min_angle_deg:.3}° < {limit_deg:.3}°")]
+    #[error(
+        "over-skewed panel (row {row}, column {column}): smallest corner angle {min_angle_deg:.3}° < {limit_deg:.3}°"
+    )]
     SkewedPanel {
         /// Chordwise row of the panel.
         row: usize,

@@ -53,7 +53,7 @@ pub fn validate_planes(planes: &[ImagePlane]) -> Result<()> {
     }
     for p in planes {
         let l2 = p.normal.iter().map(|v| v * v).sum::<f64>();
-        if !(l2.is_finite() && l2 > 0.0) || !p.point.iter().all(|v| v.is_finite()) {
+        if !(l2.is_finite() && l2 > 0.0 && p.point.iter().all(|v| v.is_finite())) {
             return Err(UvlmError::InvalidParameter { field: "images.normal", value: l2 });
         }
     }
@@ -131,7 +131,10 @@ mod tests {
     #[test]
     fn image_cancels_normal_velocity_on_plane() {
         let core = CoreModel::CutOff { radius: 0.0 };
-        for plane in [ImagePlane::through_origin([0.0, 1.0, 0.0]), ImagePlane { point: [0.0, 0.0, -0.7], normal: [0.0, 0.0, 2.0] }] {
+        for plane in [
+            ImagePlane::through_origin([0.0, 1.0, 0.0]),
+            ImagePlane { point: [0.0, 0.0, -0.7], normal: [0.0, 0.0, 2.0] },
+        ] {
             let mut fil = Filaments::default();
             let a = fil.push_node([0.1, 0.3, 0.2]);
             let b = fil.push_node([0.4, 1.3, 0.25]);

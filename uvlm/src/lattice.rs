@@ -133,7 +133,10 @@ impl Lattice {
             return Err(UvlmError::TooFewChordwise { n_chordwise: 0 });
         }
         if !(spec.min_corner_angle_deg.is_finite() && (0.0..90.0).contains(&spec.min_corner_angle_deg)) {
-            return Err(UvlmError::InvalidParameter { field: "min_corner_angle_deg", value: spec.min_corner_angle_deg });
+            return Err(UvlmError::InvalidParameter {
+                field: "min_corner_angle_deg",
+                value: spec.min_corner_angle_deg,
+            });
         }
         let m = spec.n_chordwise;
         let n = stations.len() - 1;
@@ -294,7 +297,7 @@ impl Lattice {
                 let d1 = sub(g[i * nc + j], g[i * nc + j - 1]);
                 let d2 = sub(g[i * nc + j + 1], g[i * nc + j]);
                 let cos = dot(d1, d2) / (norm(d1) * norm(d2));
-                if !(cos > MAX_TURN_COS) {
+                if cos.is_nan() || cos <= MAX_TURN_COS {
                     return Err(UvlmError::NonMonotoneColumns { row: i, column: j, cos_turn: cos });
                 }
             }
@@ -304,7 +307,7 @@ impl Lattice {
                 let d1 = sub(g[i * nc + j], g[(i - 1) * nc + j]);
                 let d2 = sub(g[(i + 1) * nc + j], g[i * nc + j]);
                 let cos = dot(d1, d2) / (norm(d1) * norm(d2));
-                if !(cos > 0.0) {
+                if cos.is_nan() || cos <= 0.0 {
                     return Err(UvlmError::NonMonotoneRows { row: i, column: j, cos_turn: cos });
                 }
             }
@@ -442,7 +445,9 @@ mod tests {
     /// Stations of a flat rectangular wing along +Y with the flow along +X (x_s = Y, y_s = −X).
     fn rect(n: usize, span: f64, chord: f64) -> Vec<SpanStation> {
         let frame = Matrix3::from_columns(&[Vector3::y(), -Vector3::x(), Vector3::z()]);
-        (0..=n).map(|j| SpanStation::new(Vector3::new(0.0, span * j as f64 / n as f64, 0.0), frame, chord, 0.0)).collect()
+        (0..=n)
+            .map(|j| SpanStation::new(Vector3::new(0.0, span * j as f64 / n as f64, 0.0), frame, chord, 0.0))
+            .collect()
     }
 
     #[test]
@@ -503,7 +508,8 @@ mod tests {
         let mut lat = Lattice::from_stations(LatticeSpec::new(2), &rect(2, 2.0, 1.0)).unwrap();
         let st = rect(2, 2.0, 1.0);
         let w = Vector3::new(0.0, 0.3, 0.0);
-        let vel: Vec<StationVelocity> = st.iter().map(|_| StationVelocity { linear: Vector3::zeros(), angular: w }).collect();
+        let vel: Vec<StationVelocity> =
+            st.iter().map(|_| StationVelocity { linear: Vector3::zeros(), angular: w }).collect();
         lat.update_stations(&st, Some(&vel)).unwrap();
         for (p, v) in lat.ring_nodes().iter().zip(lat.ring_velocities()) {
             let origin_y = p[1];

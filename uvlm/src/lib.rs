@@ -47,6 +47,8 @@
 //! [`Uvlm::solve_steady`] gives the steady solution (a ring VLM); [`Uvlm::prefill_wake`] then
 //! starts an unsteady run from it instead of impulsively.
 #![warn(missing_docs)]
+// Index loops over x/y/z components and lattice indices mirror the equations they implement.
+#![allow(clippy::needless_range_loop)]
 
 mod aic;
 pub mod biot_savart;

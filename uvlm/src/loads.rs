@@ -17,6 +17,7 @@
 
 use crate::aic::BoundSystem;
 use crate::lattice::Lattice;
+use crate::params::UvlmParams;
 
 /// Loads of the last solve, on the vortex-ring nodes of the lattice.
 #[derive(Debug, Clone, Default)]
@@ -107,10 +108,9 @@ pub(crate) fn compute_loads(
     bs: &BoundSystem,
     u_mid: &[[f64; 3]],
     gamma_dot: Option<&[f64]>,
-    te_segment_force: bool,
-    rho: f64,
-    v_inf: [f64; 3],
+    params: &UvlmParams,
 ) {
+    let (rho, v_inf, te_segment_force) = (params.rho, params.v_inf, params.te_segment_force);
     let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
     let nc = n + 1;
     let nodes = lat.ring_nodes();

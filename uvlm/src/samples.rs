@@ -53,7 +53,8 @@ pub fn elliptic_half_wing(aspect_ratio: f64, c0: f64, n_span: usize) -> Vec<Span
     (0..=n_span)
         .map(|j| {
             let t = span_fraction(j, n_span, SpanSpacing::HalfCosine);
-            let t_chord = if j == n_span { 0.5 * (t + span_fraction(j - 1, n_span, SpanSpacing::HalfCosine)) } else { t };
+            let t_chord =
+                if j == n_span { 0.5 * (t + span_fraction(j - 1, n_span, SpanSpacing::HalfCosine)) } else { t };
             let c = c0 * (1.0 - t_chord * t_chord).max(0.0).sqrt();
             SpanStation::new(Vector3::new(0.0, half * t, 0.0), aero_frame(), c, 0.25 * c)
         })

@@ -149,7 +149,11 @@ impl Uvlm {
     fn stream_dir(&self) -> Result<[f64; 3]> {
         let v = self.params.v_inf;
         let vn = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if vn > 0.0 { Ok([v[0] / vn, v[1] / vn, v[2] / vn]) } else { Err(UvlmError::InvalidParameter { field: "v_inf", value: 0.0 }) }
+        if vn > 0.0 {
+            Ok([v[0] / vn, v[1] / vn, v[2] / vn])
+        } else {
+            Err(UvlmError::InvalidParameter { field: "v_inf", value: 0.0 })
+        }
     }
 
     /// Collocation points and normals into SoA buffers.
@@ -223,29 +227,38 @@ impl Uvlm {
     /// Induced velocity at the lattice segment midpoints (bound + known wake) and the loads.
     fn update_loads(&mut self, with_known_wake: bool, unsteady: bool) {
         self.mid.clear();
-        for s in 0..self.bound.n_lattice_seg {
+        // Trailing-edge segments carry no force unless asked for: skip their midpoints.
+        let n_mid = if self.params.te_segment_force {
+            self.bound.n_lattice_seg
+        } else {
+            self.bound.n_lattice_seg - self.bound.n_te_seg
+        };
+        for s in 0..n_mid {
             let (a, b) = self.bound.fil.segment_nodes(s);
             let (pa, pb) = (self.bound.fil.node(a as usize), self.bound.fil.node(b as usize));
             self.mid.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])]);
         }
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
         let pairs = if with_known_wake {
-            induced_velocity_inplace(&[&self.bound.fil, &self.known], &self.mid, &mut self.u_mid, self.params.parallel, &mut self.blk)
+            induced_velocity_inplace(
+                &[&self.bound.fil, &self.known],
+                &self.mid,
+                &mut self.u_mid,
+                self.params.parallel,
+                &mut self.blk,
+            )
         } else {
-            induced_velocity_inplace(&[&self.bound.fil], &self.mid, &mut self.u_mid, self.params.parallel, &mut self.blk)
+            induced_velocity_inplace(
+                &[&self.bound.fil],
+                &self.mid,
+                &mut self.u_mid,
+                self.params.parallel,
+                &mut self.blk,
+            )
         };
         self.stats.n_pair_evaluations += pairs;
         let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
-        compute_loads(
-            &mut self.loads,
-            &self.lattice,
-            &self.bound,
-            &self.u_mid,
-            gd,
-            self.params.te_segment_force,
-            self.params.rho,
-            self.params.v_inf,
-        );
+        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.u_mid, gd, &self.params);
     }
 
     /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM).

@@ -95,7 +95,10 @@ fn mesher_rejects_impossible_folds() {
     let w = wing();
     let err = Lattice::from_stations(w.spec(), &w.stations(170f64.to_radians())).unwrap_err();
     assert!(
-        matches!(err, UvlmError::FoldedPanels { .. } | UvlmError::NonMonotoneColumns { .. } | UvlmError::SkewedPanel { .. }),
+        matches!(
+            err,
+            UvlmError::FoldedPanels { .. } | UvlmError::NonMonotoneColumns { .. } | UvlmError::SkewedPanel { .. }
+        ),
         "{err}"
     );
     let mut st = w.stations(0.0);

@@ -100,7 +100,8 @@ fn symmetry_plane_equals_full_wing() {
     full.solve_steady().unwrap();
     half.solve_steady().unwrap();
     compare(&full, &half);
-    let plunge = |st: &[SpanStation]| vec![StationVelocity { linear: [0.0, 0.0, -0.5].into(), ..Default::default() }; st.len()];
+    let plunge =
+        |st: &[SpanStation]| vec![StationVelocity { linear: [0.0, 0.0, -0.5].into(), ..Default::default() }; st.len()];
     for _ in 0..5 {
         full.update_stations(&full_st, Some(&plunge(&full_st))).unwrap();
         half.update_stations(&half_st, Some(&plunge(&half_st))).unwrap();
