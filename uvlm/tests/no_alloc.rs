@@ -1,0 +1,61 @@
+//! The time loop does not allocate: once the wake buffer is full and every work buffer has
+//! reached its size, `update_stations` + `step` perform no heap allocation (counting allocator,
+//! single thread; prescribed and free wake, with a symmetry plane).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use uvlm::samples::FlaredWing;
+use uvlm::*;
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator and only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn step_does_not_allocate() {
+    for convection in [WakeConvection::Prescribed, WakeConvection::Free] {
+        let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+        let stations: Vec<Vec<SpanStation>> = (0..8).map(|k| wing.stations(0.02 * k as f64)).collect();
+        let vel = vec![StationVelocity::default(); stations[0].len()];
+        let lat = Lattice::from_stations(wing.spec(), &stations[0]).unwrap();
+        let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+        p.parallel = Parallel::Off;
+        p.n_wake_rows = 6;
+        p.wake_convection = convection;
+        p.wake_core = CoreModel::Scully { fraction: 0.1 };
+        p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+        let mut u = Uvlm::new(lat, p).unwrap();
+        for k in 0..8 {
+            u.update_stations(&stations[k % 8], Some(&vel)).unwrap();
+            u.step(0.01).unwrap();
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for k in 0..8 {
+            u.update_stations(&stations[7 - k], Some(&vel)).unwrap();
+            u.step(0.01).unwrap();
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert_eq!(after - before, 0, "{convection:?}: {} allocations in 8 steps", after - before);
+    }
+}
