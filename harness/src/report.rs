@@ -170,17 +170,12 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     let axis = ["X", "Y", "Z"];
     let tip_panels: Vec<Panel> = (0..3)
         .map(|k| {
+            // References first, so the formulations are drawn on top of them.
             let mut series: Vec<Series> = r
-                .runs
+                .reference_curves
                 .iter()
-                .map(|run| Series {
-                    label: label(run.formulation).into(),
-                    color: run_color(run.formulation),
-                    points: run.rows.iter().map(|x| (x.t, x.tip[k])).collect(),
-                })
-                .collect();
-            for (i, (lab, c, shift)) in r.reference_curves.iter().enumerate() {
-                series.push(Series {
+                .enumerate()
+                .map(|(i, (lab, c, shift))| Series {
                     label: lab.clone(),
                     color: colors::REFS[i % colors::REFS.len()],
                     points: c
@@ -190,8 +185,13 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                         .map(|(&t, p)| (t - shift, p[k]))
                         .filter(|&(t, _)| t >= 0.0 && t <= t_max + 1e-9)
                         .collect(),
-                });
-            }
+                })
+                .collect();
+            series.extend(r.runs.iter().map(|run| Series {
+                label: label(run.formulation).into(),
+                color: run_color(run.formulation),
+                points: run.rows.iter().map(|x| (x.t, x.tip[k])).collect(),
+            }));
             Panel {
                 title: format!("{} — tip {}", r.name, axis[k]),
                 x_label: "t [s]".into(),
@@ -436,7 +436,10 @@ pub fn studies_html(out: &Path) -> String {
     if out.join("stress/stress_ancf.svg").exists() {
         s.push_str("<h2 id=\"stress\">Stability on hard cases: the stress matrix</h2>\n<p><a href=\"stress/stress.csv\">stress.csv</a></p>\n");
         for f in Formulation::ALL {
-            let _ = writeln!(s, "<figure><img src=\"stress/stress_{f}.svg\" alt=\"stress {f}\"><figcaption>Stress matrix, {f}</figcaption></figure>");
+            let _ = writeln!(
+                s,
+                "<figure><img src=\"stress/stress_{f}.svg\" alt=\"stress {f}\"><figcaption>Stress matrix, {f}</figcaption></figure>"
+            );
         }
     }
     s
