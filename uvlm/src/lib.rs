@@ -46,6 +46,33 @@
 //! ```
 //! [`Uvlm::solve_steady`] gives the steady solution (a ring VLM); [`Uvlm::prefill_wake`] then
 //! starts an unsteady run from it instead of impulsively.
+//!
+//! ## Public API at a glance
+//! * Geometry: [`SpanStation`] `{ origin, frame, chord, le_offset, slant }` (section frame columns
+//!   `x_s` span, `y_s` towards the leading edge, `z_s` normal), [`StationVelocity`]
+//!   `{ linear, angular }`, [`LatticeSpec`] `{ n_chordwise, spacing, hinge: Option<HingeColumn
+//!   { column, flare }>, min_corner_angle_deg }`; [`Lattice::from_stations`],
+//!   [`Lattice::update_stations`], [`Lattice::set_grid`] (arbitrary node motion). The mesher
+//!   returns [`UvlmError`] for non-finite input, non-monotone or folded grids, zero-area or
+//!   over-skewed panels, a non-interior hinge column.
+//! * Solver: [`Uvlm::new`]`(lattice, `[`UvlmParams`]`)`, [`Uvlm::update_stations`] /
+//!   [`Uvlm::set_grid`], [`Uvlm::solve_steady`], [`Uvlm::step`]`(dt)`, [`Uvlm::prefill_wake`],
+//!   accessors [`Uvlm::gamma`], [`Uvlm::gamma_dot`], [`Uvlm::wake`], [`Uvlm::loads`],
+//!   [`Uvlm::stats`], [`Uvlm::velocity_at`].
+//! * Loads: [`Loads::nodal`] (per ring node, N), [`Loads::strip`] (per panel column),
+//!   [`Loads::total_force`], [`Loads::moment_about`], [`Loads::lift_drag`],
+//!   [`Loads::column_loads_inplace`] (force + moment about each station origin).
+//! * Parameters ([`UvlmParams`], serde, unknown fields rejected): `rho`, `v_inf`, `n_wake_rows`,
+//!   `wake_convection` (prescribed / free), `wake_closure`, `bound_core` / `wake_core`
+//!   ([`CoreModel`]: SHARPy cut-off or Scully core sized from the local panel), `images`
+//!   ([`ImagePlane`]: symmetry and/or ground), `te_segment_force`, `unsteady_term`, `parallel`.
+//!
+//! ## Performance
+//! Filaments are stored once per shared edge in structure-of-arrays form; the kernels evaluate
+//! blocks of 8 points, compute `P − X` and `|P − X|` once per (point, node), and are compiled for
+//! AVX-512 and AVX2 + FMA with run-time dispatch (portable fallback otherwise). The AIC is rebuilt
+//! and refactorised only when the lattice moved. Evaluations with enough work use rayon
+//! ([`Parallel::Auto`]). No heap allocation happens in a step once the wake buffer is full.
 #![warn(missing_docs)]
 // Index loops over x/y/z components and lattice indices mirror the equations they implement.
 #![allow(clippy::needless_range_loop)]

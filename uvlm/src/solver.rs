@@ -135,6 +135,24 @@ impl Uvlm {
         &self.stats
     }
 
+    /// Total velocity `V∞ + u_ind` at a point, m/s: bound rings and wake of the last solve
+    /// (images included). The bound part is zero before the first solve.
+    pub fn velocity_at(&self, p: [f64; 3]) -> [f64; 3] {
+        let mut v = self.params.v_inf;
+        let mut add = |u: [f64; 3]| {
+            for q in 0..3 {
+                v[q] += u[q];
+            }
+        };
+        if self.has_solution {
+            add(self.bound.fil.velocity_at(p));
+            if self.bound_mode == Some(Mode::Unsteady) {
+                add(self.known.velocity_at(p));
+            }
+        }
+        v
+    }
+
     /// Move the lattice to new station frames and velocities (see [`Lattice::update_stations`]).
     pub fn update_stations(&mut self, stations: &[SpanStation], velocities: Option<&[StationVelocity]>) -> Result<()> {
         self.lattice.update_stations(stations, velocities)

@@ -149,3 +149,38 @@ fn free_wake_runs_and_stays_close_to_prescribed() {
     assert!(free.is_finite());
     assert_relative_eq!(free, prescribed, max_relative = 0.05);
 }
+
+/// The boundary condition holds after every solve: the relative velocity at each collocation
+/// point, `velocity_at(c) − ẋ_c`, is tangent to the ring (steady and unsteady, moving lattice,
+/// symmetry plane, free wake).
+#[test]
+fn non_penetration_holds_at_collocation_points() {
+    let wing = FlaredWing { aoa: 6f64.to_radians(), ..FlaredWing::default() };
+    let st = wing.stations(0.3);
+    let lat = Lattice::from_stations(wing.spec(), &st).unwrap();
+    let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+    p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+    p.wake_convection = WakeConvection::Free;
+    p.wake_core = CoreModel::Scully { fraction: 0.1 };
+    let mut u = Uvlm::new(lat, p).unwrap();
+    let check = |u: &Uvlm| {
+        let lat = u.lattice();
+        for ((c, n), xd) in lat.collocation().iter().zip(lat.normals()).zip(lat.collocation_velocities()) {
+            let v = u.velocity_at(*c);
+            let vn = (0..3).map(|q| (v[q] - xd[q]) * n[q]).sum::<f64>();
+            assert!(vn.abs() < 1e-9 * 25.0, "normal relative velocity {vn:e}");
+        }
+    };
+    u.solve_steady().unwrap();
+    check(&u);
+    for k in 0..6 {
+        let fold = 0.3 + 0.02 * k as f64;
+        let vel: Vec<StationVelocity> = st
+            .iter()
+            .map(|_| StationVelocity { linear: [0.0, 0.0, 0.4].into(), angular: [0.1, 0.0, 0.0].into() })
+            .collect();
+        u.update_stations(&wing.stations(fold), Some(&vel)).unwrap();
+        u.step(0.01).unwrap();
+        check(&u);
+    }
+}
