@@ -185,3 +185,42 @@ pub(crate) fn compute_loads(
     }
     loads.total_unsteady = tu;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn lift_drag_decomposition() {
+        // Free stream along +x tilted 10° up, span along +y: lift ⊥ stream in the x-z plane.
+        let a = 10f64.to_radians();
+        let v = [a.cos(), 0.0, a.sin()];
+        let f = [0.3, 0.7, 2.0];
+        let (l, d) = lift_drag_of(f, v, [0.0, 1.0, 0.0]);
+        assert_relative_eq!(d, 0.3 * a.cos() + 2.0 * a.sin(), max_relative = 1e-14);
+        assert_relative_eq!(l, -0.3 * a.sin() + 2.0 * a.cos(), max_relative = 1e-14);
+        // Paper frame: flow along −Y, span along +X → lift along +Z.
+        let (l, d) = lift_drag_of([0.0, 0.1, 5.0], [0.0, -25.0, 0.0], [1.0, 0.0, 0.0]);
+        assert_relative_eq!(l, 5.0, max_relative = 1e-14);
+        assert_relative_eq!(d, -0.1, max_relative = 1e-14);
+    }
+
+    #[test]
+    fn column_loads_and_moment() {
+        let loads = Loads {
+            nodal: vec![[0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+            positions: vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
+            total_steady: [1.0, 0.0, 2.0],
+            ..Default::default()
+        };
+        let m = loads.moment_about([0.0; 3]);
+        // r × f: (0,1,0)×(0,0,2) = (2,0,0); (1,0,0)×(1,0,0) = 0; (1,1,0)×(0,0,−1) = (−1, 1, 0).
+        assert_eq!(m, [1.0, 1.0, 0.0]);
+        let (mut f, mut mc) = ([[0.0; 3]; 2], [[0.0; 3]; 2]);
+        loads.column_loads_inplace(&[[0.0; 3], [0.0, 1.0, 0.0]], &mut f, &mut mc);
+        assert_eq!(f, [[1.0, 0.0, 1.0], [0.0, 0.0, 1.0]]);
+        // Column 1 about (0,1,0): (1,0,0)×(0,0,−1) = (0,1,0).
+        assert_eq!(mc[1], [0.0, 1.0, 0.0]);
+    }
+}

@@ -139,3 +139,29 @@ impl FlaredWing {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn elliptic_wing_has_requested_aspect_ratio() {
+        let st = elliptic_half_wing(8.0, 1.0, 200);
+        let half_span = st.last().unwrap().origin.y;
+        let area: f64 = st.windows(2).map(|w| 0.5 * (w[0].chord + w[1].chord) * (w[1].origin.y - w[0].origin.y)).sum();
+        assert_relative_eq!((2.0 * half_span).powi(2) / (2.0 * area), 8.0, max_relative = 2e-3);
+    }
+
+    #[test]
+    fn flared_wing_hinge_and_fold_convention() {
+        let w = FlaredWing::default();
+        let a = w.hinge_axis();
+        assert_relative_eq!(a.x, 10f64.to_radians().sin(), epsilon = 1e-15);
+        // Positive fold lifts the tip towards +z; the hinge station does not move.
+        let up = w.stations(0.3);
+        let down = w.stations(-0.3);
+        assert!(up.last().unwrap().origin.z > 0.5 && down.last().unwrap().origin.z < -0.5);
+        assert_eq!(up[w.n_inner].origin, w.stations(0.0)[w.n_inner].origin);
+    }
+}

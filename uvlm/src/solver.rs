@@ -427,3 +427,40 @@ impl Uvlm {
         Ok(&self.loads)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::LatticeSpec;
+    use crate::samples::{SpanSpacing, rectangular_wing};
+
+    fn solver(v_inf: [f64; 3]) -> Uvlm {
+        let lat =
+            Lattice::from_stations(LatticeSpec::new(2), &rectangular_wing(0.0, 2.0, 1.0, 2, SpanSpacing::Uniform))
+                .unwrap();
+        Uvlm::new(lat, UvlmParams::new(1.0, v_inf)).unwrap()
+    }
+
+    #[test]
+    fn invalid_inputs_are_errors() {
+        let mut u = solver([1.0, 0.0, 0.1]);
+        assert!(matches!(u.step(0.0), Err(UvlmError::InvalidParameter { field: "dt", .. })));
+        assert!(matches!(u.step(f64::NAN), Err(UvlmError::InvalidParameter { field: "dt", .. })));
+        assert!(matches!(u.prefill_wake(-1.0), Err(UvlmError::InvalidParameter { field: "dt", .. })));
+        let mut still = solver([0.0, 0.0, 0.0]);
+        assert!(matches!(still.solve_steady(), Err(UvlmError::InvalidParameter { field: "v_inf", .. })));
+        let lat = still.lattice().clone();
+        let bad = UvlmParams { n_wake_rows: 0, ..UvlmParams::new(1.0, [1.0, 0.0, 0.0]) };
+        assert!(matches!(Uvlm::new(lat, bad), Err(UvlmError::InvalidParameter { field: "n_wake_rows", .. })));
+        assert!(matches!(u.set_grid(&[[0.0; 3]; 3], &[[0.0; 3]; 3]), Err(UvlmError::LengthMismatch { .. })));
+    }
+
+    /// A wing at zero incidence at rest in the stream carries no circulation and no load.
+    #[test]
+    fn zero_incidence_zero_load() {
+        let mut u = solver([1.0, 0.0, 0.0]);
+        u.step(0.1).unwrap();
+        assert!(u.gamma().iter().all(|g| g.abs() < 1e-15));
+        assert!(u.loads().total_force().iter().all(|f| f.abs() < 1e-15));
+    }
+}
