@@ -13,7 +13,8 @@ fn main() {
     let rho: f64 = a[5].parse().unwrap();
     let curvature = match a.get(6).map(|s| s.as_str()) {
         Some("mixed") => Curvature::Mixed,
-        _ => Curvature::Kirchhoff,
+        Some("kirchhoff") => Curvature::Kirchhoff,
+        _ => Curvature::Hybrid,
     };
     let path = match a.get(7).map(|s| s.as_str()) {
         Some("ode") => SolvePath::Ode,
@@ -38,12 +39,17 @@ fn main() {
     for b in &mut bodies {
         b.section.ga_y *= env("GAFAC", 1.0);
         b.section.ga_z *= env("GAFAC", 1.0);
+        b.section.ei_yy *= env("EIFAC", 1.0);
+        b.section.ei_zz *= env("EIFAC", 1.0);
+        b.section.gj *= env("GJFAC", 1.0);
         b.section.rho_ixx *= env("JFAC", 1.0);
         b.section.rho_iyy *= env("JFAC", 1.0);
         b.section.rho_izz *= env("JFAC", 1.0);
     }
     let penalty_factor = env("PEN", 1.0);
-    let mut model = Model::new(&bodies, &joints, g, Options { path, curvature, penalty_factor }).unwrap();
+    let shear_gradient_factor = env("KAPPA", 100.0);
+    let mut model =
+        Model::new(&bodies, &joints, g, Options { path, curvature, penalty_factor, shear_gradient_factor }).unwrap();
     let mut ga = GenAlpha::new(IntegratorParams::new(rho, dt), &model).unwrap();
     let mut s = model.initial_state();
     ga.initialize(&model, &mut s).unwrap();
@@ -55,9 +61,16 @@ fn main() {
     let e0 = model.energies(&s.q, &s.v).total();
     let (mut max_t, mut drift, mut max_res, mut max_y, mut max_fold): (f64, f64, f64, f64, f64) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for k in 0..n {
-        if let Err(e) = ga.step(&mut model, &mut s) {
-            println!("step {k}: {e}");
-            break;
+        match ga.step(&mut model, &mut s) {
+            Err(e) => {
+                println!("step {k}: {e}");
+                break;
+            }
+            Ok(st) => {
+                if std::env::var("STEPSTATS").is_ok() && (k % 200 < 5) {
+                    println!("step {k}: {st:?}");
+                }
+            }
         }
         let tip = model.tip_position(&s.q);
         if let Some(f) = out.as_mut() {
@@ -65,6 +78,17 @@ fn main() {
             writeln!(f, "{},{},{},{}", s.t, tip.x, tip.y, tip.z).unwrap();
         }
         let en = model.energies(&s.q, &s.v);
+        if std::env::var("NODES").is_ok() && (k + 1) % (n / 20) == 0 {
+            let qf = model.full_coordinates(&s.q);
+            let mut line = String::new();
+            for node in 0..qf.len() / 12 {
+                let v = |b: usize| nalgebra::Vector3::new(qf[12 * node + 3 * b], qf[12 * node + 3 * b + 1], qf[12 * node + 3 * b + 2]);
+                let eyy = 0.5 * (v(2).norm_squared() - 1.0);
+                let exx = 0.5 * (v(1).norm_squared() - 1.0);
+                line += &format!(" {:.0}/{:.0}", eyy * 1e6, exx * 1e6);
+            }
+            println!("t {:.3} eps_yy/eps_xx (1e-6) per node:{}", s.t, line);
+        }
         if std::env::var("KINDS").is_ok() && (k + 1) % (n / 20) == 0 {
             let u = model.elastic_energy_by_kind(&s.q);
             println!("t {:.3} U {:.3e} by kind {:?}", s.t, en.elastic, u.map(|x| format!("{x:.2e}")));

@@ -6,7 +6,7 @@
 
 use crate::mass::{element_mass, nonzeros};
 use crate::shape::N_BLOCKS;
-use crate::strain::{IntegrationPoint, integration_points};
+use crate::strain::{StrainPlan, strain_plan};
 use crate::{Curvature, Section};
 
 /// The element kernel shared by all elements of one body.
@@ -18,22 +18,24 @@ pub struct Element {
     pub mass: [[f64; N_BLOCKS]; N_BLOCKS],
     /// Non-zeros of `mass`.
     pub mass_nz: Vec<(usize, usize, f64)>,
-    /// Integration points with their sampled strains.
-    pub points: Vec<IntegrationPoint>,
+    /// Fields and sampled strains.
+    pub plan: StrainPlan,
     /// Mass per unit length, kg/m (for gravity and point loads).
     pub mass_per_length: f64,
 }
 
 impl Element {
     /// Build the kernel for elements of length `l`.
-    pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64) -> Self {
+    /// `penalty_factor` scales the section penalties, `kappa` the shear-gradient stabilisation
+    /// (see [`strain`](crate::strain)).
+    pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> Self {
         let (d_yy, d_zz) = section.slope_inertias();
         let mass = element_mass(section.mass, d_yy, d_zz, l);
         Self {
             l,
             mass_nz: nonzeros(&mass),
             mass,
-            points: integration_points(l, section, curvature, penalty_factor),
+            plan: strain_plan(l, section, curvature, penalty_factor, kappa),
             mass_per_length: section.mass,
         }
     }

@@ -114,12 +114,13 @@ fn classify(f: &[f64; N_STRAINS], lambda: f64) -> ModeKind {
         return ModeKind::Rigid;
     }
     let g = |k: StrainKind| f[k as usize];
+    let _ = (SectionYY, SectionZZ, SectionYZ);
     let groups = [
         (ModeKind::Axial, g(Axial)),
         (ModeKind::BendingY, g(BendY) + g(ShearZ)),
         (ModeKind::BendingZ, g(BendZ) + g(ShearY)),
         (ModeKind::Torsion, g(Twist)),
-        (ModeKind::Penalty, g(SectionYY) + g(SectionZZ) + g(SectionYZ)),
+        (ModeKind::Penalty, f.iter().zip(StrainKind::ALL).filter(|(_, k)| k.is_penalty()).map(|(x, _)| x).sum()),
     ];
     groups.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map(|x| x.0).unwrap_or(ModeKind::Rigid)
 }

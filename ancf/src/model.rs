@@ -114,7 +114,7 @@ impl Model {
                     spec: spec.clone(),
                     offset,
                     n_nodes: spec.n_elements + 1,
-                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor),
+                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor, options.shear_gradient_factor),
                 };
                 offset += NODE_DOF * b.n_nodes;
                 b
@@ -420,6 +420,13 @@ impl Model {
             }
         }
         Ok(())
+    }
+
+    /// The constant generalized external force (full coordinates), for tests that load single
+    /// nodal vectors.
+    #[cfg(test)]
+    pub(crate) fn constant_force_mut(&mut self) -> &mut [f64] {
+        &mut self.point_force
     }
 
     /// Factor on all external loads (gravity and point loads), 1 by default; the static solver

@@ -52,7 +52,8 @@ pub struct FieldWeights {
 }
 
 impl FieldWeights {
-    fn new(entries: &[(usize, f64)]) -> Self {
+    /// Weights from `(block, weight)` pairs (at most four).
+    pub fn new(entries: &[(usize, f64)]) -> Self {
         let mut w = Self { n: entries.len(), block: [0; 4], weight: [0.0; 4] };
         for (k, &(b, x)) in entries.iter().enumerate() {
             w.block[k] = b;

@@ -195,16 +195,22 @@ pub enum SolvePath {
     Ode,
 }
 
-/// Bending-curvature measure of the element (THEORY §A.3).
+/// Bending-curvature measure of the element (THEORY §A.3; details in [`strain`](crate::strain)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Curvature {
-    /// `K2 = −r_z·r_xx`, `K3 = r_y·r_xx` from the cubic centreline; transverse shear sampled
-    /// at the nodes. Euler–Bernoulli bending accuracy (exact for linear curvature).
+    /// Element-mean curvature from the rotation of the section slopes plus the zero-mean
+    /// variation of the cubic centreline; transverse shear at the two Gauss points. Joints that
+    /// hold a section take the bending moment directly; linearly varying curvature is exact.
     #[default]
+    Hybrid,
+    /// `K2 = −r_z·r_xx`, `K3 = r_y·r_xx` from the centreline alone; transverse shear at the
+    /// nodes. Accurate inside a body, but a joint holding the section reaches the centreline only
+    /// through the nodal shear (spurious joint compliance ∝ 1/(GA·l)). For comparison.
     Kirchhoff,
-    /// `K2 = ½(r_x·r_z,x − r_z·r_xx)`, `K3 = ½(r_y·r_xx − r_x·r_y,x)` (the skew part of
-    /// `FᵀF_x`); transverse shear at the element midpoint.
+    /// `K2 = ½(r_x·r_z,x − r_z·r_xx)`, `K3 = ½(r_y·r_xx − r_x·r_y,x)` (skew part of `FᵀF_x`);
+    /// transverse shear at the midpoint. Half the moment in the centreline, half in the sections;
+    /// for comparison.
     Mixed,
 }
 
@@ -214,15 +220,18 @@ pub enum Curvature {
 pub struct Options {
     /// DAE (default) or ODE form.
     pub path: SolvePath,
-    /// Curvature measure (default Kirchhoff).
+    /// Curvature measure (default Hybrid).
     pub curvature: Curvature,
     /// Factor on the cross-section penalty stiffnesses (EA, EA, GA_y + GA_z); default 1.
     pub penalty_factor: f64,
+    /// Factor κ of the shear-gradient stabilisation `½κ∫[EI_zz γ_y'² + EI_yy γ_z'² + GJ γ_yz'²]dx`
+    /// (see [`strain`](crate::strain)); default 100, 0 switches it off.
+    pub shear_gradient_factor: f64,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { path: SolvePath::Dae, curvature: Curvature::Kirchhoff, penalty_factor: 1.0 }
+        Self { path: SolvePath::Dae, curvature: Curvature::Hybrid, penalty_factor: 1.0, shear_gradient_factor: 100.0 }
     }
 }
 
@@ -231,6 +240,13 @@ impl Options {
         finite("options.penalty_factor", self.penalty_factor)?;
         if self.penalty_factor <= 0.0 {
             return Err(Error::NotPositive { field: "options.penalty_factor".into(), value: self.penalty_factor });
+        }
+        finite("options.shear_gradient_factor", self.shear_gradient_factor)?;
+        if self.shear_gradient_factor < 0.0 {
+            return Err(Error::Negative {
+                field: "options.shear_gradient_factor".into(),
+                value: self.shear_gradient_factor,
+            });
         }
         Ok(())
     }

@@ -28,5 +28,5 @@ fn report(curvature: Curvature, n: usize) {
 
 #[test]
 fn print_modes() {
-    report(Curvature::Kirchhoff, 16);
+    report(Curvature::Hybrid, 16);
 }
