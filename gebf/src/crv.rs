@@ -37,8 +37,8 @@ pub fn axial(m: &M3) -> V3 {
 
 /// Below this angle (rad) the series expansions are used.
 const SERIES_LIMIT: f64 = 1.0;
-/// Number of Taylor terms: the remainder at `phi = 1` is below 1e-25.
-const N_TERMS: usize = 12;
+/// Number of Taylor terms: the remainder at `phi = 1` is below 1e-20.
+const N_TERMS: usize = 10;
 
 /// Taylor coefficients of α(s) = Σ (−1)^{k+1} s^k/(2k+2)! (`sign = -1`, `offset = 2`) and
 /// β(s) = Σ (−1)^k s^k/(2k+3)! (`sign = 1`, `offset = 3`), differentiated `deriv` times in s.
@@ -96,37 +96,65 @@ pub struct TangentCoefficients {
 }
 
 impl TangentCoefficients {
-    /// Coefficients at the CRV `psi`.
+    /// Coefficients at the CRV `psi` (all derivatives).
     pub fn new(psi: &V3) -> Self {
+        let mut k = Self::first_order(psi);
+        (k.dda, k.ddb) = Self::second_order(psi.norm_squared());
+        k
+    }
+
+    /// α, β and their first derivatives; the second derivatives are left at zero.
+    pub fn first_order(psi: &V3) -> Self {
         let s = psi.norm_squared();
         let phi = s.sqrt();
         if phi < SERIES_LIMIT {
-            // α = Σ (−1)^{k+1} s^k/(2k+2)!,  β = Σ (−1)^k s^k/(2k+3)!
             Self {
                 a: horner(&SERIES_A, s),
                 b: horner(&SERIES_B, s),
                 da: horner(&SERIES_DA, s),
                 db: horner(&SERIES_DB, s),
-                dda: horner(&SERIES_DDA, s),
-                ddb: horner(&SERIES_DDB, s),
+                dda: 0.0,
+                ddb: 0.0,
             }
         } else {
             let (sn, c) = phi.sin_cos();
-            let p2 = s;
-            let p3 = p2 * phi;
-            let p4 = p2 * p2;
+            let p3 = s * phi;
+            let p4 = s * s;
             let p5 = p4 * phi;
-            let p6 = p4 * p2;
-            let p7 = p6 * phi;
             Self {
-                a: (c - 1.0) / p2,
+                a: (c - 1.0) / s,
                 b: (phi - sn) / p3,
                 da: -sn / (2.0 * p3) - (c - 1.0) / p4,
                 db: -1.0 / p4 - c / (2.0 * p4) + 1.5 * sn / p5,
-                dda: -c / (4.0 * p4) + 1.25 * sn / p5 + 2.0 * (c - 1.0) / p6,
-                ddb: 2.0 / p6 + sn / (4.0 * p5) + 1.75 * c / p6 - 3.75 * sn / p7,
+                dda: 0.0,
+                ddb: 0.0,
             }
         }
+    }
+
+    /// (d²α/ds², d²β/ds²) at `s = |psi|²`.
+    pub fn second_order(s: f64) -> (f64, f64) {
+        let phi = s.sqrt();
+        if phi < SERIES_LIMIT {
+            (horner(&SERIES_DDA, s), horner(&SERIES_DDB, s))
+        } else {
+            let (sn, c) = phi.sin_cos();
+            let p4 = s * s;
+            let p5 = p4 * phi;
+            let p6 = p4 * s;
+            let p7 = p6 * phi;
+            (
+                -c / (4.0 * p4) + 1.25 * sn / p5 + 2.0 * (c - 1.0) / p6,
+                2.0 / p6 + sn / (4.0 * p5) + 1.75 * c / p6 - 3.75 * sn / p7,
+            )
+        }
+    }
+
+    /// The rotation matrix `C(psi) = I + (1 − s β) psĩ − α psĩ²` from the same coefficients.
+    #[inline]
+    pub fn rotation(&self, psi: &V3) -> M3 {
+        let p = skew(psi);
+        M3::identity() + p * (1.0 - psi.norm_squared() * self.b) - p * p * self.a
     }
 }
 
@@ -222,7 +250,7 @@ fn tangent_second_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3, b:
 pub struct Tangent {
     /// The CRV.
     pub psi: V3,
-    /// Scalar coefficients.
+    /// Scalar coefficients (first order; the second derivatives are evaluated on demand).
     pub k: TangentCoefficients,
     /// `T(psi)`.
     pub t: M3,
@@ -231,8 +259,13 @@ pub struct Tangent {
 impl Tangent {
     /// Evaluate at `psi`.
     pub fn new(psi: &V3) -> Self {
-        let k = TangentCoefficients::new(psi);
+        let k = TangentCoefficients::first_order(psi);
         Self { psi: *psi, k, t: tangent_with(psi, &k, 1.0) }
+    }
+    /// The rotation matrix `C(psi)` (C^{AB}), from the same coefficients.
+    #[inline]
+    pub fn rotation(&self) -> M3 {
+        self.k.rotation(&self.psi)
     }
     /// `dT[b] = Σ_j b_j ∂T/∂psi_j`, so that `dT[b] a = ∂(T a)/∂psi · b`.
     pub fn dir(&self, b: &V3) -> M3 {
@@ -246,16 +279,22 @@ impl Tangent {
     pub fn jac_t(&self, b: &V3) -> M3 {
         tangent_jacobian_with(&self.psi, &self.k, -1.0, b)
     }
+    fn full(&self) -> TangentCoefficients {
+        let mut k = self.k;
+        (k.dda, k.ddb) = TangentCoefficients::second_order(self.psi.norm_squared());
+        k
+    }
     /// `∂/∂psi [dT[b] a]` (a, b fixed).
     pub fn second(&self, a: &V3, b: &V3) -> M3 {
-        tangent_second_with(&self.psi, &self.k, 1.0, a, b)
+        tangent_second_with(&self.psi, &self.full(), 1.0, a, b)
     }
     /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar `mᵀ T(psi) a` (symmetric).
     pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
+        let k = self.full();
         let mut h = M3::zeros();
         for j in 0..3 {
             // Row j: mᵀ ∂/∂psi (dT[e_j] a).
-            let s = tangent_second_with(&self.psi, &self.k, 1.0, a, &V3::ith(j, 1.0));
+            let s = tangent_second_with(&self.psi, &k, 1.0, a, &V3::ith(j, 1.0));
             let row = m.transpose() * s;
             h.set_row(j, &row);
         }

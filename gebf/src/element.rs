@@ -97,21 +97,6 @@ impl ElementState {
     }
 }
 
-/// Global tangent index of each local 3-block (8 blocks: node k R, node k psi, v_A, omega_A);
-/// `None` for the clamped node 0.
-pub(crate) fn local_blocks(body: &Body, e: usize) -> [Option<usize>; 8] {
-    let mut b = [None; 8];
-    for k in 0..3 {
-        if let Some(d) = body.node_dof(2 * e + k) {
-            b[2 * k] = Some(d);
-            b[2 * k + 1] = Some(d + 3);
-        }
-    }
-    b[6] = Some(body.frame_dof());
-    b[7] = Some(body.frame_dof() + 3);
-    b
-}
-
 /// Add a 3-vector into a local vector at `off`.
 #[inline]
 pub(crate) fn add3(v: &mut Vec24, off: usize, x: &V3) {

@@ -16,7 +16,7 @@
 //! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, rotation_matrix, skew};
+use crate::crv::{M3, Tangent, skew};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
 
 /// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
@@ -60,7 +60,7 @@ pub(crate) fn add_inertia(
         // Rotation.
         let tg = Tangent::new(&psi);
         let t = tg.t;
-        let cba = rotation_matrix(&psi).transpose();
+        let cba = tg.rotation().transpose();
         let om_r = t * psid;
         let cw = cba * w;
         let om = om_r + cw;

@@ -75,7 +75,7 @@ pub(crate) fn add_load_tangent(
     k.add_block::<3, 3>(f + 3, f + 3, &(-(skew(&ri) * fat) - mat));
     if let Some(d) = body.node_dof(i) {
         let tg = Tangent::new(&psi);
-        let cba = rotation_matrix(&psi).transpose();
+        let cba = tg.rotation().transpose();
         let mb = cba * ma;
         k.add_block::<3, 3>(d, f + 3, &(-fat));
         k.add_block::<3, 3>(f + 3, d, &fat);

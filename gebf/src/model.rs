@@ -4,7 +4,7 @@
 use crate::body::Body;
 use crate::clamp::Clamp;
 use crate::crv::{M3, V3, rotation_matrix};
-use crate::element::{ElementState, Mat24, Vec24, local_blocks};
+use crate::element::{ElementState, Mat24, V_OFF, Vec24};
 use crate::flared_hinge::FlaredHinge;
 use crate::gravity::{add_gravity, potential};
 use crate::ground_hinge::GroundHinge;
@@ -54,6 +54,31 @@ pub struct Model {
     n_loaded: usize,
     /// Factor on gravity and nodal loads (load stepping in statics).
     pub(crate) load_scale: f64,
+}
+
+/// The element's local unknowns as two contiguous global ranges: (first local index, first
+/// global index, length) for its nodes (node 0 is skipped) and for the frame.
+fn local_ranges(b: &Body, e: usize) -> [(usize, usize, usize); 2] {
+    let nodes = if e == 0 {
+        (6, b.node_dof(1).expect("node 1 exists"), 12)
+    } else {
+        (0, b.node_dof(2 * e).expect("e ≥ 1"), 18)
+    };
+    [nodes, (V_OFF, b.frame_dof(), 6)]
+}
+
+/// Add an element matrix into the global view (column by column, contiguous row ranges).
+fn scatter_matrix(b: &Body, e: usize, mat: &Mat24, k: &mut MatView<'_>) {
+    let ranges = local_ranges(b, e);
+    let data = mat.as_slice();
+    for &(lc, gc, nc) in &ranges {
+        for c in 0..nc {
+            let col = &data[24 * (lc + c)..24 * (lc + c + 1)];
+            for &(lr, gr, nr) in &ranges {
+                k.add_slice(gr, gc + c, nr, 1, &col[lr..lr + nr], 1.0);
+            }
+        }
+    }
 }
 
 fn check_body(field: String, b: usize, n_bodies: usize) -> Result<(), Error> {
@@ -450,16 +475,14 @@ impl ConstrainedSystem for Model {
         for b in &self.bodies {
             let g_a = self.gravity_in_frame(b, q);
             for e in 0..b.n_elements {
-                res.fill(0.0);
+                res.as_mut_slice().fill(0.0);
                 let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
                 add_inertia(&st, b.le, &b.section, &mut res, None);
                 add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
                 add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
-                for (blk, g) in local_blocks(b, e).iter().enumerate() {
-                    if let Some(g) = g {
-                        for c in 0..3 {
-                            r[g + c] += res[3 * blk + c];
-                        }
+                for (lr, gr, nr) in local_ranges(b, e) {
+                    for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
+                        *x += y;
                     }
                 }
             }
@@ -492,22 +515,14 @@ impl ConstrainedSystem for Model {
         for b in &self.bodies {
             let g_a = self.gravity_in_frame(b, q);
             for e in 0..b.n_elements {
-                mat.fill(0.0);
+                mat.as_mut_slice().fill(0.0);
                 let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
                 add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
                 if c_k != 0.0 {
                     add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut mat, c_k)));
                     add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
                 }
-                let blocks = local_blocks(b, e);
-                for (bi, gi) in blocks.iter().enumerate() {
-                    let Some(gi) = gi else { continue };
-                    for (bj, gj) in blocks.iter().enumerate() {
-                        let Some(gj) = gj else { continue };
-                        let blk: M3 = mat.fixed_view::<3, 3>(3 * bi, 3 * bj).into_owned();
-                        k.add_block::<3, 3>(*gi, *gj, &blk);
-                    }
-                }
+                scatter_matrix(b, e, &mat, k);
             }
         }
         if self.n_loaded > 0 && c_k != 0.0 {
@@ -559,6 +574,12 @@ impl ConstrainedSystem for Model {
                 self.joints[j].project(&self.bodies, q, [&mut *v, &mut *v_dot, &mut *a]);
             }
         }
+    }
+
+    /// Each body's nodal unknowns form a band block (an element couples 3 consecutive nodes:
+    /// half-bandwidth 17); the frame velocities and the joint rows form the border.
+    fn matrix_structure(&self) -> Option<genalpha::BandedBorder> {
+        Some(genalpha::BandedBorder { blocks: self.bodies.iter().map(|b| (b.dof0, 12 * b.n_elements, 17)).collect() })
     }
 
     /// Positions in m weigh 1; rotations weigh the body length (a rotation δ moves the far end

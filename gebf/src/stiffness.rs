@@ -16,7 +16,7 @@
 //! `C^{AB}`, `T`, `D` at fixed `N`, `M` (which needs the Hessian of `Mᵀ T(psi) psi'`).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, V3, rotation_matrix, skew};
+use crate::crv::{M3, Tangent, V3, skew};
 use crate::element::{ElementState, Mat24, Vec24, add3, add33, gauss_rule, interp, shape};
 
 /// Add the elastic forces of one element to `res` (and `c_k ×` their tangent to `mat`);
@@ -43,7 +43,7 @@ pub(crate) fn add_elastic(
         let psi_p = interp(&dn, &st.psi);
         let tg = Tangent::new(&psi);
         let t = tg.t;
-        let c = rotation_matrix(&psi).transpose(); // C^{BA}
+        let c = tg.rotation().transpose(); // C^{BA}
         let e = c * r_p;
         let gamma = e - ex;
         let kappa = t * psi_p;

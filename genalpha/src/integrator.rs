@@ -59,6 +59,9 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     b_mat: DenseMatrix,
     phi_q_ready: bool,
     have_factorization: bool,
+    /// Steps left during which the factorisation is refreshed at each step's predictor, because
+    /// a factorisation reused from an earlier step recently failed to contract.
+    refresh_steps_left: usize,
     rhs: Vec<f64>,
     r: Vec<f64>,
     phi: Vec<f64>,
@@ -81,6 +84,9 @@ impl GenAlpha<DenseLu> {
         Self::with_solver(params, sys, DenseLu::default())
     }
 }
+
+/// Steps during which the factorisation is refreshed at the predictor after a reused one failed.
+const REFRESH_STEPS: usize = 10;
 
 fn copy_state(from: &State, to: &mut State) {
     to.t = from.t;
@@ -107,6 +113,9 @@ impl<L: LinearSolver> GenAlpha<L> {
         let (n, n_h, n_v, n_q) = (sys.n_dof(), sys.n_holonomic(), sys.n_velocity_constraints(), sys.n_coords());
         let n_all = n + n_h + n_v;
         solver.set_dimension(n_all);
+        if let Some(st) = sys.matrix_structure() {
+            solver.set_structure(&st);
+        }
         Ok(Self {
             params,
             c: params.coefficients(),
@@ -119,6 +128,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             b_mat: DenseMatrix::zeros(n_v, n),
             phi_q_ready: false,
             have_factorization: false,
+            refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
             r: vec![0.0; n],
             phi: vec![0.0; n_h],
@@ -331,6 +341,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
             if iter > 1 && inc_norm <= 1.0 && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
                 stats.n_newton_iters = iter - 1;
+                self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);
                 s.t = t1;
                 sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
                 return Ok(stats);
@@ -349,15 +360,22 @@ impl<L: LinearSolver> GenAlpha<L> {
                     self.hdelta[i] = h * self.delta[i];
                 }
                 self.have_factorization = false;
+                self.refresh_steps_left = REFRESH_STEPS;
                 inc_norm = f64::INFINITY;
                 prev_inc = f64::INFINITY;
                 continue;
             }
             let need = !np.reuse_factorization
                 || !self.have_factorization
+                || (iter == 1 && self.refresh_steps_left > 0)
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
                 || (iter > 4 && !fresh);
             if need {
+                if iter > 1 && !factorized_this_step {
+                    // The matrix of an earlier step did not contract: the matrix changes fast,
+                    // so refresh it at the predictor for the next steps.
+                    self.refresh_steps_left = REFRESH_STEPS;
+                }
                 self.assemble(sys, t1, s);
                 self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })?;
                 self.have_factorization = true;

@@ -22,6 +22,7 @@
 //! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
 #![warn(missing_docs)]
 
+mod banded;
 mod error;
 mod integrator;
 mod linear_solver;
@@ -30,6 +31,7 @@ mod params;
 mod stats;
 mod system;
 
+pub use banded::BandedBorder;
 pub use error::Error;
 pub use integrator::{GenAlpha, State};
 pub use linear_solver::{DenseLu, LinearSolver};

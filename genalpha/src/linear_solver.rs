@@ -2,6 +2,7 @@
 //! solve in place. faer types never leave this file.
 
 use crate::DenseMatrix;
+use crate::banded::{BandedBorder, BorderedBandLu};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::{PartialPivLuParams, lu_in_place, lu_in_place_scratch};
 use faer::linalg::lu::partial_pivoting::solve::{solve_in_place, solve_in_place_scratch};
@@ -12,6 +13,8 @@ use faer::{Mat, MatMut, MatRef, Par, Spec};
 pub trait LinearSolver {
     /// Prepare for matrices of dimension `n` (symbolic analysis; called once per topology).
     fn set_dimension(&mut self, n: usize);
+    /// The structure the system declared (called after `set_dimension`). Default: ignored.
+    fn set_structure(&mut self, _structure: &BandedBorder) {}
     /// Factorise `a`. Returns the first zero pivot row if `a` is singular.
     fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize>;
     /// Overwrite `b` with `A⁻¹ b` for the last factorised `A`.
@@ -19,8 +22,17 @@ pub trait LinearSolver {
 }
 
 /// Dense LU with partial pivoting (faer, sequential, in place, no allocation after set-up).
+///
+/// If the system declares a [`BandedBorder`] structure, the matrix is factorised by the
+/// bordered band LU instead (block-banded part without pivoting, dense Schur complement of the
+/// border); a tiny band pivot makes that factorisation fall back to the dense one.
 pub struct DenseLu {
     n: usize,
+    structured: Option<BorderedBandLu>,
+    /// The structure was checked against an actual matrix.
+    structure_checked: bool,
+    /// The last factorisation is the structured one.
+    use_structured: bool,
     lu: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -37,6 +49,9 @@ impl Default for DenseLu {
     fn default() -> Self {
         Self {
             n: 0,
+            structured: None,
+            structure_checked: false,
+            use_structured: false,
             lu: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
@@ -58,8 +73,29 @@ impl LinearSolver for DenseLu {
         self.buf = MemBuffer::new(req);
     }
 
+    fn set_structure(&mut self, structure: &BandedBorder) {
+        self.structured = structure.is_valid(self.n).then(|| BorderedBandLu::new(self.n, structure));
+        self.structure_checked = false;
+    }
+
     fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize> {
         assert!(a.n_rows() == self.n && a.n_cols() == self.n, "factorize: dimension mismatch");
+        if let Some(s) = &mut self.structured {
+            if !self.structure_checked {
+                self.structure_checked = true;
+                if !s.fits(a) {
+                    self.structured = None;
+                }
+            }
+        }
+        if let Some(s) = &mut self.structured {
+            debug_assert!(s.fits(a), "the matrix does not fit the declared structure");
+            if s.factorize(a).is_ok() {
+                self.use_structured = true;
+                return Ok(());
+            }
+        }
+        self.use_structured = false;
         let src = MatRef::from_column_major_slice(a.as_slice(), self.n, self.n);
         self.lu.copy_from(src);
         let stack = MemStack::new(&mut self.buf);
@@ -76,6 +112,12 @@ impl LinearSolver for DenseLu {
 
     fn solve_in_place(&mut self, b: &mut [f64]) {
         assert!(b.len() == self.n, "solve: dimension mismatch");
+        if self.use_structured {
+            if let Some(s) = &mut self.structured {
+                s.solve_in_place(b);
+                return;
+            }
+        }
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, self.n);
         let rhs = MatMut::from_column_major_slice_mut(b, self.n, 1);
         let stack = MemStack::new(&mut self.buf);

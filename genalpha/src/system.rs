@@ -1,6 +1,6 @@
 //! The trait a structural model implements.
 
-use crate::MatView;
+use crate::{BandedBorder, MatView};
 
 /// A constrained second-order system
 ///
@@ -92,6 +92,14 @@ pub trait ConstrainedSystem {
     /// position-level projection, renormalisation. `q`, `v`, `v_dot`, `a` may be changed
     /// consistently. Default: nothing.
     fn post_step(&mut self, _t: f64, _q: &mut [f64], _v: &mut [f64], _v_dot: &mut [f64], _a: &mut [f64]) {}
+
+    /// Optional sparsity of the iteration matrix: diagonal blocks of unknowns that couple only
+    /// within a band and to the remaining unknowns (the border; all constraint rows belong to
+    /// it). The default dense LU then factorises by Schur complement on the border. Default:
+    /// none (dense).
+    fn matrix_structure(&self) -> Option<BandedBorder> {
+        None
+    }
 
     /// Weight of tangent component `i` in the increment norm: 1 for positions in metres; a
     /// characteristic length for dimensionless coordinates (slopes, rotations). Default 1.
