@@ -382,7 +382,7 @@ macro_rules! kernels {
                 let r1 = &r[fil.seg_a[s] as usize];
                 let r2 = &r[fil.seg_b[s] as usize];
                 let (g, core2, cut2) = (fil.seg_g[s], fil.seg_core2[s], fil.seg_cut2[s]);
-                let out = &mut infl[s];
+                let mut out = [0.0; LANES];
                 for l in 0..LANES {
                     let (c, k) = pair(
                         [r1[0][l], r1[1][l], r1[2][l]],
@@ -394,15 +394,17 @@ macro_rules! kernels {
                     );
                     out[l] = g * k * (c[0] * nx[l] + c[1] * ny[l] + c[2] * nz[l]);
                 }
+                infl[s] = out;
             }
             for j in 0..fil.n_legs() {
                 let rr = &r[fil.leg_a[j] as usize];
                 let (d, g, core2, cut2) = (fil.leg_d[j], fil.leg_g[j], fil.leg_core2[j], fil.leg_cut2[j]);
-                let out = &mut infl[ns + j];
+                let mut out = [0.0; LANES];
                 for l in 0..LANES {
                     let (c, k) = leg([rr[0][l], rr[1][l], rr[2][l]], rr[3][l], d, core2, cut2);
                     out[l] = g * k * (c[0] * nx[l] + c[1] * ny[l] + c[2] * nz[l]);
                 }
+                infl[ns + j] = out;
             }
         }
     };
