@@ -711,4 +711,69 @@ mod tests {
             }
         }
     }
+
+    /// Every compiled instruction-set variant (portable, AVX2, AVX-512 when the CPU has them)
+    /// gives the same block velocities and influences.
+    #[test]
+    fn all_isa_variants_agree() {
+        let mut fil = Filaments::default();
+        let core = CoreModel::CutOff { radius: 1e-3 };
+        for i in 0..30 {
+            let t = i as f64 * 0.21;
+            fil.push_node([t.cos(), t.sin(), 0.1 * t]);
+        }
+        for i in 0..29u32 {
+            fil.push_segment(i, i + 1, 1.0 + 0.1 * i as f64, &core);
+        }
+        fil.push_leg(5, [1.0, 0.0, 0.0], -0.3, &core, 0.2);
+        let px = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8];
+        let (py, pz) = ([0.3; LANES], [-0.2; LANES]);
+        let n = [0.0, 0.0, 1.0];
+        let (nx, ny, nz) = ([n[0]; LANES], [n[1]; LANES], [n[2]; LANES]);
+        let run = |fill: &dyn Fn(&mut NodeBlock),
+                   vel: &dyn Fn(&NodeBlock, &mut [[f64; LANES]; 3]),
+                   infl: &dyn Fn(&mut NodeBlock)| {
+            let mut blk = NodeBlock::default();
+            fill(&mut blk);
+            let mut u = [[0.0; LANES]; 3];
+            vel(&blk, &mut u);
+            infl(&mut blk);
+            (u, blk.infl.clone())
+        };
+        let reference = run(&|b| fill_generic(&fil, &px, &py, &pz, b), &|b, u| velocity_generic(&fil, b, u), &|b| {
+            influence_generic(&fil, b, &nx, &ny, &nz)
+        });
+        let mut variants = Vec::new();
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: features detected above.
+                variants.push(run(
+                    &|b| unsafe { fill_avx2(&fil, &px, &py, &pz, b) },
+                    &|b, u| unsafe { velocity_avx2(&fil, b, u) },
+                    &|b| unsafe { influence_avx2(&fil, b, &nx, &ny, &nz) },
+                ));
+            }
+            if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: features detected above.
+                variants.push(run(
+                    &|b| unsafe { fill_avx512(&fil, &px, &py, &pz, b) },
+                    &|b, u| unsafe { velocity_avx512(&fil, b, u) },
+                    &|b| unsafe { influence_avx512(&fil, b, &nx, &ny, &nz) },
+                ));
+            }
+        }
+        for (u, infl) in &variants {
+            for k in 0..3 {
+                for l in 0..LANES {
+                    assert_relative_eq!(u[k][l], reference.0[k][l], max_relative = 1e-12, epsilon = 1e-14);
+                }
+            }
+            for (a, b) in infl.iter().zip(&reference.1) {
+                for l in 0..LANES {
+                    assert_relative_eq!(a[l], b[l], max_relative = 1e-12, epsilon = 1e-14);
+                }
+            }
+        }
+    }
 }
