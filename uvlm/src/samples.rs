@@ -82,6 +82,10 @@ pub struct FlaredWing {
     pub flare: f64,
     /// Angle of attack: nose-up pitch of the whole wing about +X, rad.
     pub aoa: f64,
+    /// Blend the slant over this many columns on each side of the hinge (UVLM.md §4.5): column at
+    /// distance d gets slant β·(1 − d/(blend + 1)). 0 = only the hinge column is slanted; needed
+    /// when tanβ·c/2 approaches the panel width (fine spanwise meshes).
+    pub blend_columns: usize,
 }
 
 impl Default for FlaredWing {
@@ -95,6 +99,7 @@ impl Default for FlaredWing {
             n_chordwise: 4,
             flare: 10f64.to_radians(),
             aoa: 0.0,
+            blend_columns: 0,
         }
     }
 }
@@ -125,16 +130,21 @@ impl FlaredWing {
         let axis = Unit::new_normalize(-self.hinge_axis());
         let rot = Rotation3::from_axis_angle(&axis, fold);
         let n = self.n_inner + self.n_outer;
+        let slant = |j: usize| {
+            let d = j.abs_diff(self.n_inner);
+            if d <= self.blend_columns { self.flare * (1.0 - d as f64 / (self.blend_columns + 1) as f64) } else { 0.0 }
+        };
         (0..=n)
             .map(|j| {
-                if j <= self.n_inner {
+                let station = if j <= self.n_inner {
                     let x = self.inner_length * j as f64 / self.n_inner as f64;
                     SpanStation::new(Vector3::new(x, 0.0, 0.0), frame, self.chord, 0.5 * self.chord)
                 } else {
                     let x = self.inner_length + self.outer_length * (j - self.n_inner) as f64 / self.n_outer as f64;
                     let o = hinge + rot * (Vector3::new(x, 0.0, 0.0) - hinge);
                     SpanStation::new(o, rot.matrix() * frame, self.chord, 0.5 * self.chord)
-                }
+                };
+                SpanStation { slant: slant(j), ..station }
             })
             .collect()
     }

@@ -138,3 +138,25 @@ fn column_loads_conserve_force_and_moment() {
         assert_relative_eq!(mm[q], m0[q], max_relative = 1e-10, epsilon = 1e-8);
     }
 }
+
+/// On a fine spanwise mesh (panel width 1/16 m < tanβ·c/2 = 0.088 m) a single slanted column
+/// crosses its neighbours: the mesher rejects it. Blending the slant over the neighbouring columns
+/// gives a valid lattice whose lift equals that of the unflared mesh of the same flat wing.
+#[test]
+fn fine_mesh_needs_blended_slant() {
+    let fine = FlaredWing { n_inner: 192, n_outer: 64, ..wing() };
+    let err = Lattice::from_stations(fine.spec(), &fine.stations(0.0)).unwrap_err();
+    assert!(
+        matches!(err, UvlmError::SkewedPanel { .. } | UvlmError::NonMonotoneColumns { .. } | UvlmError::DegeneratePanel { .. }),
+        "{err}"
+    );
+    let blended = FlaredWing { blend_columns: 4, ..fine };
+    let lift = |w: &FlaredWing, fold: f64| {
+        let lat = Lattice::from_stations(w.spec(), &w.stations(fold)).unwrap();
+        let mut u = Uvlm::new(lat, UvlmParams::new(0.0889, [0.0, -25.0, 0.0])).unwrap();
+        u.solve_steady().unwrap().total_force()[2]
+    };
+    let unflared = FlaredWing { flare: 0.0, ..fine };
+    assert_relative_eq!(lift(&blended, 0.0), lift(&unflared, 0.0), max_relative = 1e-3);
+    assert!(lift(&blended, 0.5).is_finite());
+}
