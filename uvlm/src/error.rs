@@ -122,6 +122,14 @@ pub enum UvlmError {
         /// Row of the first zero pivot.
         pivot: usize,
     },
+    /// The phases of a step were called out of order.
+    #[error("`{call}` called out of order: `{expected}` must come first")]
+    StepOrder {
+        /// The offending call.
+        call: &'static str,
+        /// The call that must precede it.
+        expected: &'static str,
+    },
     /// The circulation solution stopped being finite.
     #[error("non-finite circulation at step {step}")]
     NonFiniteSolution {

@@ -56,7 +56,9 @@
 //!   returns [`UvlmError`] for non-finite input, non-monotone or folded grids, zero-area or
 //!   over-skewed panels, a non-interior hinge column.
 //! * Solver: [`Uvlm::new`]`(lattice, `[`UvlmParams`]`)`, [`Uvlm::update_stations`] /
-//!   [`Uvlm::set_grid`], [`Uvlm::solve_steady`], [`Uvlm::step`]`(dt)`, [`Uvlm::prefill_wake`],
+//!   [`Uvlm::set_grid`], [`Uvlm::solve_steady`], [`Uvlm::step`]`(dt)` — or, for sub-iterated
+//!   (strongly coupled) steps, [`Uvlm::advance_wake`]`(dt)` once, then [`Uvlm::solve_step`] as
+//!   often as needed, then [`Uvlm::commit_step`] — [`Uvlm::prefill_wake`],
 //!   accessors [`Uvlm::gamma`], [`Uvlm::gamma_dot`], [`Uvlm::wake`], [`Uvlm::loads`],
 //!   [`Uvlm::stats`], [`Uvlm::velocity_at`].
 //! * Loads: [`Loads::nodal`] (per ring node, N), [`Loads::strip`] (per panel column),

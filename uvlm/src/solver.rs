@@ -62,6 +62,8 @@ pub struct Uvlm {
     blk: NodeBlock,
     loads: Loads,
     stats: Stats,
+    pending_dt: Option<f64>,
+    solved_pending: bool,
 }
 
 impl Uvlm {
@@ -101,6 +103,8 @@ impl Uvlm {
             blk: NodeBlock::default(),
             loads: Loads::default(),
             stats: Stats::default(),
+            pending_dt: None,
+            solved_pending: false,
             lattice,
             params,
         })
@@ -282,6 +286,9 @@ impl Uvlm {
     /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM).
     /// Does not touch the wake or the unsteady history.
     pub fn solve_steady(&mut self) -> Result<&Loads> {
+        if self.pending_dt.is_some() {
+            return Err(UvlmError::StepOrder { call: "solve_steady", expected: "commit_step" });
+        }
         let t0 = Instant::now();
         self.prepare_aic(Mode::Steady)?;
         self.solve_gamma(false)?;
@@ -299,6 +306,9 @@ impl Uvlm {
     pub fn prefill_wake(&mut self, dt: f64) -> Result<()> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(UvlmError::InvalidParameter { field: "dt", value: dt });
+        }
+        if self.pending_dt.is_some() {
+            return Err(UvlmError::StepOrder { call: "prefill_wake", expected: "commit_step" });
         }
         let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         let v = self.params.v_inf;
@@ -376,25 +386,55 @@ impl Uvlm {
         }
     }
 
-    /// Advance one time step of length `dt` (s). The lattice must already be at the new time.
+    /// Advance one time step of length `dt` (s): [`Uvlm::advance_wake`], [`Uvlm::solve_step`],
+    /// [`Uvlm::commit_step`]. The lattice must already be at the new time.
     pub fn step(&mut self, dt: f64) -> Result<&Loads> {
+        self.advance_wake(dt)?;
+        self.solve_step()?;
+        self.commit_step()?;
+        Ok(&self.loads)
+    }
+
+    /// First phase of a step: convect the wake over `dt` (s) and shed the trailing-edge row of
+    /// the last committed step. For strongly coupled (sub-iterated) runs call this once per time
+    /// step, then [`Uvlm::update_stations`] + [`Uvlm::solve_step`] as often as needed, then
+    /// [`Uvlm::commit_step`].
+    pub fn advance_wake(&mut self, dt: f64) -> Result<()> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(UvlmError::InvalidParameter { field: "dt", value: dt });
         }
+        if self.pending_dt.is_some() {
+            return Err(UvlmError::StepOrder { call: "advance_wake", expected: "commit_step" });
+        }
         let t0 = Instant::now();
         let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
-        // 1–2. Convect, then shed the previous trailing edge as the newest wake row.
         self.convect(dt);
         for j in 0..n {
-            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
+            self.gamma_row[j] = self.gamma_prev_te(m, j);
         }
         self.wake.push_front(&self.prev_te, &self.gamma_row);
-        // 3. AIC.
+        self.pending_dt = Some(dt);
+        self.stats.wall_time += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Circulation of trailing-edge ring `j` at the last committed solve.
+    fn gamma_prev_te(&self, m: usize, j: usize) -> f64 {
+        self.gamma[self.lattice.ring_index(m - 1, j)]
+    }
+
+    /// Second phase: solve the current step for the lattice as it is now (AIC if it moved, known
+    /// wake, circulations, dΓ/dt by backward differences against the committed history, loads).
+    /// May be repeated within one step (sub-iterations).
+    pub fn solve_step(&mut self) -> Result<&Loads> {
+        let Some(dt) = self.pending_dt else {
+            return Err(UvlmError::StepOrder { call: "solve_step", expected: "advance_wake" });
+        };
+        let t0 = Instant::now();
+        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         self.prepare_aic(Mode::Unsteady)?;
-        // 4. Known wake (rows ≥ 1), solve, implicit Kutta.
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
-        let nc = n + 1;
-        let te = &self.lattice.ring_nodes()[m * nc..];
+        let te = &self.lattice.ring_nodes()[m * (n + 1)..];
         build_known_wake(
             &mut self.known,
             te,
@@ -405,9 +445,7 @@ impl Uvlm {
             &self.params.images,
         );
         self.solve_gamma(true)?;
-        // 5. dΓ/dt and loads.
-        let nr = self.gamma.len();
-        for r in 0..nr {
+        for r in 0..self.gamma.len() {
             self.gamma_dot[r] = if self.n_history >= 2 {
                 (3.0 * self.gamma[r] - 4.0 * self.gamma_prev[r] + self.gamma_prev2[r]) / (2.0 * dt)
             } else {
@@ -415,16 +453,28 @@ impl Uvlm {
             };
         }
         self.update_loads(true, true);
-        // History.
+        self.solved_pending = true;
+        self.stats.wall_time += t0.elapsed().as_secs_f64();
+        Ok(&self.loads)
+    }
+
+    /// Third phase: accept the last [`Uvlm::solve_step`] as the state at the new time (history
+    /// for dΓ/dt, trailing-edge row to shed next).
+    pub fn commit_step(&mut self) -> Result<()> {
+        if self.pending_dt.is_none() || !self.solved_pending {
+            return Err(UvlmError::StepOrder { call: "commit_step", expected: "solve_step" });
+        }
+        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         std::mem::swap(&mut self.gamma_prev2, &mut self.gamma_prev);
         self.gamma_prev.copy_from_slice(&self.gamma);
         self.n_history += 1;
         for j in 0..=n {
             self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
         }
+        self.pending_dt = None;
+        self.solved_pending = false;
         self.stats.n_steps += 1;
-        self.stats.wall_time += t0.elapsed().as_secs_f64();
-        Ok(&self.loads)
+        Ok(())
     }
 }
 
@@ -453,6 +503,43 @@ mod tests {
         let bad = UvlmParams { n_wake_rows: 0, ..UvlmParams::new(1.0, [1.0, 0.0, 0.0]) };
         assert!(matches!(Uvlm::new(lat, bad), Err(UvlmError::InvalidParameter { field: "n_wake_rows", .. })));
         assert!(matches!(u.set_grid(&[[0.0; 3]; 3], &[[0.0; 3]; 3]), Err(UvlmError::LengthMismatch { .. })));
+    }
+
+    /// Sub-iterations: the result of a step depends only on the committed state and the final
+    /// lattice, so intermediate solves with other geometries leave no trace; phases out of order
+    /// are errors.
+    #[test]
+    fn sub_iterations_and_step_order() {
+        use crate::station::StationVelocity;
+        let st = rectangular_wing(0.0, 2.0, 1.0, 4, SpanSpacing::Uniform);
+        let lat = Lattice::from_stations(LatticeSpec::new(2), &st).unwrap();
+        let p = UvlmParams::new(1.0, [1.0, 0.0, 0.1]);
+        let (mut a, mut b) = (Uvlm::new(lat.clone(), p.clone()).unwrap(), Uvlm::new(lat, p).unwrap());
+        let heave = |z: f64| -> Vec<SpanStation> {
+            st.iter().map(|s| SpanStation { origin: s.origin + nalgebra::Vector3::new(0.0, 0.0, z), ..*s }).collect()
+        };
+        let vel = vec![StationVelocity { linear: [0.0, 0.0, 0.2].into(), ..Default::default() }; st.len()];
+        for k in 1..=4 {
+            let z = 0.02 * k as f64;
+            a.update_stations(&heave(z), Some(&vel)).unwrap();
+            a.step(0.1).unwrap();
+            b.advance_wake(0.1).unwrap();
+            for guess in [z + 0.05, z - 0.03] {
+                b.update_stations(&heave(guess), None).unwrap();
+                b.solve_step().unwrap();
+            }
+            b.update_stations(&heave(z), Some(&vel)).unwrap();
+            b.solve_step().unwrap();
+            b.commit_step().unwrap();
+            assert_eq!(a.gamma(), b.gamma());
+            assert_eq!(a.loads().total_force(), b.loads().total_force());
+        }
+        assert!(matches!(b.solve_step(), Err(UvlmError::StepOrder { call: "solve_step", .. })));
+        assert!(matches!(b.commit_step(), Err(UvlmError::StepOrder { call: "commit_step", .. })));
+        b.advance_wake(0.1).unwrap();
+        assert!(matches!(b.advance_wake(0.1), Err(UvlmError::StepOrder { call: "advance_wake", .. })));
+        assert!(matches!(b.commit_step(), Err(UvlmError::StepOrder { .. })));
+        assert!(matches!(b.solve_steady(), Err(UvlmError::StepOrder { .. })));
     }
 
     /// A wing at zero incidence at rest in the stream carries no circulation and no load.

@@ -147,7 +147,10 @@ fn fine_mesh_needs_blended_slant() {
     let fine = FlaredWing { n_inner: 192, n_outer: 64, ..wing() };
     let err = Lattice::from_stations(fine.spec(), &fine.stations(0.0)).unwrap_err();
     assert!(
-        matches!(err, UvlmError::SkewedPanel { .. } | UvlmError::NonMonotoneColumns { .. } | UvlmError::DegeneratePanel { .. }),
+        matches!(
+            err,
+            UvlmError::SkewedPanel { .. } | UvlmError::NonMonotoneColumns { .. } | UvlmError::DegeneratePanel { .. }
+        ),
         "{err}"
     );
     let blended = FlaredWing { blend_columns: 4, ..fine };
