@@ -33,7 +33,9 @@ fn bench_step(c: &mut Criterion) {
         let (mut u, st) = solver(mirror);
         // Pair evaluations of one step, for the ns/pair figure.
         let before = u.stats().n_pair_evaluations;
-        u.update_stations(&st, None).unwrap();
+        if moving {
+            u.update_stations(&st, None).unwrap();
+        }
         u.step(0.01).unwrap();
         let pairs = u.stats().n_pair_evaluations - before;
         println!("{name}: {pairs} point-filament pairs per step");
