@@ -40,21 +40,25 @@ mod ground_hinge;
 mod inertia;
 mod joint;
 mod loads;
+mod modal;
 mod model;
 mod options;
 pub mod quaternion;
 pub mod samples;
 mod section;
 pub mod simulate;
+mod statics;
 mod stiffness;
 
 pub use body::BodySpec;
 pub use error::Error;
 pub use joint::JointSpec;
 pub use loads::NodalLoad;
+pub use modal::Modes;
 pub use model::{Energies, Model};
 pub use options::Options;
 pub use section::Section;
+pub use statics::{StaticOptions, StaticSolution};
 
 #[cfg(test)]
 mod tangent_tests;
