@@ -1,7 +1,7 @@
 //! Run one double-pendulum case and compare the tip with a reference CSV.
 //! Usage: pendulum_check c beta_deg n_el dt rho_inf [kirchhoff|mixed] [dae|ode] [reference.csv]
 use ancf::{Curvature, Model, Options, SolvePath, samples};
-use genalpha::{GenAlpha, IntegratorParams};
+use genalpha::IntegratorParams;
 use std::time::Instant;
 
 fn main() {
@@ -47,10 +47,10 @@ fn main() {
         b.section.rho_izz *= env("JFAC", 1.0);
     }
     let penalty_factor = env("PEN", 1.0);
-    let shear_gradient_factor = env("KAPPA", 100.0);
+    let shear_gradient_factor = env("KAPPA", 1000.0);
     let mut model =
         Model::new(&bodies, &joints, g, Options { path, curvature, penalty_factor, shear_gradient_factor }).unwrap();
-    let mut ga = GenAlpha::new(IntegratorParams::new(rho, dt), &model).unwrap();
+    let mut ga = model.integrator(IntegratorParams::new(rho, dt)).unwrap();
     let mut s = model.initial_state();
     ga.initialize(&model, &mut s).unwrap();
     let n = (2.0 / dt).round() as usize;

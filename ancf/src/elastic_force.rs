@@ -122,7 +122,22 @@ impl Element {
         for s in &self.plan.strains {
             let d = strain_value(s, &f) - s.reference;
             let g = strain_gradient(&self.plan, s, &f);
-            k.ger(c * s.stiffness, &g, &g, 1.0);
+            // rank-1 update restricted to the blocks the strain depends on
+            let cs = c * s.stiffness;
+            let blocks = &s.blocks[..s.n_blocks];
+            for &bj in blocks {
+                for j in 3 * bj..3 * bj + 3 {
+                    let gj = cs * g[j];
+                    if gj == 0.0 {
+                        continue;
+                    }
+                    for &bi in blocks {
+                        for i in 3 * bi..3 * bi + 3 {
+                            k[(i, j)] += g[i] * gj;
+                        }
+                    }
+                }
+            }
             let sd = c * s.stiffness * d;
             for (row, hrow) in geometric.iter_mut().zip(&s.hessian) {
                 for (x, h) in row.iter_mut().zip(hrow) {

@@ -52,12 +52,13 @@ pub struct FieldWeights {
 }
 
 impl FieldWeights {
-    /// Weights from `(block, weight)` pairs (at most four).
+    /// Weights from `(block, weight)` pairs (at most four); zero weights are dropped.
     pub fn new(entries: &[(usize, f64)]) -> Self {
-        let mut w = Self { n: entries.len(), block: [0; 4], weight: [0.0; 4] };
-        for (k, &(b, x)) in entries.iter().enumerate() {
-            w.block[k] = b;
-            w.weight[k] = x;
+        let mut w = Self { n: 0, block: [0; 4], weight: [0.0; 4] };
+        for &(b, x) in entries.iter().filter(|e| e.1 != 0.0) {
+            w.block[w.n] = b;
+            w.weight[w.n] = x;
+            w.n += 1;
         }
         w
     }

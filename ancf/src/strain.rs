@@ -159,6 +159,10 @@ pub struct SampledStrain {
     pub reference: f64,
     /// The 8×8 scalar Hessian `a` (`∂²s/∂e∂e = a ⊗ I₃`).
     pub hessian: [[f64; N_BLOCKS]; N_BLOCKS],
+    /// Number of blocks the strain depends on.
+    pub n_blocks: usize,
+    /// The blocks the strain depends on (first `n_blocks` entries).
+    pub blocks: [usize; N_BLOCKS],
 }
 
 impl SampledStrain {
@@ -247,6 +251,23 @@ impl Builder {
                 }
             }
         }
+        let mut used = [false; N_BLOCKS];
+        for &(_, fa, fb) in terms {
+            for f in [fa, fb] {
+                let w = &self.fields[f];
+                for k in 0..w.n {
+                    used[w.block[k]] = true;
+                }
+            }
+        }
+        let mut blocks = [0; N_BLOCKS];
+        let mut n_blocks = 0;
+        for (b, u) in used.iter().enumerate() {
+            if *u {
+                blocks[n_blocks] = b;
+                n_blocks += 1;
+            }
+        }
         self.strains.push(SampledStrain {
             kind,
             xi,
@@ -255,6 +276,8 @@ impl Builder {
             stiffness: kind.stiffness(section, pf, kappa) * weight * self.l,
             reference: 0.0,
             hessian,
+            n_blocks,
+            blocks,
         });
     }
 }

@@ -1,0 +1,382 @@
+//! A variable-band ("skyline") LU for the integrator's iteration matrix, behind
+//! [`genalpha::LinearSolver`].
+//!
+//! ANCF matrices are banded: a node couples only to its neighbours (half-bandwidth 23 in node
+//! order), the joints add a few rows. The solver
+//!
+//! 1. orders the unknowns once (the integrator's matrix keeps its structure): rows with an exactly zero diagonal (Lagrange-multiplier rows of the
+//!    DAE) are moved right behind the last coordinate they couple to, so that no zero pivot is met
+//!    and their profile stays short;
+//! 2. finds the profile (first non-zero of every row/column) from the matrix itself;
+//! 3. factorises `P A Pᵀ = L U` in Crout form without pivoting inside the profile (stable for the
+//!    mass-dominated, symmetric-positive-definite-like iteration matrices of a time step, and for
+//!    their saddle-point extension by constraint rows);
+//! 4. falls back to the dense partial-pivoting LU ([`genalpha::DenseLu`]) if a pivot is tiny or
+//!    the profile is not much sparser than the full matrix.
+//!
+//! Buffers are sized once in `set_dimension`; factorising and solving do not allocate.
+
+use genalpha::{DenseLu, DenseMatrix, LinearSolver};
+
+/// Skyline LU with dense fallback. See the module documentation.
+#[derive(Debug, Default)]
+pub struct SkylineLu {
+    n: usize,
+    /// New position → original index.
+    order: Vec<usize>,
+    /// Original index → new position.
+    inverse: Vec<usize>,
+    /// First index of the profile of row/column `i` (new numbering).
+    first: Vec<usize>,
+    lptr: Vec<usize>,
+    uptr: Vec<usize>,
+    lval: Vec<f64>,
+    uval: Vec<f64>,
+    work: Vec<f64>,
+    is_multiplier: Vec<bool>,
+    last_coupled: Vec<usize>,
+    ordered: bool,
+    /// Known sparsity: `(n_primary, adjacency)`; indices ≥ `n_primary` are multiplier rows.
+    structure: Option<(usize, Vec<Vec<usize>>)>,
+    dense: DenseLu,
+    use_dense: bool,
+    /// Skyline factorisations done.
+    pub n_skyline: usize,
+    /// Dense fallback factorisations done.
+    pub n_dense: usize,
+}
+
+impl SkylineLu {
+    /// A solver that finds the matrix structure by scanning every matrix it factorises; call
+    /// `set_dimension` (the integrator does) before use.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A solver for matrices whose non-zeros lie within a known symmetric structure:
+    /// `adjacency[i]` lists the indices coupled to `i`; indices `≥ n_primary` are multiplier
+    /// rows (zero diagonal). Order and profile are computed once in `set_dimension`; entries
+    /// outside the structure are ignored, so the structure must be complete.
+    pub fn with_structure(n_primary: usize, adjacency: Vec<Vec<usize>>) -> Self {
+        Self { structure: Some((n_primary, adjacency)), ..Self::default() }
+    }
+
+    fn order_from_structure(&mut self) {
+        let Some((n_primary, adj)) = &self.structure else { return };
+        let n = self.n;
+        self.order.clear();
+        for i in 0..*n_primary {
+            self.order.push(i);
+            for m in *n_primary..n {
+                if adj[m].iter().copied().filter(|&j| j < *n_primary).max() == Some(i) {
+                    self.order.push(m);
+                }
+            }
+        }
+        for m in *n_primary..n {
+            if !adj[m].iter().any(|&j| j < *n_primary) {
+                self.order.push(m);
+            }
+        }
+        for (new, &old) in self.order.iter().enumerate() {
+            self.inverse[old] = new;
+        }
+        for (i, f) in self.first.iter_mut().enumerate() {
+            *f = i;
+        }
+        for (old_i, list) in adj.iter().enumerate() {
+            for &old_j in list {
+                let (a, b) = (self.inverse[old_i], self.inverse[old_j]);
+                let (hi, lo) = if a > b { (a, b) } else { (b, a) };
+                self.first[hi] = self.first[hi].min(lo);
+            }
+        }
+        self.ordered = true;
+    }
+
+    fn order_unknowns(&mut self, a: &[f64]) {
+        let n = self.n;
+        for i in 0..n {
+            self.is_multiplier[i] = a[i * n + i] == 0.0;
+            self.last_coupled[i] = usize::MAX;
+        }
+        for c in 0..n {
+            let col = &a[c * n..(c + 1) * n];
+            for (r, &x) in col.iter().enumerate() {
+                if x != 0.0 && r != c {
+                    if self.is_multiplier[r] && !self.is_multiplier[c] {
+                        let l = &mut self.last_coupled[r];
+                        *l = if *l == usize::MAX { c } else { (*l).max(c) };
+                    }
+                    if self.is_multiplier[c] && !self.is_multiplier[r] {
+                        let l = &mut self.last_coupled[c];
+                        *l = if *l == usize::MAX { r } else { (*l).max(r) };
+                    }
+                }
+            }
+        }
+        self.order.clear();
+        for i in 0..n {
+            if self.is_multiplier[i] {
+                continue;
+            }
+            self.order.push(i);
+            for m in 0..n {
+                if self.is_multiplier[m] && self.last_coupled[m] == i {
+                    self.order.push(m);
+                }
+            }
+        }
+        for m in 0..n {
+            if self.is_multiplier[m] && self.last_coupled[m] == usize::MAX {
+                self.order.push(m);
+            }
+        }
+        for (new, &old) in self.order.iter().enumerate() {
+            self.inverse[old] = new;
+        }
+    }
+
+    /// Returns false when the skyline path cannot be used for this matrix.
+    fn factorize_skyline(&mut self, a: &[f64]) -> bool {
+        let n = self.n;
+        if self.structure.is_none() {
+            if !self.ordered {
+                self.order_unknowns(a);
+                self.ordered = true;
+            }
+            // Profile in the new numbering from every non-zero (both triangles).
+            for (i, f) in self.first.iter_mut().enumerate() {
+                *f = i;
+            }
+            for c in 0..n {
+                let nc = self.inverse[c];
+                for (r, &x) in a[c * n..(c + 1) * n].iter().enumerate() {
+                    if x != 0.0 {
+                        let nr = self.inverse[r];
+                        let (hi, lo) = if nr > nc { (nr, nc) } else { (nc, nr) };
+                        if lo < self.first[hi] {
+                            self.first[hi] = lo;
+                        }
+                    }
+                }
+            }
+        }
+        let (mut lsize, mut usize_) = (0, 0);
+        for i in 0..n {
+            self.lptr[i] = lsize;
+            self.uptr[i] = usize_;
+            lsize += i - self.first[i];
+            usize_ += i - self.first[i] + 1;
+        }
+        self.lptr[n] = lsize;
+        self.uptr[n] = usize_;
+        if lsize > self.lval.len() || usize_ > self.uval.len() {
+            return false;
+        }
+        // Gather the envelope of P A Pᵀ: L rows (strictly lower) and U columns (with diagonal).
+        let mut scale: f64 = 0.0;
+        for i in 0..n {
+            let (oi, fi) = (self.order[i], self.first[i]);
+            let (lp, up) = (self.lptr[i], self.uptr[i]);
+            for (k, ok) in self.order[fi..=i].iter().enumerate() {
+                // U column i, row fi + k: A[order[fi + k], order[i]]
+                self.uval[up + k] = a[oi * n + ok];
+                if k < i - fi {
+                    // L row i, column fi + k: A[order[i], order[fi + k]]
+                    self.lval[lp + k] = a[ok * n + oi];
+                }
+            }
+            scale = scale.max(a[oi * n + oi].abs());
+        }
+        // Crout, in place.
+        for j in 0..n {
+            let fj = self.first[j];
+            let (lpj, upj) = (self.lptr[j], self.uptr[j]);
+            for i in fj..j {
+                let fi = self.first[i];
+                let lo = fi.max(fj);
+                let (lpi, upi) = (self.lptr[i], self.uptr[i]);
+                // U[i][j] −= L[i][lo..i] · U[lo..i][j]
+                let s = dot(&self.lval[lpi + (lo - fi)..lpi + (i - fi)], &self.uval[upj + (lo - fj)..upj + (i - fj)]);
+                self.uval[upj + (i - fj)] -= s;
+                // L[j][i] = (A[j][i] − L[j][lo..i] · U[lo..i][i]) / U[i][i]
+                let s = dot(&self.lval[lpj + (lo - fj)..lpj + (i - fj)], &self.uval[upi + (lo - fi)..upi + (i - fi)]);
+                let d = self.uval[upi + (i - fi)];
+                self.lval[lpj + (i - fj)] = (self.lval[lpj + (i - fj)] - s) / d;
+            }
+            let s = dot(&self.lval[lpj..lpj + (j - fj)], &self.uval[upj..upj + (j - fj)]);
+            let d = self.uval[upj + (j - fj)] - s;
+            self.uval[upj + (j - fj)] = d;
+            if !d.is_finite() || d.abs() <= 1e-13 * scale {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    // four independent accumulators so that the compiler can vectorise the short dot products
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let split = n - n % 4;
+    for (x, y) in a[..split].chunks_exact(4).zip(b[..split].chunks_exact(4)) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in a[split..].iter().zip(&b[split..]) {
+        s += x * y;
+    }
+    s
+}
+
+impl LinearSolver for SkylineLu {
+    fn set_dimension(&mut self, n: usize) {
+        self.n = n;
+        self.order = Vec::with_capacity(n);
+        self.inverse = vec![0; n];
+        self.first = vec![0; n];
+        self.lptr = vec![0; n + 1];
+        self.uptr = vec![0; n + 1];
+        // profiles larger than a third of the matrix go to the dense LU
+        self.lval = vec![0.0; n * n / 6 + n];
+        self.uval = vec![0.0; n * n / 6 + 2 * n];
+        self.work = vec![0.0; n];
+        self.is_multiplier = vec![false; n];
+        self.last_coupled = vec![0; n];
+        self.ordered = false;
+        self.dense.set_dimension(n);
+        if let Some((_, adj)) = &self.structure {
+            assert_eq!(adj.len(), n, "SkylineLu: the structure has the wrong dimension");
+            self.order_from_structure();
+        }
+    }
+
+    fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize> {
+        assert!(a.n_rows() == self.n && a.n_cols() == self.n, "factorize: dimension mismatch");
+        if self.factorize_skyline(a.as_slice()) {
+            self.use_dense = false;
+            self.n_skyline += 1;
+            Ok(())
+        } else {
+            self.use_dense = true;
+            self.n_dense += 1;
+            self.dense.factorize(a)
+        }
+    }
+
+    fn solve_in_place(&mut self, b: &mut [f64]) {
+        assert!(b.len() == self.n, "solve: dimension mismatch");
+        if self.use_dense {
+            self.dense.solve_in_place(b);
+            return;
+        }
+        let n = self.n;
+        let y = &mut self.work;
+        for i in 0..n {
+            let fi = self.first[i];
+            let lrow = &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)];
+            y[i] = b[self.order[i]] - dot(lrow, &y[fi..i]);
+        }
+        for j in (0..n).rev() {
+            let fj = self.first[j];
+            let base = self.uptr[j];
+            let xj = y[j] / self.uval[base + (j - fj)];
+            y[j] = xj;
+            for (k, u) in (fj..j).zip(&self.uval[base..base + (j - fj)]) {
+                y[k] -= u * xj;
+            }
+        }
+        for i in 0..n {
+            b[self.order[i]] = y[i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn solve_both(a: &DenseMatrix, b: &[f64]) -> (Vec<f64>, Vec<f64>, usize) {
+        let n = a.n_rows();
+        let mut s = SkylineLu::new();
+        s.set_dimension(n);
+        s.factorize(a).unwrap();
+        let mut x = b.to_vec();
+        s.solve_in_place(&mut x);
+        let mut d = DenseLu::default();
+        d.set_dimension(n);
+        d.factorize(a).unwrap();
+        let mut y = b.to_vec();
+        d.solve_in_place(&mut y);
+        (x, y, s.n_skyline)
+    }
+
+    /// A banded SPD matrix with a saddle-point border (two multiplier rows coupling to the
+    /// first and the middle unknowns), like a constrained ANCF iteration matrix.
+    fn kkt(n: usize, bw: usize) -> DenseMatrix {
+        let m = n + 2;
+        let mut a = DenseMatrix::zeros(m, m);
+        for i in 0..n {
+            for j in i.saturating_sub(bw)..(i + bw + 1).min(n) {
+                let v = if i == j { 10.0 + i as f64 * 0.1 } else { 1.0 / (1.0 + (i + 2 * j) as f64) };
+                *a.get_mut(i, j) = v;
+                *a.get_mut(j, i) = v;
+            }
+        }
+        for (row, cols) in [(n, [0usize, 1]), (n + 1, [n / 2, n / 2 + 1])] {
+            for (k, c) in cols.iter().enumerate() {
+                *a.get_mut(row, *c) = 1.0 + k as f64;
+                *a.get_mut(*c, row) = 1.0 + k as f64;
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn matches_dense_lu_on_a_banded_saddle_point_matrix() {
+        let a = kkt(60, 5);
+        let b: Vec<f64> = (0..62).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (x, y, n_skyline) = solve_both(&a, &b);
+        assert_eq!(n_skyline, 1, "the skyline path must be taken");
+        for (p, q) in x.iter().zip(&y) {
+            assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
+        }
+        // the same with the structure given up front
+        let adjacency: Vec<Vec<usize>> =
+            (0..62).map(|i| (0..62).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        let mut s = SkylineLu::with_structure(60, adjacency);
+        s.set_dimension(62);
+        s.factorize(&a).unwrap();
+        let mut z = b.to_vec();
+        s.solve_in_place(&mut z);
+        assert_eq!(s.n_skyline, 1);
+        for (p, q) in z.iter().zip(&y) {
+            assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
+        }
+    }
+
+    #[test]
+    fn falls_back_to_dense_for_a_zero_pivot() {
+        // [[0 1], [1 0]] has zero diagonals but no coupling that could be reordered.
+        let mut a = DenseMatrix::zeros(2, 2);
+        *a.get_mut(0, 1) = 1.0;
+        *a.get_mut(1, 0) = 1.0;
+        let mut s = SkylineLu::new();
+        s.set_dimension(2);
+        s.factorize(&a).unwrap();
+        let mut x = vec![2.0, 3.0];
+        s.solve_in_place(&mut x);
+        assert_eq!(s.n_dense, 1);
+        assert_relative_eq!(x[0], 3.0, epsilon = 1e-15);
+        assert_relative_eq!(x[1], 2.0, epsilon = 1e-15);
+    }
+}
+
