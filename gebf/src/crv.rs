@@ -338,6 +338,85 @@ pub fn rescale_accelerations(psi_old: &V3, psi_new: &V3, psi_dot_old: &V3, psi_d
     tangent_inverse(psi_new) * (omega_dot - tn.dir(psi_dot_new) * psi_dot_new)
 }
 
+/// The branch change `u_j(psi) = psi (1 + 2πj/|psi|)` of a CRV (the same rotation, norm
+/// shifted by 2πj) and its derivatives, used to bring the nodes of an element onto one branch
+/// when their stored CRVs were rescaled separately. With `c(s) = 1 + 2πj s^{-1/2}`,
+/// `J = ∂u/∂psi = c I + 2c' psi psiᵀ` (symmetric), `dJ[a] b = ∂(J b)/∂psi · a` (symmetric in
+/// a, b), and `H(a, b) = ∂/∂psi (dJ[a] b)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BranchMap {
+    /// The stored CRV.
+    pub psi: V3,
+    /// Number of turns added.
+    pub j: i32,
+    c: f64,
+    c1: f64,
+    c2: f64,
+    c3: f64,
+}
+
+impl BranchMap {
+    /// The map for `j` turns at `psi` (`psi ≠ 0`).
+    pub fn new(psi: &V3, j: i32) -> Self {
+        let s = psi.norm_squared();
+        let pj = std::f64::consts::PI * j as f64;
+        let r = 1.0 / s.sqrt(); // s^{-1/2}
+        Self {
+            psi: *psi,
+            j,
+            c: 1.0 + 2.0 * pj * r,
+            c1: -pj * r / s,
+            c2: 1.5 * pj * r / (s * s),
+            c3: -3.75 * pj * r / (s * s * s),
+        }
+    }
+
+    /// The number of turns that brings `psi` closest to `target`, if it is not zero.
+    pub fn toward(psi: &V3, target: &V3) -> Option<Self> {
+        let phi = psi.norm();
+        if phi == 0.0 || phi + target.norm() <= std::f64::consts::PI {
+            return None;
+        }
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let n = psi / phi;
+        // The branch points are (phi + 2πj) n; pick j minimising the distance to target.
+        let along = target.dot(&n);
+        let j = ((along - phi) / two_pi).round() as i32;
+        let dist = |j: i32| ((phi + two_pi * j as f64) * n - target).norm();
+        let best = (j - 1..=j + 1).min_by(|a, b| dist(*a).total_cmp(&dist(*b))).unwrap_or(0);
+        (best != 0).then(|| Self::new(psi, best))
+    }
+
+    /// `u(psi)`.
+    pub fn apply(&self) -> V3 {
+        self.psi * self.c
+    }
+
+    /// `J = ∂u/∂psi`.
+    pub fn jac(&self) -> M3 {
+        M3::identity() * self.c + self.psi * self.psi.transpose() * (2.0 * self.c1)
+    }
+
+    /// The matrix `b ↦ dJ[a] b`.
+    pub fn djac(&self, a: &V3) -> M3 {
+        let p = &self.psi;
+        let pa = p.dot(a);
+        (M3::identity() * pa + a * p.transpose() + p * a.transpose()) * (2.0 * self.c1)
+            + p * p.transpose() * (4.0 * self.c2 * pa)
+    }
+
+    /// `H(a, b) = ∂/∂psi (dJ[a] b)`.
+    pub fn hess(&self, a: &V3, b: &V3) -> M3 {
+        let p = &self.psi;
+        let (pa, pb, ab) = (p.dot(a), p.dot(b), a.dot(b));
+        let pt = p.transpose();
+        (b * a.transpose() + a * b.transpose() + M3::identity() * ab) * (2.0 * self.c1)
+            + (b * pa + a * pb + p * ab) * pt * (4.0 * self.c2)
+            + (p * a.transpose() * pb + p * b.transpose() * pa + M3::identity() * (pa * pb)) * (4.0 * self.c2)
+            + p * pt * (8.0 * self.c3 * pa * pb)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -455,6 +534,32 @@ mod tests {
             assert!((an - fd).norm() < 1e-7 * (1.0 + an.norm()), "hessian at {psi:?}");
             assert_relative_eq!(an, an.transpose(), epsilon = 1e-12 * (1.0 + an.norm()));
         }
+    }
+
+    #[test]
+    fn branch_map_derivatives_match_finite_differences() {
+        let a = V3::new(0.4, -1.3, 0.8);
+        let b = V3::new(-0.6, 0.2, 1.1);
+        for (psi, j) in [(V3::new(1.0, 2.0, -1.5), 1), (V3::new(-2.0, 0.5, 1.0), -1), (V3::new(0.3, 0.1, 3.0), 2)] {
+            let m = BranchMap::new(&psi, j);
+            // Same rotation.
+            assert_relative_eq!(rotation_matrix(&m.apply()), rotation_matrix(&psi), epsilon = 1e-12);
+            let fd = fd_jac(|p| BranchMap::new(p, j).apply(), &psi);
+            assert_relative_eq!(m.jac(), fd, epsilon = 1e-7);
+            let fd = fd_jac(|p| BranchMap::new(p, j).jac() * b, &psi);
+            assert_relative_eq!(m.djac(&b), fd, epsilon = 1e-7);
+            assert_relative_eq!(m.djac(&a) * b, m.djac(&b) * a, epsilon = 1e-12);
+            let fd = fd_jac(|p| BranchMap::new(p, j).djac(&a) * b, &psi);
+            assert_relative_eq!(m.hess(&a, &b), fd, epsilon = 1e-6);
+            // T u̇ is the same angular velocity: T(u) J = T(psi).
+            assert_relative_eq!(tangent(&m.apply()) * m.jac(), tangent(&psi), epsilon = 1e-10);
+        }
+        // Nearest branch.
+        let psi = V3::new(0.0, 0.0, -PI + 0.1);
+        let m = BranchMap::toward(&psi, &V3::new(0.0, 0.0, PI - 0.2)).unwrap();
+        assert_eq!(m.j, -1);
+        assert_relative_eq!(m.apply(), V3::new(0.0, 0.0, PI + 0.1), epsilon = 1e-12);
+        assert!(BranchMap::toward(&V3::new(0.1, 0.0, 0.0), &V3::new(0.2, 0.0, 0.0)).is_none());
     }
 
     #[test]

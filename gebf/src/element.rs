@@ -6,7 +6,8 @@
 //! quadratic Lagrange functions of `ξ ∈ [−1, 1]` (nodes at −1, 0, 1), `s = (1 + ξ) L_e / 2`.
 
 use crate::body::Body;
-use crate::crv::V3;
+use crate::crv::{BranchMap, M3, V3};
+use crate::inertia::MatrixCoefficients;
 use nalgebra::{SMatrix, SVector};
 
 /// Element-local vector.
@@ -71,6 +72,13 @@ pub(crate) struct ElementState {
     pub vd: V3,
     /// Frame angular acceleration omega_A_dot.
     pub wd: V3,
+    /// Branch maps of end nodes whose stored CRV lies on another branch than the middle
+    /// node's; for those nodes `psi`, `psid`, `psidd` above hold the mapped values.
+    pub branch: [Option<BranchMap>; 3],
+    /// Stored (unmapped) CRV rates of mapped nodes.
+    pub psid_stored: [V3; 3],
+    /// Stored (unmapped) CRV second rates of mapped nodes.
+    pub psidd_stored: [V3; 3],
 }
 
 impl ElementState {
@@ -93,7 +101,72 @@ impl ElementState {
         if let Some(a) = v_dot {
             (s.vd, s.wd) = body.frame_rates(a);
         }
+        // Bring the end nodes onto the middle node's branch (stored CRVs are rescaled to
+        // |psi| ≤ π node by node): psi' = u(psi), psi_dot' = J psi_dot,
+        // psi_ddot' = J psi_ddot + dJ[psi_dot] psi_dot.
+        for k in [0, 2] {
+            if let Some(m) = BranchMap::toward(&s.psi[k], &s.psi[1]) {
+                let j = m.jac();
+                s.psid_stored[k] = s.psid[k];
+                s.psidd_stored[k] = s.psidd[k];
+                s.psi[k] = m.apply();
+                s.psid[k] = j * s.psid_stored[k];
+                s.psidd[k] = j * s.psidd_stored[k] + m.djac(&s.psid_stored[k]) * s.psid_stored[k];
+                s.branch[k] = Some(m);
+            }
+        }
         s
+    }
+
+    /// Whether a node was mapped to another branch.
+    pub fn is_mapped(&self) -> bool {
+        self.branch.iter().any(Option::is_some)
+    }
+
+    /// Residual rows of the stored CRVs: `r_psi = Jᵀ r'_psi` (virtual work `δpsi' = J δpsi`).
+    pub fn map_residual(&self, res: &mut Vec24) {
+        for (k, m) in self.branch.iter().enumerate() {
+            if let Some(m) = m {
+                let o = 6 * k + 3;
+                let r = m.jac().transpose() * V3::new(res[o], res[o + 1], res[o + 2]);
+                res.fixed_rows_mut::<3>(o).copy_from(&r);
+            }
+        }
+    }
+
+    /// The iteration matrix in the stored unknowns from the separate (unscaled) mass,
+    /// gyroscopic and stiffness matrices `m`, `g`, `k` and the residual `res` (all in the
+    /// mapped unknowns), by the chain rule through `psi' = u(psi)` and its rates.
+    pub fn map_matrix(&self, res: &Vec24, m: &Mat24, g: &Mat24, k: &Mat24, c: MatrixCoefficients) -> Mat24 {
+        let mut a = m * c.c_m + g * c.c_c + k * c.c_k;
+        // Columns of mapped CRVs.
+        for (l, map) in self.branch.iter().enumerate() {
+            if let Some(map) = map {
+                let o = 6 * l + 3;
+                let j = map.jac();
+                let djd = map.djac(&self.psid_stored[l]);
+                let d2 = map.djac(&self.psidd_stored[l]) + map.hess(&self.psid_stored[l], &self.psid_stored[l]);
+                let (ml, gl, kl) = (m.fixed_columns::<3>(o), g.fixed_columns::<3>(o), k.fixed_columns::<3>(o));
+                let col = (ml * j) * c.c_m
+                    + (gl * j + ml * djd * 2.0) * c.c_c
+                    + (kl * j + gl * djd + ml * d2) * c.c_k;
+                a.fixed_columns_mut::<3>(o).copy_from(&col);
+            }
+        }
+        // Rows of mapped CRVs.
+        for (kk, map) in self.branch.iter().enumerate() {
+            if let Some(map) = map {
+                let o = 6 * kk + 3;
+                let jt = map.jac().transpose();
+                let rows = jt * a.fixed_rows::<3>(o);
+                a.fixed_rows_mut::<3>(o).copy_from(&rows);
+                let r = V3::new(res[o], res[o + 1], res[o + 2]);
+                let extra: M3 = map.djac(&r) * c.c_k;
+                let mut blk = a.fixed_view_mut::<3, 3>(o, o);
+                blk += extra;
+            }
+        }
+        a
     }
 }
 

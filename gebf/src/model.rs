@@ -423,6 +423,49 @@ impl Model {
         m
     }
 
+    /// Element matrix when a node's CRV was mapped to another branch: the mass, gyroscopic and
+    /// stiffness parts are needed separately for the chain rule.
+    fn mapped_element_matrix(&self, b: &Body, st: &ElementState, g_a: &V3, c: MatrixCoefficients) -> Mat24 {
+        let (mut m, mut g, mut k) = (Mat24::zeros(), Mat24::zeros(), Mat24::zeros());
+        let mut res = Vec24::zeros();
+        let mut scratch = Vec24::zeros();
+        let unit = |c_m, c_c, c_k| MatrixCoefficients { c_m, c_c, c_k };
+        add_inertia(st, b.le, &b.section, &mut res, Some((&mut m, unit(1.0, 0.0, 0.0))));
+        add_inertia(st, b.le, &b.section, &mut scratch, Some((&mut g, unit(0.0, 1.0, 0.0))));
+        add_inertia(st, b.le, &b.section, &mut scratch, Some((&mut k, unit(0.0, 0.0, 1.0))));
+        add_elastic(st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut k, 1.0)));
+        add_gravity(st, b.le, b.section.mass, g_a, &mut res, Some((&mut k, 1.0)));
+        st.map_matrix(&res, &m, &g, &k, c)
+    }
+
+    /// Rescale every nodal CRV with |psi| > π to the equivalent one below π, transforming its
+    /// rates (`rates = (v, v_dot, a)`) so that the angular velocity and acceleration are kept.
+    /// Elements then map their end nodes back onto the middle node's branch (exact chain rule),
+    /// so rotations of more than π relative to the body frame are handled; T(psi) is never
+    /// evaluated near its singularity at 2π.
+    pub fn rescale_rotations(&self, q: &mut [f64], rates: Option<(&mut [f64], &mut [f64], &mut [f64])>) {
+        let mut rates = rates;
+        for b in &self.bodies {
+            for i in 1..b.n_nodes() {
+                let (_, psi) = b.node_state(q, i);
+                let Some(new) = crate::crv::rescale(&psi) else { continue };
+                let k = b.node_coord(i).expect("i ≥ 1") + 3;
+                q[k..k + 3].copy_from_slice(new.as_slice());
+                if let Some((v, vd, a)) = rates.as_mut() {
+                    let d = b.node_dof(i).expect("i ≥ 1") + 3;
+                    let get = |x: &[f64]| V3::new(x[d], x[d + 1], x[d + 2]);
+                    let (pd, pdd, pa) = (get(v), get(vd), get(a));
+                    let pd_new = crate::crv::rescale_rates(&psi, &new, &pd);
+                    let pdd_new = crate::crv::rescale_accelerations(&psi, &new, &pd, &pd_new, &pdd);
+                    let pa_new = crate::crv::rescale_accelerations(&psi, &new, &pd, &pd_new, &pa);
+                    v[d..d + 3].copy_from_slice(pd_new.as_slice());
+                    vd[d..d + 3].copy_from_slice(pdd_new.as_slice());
+                    a[d..d + 3].copy_from_slice(pa_new.as_slice());
+                }
+            }
+        }
+    }
+
     fn gravity_in_frame(&self, b: &Body, q: &[f64]) -> V3 {
         let (_, chi) = b.frame_state(q);
         chi.conjugate().rotate(&self.gravity) * self.load_scale
@@ -480,6 +523,7 @@ impl ConstrainedSystem for Model {
                 add_inertia(&st, b.le, &b.section, &mut res, None);
                 add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
                 add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
+                st.map_residual(&mut res);
                 for (lr, gr, nr) in local_ranges(b, e) {
                     for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
                         *x += y;
@@ -517,10 +561,15 @@ impl ConstrainedSystem for Model {
             for e in 0..b.n_elements {
                 mat.as_mut_slice().fill(0.0);
                 let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
-                add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
-                if c_k != 0.0 {
-                    add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut mat, c_k)));
-                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
+                if st.is_mapped() {
+                    mat = self.mapped_element_matrix(b, &st, &g_a, coeffs);
+                } else {
+                    add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
+                    if c_k != 0.0 {
+                        let ng = self.options.n_gauss_stiffness;
+                        add_elastic(&st, b.le, &b.section, ng, &mut res, Some((&mut mat, c_k)));
+                        add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
+                    }
                 }
                 scatter_matrix(b, e, &mat, k);
             }
@@ -569,6 +618,7 @@ impl ConstrainedSystem for Model {
     }
 
     fn post_step(&mut self, _t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
+        self.rescale_rotations(q, Some((&mut *v, &mut *v_dot, &mut *a)));
         if self.options.stabilization {
             for &j in &self.projection_order {
                 self.joints[j].project(&self.bodies, q, [&mut *v, &mut *v_dot, &mut *a]);

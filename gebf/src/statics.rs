@@ -126,6 +126,7 @@ impl Model {
                 inc = rhs[..n].iter().zip(&weights).fold(0.0_f64, |m, (x, w)| m.max((x * w).abs()));
                 self.retract_inplace(&q, &rhs[..n], &mut q_new);
                 std::mem::swap(&mut q, &mut q_new);
+                self.rescale_rotations(&mut q, None);
                 for (m, d) in mu.iter_mut().zip(&rhs[n..]) {
                     *m += d;
                 }

@@ -30,7 +30,7 @@ fn cantilever(n_el: usize) -> Model {
 #[test]
 fn tip_moment_rolls_a_full_circle() {
     let mut report = Vec::new();
-    for n_el in [16, 32] {
+    for n_el in [8, 16, 32] {
         let mut m = cantilever(n_el);
         let tip = m.n_nodes(0) - 1;
         let moment = 2.0 * std::f64::consts::PI; // EI/L = 1
@@ -40,14 +40,16 @@ fn tip_moment_rolls_a_full_circle() {
         let sol = m.solve_static(&q0, &StaticOptions { n_load_steps: 16, ..StaticOptions::default() }).unwrap();
         let p = m.tip_position(&sol.q);
         report.push((n_el, p.norm()));
-        // Half the moment: the analytic semicircle tip (0, 2L/π·…): x = sin(π)/π = 0, y = (1 − cos π)/π.
         assert!(p.z.abs() < 1e-12, "out of plane: {p:?}");
     }
     println!("tip distance from the root (fraction of L): {report:?}");
-    let (_, d32) = report[2];
-    assert!(d32 < 0.01, "32 elements: tip {d32} L from the root");
-    // The error falls with refinement.
-    assert!(report[2].1 < report[1].1 && report[1].1 < report[0].1);
+    // Reduced integration makes the uniform-curvature solution nodally exact (psi is linear
+    // in s and γ vanishes at both Gauss points), so already 8 elements close the circle to
+    // round-off. This needs the CRV rescaling: the tip rotation is 2π, where T(psi) is singular;
+    // stored CRVs are rescaled past π and elements map their end nodes onto one branch.
+    for (n_el, d) in report {
+        assert!(d < 0.01, "{n_el} elements: tip {d} L from the root");
+    }
 }
 
 /// Quarter of the circle moment: exact tip ((EI/M) sin θ, (EI/M)(1 − cos θ)) with θ = ML/EI.
