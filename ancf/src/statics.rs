@@ -71,12 +71,14 @@ impl Model {
                 res_norm = r.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
                 mat.fill_zero();
                 self.assemble_full_inplace(&q, 0.0, 1.0, &mut mat.block(0, 0, n, n));
+                // constraint rows scaled to the stiffness so that the pivots stay balanced
+                let scale = (0..n).map(|i| mat.get(i, i).abs()).fold(0.0, f64::max).max(1.0);
                 for (i, row) in self.rows().iter().enumerate() {
                     for &(j, c) in &row.entries {
-                        *mat.get_mut(n + i, j) += c;
-                        *mat.get_mut(j, n + i) += c;
+                        *mat.get_mut(n + i, j) += scale * c;
+                        *mat.get_mut(j, n + i) += scale * c;
                     }
-                    rhs[n + i] = -row.value(&q);
+                    rhs[n + i] = -scale * row.value(&q);
                 }
                 for i in 0..n {
                     rhs[i] = -r[i];
@@ -92,7 +94,7 @@ impl Model {
                     inc = inc.max((rhs[i] * weights[i]).abs());
                 }
                 for i in 0..m {
-                    lambda[i] += rhs[n + i];
+                    lambda[i] += scale * rhs[n + i];
                 }
                 n_iterations += 1;
                 if inc < params.tol {
