@@ -374,7 +374,9 @@ impl BranchMap {
     /// The number of turns that brings `psi` closest to `target`, if it is not zero.
     pub fn toward(psi: &V3, target: &V3) -> Option<Self> {
         let phi = psi.norm();
-        if phi == 0.0 || phi + target.norm() <= std::f64::consts::PI {
+        let reach = phi + target.norm();
+        // Non-finite or absurd values (a diverging Newton iterate) are left alone.
+        if phi == 0.0 || !(reach > std::f64::consts::PI && reach < 1e6) {
             return None;
         }
         let two_pi = 2.0 * std::f64::consts::PI;
