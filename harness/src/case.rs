@@ -60,6 +60,9 @@ pub struct Case {
     /// Gate tolerances (omit: the case is reported but not gated).
     #[serde(default)]
     pub gate: Option<Gate>,
+    /// Aerodynamics (UVLM) — omit for a purely structural case.
+    #[serde(default)]
+    pub aero: Option<crate::aero::AeroSettings>,
     /// `harness all` also runs the refinement ladders of this case (`harness converge`).
     #[serde(default)]
     pub converge: bool,
@@ -221,6 +224,59 @@ impl NewtonSettings {
     }
 }
 
+/// Elements per body: one number for every body, or a list in body order.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum Elements {
+    /// The same count for every body.
+    Uniform(usize),
+    /// One count per body, in body order.
+    PerBody(Vec<usize>),
+}
+
+impl Elements {
+    /// Count for body `i` (the last entry repeats if the list is short; validation rejects that).
+    pub fn for_body(&self, i: usize) -> usize {
+        match self {
+            Elements::Uniform(n) => *n,
+            Elements::PerBody(v) => v.get(i).or(v.last()).copied().unwrap_or(0),
+        }
+    }
+    /// Every count multiplied by `k` (rounded, at least 1).
+    pub fn scaled(&self, k: f64) -> Elements {
+        let f = |n: usize| ((n as f64 * k).round() as usize).max(1);
+        match self {
+            Elements::Uniform(n) => Elements::Uniform(f(*n)),
+            Elements::PerBody(v) => Elements::PerBody(v.iter().map(|&n| f(n)).collect()),
+        }
+    }
+    fn check(&self, field: &str, n_bodies: usize) -> Result<(), String> {
+        match self {
+            Elements::Uniform(0) => Err(format!("{field}: must be at least 1")),
+            Elements::Uniform(_) => Ok(()),
+            Elements::PerBody(v) if v.len() != n_bodies => {
+                Err(format!("{field}: {} entries for {n_bodies} bodies", v.len()))
+            }
+            Elements::PerBody(v) => match v.iter().position(|&n| n == 0) {
+                Some(i) => Err(format!("{field}[{i}]: must be at least 1")),
+                None => Ok(()),
+            },
+        }
+    }
+}
+
+impl std::fmt::Display for Elements {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Elements::Uniform(n) => write!(f, "{n}"),
+            Elements::PerBody(v) => {
+                let s: Vec<String> = v.iter().map(|n| n.to_string()).collect();
+                write!(f, "{}", s.join("+"))
+            }
+        }
+    }
+}
+
 /// ANCF solve path.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -236,8 +292,8 @@ pub enum AncfPath {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AncfSettings {
-    /// Two-node elements per body.
-    pub elements_per_body: usize,
+    /// Two-node elements per body (a number, or a list in body order).
+    pub elements_per_body: Elements,
     /// Time step, s.
     pub dt: f64,
     /// Spectral radius at infinite frequency. Default 0.8.
@@ -255,8 +311,8 @@ pub struct AncfSettings {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GebfSettings {
-    /// Three-node elements per body.
-    pub elements_per_body: usize,
+    /// Three-node elements per body (a number, or a list in body order).
+    pub elements_per_body: Elements,
     /// Time step, s.
     pub dt: f64,
     /// Spectral radius at infinite frequency. Default 0.8.
@@ -649,12 +705,10 @@ impl Case {
             pos("output_dt", o)?;
         }
         for (f, n, dt, rho) in [
-            ("ancf", self.ancf.elements_per_body, self.ancf.dt, self.ancf.rho_inf),
-            ("gebf", self.gebf.elements_per_body, self.gebf.dt, self.gebf.rho_inf),
+            ("ancf", &self.ancf.elements_per_body, self.ancf.dt, self.ancf.rho_inf),
+            ("gebf", &self.gebf.elements_per_body, self.gebf.dt, self.gebf.rho_inf),
         ] {
-            if n == 0 {
-                return Err(format!("{f}.elements_per_body: must be at least 1"));
-            }
+            n.check(&format!("{f}.elements_per_body"), self.bodies.len())?;
             pos(&format!("{f}.dt"), dt)?;
             if !(0.0..=1.0).contains(&rho) {
                 return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
@@ -667,6 +721,28 @@ impl Case {
             if let Some(t) = r.tip_max_m {
                 pos(&format!("references[{k}].tip_max_m"), t)?;
             }
+        }
+        if let Some(a) = &self.aero {
+            pos("aero.rho", a.rho)?;
+            pos("aero.chord", a.chord)?;
+            if !finite3(&a.v_inf) || norm3(&a.v_inf) == 0.0 {
+                return Err("aero.v_inf: not a finite non-zero vector".into());
+            }
+            if !a.le_offset.is_finite() {
+                return Err("aero.le_offset: not finite".into());
+            }
+            if a.n_chordwise == 0 {
+                return Err("aero.n_chordwise: must be at least 1".into());
+            }
+            if a.n_wake_rows == 0 {
+                return Err("aero.n_wake_rows: must be at least 1".into());
+            }
+            nonneg("aero.cutoff_radius", a.cutoff_radius)?;
+            if !(a.coupling.relaxation > 0.0 && a.coupling.relaxation <= 1.0) {
+                return Err(format!("aero.coupling.relaxation: {} is not in (0, 1]", a.coupling.relaxation));
+            }
+            pos("aero.coupling.tolerance", a.coupling.tolerance)?;
+            crate::aero::station_map(self, a)?;
         }
         if let Some(g) = &self.gate {
             pos("gate.energy_drift", g.energy_drift)?;

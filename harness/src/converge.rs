@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Error;
-use crate::case::{Formulation, RunSpec};
+use crate::case::{Elements, Formulation, RunSpec};
 use crate::csv::{Curve, read_curve, write_file};
 use crate::metrics::{tip_curve, tip_difference, window_stats};
 use crate::plot::{Panel, Series, colors, panels_svg};
@@ -55,7 +55,7 @@ pub struct Rung {
     /// Ladder.
     pub ladder: Ladder,
     /// Elements per body.
-    pub elements: usize,
+    pub elements: Elements,
     /// Time step, s.
     pub dt: f64,
     /// Whether this rung is the ladder's truth.
@@ -96,7 +96,7 @@ pub struct ConvergeResult {
     pub orders: Vec<Order>,
 }
 
-fn rung_spec(spec: &RunSpec, f: Formulation, elements: usize, dt: f64) -> crate::case::Case {
+fn rung_spec(spec: &RunSpec, f: Formulation, elements: Elements, dt: f64) -> crate::case::Case {
     let mut c = spec.case(f).clone();
     match f {
         Formulation::Ancf => {
@@ -120,26 +120,28 @@ fn max_distance(a: &RunOutput, truth: &Curve) -> f64 {
 }
 
 /// Plan of one study: (formulation, ladder, elements, dt, is_truth).
-fn plan(spec: &RunSpec) -> Vec<(Formulation, Ladder, usize, f64, bool)> {
+type Plan = Vec<(Formulation, Ladder, Elements, f64, bool)>;
+
+fn plan(spec: &RunSpec) -> Plan {
     let mut p = Vec::new();
     for f in Formulation::ALL {
         let c = spec.case(f);
         let (n, h) = match f {
-            Formulation::Ancf => (c.ancf.elements_per_body, c.ancf.dt),
-            Formulation::Gebf => (c.gebf.elements_per_body, c.gebf.dt),
+            Formulation::Ancf => (&c.ancf.elements_per_body, c.ancf.dt),
+            Formulation::Gebf => (&c.gebf.elements_per_body, c.gebf.dt),
         };
         for (k, m) in [2.0, 1.0, 0.5, 0.25, 0.125].into_iter().enumerate() {
-            p.push((f, Ladder::Time, n, h * m, k == 4));
+            p.push((f, Ladder::Time, n.clone(), h * m, k == 4));
         }
-        let mut space: Vec<usize> = vec![(n / 2).max(1), n, 2 * n, 4 * n];
+        let mut space: Vec<Elements> = [0.5, 1.0, 2.0, 4.0].iter().map(|&k| n.scaled(k)).collect();
         space.dedup();
         let last = space.len() - 1;
         for (k, e) in space.into_iter().enumerate() {
             p.push((f, Ladder::Space, e, h / 4.0, k == last));
         }
-        for k in 0..4u32 {
-            let s = 2usize.pow(k);
-            p.push((f, Ladder::Diagonal, n * s, h / s as f64, k == 3));
+        for k in 0..4i32 {
+            let s = 2f64.powi(k);
+            p.push((f, Ladder::Diagonal, n.scaled(s), h / s, k == 3));
         }
     }
     p
@@ -158,14 +160,14 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
     // Most expensive first so the two cores stay busy to the end.
     let mut order: Vec<usize> = (0..plan.len()).collect();
     order.sort_by(|&a, &b| {
-        let cost = |i: usize| plan[i].2 as f64 / plan[i].3;
+        let cost = |i: usize| plan[i].2.for_body(0) as f64 / plan[i].3;
         cost(b).total_cmp(&cost(a))
     });
     let mut outs: Vec<(usize, RunOutput)> = order
         .par_iter()
         .map(|&i| {
-            let (f, _, e, dt, _) = plan[i];
-            let out = run_formulation(&rung_spec(spec, f, e, dt), f);
+            let (f, _, ref e, dt, _) = plan[i];
+            let out = run_formulation(&rung_spec(spec, f, e.clone(), dt), f);
             bar.inc(1);
             (i, out)
         })
@@ -188,7 +190,7 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
             };
             let mut errs = Vec::new();
             for &i in &idx {
-                let (_, _, e, dt, is_truth) = plan[i];
+                let (_, _, ref e, dt, is_truth) = plan[i];
                 let o = &outs[i];
                 let error_m =
                     if o.error.is_some() || (is_truth && !use_external) { f64::NAN } else { max_distance(o, truth) };
@@ -198,7 +200,7 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                 rungs.push(Rung {
                     formulation: f,
                     ladder,
-                    elements: e,
+                    elements: e.clone(),
                     dt,
                     is_truth: is_truth && !use_external,
                     wall_s: o.wall_s,
@@ -287,10 +289,10 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
     };
     let s = Panel {
         title: format!("{} — error against elements per body", r.name),
-        x_label: "log10 elements per body [-]".into(),
+        x_label: "log10 elements (first body) [-]".into(),
         y_label: "max tip error [m]".into(),
         log_y: true,
-        series: series(&|g| g.elements as f64, &[Ladder::Space]),
+        series: series(&|g| g.elements.for_body(0) as f64, &[Ladder::Space]),
     };
     panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (600, 420))
 }

@@ -10,12 +10,37 @@ use crate::run::Row;
 pub const HEADER: &str =
     "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,constraint_residual,newton_iterations";
 
-/// Render rows as CSV text.
+/// Column header with aerodynamics (`aero_work` after `total`, `lift` at the end).
+pub const HEADER_AERO: &str =
+    "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,newton_iterations,lift";
+
+/// Render rows as CSV text (aerodynamic columns when the run has them).
 pub fn to_csv(rows: &[Row]) -> String {
-    let mut s = String::with_capacity(rows.len() * 180);
-    s.push_str(HEADER);
+    let aero = rows.iter().any(|r| r.aero_work.is_finite());
+    let mut s = String::with_capacity(rows.len() * 200);
+    s.push_str(if aero { HEADER_AERO } else { HEADER });
     s.push('\n');
     for r in rows {
+        if aero {
+            let _ = writeln!(
+                s,
+                "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e},{},{:.6e}",
+                r.t,
+                r.tip[0],
+                r.tip[1],
+                r.tip[2],
+                r.fold,
+                r.kinetic,
+                r.elastic,
+                r.potential,
+                r.total,
+                r.aero_work,
+                r.constraint_residual,
+                r.newton_iterations,
+                r.lift
+            );
+            continue;
+        }
         let _ = writeln!(
             s,
             "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e},{}",

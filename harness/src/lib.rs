@@ -6,6 +6,7 @@
 //! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]).
 #![warn(missing_docs)]
 
+pub mod aero;
 pub mod case;
 pub mod converge;
 pub mod csv;

@@ -80,7 +80,7 @@ pub struct FormulationMetrics {
     pub n_dof: usize,
     /// Last time reached, s.
     pub t_reached: f64,
-    /// max |E(t) − E(0)| / max kinetic energy.
+    /// max |E(t) − E(0) − W_aero(t)| / max kinetic energy.
     pub energy_drift: f64,
     /// Peak kinetic energy, J.
     pub peak_kinetic: f64,
@@ -88,6 +88,8 @@ pub struct FormulationMetrics {
     pub max_constraint_residual: f64,
     /// Error that stopped the run.
     pub error: Option<String>,
+    /// Wall time in the aerodynamics, s.
+    pub aero_wall_s: f64,
 }
 
 impl FormulationMetrics {
@@ -95,7 +97,8 @@ impl FormulationMetrics {
     pub fn of(run: &RunOutput) -> Self {
         let e0 = run.rows.first().map_or(0.0, |r| r.total);
         let peak = run.rows.iter().map(|r| r.kinetic).fold(0.0, f64::max);
-        let drift = run.rows.iter().map(|r| (r.total - e0).abs()).fold(0.0, f64::max);
+        let w = |r: &Row| if r.aero_work.is_finite() { r.aero_work } else { 0.0 };
+        let drift = run.rows.iter().map(|r| (r.total - e0 - w(r)).abs()).fold(0.0, f64::max);
         Self {
             wall_s: run.wall_s,
             n_steps: run.stats.n_steps,
@@ -110,6 +113,7 @@ impl FormulationMetrics {
             peak_kinetic: peak,
             max_constraint_residual: run.rows.iter().map(|r| r.constraint_residual).fold(0.0, f64::max),
             error: run.error.clone(),
+            aero_wall_s: run.aero_wall_s,
         }
     }
 }

@@ -54,6 +54,10 @@ pub struct Row {
     pub constraint_residual: f64,
     /// Newton iterations of the step that reached this row.
     pub newton_iterations: usize,
+    /// Work done by the aerodynamic loads since t = 0, J (NaN without aerodynamics).
+    pub aero_work: f64,
+    /// Aerodynamic lift, N (NaN without aerodynamics).
+    pub lift: f64,
 }
 
 /// Solver settings of one run.
@@ -82,16 +86,27 @@ pub struct RunOutput {
     pub n_dof: usize,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
+    /// Wall time spent in the aerodynamics, s (0 without).
+    pub aero_wall_s: f64,
 }
 
 impl RunOutput {
     /// A run that could not even start.
     pub fn failed(formulation: Formulation, error: String) -> Self {
-        Self { formulation, rows: Vec::new(), wall_s: 0.0, stats: Stats::default(), n_dof: 0, error: Some(error) }
+        Self {
+            formulation,
+            rows: Vec::new(),
+            wall_s: 0.0,
+            stats: Stats::default(),
+            n_dof: 0,
+            error: Some(error),
+            aero_wall_s: 0.0,
+        }
     }
 }
 
-fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize) -> Row {
+/// The sensors of `model` at state `s` (aerodynamic columns NaN).
+pub fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize) -> Row {
     let e = model.energies(&s.q, &s.v);
     Row {
         t: s.t,
@@ -103,6 +118,8 @@ fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize) ->
         total: e.kinetic + e.elastic + e.potential,
         constraint_residual: model.constraint_residual(&s.q),
         newton_iterations,
+        aero_work: f64::NAN,
+        lift: f64::NAN,
     }
 }
 
@@ -117,6 +134,7 @@ pub fn simulate<S: Structure + ?Sized>(formulation: Formulation, model: &mut S, 
         stats: Stats::default(),
         n_dof: model.n_dof(),
         error: None,
+        aero_wall_s: 0.0,
     };
     let dt = settings.params.dt;
     let n_steps = (settings.t_end / dt - 1e-9).ceil().max(0.0) as usize;

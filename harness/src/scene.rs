@@ -4,6 +4,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::Error;
+use crate::aero::{AeroStructure, SectionLoad, simulate_aero, station_map};
 use crate::case::{AncfPath, Case, Formulation, Joint};
 use crate::run::{Energies, RunOutput, RunSettings, Structure, simulate};
 
@@ -26,7 +27,8 @@ macro_rules! specs {
         let bodies: Vec<$krate::BodySpec> = case
             .bodies
             .iter()
-            .map(|b| $krate::BodySpec {
+            .enumerate()
+            .map(|(i, b)| $krate::BodySpec {
                 name: b.name.clone(),
                 start: Vector3::from(b.start),
                 length: b.length,
@@ -43,7 +45,7 @@ macro_rules! specs {
                     ei_yy: c * b.section.ei_yy,
                     ei_zz: c * b.section.ei_zz,
                 },
-                n_elements: $n_el,
+                n_elements: $n_el.for_body(i),
             })
             .collect();
         let idx = |n: &str| case.body_index(n).unwrap_or(usize::MAX);
@@ -178,6 +180,79 @@ macro_rules! structure {
 structure!(ancf::Model);
 structure!(gebf::Model);
 
+impl AeroStructure for Sensed<ancf::Model> {
+    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
+        // The station list is validated against the case, so (body, s) is always in range.
+        self.model.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))
+    }
+    fn set_section_loads(&mut self, loads: &[SectionLoad]) {
+        let pl: Vec<ancf::PointLoad> = loads
+            .iter()
+            .map(|l| ancf::PointLoad { body: l.body, s: l.s, y: 0.0, z: 0.0, force: l.force, moment: l.moment })
+            .collect();
+        // Stations come from the validated case: in range by construction.
+        let _ = self.model.set_point_loads(&pl);
+    }
+}
+
+/// Element of a GEBF body holding arclength `s`: its three node indices and the quadratic
+/// Lagrange weights of `s`.
+fn gebf_element(model: &gebf::Model, body: usize, s: f64) -> Option<([usize; 3], [f64; 3])> {
+    let n = model.n_nodes(body);
+    let arc = |k: usize| model.node_arc_length(body, k).ok();
+    let n_el = (n - 1) / 2;
+    for e in 0..n_el {
+        let (s0, s1, s2) = (arc(2 * e)?, arc(2 * e + 1)?, arc(2 * e + 2)?);
+        if s <= s2 + 1e-12 || e + 1 == n_el {
+            let w = [
+                (s - s1) * (s - s2) / ((s0 - s1) * (s0 - s2)),
+                (s - s0) * (s - s2) / ((s1 - s0) * (s1 - s2)),
+                (s - s0) * (s - s1) / ((s2 - s0) * (s2 - s1)),
+            ];
+            return Some(([2 * e, 2 * e + 1, 2 * e + 2], w));
+        }
+    }
+    None
+}
+
+/// Rotation vector of a rotation matrix (|θ| < π).
+fn log_so3(r: &Matrix3<f64>) -> Vector3<f64> {
+    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+}
+
+impl AeroStructure for Sensed<gebf::Model> {
+    /// Quadratic interpolation of the element's nodal positions, and of the nodal rotations
+    /// relative to the middle node (objective).
+    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
+        let m = &self.model;
+        let Some((nodes, w)) = gebf_element(m, body, s) else {
+            return (Vector3::from_element(f64::NAN), Matrix3::identity());
+        };
+        let pos = |k| m.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
+        let frm = |k| m.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+        let p = pos(nodes[0]) * w[0] + pos(nodes[1]) * w[1] + pos(nodes[2]) * w[2];
+        let r1 = frm(nodes[1]);
+        let phi = log_so3(&(r1.transpose() * frm(nodes[0]))) * w[0] + log_so3(&(r1.transpose() * frm(nodes[2]))) * w[2];
+        let r = r1 * nalgebra::Rotation3::new(phi).into_inner();
+        (p, r)
+    }
+    /// Consistent nodal loads: the quadratic weights distribute each station's force and moment.
+    fn set_section_loads(&mut self, loads: &[SectionLoad]) {
+        self.model.clear_nodal_loads();
+        for l in loads {
+            let Some((nodes, w)) = gebf_element(&self.model, l.body, l.s) else { continue };
+            for (k, wk) in nodes.iter().zip(w) {
+                let old = self
+                    .model
+                    .nodal_load(l.body, *k)
+                    .unwrap_or(gebf::NodalLoad { force: Vector3::zeros(), moment: Vector3::zeros() });
+                let new = gebf::NodalLoad { force: old.force + wk * l.force, moment: old.moment + wk * l.moment };
+                let _ = self.model.set_nodal_load(l.body, *k, new);
+            }
+        }
+    }
+}
+
 fn settings(case: &Case, f: Formulation) -> RunSettings {
     let (dt, rho, newton) = match f {
         Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton),
@@ -212,9 +287,20 @@ pub fn build_gebf(case: &Case) -> Result<gebf::Model, Error> {
 pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
     let s = settings(case, f);
     let fold_joint = case.fold_joint_index();
-    let built = match f {
-        Formulation::Ancf => build_ancf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
-        Formulation::Gebf => build_gebf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
+    let built = match (&case.aero, f) {
+        (None, Formulation::Ancf) => build_ancf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
+        (None, Formulation::Gebf) => build_gebf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
+        (Some(aero), _) => {
+            match station_map(case, aero) {
+                Err(msg) => Err(Error::Model { formulation: f, msg }),
+                Ok(map) => match f {
+                    Formulation::Ancf => build_ancf(case)
+                        .map(|model| simulate_aero(f, &mut Sensed { model, fold_joint }, &s, aero, &map)),
+                    Formulation::Gebf => build_gebf(case)
+                        .map(|model| simulate_aero(f, &mut Sensed { model, fold_joint }, &s, aero, &map)),
+                },
+            }
+        }
     };
     built.unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
 }
