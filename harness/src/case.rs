@@ -448,7 +448,9 @@ pub fn set_path(root: &mut Value, path: &str, value: Value) -> Result<(), Error>
                     map.insert((*key).to_string(), value);
                     return Ok(());
                 }
-                map.get_mut(*key).ok_or_else(|| Error::Override(format!("`{here}` does not exist")))?
+                // Missing intermediate objects are created (e.g. `ancf.newton.rtol`); a misspelt
+                // key is then rejected by the schema, naming the field.
+                map.entry((*key).to_string()).or_insert_with(|| Value::Object(Default::default()))
             }
             Value::Array(arr) => {
                 let idx: usize =
@@ -799,7 +801,10 @@ mod tests {
         set_path(&mut v, "joints.1.flare_deg", json!(10)).unwrap();
         assert_eq!(v["joints"][1]["flare_deg"], json!(10));
         assert!(set_path(&mut v, "joints.9.flare_deg", json!(1)).unwrap_err().to_string().contains("joints.9"));
-        assert!(set_path(&mut v, "nope.x", json!(1)).unwrap_err().to_string().contains("nope"));
+        set_path(&mut v, "ancf.newton.rtol", json!(1e-6)).unwrap();
+        assert_eq!(parse_case(&v).unwrap().ancf.newton.rtol, 1e-6);
+        set_path(&mut v, "nope.x", json!(1)).unwrap();
+        assert!(parse_case(&v).unwrap_err().contains("nope"));
     }
 
     #[test]
