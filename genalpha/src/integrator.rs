@@ -320,31 +320,46 @@ impl<L: LinearSolver> GenAlpha<L> {
         let mut fresh = false; // factorisation made at this iterate's matrix
         let mut factorized_this_step = false;
         let mut inc_norm = f64::INFINITY;
-        let mut res_norm;
+        let mut prev_prev_inc = f64::INFINITY;
         for iter in 1..=np.max_iter + 1 {
-            // Residuals at the current iterate.
-            self.update_jacobians(sys, t1, &s.q);
-            sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
-            self.stats.n_residual_evals += 1;
-            self.phi_q.add_mul_transpose_vec_inplace(&s.lambda, &mut self.r);
-            self.b_mat.add_mul_transpose_vec_inplace(&s.mu, &mut self.r);
+            // Constraints at the current iterate first: if the increment says converged, the
+            // dynamic residual is not needed.
             sys.phi_inplace(t1, &s.q, &mut self.phi);
             sys.psi_inplace(t1, &s.q, &s.v, &mut self.psi);
-            res_norm = inf_norm(&self.r) / c.beta_prime;
             let phi_norm = inf_norm(&self.phi);
             let psi_norm = inf_norm(&self.psi);
-            stats.residual_norm = res_norm;
             stats.phi_norm = phi_norm;
             stats.psi_norm = psi_norm;
-            if !(res_norm.is_finite() && phi_norm.is_finite() && psi_norm.is_finite()) {
+            if !(phi_norm.is_finite() && psi_norm.is_finite()) {
                 return Err(Error::NonFinite { t: t1, iter });
             }
-            if iter > 1 && inc_norm <= 1.0 && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
+            // Converged when the last increment, or the error estimate θ/(1 − θ)·|Δ| of a
+            // contracting iteration (θ = |Δ_k|/|Δ_{k−1}|), is below the tolerance.
+            let theta = inc_norm / prev_inc;
+            let small = inc_norm <= 1.0
+                || (np.estimate_convergence && iter > 2 && theta < 0.5 && theta / (1.0 - theta) * inc_norm <= 1.0);
+            if iter > 1 && small && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
                 stats.n_newton_iters = iter - 1;
                 self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);
                 s.t = t1;
                 sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
                 return Ok(stats);
+            }
+            // Dynamic residual at the current iterate.
+            self.update_jacobians(sys, t1, &s.q);
+            sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
+            self.stats.n_residual_evals += 1;
+            self.phi_q.add_mul_transpose_vec_inplace(&s.lambda, &mut self.r);
+            self.b_mat.add_mul_transpose_vec_inplace(&s.mu, &mut self.r);
+            let res_norm = inf_norm(&self.r) / c.beta_prime;
+            stats.residual_norm = res_norm;
+            if !res_norm.is_finite() {
+                return Err(Error::NonFinite { t: t1, iter });
+            }
+            // A fresh matrix whose increments grew twice in a row: give up early (the caller
+            // halves the step).
+            if factorized_this_step && fresh && inc_norm > 2.0 * prev_inc && prev_inc > 2.0 * prev_prev_inc {
+                break;
             }
             if iter > np.max_iter {
                 break;
@@ -399,6 +414,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 return Err(Error::NonFinite { t: t1, iter });
             }
             // Update.
+            prev_prev_inc = prev_inc;
             prev_inc = inc_norm;
             inc_norm = 0.0;
             for i in 0..n {

@@ -25,6 +25,10 @@ pub struct NewtonParams {
     /// down to dt/16). 0 turns the retry off. A successful run without failures is unaffected;
     /// the halvings are counted in [`Stats::n_step_halvings`](crate::Stats).
     pub max_step_halvings: usize,
+    /// Also accept an iterate when the contraction estimate `θ/(1 − θ)·|Δ_k|` (θ the ratio of
+    /// the last two increment norms, θ < 0.5) is below the tolerance, as RADAU5 does: saves the
+    /// last, confirming iteration. Default true.
+    pub estimate_convergence: bool,
 }
 
 impl Default for NewtonParams {
@@ -38,6 +42,7 @@ impl Default for NewtonParams {
             reuse_factorization: true,
             max_contraction: 0.2,
             max_step_halvings: 4,
+            estimate_convergence: true,
         }
     }
 }

@@ -212,6 +212,31 @@ fn consistent_initial_multiplier() {
     assert_relative_eq!(s.lambda[0], 0.0, epsilon = 1e-12);
 }
 
+/// The contraction estimate saves the confirming iteration; accepting each step within the
+/// Newton tolerance changes the answer after 500 steps far less than the time discretisation
+/// error (~1e-3 here, see `pendulum_velocity_level_matches_index3`).
+#[test]
+fn convergence_estimate_saves_iterations() {
+    let run = |estimate: bool| {
+        let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
+        let mut p = IntegratorParams::new(0.8, 1e-3);
+        p.newton.estimate_convergence = estimate;
+        let mut ga = GenAlpha::new(p, &sys).unwrap();
+        let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+        ga.initialize(&sys, &mut s).unwrap();
+        for _ in 0..500 {
+            ga.step(&mut sys, &mut s).unwrap();
+        }
+        (s, *ga.stats())
+    };
+    let (a, sa) = run(false);
+    let (b, sb) = run(true);
+    assert!(sb.n_newton_iters < sa.n_newton_iters, "{sb:?} vs {sa:?}");
+    for (x, y) in a.q.iter().zip(&b.q) {
+        assert!((x - y).abs() < 1e-5, "{x} vs {y}");
+    }
+}
+
 #[test]
 fn invalid_parameters_name_the_field() {
     let sys = Oscillator { m: 1.0, k: 1.0 };
@@ -230,6 +255,7 @@ fn failed_step_is_retried_in_halves() {
     let mut p = IntegratorParams::new(0.9, 0.02);
     p.newton.max_iter = 2;
     p.newton.reuse_factorization = false;
+    p.newton.estimate_convergence = false;
     let mut ga = GenAlpha::new(p, &sys).unwrap();
     let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
     ga.initialize(&sys, &mut s).unwrap();
