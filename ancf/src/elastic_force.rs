@@ -119,40 +119,55 @@ impl Element {
     pub fn add_elastic_tangent(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let f = eval_fields(&self.plan, e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS];
+        // Upper block triangle (block row ≤ block column) of Σ C g gᵀ, mirrored at the end so
+        // that the matrix is exactly symmetric.
+        let mut upper = ElementMatrix::zeros();
+        let data = upper.as_mut_slice(); // column-major 24 × 24
         for s in &self.plan.strains {
             let d = strain_value(s, &f) - s.reference;
             let g = strain_gradient(&self.plan, s, &f);
-            // rank-1 update restricted to the blocks the strain depends on
             let cs = c * s.stiffness;
             let blocks = &s.blocks[..s.n_blocks];
-            for &bj in blocks {
+            for (jb, &bj) in blocks.iter().enumerate() {
                 for j in 3 * bj..3 * bj + 3 {
-                    let gj = cs * g[j];
+                    let gj = g[j];
                     if gj == 0.0 {
                         continue;
                     }
-                    for &bi in blocks {
-                        for i in 3 * bi..3 * bi + 3 {
-                            k[(i, j)] += g[i] * gj;
-                        }
+                    let col = &mut data[ELEMENT_DOF * j..ELEMENT_DOF * (j + 1)];
+                    for &bi in &blocks[..=jb] {
+                        let (gi, ci) = (&g.as_slice()[3 * bi..3 * bi + 3], &mut col[3 * bi..3 * bi + 3]);
+                        ci[0] += cs * (gi[0] * gj);
+                        ci[1] += cs * (gi[1] * gj);
+                        ci[2] += cs * (gi[2] * gj);
                     }
                 }
             }
             let sd = c * s.stiffness * d;
-            for (row, hrow) in geometric.iter_mut().zip(&s.hessian) {
-                for (x, h) in row.iter_mut().zip(hrow) {
-                    *x += sd * h;
+            for (jb, &b) in blocks.iter().enumerate() {
+                for &a in &blocks[..=jb] {
+                    geometric[a][b] += sd * s.hessian[a][b];
                 }
             }
         }
-        for a in 0..N_BLOCKS {
-            for b in 0..N_BLOCKS {
+        for b in 0..N_BLOCKS {
+            for a in 0..=b {
                 let x = geometric[a][b];
                 if x != 0.0 {
                     for i in 0..3 {
-                        k[(3 * a + i, 3 * b + i)] += x;
+                        data[ELEMENT_DOF * (3 * b + i) + 3 * a + i] += x;
                     }
                 }
+            }
+        }
+        // mirror: column j, rows of blocks below j's block
+        for j in 0..ELEMENT_DOF {
+            let bj = j / 3;
+            for i in 3 * (bj + 1)..ELEMENT_DOF {
+                k[(i, j)] += upper[(j, i)];
+            }
+            for i in 0..3 * (bj + 1) {
+                k[(i, j)] += upper[(i, j)];
             }
         }
     }

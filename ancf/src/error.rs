@@ -133,7 +133,9 @@ pub enum Error {
         length: f64,
     },
     /// The static Newton iteration failed.
-    #[error("statics did not converge at load factor {load_factor:.4} after {iter} iterations (residual {residual_norm:.3e})")]
+    #[error(
+        "statics did not converge at load factor {load_factor:.4} after {iter} iterations (residual {residual_norm:.3e})"
+    )]
     StaticsDiverged {
         /// Load factor of the failed load step.
         load_factor: f64,

@@ -78,7 +78,8 @@ impl Joint {
 
     /// The constraint equations of this joint (index `j`).
     pub(crate) fn rows(&self, j: usize, bodies: &[Body]) -> Vec<ConstraintRow> {
-        let dof = |body: usize, node: usize, block: usize, i: usize| bodies[body].offset + NODE_DOF * node + 3 * block + i;
+        let dof =
+            |body: usize, node: usize, block: usize, i: usize| bodies[body].offset + NODE_DOF * node + 3 * block + i;
         let mut rows = Vec::new();
         match self {
             Joint::Ground { body, axis, alpha, r0 } => {
@@ -115,7 +116,11 @@ impl Joint {
                 for (block, target) in [(0, *r0), (2, frame0.column(1).into()), (3, frame0.column(2).into())] {
                     let target: Vector3<f64> = target;
                     for i in 0..3 {
-                        rows.push(ConstraintRow { entries: vec![(dof(*body, 0, block, i), 1.0)], rhs: target[i], joint: j });
+                        rows.push(ConstraintRow {
+                            entries: vec![(dof(*body, 0, block, i), 1.0)],
+                            rhs: target[i],
+                            joint: j,
+                        });
                     }
                 }
             }

@@ -92,21 +92,24 @@ fn moment_jacobian(st: Station, m: &Vector3<f64>, q: &[f64]) -> [[Matrix3<f64>; 
     let s = m.cross_matrix();
     let (cy, cz) = (ry.cross_matrix(), rz.cross_matrix());
     let w1 = (0.5 * m.cross(&ry.cross(&rz))).cross_matrix();
-    [
-        [0.5 * s - 0.5 * cz * s * cz, -w1 + 0.5 * cz * s * cy],
-        [w1 + 0.5 * cy * s * cz, 0.5 * s - 0.5 * cy * s * cy],
-    ]
+    [[0.5 * s - 0.5 * cz * s * cz, -w1 + 0.5 * cz * s * cy], [w1 + 0.5 * cy * s * cz, 0.5 * s - 0.5 * cy * s * cy]]
 }
 
 /// Calls `add(row, col, block)` with the 3×3 blocks of `−c ∂Q_M/∂q` (full coordinates).
-pub(crate) fn moment_tangent(st: Station, m: &Vector3<f64>, q: &[f64], c: f64, mut add: impl FnMut(usize, usize, &Matrix3<f64>)) {
+pub(crate) fn moment_tangent(
+    st: Station,
+    m: &Vector3<f64>,
+    q: &[f64],
+    c: f64,
+    mut add: impl FnMut(usize, usize, &Matrix3<f64>),
+) {
     let jac = moment_jacobian(st, m, q);
     let nodes = [(0usize, 1.0 - st.xi), (4usize, st.xi)];
     for &(na, wa) in &nodes {
         for &(nb, wb) in &nodes {
-            for fa in 0..2 {
-                for fb in 0..2 {
-                    let blk = -c * wa * wb * jac[fa][fb];
+            for (fa, row) in jac.iter().enumerate() {
+                for (fb, j) in row.iter().enumerate() {
+                    let blk = -c * wa * wb * j;
                     add(st.first + 3 * (na + 2 + fa), st.first + 3 * (nb + 2 + fb), &blk);
                 }
             }

@@ -6,11 +6,11 @@
 //! strain kind that stores most of its linearised strain energy, so that the cross-section
 //! penalty modes can be told apart from beam modes.
 
+use crate::Error;
 use crate::elastic_force::ElementVector;
 use crate::model::Model;
 use crate::shape::{ELEMENT_DOF, NODE_DOF};
 use crate::strain::{N_STRAINS, StrainKind};
-use crate::Error;
 use genalpha::DenseMatrix;
 use nalgebra::DMatrix;
 
@@ -74,7 +74,8 @@ impl Model {
         let eig = a.symmetric_eigen();
         let mut order: Vec<usize> = (0..nz).collect();
         order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-        let grads: Vec<(usize, Vec<(StrainKind, f64, ElementVector)>)> = self
+        type Gradients = Vec<(StrainKind, f64, ElementVector)>;
+        let grads: Vec<(usize, Gradients)> = self
             .bodies
             .iter()
             .flat_map(|body| {

@@ -1,8 +1,8 @@
 //! The assembled multibody model: bodies of two-node elements, linear joints, loads, and its
 //! two presentations to the integrator (index-3 DAE or reduced ODE).
 
-use crate::element::Element;
 use crate::elastic_force::ElementMatrix;
+use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
 use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
@@ -90,7 +90,12 @@ pub struct Model {
 impl Model {
     /// Validate the scene and build the model (constant mass, element kernels, constraint
     /// equations, elimination basis). Errors name the offending field.
-    pub fn new(bodies: &[BodySpec], joints: &[JointSpec], gravity: Vector3<f64>, options: Options) -> Result<Model, Error> {
+    pub fn new(
+        bodies: &[BodySpec],
+        joints: &[JointSpec],
+        gravity: Vector3<f64>,
+        options: Options,
+    ) -> Result<Model, Error> {
         if bodies.is_empty() {
             return Err(Error::NoBodies);
         }
@@ -114,7 +119,13 @@ impl Model {
                     spec: spec.clone(),
                     offset,
                     n_nodes: spec.n_elements + 1,
-                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor, options.shear_gradient_factor),
+                    element: Element::new(
+                        l,
+                        &spec.section,
+                        options.curvature,
+                        options.penalty_factor,
+                        options.shear_gradient_factor,
+                    ),
                 };
                 offset += NODE_DOF * b.n_nodes;
                 b
@@ -160,7 +171,8 @@ impl Model {
             for k in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * k;
                 let z0 = reduction.z_of(first);
-                let contiguous = z0.is_some_and(|z0| (0..ELEMENT_DOF).all(|a| reduction.z_of(first + a) == Some(z0 + a)));
+                let contiguous =
+                    z0.is_some_and(|z0| (0..ELEMENT_DOF).all(|a| reduction.z_of(first + a) == Some(z0 + a)));
                 element_z.push(if contiguous { z0 } else { None });
             }
         }
@@ -369,7 +381,8 @@ impl Model {
                 e.elastic += b.element.elastic_energy(&qf[range]);
             }
         }
-        e.potential = -self.gravity_force.iter().zip(qf.iter().zip(&self.q_ref)).map(|(g, (q, q0))| g * (q - q0)).sum::<f64>();
+        e.potential =
+            -self.gravity_force.iter().zip(qf.iter().zip(&self.q_ref)).map(|(g, (q, q0))| g * (q - q0)).sum::<f64>();
         e
     }
 
@@ -409,7 +422,9 @@ impl Model {
         let st = locate(b, s);
         Ok(self.with_full(q, |q| {
             let w = point_weights(st.xi, st.l, y, z);
-            (0..8).map(|k| Vector3::new(q[st.first + 3 * k], q[st.first + 3 * k + 1], q[st.first + 3 * k + 2]) * w[k]).sum()
+            (0..8)
+                .map(|k| Vector3::new(q[st.first + 3 * k], q[st.first + 3 * k + 1], q[st.first + 3 * k + 2]) * w[k])
+                .sum()
         }))
     }
 
@@ -421,7 +436,9 @@ impl Model {
         let vf = &mut sens.1[..self.n_full];
         self.full_velocities_inplace(v, vf);
         let w = point_weights(st.xi, st.l, y, z);
-        Ok((0..8).map(|k| Vector3::new(vf[st.first + 3 * k], vf[st.first + 3 * k + 1], vf[st.first + 3 * k + 2]) * w[k]).sum())
+        Ok((0..8)
+            .map(|k| Vector3::new(vf[st.first + 3 * k], vf[st.first + 3 * k + 1], vf[st.first + 3 * k + 2]) * w[k])
+            .sum())
     }
 
     /// Axis point (global, m) and orthonormalised section frame (columns x, y, z) at arclength
@@ -517,18 +534,6 @@ impl Model {
                 add_moment_force(*st, &(-lf * m), q, r);
             }
         }
-    }
-
-    /// Elastic energy of full coordinates `q`.
-    pub(crate) fn elastic_energy_full(&self, q: &[f64]) -> f64 {
-        let mut u = 0.0;
-        for b in &self.bodies {
-            for k in 0..b.n_elements() {
-                let first = b.offset + NODE_DOF * k;
-                u += b.element.elastic_energy(&q[first..first + ELEMENT_DOF]);
-            }
-        }
-        u
     }
 
     /// `k += c_m M + c_k ∂r/∂q` at full coordinates `q`, written through the chosen form.

@@ -65,19 +65,14 @@ impl SkylineLu {
         let Some((n_primary, adj)) = &self.structure else { return };
         let n = self.n;
         self.order.clear();
-        for i in 0..*n_primary {
+        let np = *n_primary;
+        let last: Vec<Option<usize>> =
+            adj[np..n].iter().map(|list| list.iter().copied().filter(|&j| j < np).max()).collect();
+        for i in 0..np {
             self.order.push(i);
-            for m in *n_primary..n {
-                if adj[m].iter().copied().filter(|&j| j < *n_primary).max() == Some(i) {
-                    self.order.push(m);
-                }
-            }
+            self.order.extend(last.iter().enumerate().filter(|(_, l)| **l == Some(i)).map(|(k, _)| np + k));
         }
-        for m in *n_primary..n {
-            if !adj[m].iter().any(|&j| j < *n_primary) {
-                self.order.push(m);
-            }
-        }
+        self.order.extend(last.iter().enumerate().filter(|(_, l)| l.is_none()).map(|(k, _)| np + k));
         for (new, &old) in self.order.iter().enumerate() {
             self.inverse[old] = new;
         }
@@ -189,6 +184,14 @@ impl SkylineLu {
             }
             scale = scale.max(a[oi * n + oi].abs());
         }
+        // Symmetric values up to round-off (no follower moments): L = D⁻¹Uᵀ, half the work.
+        let symmetric = (0..n).all(|i| {
+            let (lp, up, h) = (self.lptr[i], self.uptr[i], i - self.first[i]);
+            self.lval[lp..lp + h]
+                .iter()
+                .zip(&self.uval[up..up + h])
+                .all(|(l, u)| (l - u).abs() <= 1e-10 * (l.abs() + u.abs()))
+        });
         // Crout, in place.
         for j in 0..n {
             let fj = self.first[j];
@@ -200,10 +203,15 @@ impl SkylineLu {
                 // U[i][j] −= L[i][lo..i] · U[lo..i][j]
                 let s = dot(&self.lval[lpi + (lo - fi)..lpi + (i - fi)], &self.uval[upj + (lo - fj)..upj + (i - fj)]);
                 self.uval[upj + (i - fj)] -= s;
-                // L[j][i] = (A[j][i] − L[j][lo..i] · U[lo..i][i]) / U[i][i]
-                let s = dot(&self.lval[lpj + (lo - fj)..lpj + (i - fj)], &self.uval[upi + (lo - fi)..upi + (i - fi)]);
                 let d = self.uval[upi + (i - fi)];
-                self.lval[lpj + (i - fj)] = (self.lval[lpj + (i - fj)] - s) / d;
+                if symmetric {
+                    self.lval[lpj + (i - fj)] = self.uval[upj + (i - fj)] / d;
+                } else {
+                    // L[j][i] = (A[j][i] − L[j][lo..i] · U[lo..i][i]) / U[i][i]
+                    let s =
+                        dot(&self.lval[lpj + (lo - fj)..lpj + (i - fj)], &self.uval[upi + (lo - fi)..upi + (i - fi)]);
+                    self.lval[lpj + (i - fj)] = (self.lval[lpj + (i - fj)] - s) / d;
+                }
             }
             let s = dot(&self.lval[lpj..lpj + (j - fj)], &self.uval[upj..upj + (j - fj)]);
             let d = self.uval[upj + (j - fj)] - s;
@@ -379,4 +387,3 @@ mod tests {
         assert_relative_eq!(x[1], 2.0, epsilon = 1e-15);
     }
 }
-

@@ -6,8 +6,8 @@
 //!
 //! with the load factor `λ_L` ramped linearly over the load steps.
 
-use crate::model::Model;
 use crate::Error;
+use crate::model::Model;
 use genalpha::{DenseLu, DenseMatrix, LinearSolver};
 
 /// Static solver settings.

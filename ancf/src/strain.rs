@@ -308,8 +308,24 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
         match curvature {
             Curvature::Hybrid => {
                 let (m0, m1) = (mean_terms[0], mean_terms[1]);
-                bld.push(BendY, xi, w, &[(1.0, chord, zx), (-1.0, z, xx), (0.5, m0.0, m0.2), (0.5, m1.0, m1.2)], section, pf, kappa);
-                bld.push(BendZ, xi, w, &[(-1.0, chord, yx), (1.0, y, xx), (-0.5, m0.1, m0.2), (-0.5, m1.1, m1.2)], section, pf, kappa);
+                bld.push(
+                    BendY,
+                    xi,
+                    w,
+                    &[(1.0, chord, zx), (-1.0, z, xx), (0.5, m0.0, m0.2), (0.5, m1.0, m1.2)],
+                    section,
+                    pf,
+                    kappa,
+                );
+                bld.push(
+                    BendZ,
+                    xi,
+                    w,
+                    &[(-1.0, chord, yx), (1.0, y, xx), (-0.5, m0.1, m0.2), (-0.5, m1.1, m1.2)],
+                    section,
+                    pf,
+                    kappa,
+                );
             }
             Curvature::Kirchhoff => {
                 bld.push(BendY, xi, w, &[(-1.0, z, xx)], section, pf, kappa);

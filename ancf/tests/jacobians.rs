@@ -23,7 +23,14 @@ fn iteration_matrix_equals_finite_differences_of_the_residual() {
         model
             .set_point_loads(&[
                 PointLoad::moment(1, 0.31, Vector3::new(0.4, -1.2, 0.7)),
-                PointLoad { body: 0, s: 0.2, y: 0.01, z: -0.02, force: Vector3::new(1.0, 2.0, -3.0), moment: Vector3::zeros() },
+                PointLoad {
+                    body: 0,
+                    s: 0.2,
+                    y: 0.01,
+                    z: -0.02,
+                    force: Vector3::new(1.0, 2.0, -3.0),
+                    moment: Vector3::zeros(),
+                },
             ])
             .unwrap();
         let n = model.n_dof();

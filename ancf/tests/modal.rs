@@ -1,7 +1,7 @@
 //! Linear dynamics of a clamped cantilever (16 elements) against Euler–Bernoulli, rod and shaft
 //! theory: first two bending frequencies about each axis, first torsion, first axial mode
 //! within 1 %. Penalty (cross-section) modes are told apart by their strain energy.
-use ancf::{Model, ModeKind, Options, Section, samples};
+use ancf::{ModeKind, Model, Options, Section, samples};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 

@@ -43,7 +43,9 @@ fn beta0_planar_and_beta90_unfolded() {
     let max_fold = run90.iter().map(|r| r.fold.abs()).fold(0.0, f64::max).to_degrees();
     assert!(max_fold < 1.0, "beta = 90 folds by {max_fold} deg");
     let (err90, _) = max_tip_error(&run90, &reference("exudyn/flex_c1_beta90_gebf_n40_dt0.0005.csv"), 0.0);
-    println!("beta 0: max|Y| {max_y:e} m, tip error {err0:.3e} m; beta 90: max|fold| {max_fold:e} deg, tip error {err90:.3e} m");
+    println!(
+        "beta 0: max|Y| {max_y:e} m, tip error {err0:.3e} m; beta 90: max|fold| {max_fold:e} deg, tip error {err90:.3e} m"
+    );
     assert!(err0 < 0.01 && err90 < 0.01, "tip errors {err0}, {err90}");
     for run in [&run0, &run90] {
         let worst = run.iter().map(|r| r.residual).fold(0.0, f64::max);

@@ -39,7 +39,8 @@ fn tip_moment_rolls_into_a_full_circle() {
         let moment = factor * 2.0 * PI * 1.0 / l;
         // −y moment bends the beam toward +z
         m.set_point_loads(&[PointLoad::moment(0, l, Vector3::new(0.0, -moment, 0.0))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: (40.0 * factor) as usize, ..Default::default() }).unwrap();
+        let sol =
+            m.solve_statics(StaticsParams { n_load_steps: (40.0 * factor) as usize, ..Default::default() }).unwrap();
         let tip = m.tip_position(&sol.q);
         let theta = moment * l;
         let exact = Vector3::new(theta.sin() / moment, 0.0, (1.0 - theta.cos()) / moment);
@@ -73,7 +74,10 @@ fn tip_load_elastica_table() {
         let tip = m.tip_position(&sol.q);
         let (u, w, rot) = ((l - tip.x) / l, -tip.z / l, -tip_rotation_about_y(&m, &sol.q));
         let errs = [(u / u_ref - 1.0).abs(), (w / w_ref - 1.0).abs(), (rot / rot_ref - 1.0).abs()];
-        println!("PL²/EI = {p}: u/L {u:.5} ({u_ref}), w/L {w:.5} ({w_ref}), rot {rot:.5} ({rot_ref}), rel errors {:.2e} {:.2e} {:.2e}", errs[0], errs[1], errs[2]);
+        println!(
+            "PL²/EI = {p}: u/L {u:.5} ({u_ref}), w/L {w:.5} ({w_ref}), rot {rot:.5} ({rot_ref}), rel errors {:.2e} {:.2e} {:.2e}",
+            errs[0], errs[1], errs[2]
+        );
         assert!(errs.iter().all(|e| *e < 0.005), "PL²/EI = {p}: relative errors {errs:?}");
     }
 }

@@ -26,6 +26,17 @@ pub fn interpolate(r: &[(f64, Vector3<f64>)], t: f64) -> Vector3<f64> {
     a.1 + (b.1 - a.1) * w
 }
 
+/// Integrator settings of these tests: defaults except the RADAU5-style convergence estimate,
+/// which is switched off. With it (genalpha f21ae6a) the β = 45° runs at c = 1 and c = 0.1 at
+/// the paper's settings hit a Newton failure at t ≈ 1.51 s: the early-exit/step-halving path
+/// taken at t = 1.424 s (a step full Newton converges in four iterations) accepts halved steps
+/// whose estimate passes too early, and the run blows up. Reported to the integrator's owner.
+pub fn params(rho_inf: f64, dt: f64) -> IntegratorParams {
+    let mut p = IntegratorParams::new(rho_inf, dt);
+    p.newton.estimate_convergence = false;
+    p
+}
+
 /// One recorded output step.
 #[derive(Debug, Clone, Copy)]
 pub struct Record {
@@ -41,7 +52,7 @@ pub struct Record {
 pub fn run_pendulum(c: f64, beta_deg: f64, n_el: usize, dt: f64, rho_inf: f64, options: Options) -> Vec<Record> {
     let (bodies, joints, g) = samples::double_pendulum(c, beta_deg, n_el);
     let mut model = Model::new(&bodies, &joints, g, options).expect("valid scene");
-    let mut ga = model.integrator(IntegratorParams::new(rho_inf, dt)).expect("valid parameters");
+    let mut ga = model.integrator(params(rho_inf, dt)).expect("valid parameters");
     let mut s = model.initial_state();
     ga.initialize(&model, &mut s).expect("consistent start");
     let n = (2.0 / dt).round() as usize;
