@@ -53,7 +53,7 @@ const fn series(sign: f64, offset: usize, deriv: usize) -> [f64; N_TERMS] {
             f *= i as f64;
             i += 1;
         }
-        let mut c = if n % 2 == 0 { sign / f } else { -sign / f };
+        let mut c = if n & 1 == 0 { sign / f } else { -sign / f };
         let mut d = 0;
         while d < deriv {
             c *= (n - d) as f64;
@@ -431,7 +431,7 @@ mod tests {
             V3::new(1e-9, -2e-9, 0.5e-9),
             V3::new(1e-3, 2e-3, -1e-3),
             V3::new(0.3, -0.2, 0.4),
-            V3::new(0.6, 0.7, -0.2), // φ ≈ 0.94 (series side)
+            V3::new(0.6, 0.7, -0.2),  // φ ≈ 0.94 (series side)
             V3::new(0.6, 0.7, -0.45), // φ ≈ 1.03 (closed-form side)
             V3::new(1.2, -0.8, 2.0),
             V3::new(0.0, 0.0, PI - 1e-6),

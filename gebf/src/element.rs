@@ -147,9 +147,7 @@ impl ElementState {
                 let djd = map.djac(&self.psid_stored[l]);
                 let d2 = map.djac(&self.psidd_stored[l]) + map.hess(&self.psid_stored[l], &self.psid_stored[l]);
                 let (ml, gl, kl) = (m.fixed_columns::<3>(o), g.fixed_columns::<3>(o), k.fixed_columns::<3>(o));
-                let col = (ml * j) * c.c_m
-                    + (gl * j + ml * djd * 2.0) * c.c_c
-                    + (kl * j + gl * djd + ml * d2) * c.c_k;
+                let col = (ml * j) * c.c_m + (gl * j + ml * djd * 2.0) * c.c_c + (kl * j + gl * djd + ml * d2) * c.c_k;
                 a.fixed_columns_mut::<3>(o).copy_from(&col);
             }
         }

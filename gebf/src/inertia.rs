@@ -93,8 +93,8 @@ pub(crate) fn add_inertia(
             let omr_t = skew(&om_r);
             let d_psid = tg.jac(&psid);
             let dom_dpsi = d_psid + cwt * t;
-            let domd_dpsi = tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt * t
-                + skew(&(cba * wd)) * t;
+            let domd_dpsi =
+                tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt * t + skew(&(cba * wd)) * t;
             let domd_dpsid = dtp + d_psid + cwt * t;
             let h_psi = j * t * c.c_m + (j * domd_dpsid + x * t) * c.c_c + (j * domd_dpsi + x * dom_dpsi) * c.c_k;
             let h_w = j * cba * c.c_m + (j * (-omr_t * cba) + x * cba) * c.c_c;

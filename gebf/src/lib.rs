@@ -28,6 +28,8 @@
 //!
 //! Start with [`samples::double_pendulum`], [`Model::new`] and [`simulate::run`].
 #![warn(missing_docs)]
+// The element math indexes nodes k, l and their shape functions explicitly, as the equations do.
+#![allow(clippy::needless_range_loop)]
 
 mod body;
 mod clamp;

@@ -87,7 +87,12 @@ fn check_body(field: String, b: usize, n_bodies: usize) -> Result<(), Error> {
 
 impl Model {
     /// Validates everything and returns an [`Error`] naming the field.
-    pub fn new(bodies: &[BodySpec], joints: &[JointSpec], gravity: Vector3<f64>, options: Options) -> Result<Model, Error> {
+    pub fn new(
+        bodies: &[BodySpec],
+        joints: &[JointSpec],
+        gravity: Vector3<f64>,
+        options: Options,
+    ) -> Result<Model, Error> {
         if bodies.is_empty() {
             return Err(Error::ZeroCount { field: "bodies".into() });
         }

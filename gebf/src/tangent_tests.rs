@@ -142,7 +142,11 @@ fn check_element(seed: u64, rot: f64) {
         add_inertia(&st, le, &sec, &mut r, Some((&mut an, coeffs)));
         let fd = fd_matrix(inertia, &st, &g_a, slot);
         let e = rel_err(&an, &fd);
-        assert!(e < TOL, "inertia tangent (seed {seed}, slot {}) rel err {e:.2e}", c.iter().position(|x| *x == 1.0).unwrap());
+        assert!(
+            e < TOL,
+            "inertia tangent (seed {seed}, slot {}) rel err {e:.2e}",
+            c.iter().position(|x| *x == 1.0).unwrap()
+        );
     }
     let mut an = Mat24::zeros();
     let mut r = Vec24::zeros();

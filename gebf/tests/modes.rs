@@ -53,9 +53,8 @@ fn cantilever_frequencies_at_16_elements() {
             if rot_x * 1e-4 > disp { Kind::Torsion } else { classify(&col) }
         })
         .collect();
-    let first = |k: Kind, nth: usize| {
-        (0..n).filter(|&i| kinds[i] == k).nth(nth).map(|i| modes.omega[i]).expect("mode found")
-    };
+    let first =
+        |k: Kind, nth: usize| (0..n).filter(|&i| kinds[i] == k).nth(nth).map(|i| modes.omega[i]).expect("mode found");
     let eb = (sec.ei_yy / (sec.mass * l.powi(4))).sqrt();
     let checks = [
         ("bending 1 (y)", first(Kind::BendingY, 0), 3.516_015 * eb),

@@ -94,7 +94,10 @@ fn tip_load_elastica_table() {
         // Rotation of the tip section about −y (tip tangent dips below the x axis).
         let rot = (-c[(2, 0)]).atan2(c[(0, 0)]);
         let errs = [(u - u_ref) / u_ref, (w - w_ref) / w_ref, (rot - rot_ref) / rot_ref];
-        println!("PL²/EI = {p}: u/L {u:.5} ({u_ref}), w/L {w:.5} ({w_ref}), rot {rot:.5} ({rot_ref}); rel errors {:.2e} {:.2e} {:.2e}", errs[0], errs[1], errs[2]);
+        println!(
+            "PL²/EI = {p}: u/L {u:.5} ({u_ref}), w/L {w:.5} ({w_ref}), rot {rot:.5} ({rot_ref}); rel errors {:.2e} {:.2e} {:.2e}",
+            errs[0], errs[1], errs[2]
+        );
         for e in errs {
             worst = worst.max(e.abs());
         }

@@ -70,7 +70,7 @@ impl Block {
         let tiny = 1e-13 * scale;
         for k in 0..m {
             let p = self.band[k * ld + w];
-            if !(p.abs() > tiny) {
+            if p.abs() <= tiny || !p.is_finite() {
                 return false;
             }
             let end = (k + w + 1).min(m);
@@ -229,8 +229,8 @@ impl BorderedBandLu {
                 let col = &data[(first + j) * n + first..(first + j) * n + first + m];
                 let lo = j.saturating_sub(w);
                 let hi = (j + w + 1).min(m);
-                for i in lo..hi {
-                    blk.band[i * ld + j + w - i] = col[i];
+                for (i, x) in col.iter().enumerate().take(hi).skip(lo) {
+                    blk.band[i * ld + j + w - i] = *x;
                 }
             }
             // Active border rows (F) and columns (E) of this block, found on every matrix:
@@ -292,7 +292,7 @@ impl BorderedBandLu {
         for k in 0..nb {
             let (piv, pmax) =
                 (k..nb).map(|i| (i, self.s[i * nb + k].abs())).fold((k, -1.0), |b, x| if x.1 > b.1 { x } else { b });
-            if !(pmax > 1e-14 * scale) {
+            if pmax <= 1e-14 * scale || !pmax.is_finite() {
                 return Err(self.border[k]);
             }
             if piv != k {

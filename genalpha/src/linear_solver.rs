@@ -80,12 +80,12 @@ impl LinearSolver for DenseLu {
 
     fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize> {
         assert!(a.n_rows() == self.n && a.n_cols() == self.n, "factorize: dimension mismatch");
-        if let Some(s) = &mut self.structured {
-            if !self.structure_checked {
-                self.structure_checked = true;
-                if !s.fits(a) {
-                    self.structured = None;
-                }
+        if let Some(s) = &mut self.structured
+            && !self.structure_checked
+        {
+            self.structure_checked = true;
+            if !s.fits(a) {
+                self.structured = None;
             }
         }
         if let Some(s) = &mut self.structured {
@@ -112,11 +112,11 @@ impl LinearSolver for DenseLu {
 
     fn solve_in_place(&mut self, b: &mut [f64]) {
         assert!(b.len() == self.n, "solve: dimension mismatch");
-        if self.use_structured {
-            if let Some(s) = &mut self.structured {
-                s.solve_in_place(b);
-                return;
-            }
+        if self.use_structured
+            && let Some(s) = &mut self.structured
+        {
+            s.solve_in_place(b);
+            return;
         }
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, self.n);
         let rhs = MatMut::from_column_major_slice_mut(b, self.n, 1);
