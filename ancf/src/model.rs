@@ -249,9 +249,9 @@ impl Model {
         genalpha::GenAlpha::with_solver(params, self, self.linear_solver())
     }
 
-    /// A [`SkylineLu`](crate::SkylineLu) that knows the structure of this model's iteration
-    /// matrix (in the integrator's layout: coordinates, then multipliers).
-    pub fn linear_solver(&self) -> crate::SkylineLu {
+    /// Coordinates coupled through the iteration matrix (symmetric adjacency, integrator layout:
+    /// coordinates then multipliers).
+    fn adjacency(&self) -> Vec<Vec<usize>> {
         let n = self.n_dof();
         let n_all = n + self.n_holonomic();
         let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n_all];
@@ -283,7 +283,13 @@ impl Model {
             list.sort_unstable();
             list.dedup();
         }
-        crate::SkylineLu::with_structure(n, adj)
+        adj
+    }
+
+    /// A [`SkylineLu`](crate::SkylineLu) that knows the structure of this model's iteration
+    /// matrix (in the integrator's layout: coordinates, then multipliers).
+    pub fn linear_solver(&self) -> crate::SkylineLu {
+        crate::SkylineLu::with_structure(self.n_dof(), self.adjacency())
     }
 
     /// The undeformed reference configuration at rest, sized for genalpha.
@@ -401,16 +407,20 @@ impl Model {
         })
     }
 
-    fn check_station(&self, field: &str, body: usize, s: f64) -> Result<&Body, Error> {
-        let b = self.bodies.get(body).ok_or(Error::NoSuchBody {
-            field: format!("{field}.body"),
+    /// Check a station; `field` names the input (formatted only on error: no allocation on
+    /// the valid path).
+    fn check_station(&self, field: impl Fn() -> String, body: usize, s: f64) -> Result<&Body, Error> {
+        let b = self.bodies.get(body).ok_or_else(|| Error::NoSuchBody {
+            field: format!("{}.body", field()),
             body,
             n_bodies: self.bodies.len(),
         })?;
-        finite(&format!("{field}.s"), s)?;
+        if !s.is_finite() {
+            return Err(Error::NonFinite { field: format!("{}.s", field()), value: s });
+        }
         let len = b.spec.length;
         if s < -1e-12 * len || s > len * (1.0 + 1e-12) {
-            return Err(Error::ArclengthOutOfRange { field: format!("{field}.s"), s, length: len });
+            return Err(Error::ArclengthOutOfRange { field: format!("{}.s", field()), s, length: len });
         }
         Ok(b)
     }
@@ -418,7 +428,7 @@ impl Model {
     /// Position (global, m) of the material point with section coordinates (y, z) at arclength
     /// `s` of `body`: `S(x, y, z) q`.
     pub fn material_point(&self, q: &[f64], body: usize, s: f64, y: f64, z: f64) -> Result<Vector3<f64>, Error> {
-        let b = self.check_station("station", body, s)?;
+        let b = self.check_station(|| "station".to_string(), body, s)?;
         let st = locate(b, s);
         Ok(self.with_full(q, |q| {
             let w = point_weights(st.xi, st.l, y, z);
@@ -430,7 +440,7 @@ impl Model {
 
     /// Velocity (global, m/s) of the material point (s, y, z) of `body`: `S(x, y, z) q̇`.
     pub fn material_velocity(&self, v: &[f64], body: usize, s: f64, y: f64, z: f64) -> Result<Vector3<f64>, Error> {
-        let b = self.check_station("station", body, s)?;
+        let b = self.check_station(|| "station".to_string(), body, s)?;
         let st = locate(b, s);
         let mut sens = self.sensor.borrow_mut();
         let vf = &mut sens.1[..self.n_full];
@@ -444,7 +454,7 @@ impl Model {
     /// Axis point (global, m) and orthonormalised section frame (columns x, y, z) at arclength
     /// `s` of `body`.
     pub fn section_frame(&self, q: &[f64], body: usize, s: f64) -> Result<(Vector3<f64>, Matrix3<f64>), Error> {
-        let b = self.check_station("station", body, s)?;
+        let b = self.check_station(|| "station".to_string(), body, s)?;
         let st = locate(b, s);
         Ok(self.with_full(q, |q| {
             let w = point_weights(st.xi, st.l, 0.0, 0.0);
@@ -462,14 +472,17 @@ impl Model {
     /// On error the previous loads are kept.
     pub fn set_point_loads(&mut self, loads: &[PointLoad]) -> Result<(), Error> {
         for (i, p) in loads.iter().enumerate() {
-            let field = format!("loads[{i}]");
-            self.check_station(&field, p.body, p.s)?;
-            for (name, x) in [("y", p.y), ("z", p.z)] {
-                finite(&format!("{field}.{name}"), x)?;
-            }
-            for k in 0..3 {
-                finite(&format!("{field}.force[{k}]"), p.force[k])?;
-                finite(&format!("{field}.moment[{k}]"), p.moment[k])?;
+            self.check_station(|| format!("loads[{i}]"), p.body, p.s)?;
+            let values = [("y", p.y), ("z", p.z)].into_iter().chain((0..3).flat_map(|k| {
+                [
+                    (["force[0]", "force[1]", "force[2]"][k], p.force[k]),
+                    (["moment[0]", "moment[1]", "moment[2]"][k], p.moment[k]),
+                ]
+            }));
+            for (name, x) in values {
+                if !x.is_finite() {
+                    return Err(Error::NonFinite { field: format!("loads[{i}].{name}"), value: x });
+                }
             }
         }
         self.point_force.iter_mut().for_each(|x| *x = 0.0);
@@ -724,6 +737,22 @@ impl ConstrainedSystem for Model {
 
     fn phi_q_is_constant(&self) -> bool {
         true
+    }
+
+    /// DAE: one band block per body (node-ordered coordinates, half-bandwidth 23), the joint
+    /// rows on the border. ODE: one band block over all independent coordinates with the
+    /// half-bandwidth of the eliminated couplings.
+    fn matrix_structure(&self) -> Option<genalpha::BandedBorder> {
+        let blocks = match self.options.path {
+            SolvePath::Dae => self.bodies.iter().map(|b| (b.offset, NODE_DOF * b.n_nodes, ELEMENT_DOF - 1)).collect(),
+            SolvePath::Ode => {
+                let adj = self.adjacency();
+                let w =
+                    adj.iter().enumerate().flat_map(|(i, l)| l.iter().map(move |&j| i.abs_diff(j))).max().unwrap_or(0);
+                vec![(0, self.reduction.n_reduced(), w)]
+            }
+        };
+        Some(genalpha::BandedBorder { blocks })
     }
 
     fn increment_weight(&self, i: usize) -> f64 {

@@ -1,0 +1,60 @@
+//! The model's per-step primitives do not allocate (STYLE rule 4): residual, iteration matrix,
+//! constraints, sensors and load updates, on both solve paths, counted with a global allocator.
+use ancf::{Model, Options, PointLoad, SolvePath, samples};
+use genalpha::{ConstrainedSystem, DenseMatrix};
+use nalgebra::Vector3;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn per_step_primitives_do_not_allocate() {
+    // the counter works
+    let c0 = ALLOCATIONS.load(Ordering::Relaxed);
+    let probe: Vec<u64> = Vec::with_capacity(16);
+    assert!(ALLOCATIONS.load(Ordering::Relaxed) > c0 && probe.capacity() >= 16);
+    for path in [SolvePath::Dae, SolvePath::Ode] {
+        let (b, j, g) = samples::double_pendulum(1.0, 45.0, 4);
+        let mut model = Model::new(&b, &j, g, Options { path, ..Default::default() }).unwrap();
+        let loads = [PointLoad::force(1, 0.3, Vector3::new(0.0, 0.0, 1.0)), PointLoad::moment(0, 0.2, Vector3::y())];
+        model.set_point_loads(&loads).unwrap(); // sizes the moment list
+        let s = model.initial_state();
+        let (n, m) = (model.n_dof(), model.n_holonomic());
+        let mut r = vec![0.0; n];
+        let mut phi = vec![0.0; m];
+        let mut k = DenseMatrix::zeros(n, n);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..3 {
+            model.set_point_loads(&loads).unwrap();
+            model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
+            model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.0, 1e-6, &mut k.view());
+            model.phi_inplace(0.0, &s.q, &mut phi);
+            let _ = model.tip_position(&s.q);
+            let _ = model.fold_angle(&s.q, 1).unwrap();
+            let _ = model.energies(&s.q, &s.v);
+            let _ = model.constraint_residual(&s.q);
+            let _ = model.section_frame(&s.q, 1, 0.25).unwrap();
+            let _ = model.material_velocity(&s.v, 1, 0.25, 0.1, 0.0).unwrap();
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert_eq!(after - before, 0, "{path:?}: {} allocations", after - before);
+    }
+}
