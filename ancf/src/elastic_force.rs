@@ -58,6 +58,15 @@ fn scatter(plan: &StrainPlan, pf: &Fields, out: &mut [f64]) {
     }
 }
 
+/// Copy the upper block triangle (3×3 blocks `(a, b)`, `a ≤ b`) onto the lower one.
+pub fn mirror_upper_inplace(k: &mut ElementMatrix) {
+    for j in 0..ELEMENT_DOF {
+        for i in 3 * (j / 3 + 1)..ELEMENT_DOF {
+            k[(i, j)] = k[(j, i)];
+        }
+    }
+}
+
 /// `A_k e` of one strain as a 24-vector.
 fn strain_gradient(plan: &StrainPlan, s: &crate::strain::SampledStrain, f: &Fields) -> ElementVector {
     let mut g = ElementVector::zeros();
@@ -117,12 +126,19 @@ impl Element {
 
     /// `k += c · K_el(e)`, the analytic elastic tangent of one element.
     pub fn add_elastic_tangent(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        let mut upper = ElementMatrix::zeros();
+        self.add_elastic_tangent_upper(e, c, &mut upper);
+        mirror_upper_inplace(&mut upper);
+        *k += upper;
+    }
+
+    /// `k += c · K_el(e)` on the upper block triangle only (3×3 blocks `(a, b)` with `a ≤ b`,
+    /// diagonal blocks in full); [`mirror_upper_inplace`] completes the symmetric matrix, so that
+    /// it is exactly symmetric.
+    pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let f = eval_fields(&self.plan, e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS];
-        // Upper block triangle (block row ≤ block column) of Σ C g gᵀ, mirrored at the end so
-        // that the matrix is exactly symmetric.
-        let mut upper = ElementMatrix::zeros();
-        let data = upper.as_mut_slice(); // column-major 24 × 24
+        let data = k.as_mut_slice(); // column-major 24 × 24
         for s in &self.plan.strains {
             let d = strain_value(s, &f) - s.reference;
             let g = strain_gradient(&self.plan, s, &f);
@@ -158,16 +174,6 @@ impl Element {
                         data[ELEMENT_DOF * (3 * b + i) + 3 * a + i] += x;
                     }
                 }
-            }
-        }
-        // mirror: column j, rows of blocks below j's block
-        for j in 0..ELEMENT_DOF {
-            let bj = j / 3;
-            for i in 3 * (bj + 1)..ELEMENT_DOF {
-                k[(i, j)] += upper[(j, i)];
-            }
-            for i in 0..3 * (bj + 1) {
-                k[(i, j)] += upper[(i, j)];
             }
         }
     }

@@ -1,7 +1,7 @@
 //! The assembled multibody model: bodies of two-node elements, linear joints, loads, and its
 //! two presentations to the integrator (index-3 DAE or reduced ODE).
 
-use crate::elastic_force::ElementMatrix;
+use crate::elastic_force::{ElementMatrix, mirror_upper_inplace};
 use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
 use crate::joint::{ConstraintRow, Joint, node_vector};
@@ -557,16 +557,17 @@ impl Model {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
                 ke.fill(0.0);
+                if c_k != 0.0 {
+                    b.element.add_elastic_tangent_upper(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
+                }
                 if c_m != 0.0 {
-                    for &(a, bb, m) in &b.element.mass_nz {
+                    for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
                         for i in 0..3 {
                             ke[(3 * a + i, 3 * bb + i)] += c_m * m;
                         }
                     }
                 }
-                if c_k != 0.0 {
-                    b.element.add_elastic_tangent(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
-                }
+                mirror_upper_inplace(&mut ke);
                 self.scatter_element(first, self.element_z[e_index], &ke, k);
                 e_index += 1;
             }

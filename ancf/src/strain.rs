@@ -36,7 +36,8 @@
 //! section only through shear over half an element: a spurious joint compliance `∝ 1/(GA l)`
 //! that grows as the mesh is refined. They are kept for comparison.
 //!
-//! **Locking.** Axial strain, twist and curvature use 3-point Gauss quadrature. The section
+//! **Locking.** Axial strain and curvature use 3-point Gauss quadrature, the twist (linear in ξ)
+//! 2-point Gauss, both exact or nearly so. The section
 //! penalties are sampled at the nodes only (trapezoidal rule): linearly interpolated rotated
 //! unit slopes shorten between the nodes, and penalising that would lock
 //! (curvature-thickness locking).
@@ -304,7 +305,6 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
     for (xi, w) in gauss3 {
         let (x, xx, y, z) = (bld.at(X, xi), bld.at(XX, xi), bld.at(Y, xi), bld.at(Z, xi));
         bld.push(Axial, xi, w, &[(0.5, x, x)], section, pf, kappa);
-        bld.push(Twist, xi, w, &[(0.5, z, yx), (-0.5, y, zx)], section, pf, kappa);
         match curvature {
             Curvature::Hybrid => {
                 let (m0, m1) = (mean_terms[0], mean_terms[1]);
@@ -336,6 +336,11 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
                 bld.push(BendZ, xi, w, &[(0.5, y, xx), (-0.5, x, yx)], section, pf, kappa);
             }
         }
+    }
+    // K1 is linear in ξ (linear sections, constant derivatives): 2-point Gauss is exact.
+    for xi in gauss2 {
+        let (y, z) = (bld.at(Y, xi), bld.at(Z, xi));
+        bld.push(Twist, xi, 0.5, &[(0.5, z, yx), (-0.5, y, zx)], section, pf, kappa);
     }
     let shear_points: Vec<(f64, f64)> = match curvature {
         Curvature::Hybrid | Curvature::Kirchhoff => vec![(0.0, 0.5), (1.0, 0.5)],
