@@ -206,7 +206,7 @@ fn power(loads: &[SectionLoad], vel: &[uvlm::StationVelocity]) -> f64 {
 }
 
 /// Integrate an aeroelastic case (see the module docs for the scheme).
-pub fn simulate_aero<S: AeroStructure + ?Sized>(
+pub fn simulate_aero<S: AeroStructure>(
     formulation: crate::case::Formulation,
     model: &mut S,
     settings: &crate::run::RunSettings,
@@ -214,7 +214,7 @@ pub fn simulate_aero<S: AeroStructure + ?Sized>(
     map: &[StationMap],
 ) -> crate::run::RunOutput {
     use crate::run::{RunOutput, row};
-    use genalpha::{GenAlpha, State};
+    use genalpha::State;
     let start = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
     out.error = None;
@@ -227,7 +227,7 @@ pub fn simulate_aero<S: AeroStructure + ?Sized>(
         out.wall_s = start.elapsed().as_secs_f64();
         out
     };
-    let mut ga = match GenAlpha::new(settings.params, model) {
+    let mut ga = match model.integrator(settings.params) {
         Ok(g) => g,
         Err(e) => return fail(out, e.to_string()),
     };

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, State, Stats};
+use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, LinearSolver, State, Stats};
 use serde::Serialize;
 
 use crate::case::Formulation;
@@ -21,6 +21,10 @@ pub struct Energies {
 /// What the harness needs from a structural model beyond the integrator's trait: its initial
 /// state and the sensors. Implemented in [`crate::scene`] for both formulations.
 pub trait Structure: ConstrainedSystem {
+    /// The linear solver the formulation integrates best with.
+    type Solver: LinearSolver;
+    /// A generalized-α integrator with that solver.
+    fn integrator(&self, params: IntegratorParams) -> Result<GenAlpha<Self::Solver>, genalpha::Error>;
     /// Reference configuration at rest.
     fn initial_state(&self) -> State;
     /// Tip position (centroid of the last body's free end), m.
@@ -125,7 +129,7 @@ pub fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize
 
 /// Integrate `model` from its reference state to `t_end`, recording rows.
 /// A Newton failure ends the run with `error` set and the rows computed so far.
-pub fn simulate<S: Structure + ?Sized>(formulation: Formulation, model: &mut S, settings: &RunSettings) -> RunOutput {
+pub fn simulate<S: Structure>(formulation: Formulation, model: &mut S, settings: &RunSettings) -> RunOutput {
     let start = Instant::now();
     let mut out = RunOutput {
         formulation,
@@ -140,7 +144,7 @@ pub fn simulate<S: Structure + ?Sized>(formulation: Formulation, model: &mut S, 
     let n_steps = (settings.t_end / dt - 1e-9).ceil().max(0.0) as usize;
     let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
     out.rows.reserve(n_steps / every + 2);
-    let mut ga = match GenAlpha::new(settings.params, model) {
+    let mut ga = match model.integrator(settings.params) {
         Ok(g) => g,
         Err(e) => {
             out.error = Some(e.to_string());

@@ -154,9 +154,18 @@ macro_rules! forward_system {
 }
 
 macro_rules! structure {
-    ($t:ty) => {
+    ($t:ty, $solver:ty, $make:expr) => {
         forward_system!($t);
         impl Structure for Sensed<$t> {
+            type Solver = $solver;
+            fn integrator(
+                &self,
+                params: genalpha::IntegratorParams,
+            ) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> {
+                let make: fn(&$t, genalpha::IntegratorParams) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> =
+                    $make;
+                make(&self.model, params)
+            }
             fn initial_state(&self) -> genalpha::State {
                 self.model.initial_state()
             }
@@ -177,8 +186,10 @@ macro_rules! structure {
     };
 }
 
-structure!(ancf::Model);
-structure!(gebf::Model);
+// ANCF brings its skyline LU (banded, symmetric-structure); GEBF declares a block-banded
+// structure that genalpha's default solver exploits.
+structure!(ancf::Model, ancf::SkylineLu, |m, p| m.integrator(p));
+structure!(gebf::Model, genalpha::DenseLu, |m, p| genalpha::GenAlpha::new(p, m));
 
 impl AeroStructure for Sensed<ancf::Model> {
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
