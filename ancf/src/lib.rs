@@ -18,6 +18,25 @@
 //! $$ U = \tfrac12\int_0^L \big[EA\,\varepsilon^2 + GA_y\gamma_y^2 + GA_z\gamma_z^2 + GJ K_1^2
 //!      + EI_{yy} K_2^2 + EI_{zz} K_3^2\big] dx + \text{section penalties}. $$
 //!
+//! **Element** ([`strain`], [`elastic_force`]): every strain is a quadratic form of the element
+//! coordinates, so force and tangent are exact and trigonometry-free. Bending uses the
+//! *hybrid* curvature ([`Curvature::Hybrid`]): element-mean curvature from the rotation of the
+//! section slopes (so a joint that holds a section takes the moment directly) plus the zero-mean
+//! variation of the cubic centreline (linearly varying curvature exact); shear and the
+//! cross-section penalties are sampled at the nodes (no shear or curvature-thickness locking).
+//! Joint loads on single nodal slopes (the flared hinge's `a = sin β r_x + cos β r_y`) would reach
+//! the section only through node-local terms whose stiffness vanishes with the element length;
+//! a shear/section-strain *gradient* stabilisation (zero for uniform shear and section strain)
+//! keeps that compliance small and mesh-independent.
+//!
+//! **Use**: build a [`Model`] from [`BodySpec`]s and [`JointSpec`]s, take
+//! [`Model::initial_state`], integrate with [`Model::integrator`] (generalized-α with the
+//! [`SkylineLu`] solver) or `genalpha::GenAlpha::new` (the model declares its band structure),
+//! read [`Model::tip_position`], [`Model::fold_angle`], [`Model::energies`],
+//! [`Model::constraint_residual`]; apply aerodynamic or other loads with
+//! [`Model::set_point_loads`]; statics with [`Model::solve_statics`], linear modes with
+//! [`Model::linear_modes`]. Reference scenes are in [`samples`].
+//!
 //! Units SI; global frame as in DESIGN §3.
 #![warn(missing_docs)]
 

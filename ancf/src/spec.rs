@@ -255,3 +255,29 @@ impl Options {
 pub(crate) fn finite(field: &str, value: f64) -> Result<(), Error> {
     if value.is_finite() { Ok(()) } else { Err(Error::NonFinite { field: field.to_string(), value }) }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_deserialise_with_defaults_and_reject_unknown_fields() {
+        let o: Options = serde_json::from_str(r#"{"path": "ode"}"#).unwrap();
+        assert_eq!(o, Options { path: SolvePath::Ode, ..Options::default() });
+        let o: Options = serde_json::from_str(r#"{"curvature": "kirchhoff", "penalty_factor": 10}"#).unwrap();
+        assert_eq!(o.curvature, Curvature::Kirchhoff);
+        assert_eq!(o.penalty_factor, 10.0);
+        let e = serde_json::from_str::<Options>(r#"{"pth": "ode"}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown field `pth`"), "{e}");
+    }
+
+    #[test]
+    fn slope_inertias_preserve_the_torsional_inertia() {
+        let s = crate::samples::pendulum_section(1.0);
+        let (d_yy, d_zz) = s.slope_inertias();
+        approx::assert_relative_eq!(d_yy + d_zz, s.rho_ixx, max_relative = 1e-14);
+        // exact when J_xx = J_yy + J_zz: J_yy = D_zz, J_zz = D_yy
+        approx::assert_relative_eq!(d_zz, s.rho_iyy, max_relative = 1e-14);
+        approx::assert_relative_eq!(d_yy, s.rho_izz, max_relative = 1e-14);
+    }
+}
