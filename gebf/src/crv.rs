@@ -72,9 +72,21 @@ const SERIES_B: [f64; N_TERMS] = series(1.0, 3, 0);
 const SERIES_DB: [f64; N_TERMS] = series(1.0, 3, 1);
 const SERIES_DDB: [f64; N_TERMS] = series(1.0, 3, 2);
 
+/// Number of Taylor terms needed at `s = φ²` for a remainder below 1e-17 (φ < 1).
+#[inline]
+fn n_terms(s: f64) -> usize {
+    if s < 0.04 {
+        5
+    } else if s < 0.36 {
+        7
+    } else {
+        N_TERMS
+    }
+}
+
 #[inline]
 fn horner(c: &[f64; N_TERMS], s: f64) -> f64 {
-    c.iter().rev().fold(0.0, |acc, ck| acc * s + ck)
+    c[..n_terms(s)].iter().rev().fold(0.0, |acc, ck| acc * s + ck)
 }
 
 /// Scalar coefficients of `T(psi) = I + a·psĩ + b·psĩ²` and their first and second derivatives
@@ -270,6 +282,16 @@ impl Tangent {
     /// `dT[b] = Σ_j b_j ∂T/∂psi_j`, so that `dT[b] a = ∂(T a)/∂psi · b`.
     pub fn dir(&self, b: &V3) -> M3 {
         tangent_dir_with(&self.psi, &self.k, 1.0, b)
+    }
+    /// The vector `dT[b] a` (cheaper than `dir(b) * a`).
+    pub fn dir_vec(&self, b: &V3, a: &V3) -> V3 {
+        let (k, p) = (&self.k, &self.psi);
+        let pb = p.dot(b);
+        let pa = p.cross(a);
+        b.cross(a) * k.a
+            + pa * (2.0 * k.da * pb)
+            + (b.cross(&pa) + p.cross(&b.cross(a))) * k.b
+            + p.cross(&pa) * (2.0 * k.db * pb)
     }
     /// `∂(T a)/∂psi`.
     pub fn jac(&self, a: &V3) -> M3 {
@@ -526,6 +548,7 @@ mod tests {
             assert!((t.jac_t(&b) - fd).norm() < 1e-8 * scale, "jac_t at {psi:?}");
             // dT[b] a = jac(a) b
             assert_relative_eq!(t.dir(&b) * a, t.jac(&a) * b, epsilon = 1e-13 * scale);
+            assert_relative_eq!(t.dir_vec(&b, &a), t.dir(&b) * a, epsilon = 1e-13 * scale);
             // Second derivative: ∂/∂psi [dT[b] a].
             let fd = fd_jac(|p| Tangent::new(p).dir(&b) * a, &psi);
             let an = t.second(&a, &b);

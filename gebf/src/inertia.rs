@@ -65,8 +65,7 @@ pub(crate) fn add_inertia(
         let cw = cba * w;
         let om = om_r + cw;
         let jom = jd.component_mul(&om);
-        let dtp = tg.dir(&psid);
-        let om_d = t * psidd + dtp * psid + cw.cross(&om_r) + cba * wd;
+        let om_d = t * psidd + tg.dir_vec(&psid, &psid) + cw.cross(&om_r) + cba * wd;
         let h = jd.component_mul(&om_d) + om.cross(&jom);
         kinetic += 0.5 * wt * (m * vel.norm_squared() + om.dot(&jom));
 
@@ -95,7 +94,7 @@ pub(crate) fn add_inertia(
             let dom_dpsi = d_psid + cwt * t;
             let domd_dpsi =
                 tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt * t + skew(&(cba * wd)) * t;
-            let domd_dpsid = dtp + d_psid + cwt * t;
+            let domd_dpsid = tg.dir(&psid) + d_psid + cwt * t;
             let h_psi = j * t * c.c_m + (j * domd_dpsid + x * t) * c.c_c + (j * domd_dpsi + x * dom_dpsi) * c.c_k;
             let h_w = j * cba * c.c_m + (j * (-omr_t * cba) + x * cba) * c.c_c;
             let tt = t.transpose();

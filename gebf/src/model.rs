@@ -408,7 +408,14 @@ impl Model {
     /// Position-level joint violation: the Euclidean norm, over all joints, of (position gap in
     /// m, axis misalignment angle in rad [for clamps: the full relative rotation angle]).
     pub fn constraint_residual(&self, q: &[f64]) -> f64 {
-        self.joint_violations(q).iter().map(|(g, a)| g * g + a * a).sum::<f64>().sqrt()
+        self.joints
+            .iter()
+            .map(|j| {
+                let (g, a) = j.violation(&self.bodies, q);
+                g * g + a * a
+            })
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// Per joint: (position gap, m; axis misalignment angle, rad).

@@ -160,6 +160,10 @@ pub(crate) struct BorderedBandLu {
     tmp: Vec<f64>,
     /// Border solution, length n_b.
     xb: Vec<f64>,
+    /// Scratch flags, length n_b.
+    flags: Vec<bool>,
+    /// Block of each unknown (`usize::MAX` for the border).
+    owner: Vec<usize>,
 }
 
 impl BorderedBandLu {
@@ -170,6 +174,10 @@ impl BorderedBandLu {
             in_block[first..first + len].iter_mut().for_each(|b| *b = true);
         }
         let border: Vec<usize> = (0..n).filter(|&i| !in_block[i]).collect();
+        let mut owner = vec![usize::MAX; n];
+        for (bi, &(first, len, _)) in structure.blocks.iter().enumerate() {
+            owner[first..first + len].iter_mut().for_each(|o| *o = bi);
+        }
         let nb = border.len();
         let blocks = structure
             .blocks
@@ -185,15 +193,22 @@ impl BorderedBandLu {
                 f: vec![0.0; nb * m],
             })
             .collect();
-        Self { n, blocks, border, s: vec![0.0; nb * nb], perm: vec![0; nb], tmp: vec![0.0; nb], xb: vec![0.0; nb] }
+        Self {
+            n,
+            blocks,
+            border,
+            s: vec![0.0; nb * nb],
+            perm: vec![0; nb],
+            tmp: vec![0.0; nb],
+            xb: vec![0.0; nb],
+            flags: vec![false; nb],
+            owner,
+        }
     }
 
     /// Whether `a` has no non-zero entry outside the declared structure.
     pub fn fits(&self, a: &DenseMatrix) -> bool {
-        let mut owner = vec![usize::MAX; self.n];
-        for (bi, b) in self.blocks.iter().enumerate() {
-            owner[b.first..b.first + b.m].iter_mut().for_each(|o| *o = bi);
-        }
+        let owner = &self.owner;
         for j in 0..self.n {
             for i in 0..self.n {
                 let (oi, oj) = (owner[i], owner[j]);
@@ -234,11 +249,21 @@ impl BorderedBandLu {
                 }
             }
             // Active border rows (F) and columns (E) of this block, found on every matrix:
-            // entries that vanish at rest may not vanish later.
+            // entries that vanish at rest may not vanish later. Rows are scanned column by
+            // column of the block (contiguous in the column-major storage).
             blk.rows.clear();
             blk.cols.clear();
+            self.flags.iter_mut().for_each(|f| *f = false);
+            for j in 0..m {
+                let col = &data[(first + j) * n..(first + j + 1) * n];
+                for (c, &bj) in self.border.iter().enumerate() {
+                    if col[bj] != 0.0 {
+                        self.flags[c] = true;
+                    }
+                }
+            }
             for (c, &bj) in self.border.iter().enumerate() {
-                if (0..m).any(|j| data[(first + j) * n + bj] != 0.0) {
+                if self.flags[c] {
                     blk.rows.push(c);
                 }
                 if data[bj * n + first..bj * n + first + m].iter().any(|x| *x != 0.0) {
@@ -246,10 +271,10 @@ impl BorderedBandLu {
                 }
             }
             let nc = blk.cols.len();
-            for (r, &c) in blk.rows.iter().enumerate() {
-                let bj = self.border[c];
-                for j in 0..m {
-                    blk.f[r * m + j] = data[(first + j) * n + bj];
+            for j in 0..m {
+                let col = &data[(first + j) * n..(first + j + 1) * n];
+                for (r, &c) in blk.rows.iter().enumerate() {
+                    blk.f[r * m + j] = col[self.border[c]];
                 }
             }
             for (cc, &c) in blk.cols.iter().enumerate() {
