@@ -4,7 +4,8 @@
 //!
 //! Environment: `OUT=file.csv` writes `t,tip_x,tip_y,tip_z`; `KAPPA`, `PEN` set the
 //! shear-gradient and penalty factors; `KINDS=1` prints the elastic energy by strain kind;
-//! `FAST=1` skips all sensors (timing); `NOEST=1` switches genalpha's convergence estimate off.
+//! `FAST=1` skips all sensors (timing); `NOEST=1` switches genalpha's convergence estimate off;
+//! `FULL=1` refactorises at every Newton iteration.
 use ancf::{Curvature, Model, Options, SolvePath, samples};
 use genalpha::IntegratorParams;
 use nalgebra::Vector3;
@@ -53,6 +54,7 @@ fn main() {
     let mut model = Model::new(&bodies, &joints, g, options).expect("valid scene");
     let mut params = IntegratorParams::new(rho, dt);
     params.newton.estimate_convergence = !flag("NOEST");
+    params.newton.reuse_factorization = !flag("FULL");
     let mut ga = model.integrator(params).expect("valid parameters");
     let mut s = model.initial_state();
     ga.initialize(&model, &mut s).expect("consistent start");
