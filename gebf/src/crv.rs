@@ -310,17 +310,24 @@ impl Tangent {
     pub fn second(&self, a: &V3, b: &V3) -> M3 {
         tangent_second_with(&self.psi, &self.full(), 1.0, a, b)
     }
-    /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar `mᵀ T(psi) a` (symmetric).
+    /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar
+    /// `f = mᵀ T a = mᵀa + α L + β Q` with `L = psi·(a × m)` and
+    /// `Q = (m·psi)(psi·a) − s (m·a)` (symmetric).
     pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
         let k = self.full();
-        let mut h = M3::zeros();
-        for j in 0..3 {
-            // Row j: mᵀ ∂/∂psi (dT[e_j] a).
-            let s = tangent_second_with(&self.psi, &k, 1.0, a, &V3::ith(j, 1.0));
-            let row = m.transpose() * s;
-            h.set_row(j, &row);
-        }
-        h
+        let p = &self.psi;
+        let i3 = M3::identity();
+        let axm = a.cross(m);
+        let (ma, mp, pa) = (m.dot(a), m.dot(p), p.dot(a));
+        let l = p.dot(&axm);
+        let q = mp * pa - p.norm_squared() * ma;
+        let grad_q = m * pa + a * mp - p * (2.0 * ma);
+        let ppt = p * p.transpose();
+        (i3 * (2.0 * k.da) + ppt * (4.0 * k.dda)) * l
+            + (p * axm.transpose() + axm * p.transpose()) * (2.0 * k.da)
+            + (i3 * (2.0 * k.db) + ppt * (4.0 * k.ddb)) * q
+            + (p * grad_q.transpose() + grad_q * p.transpose()) * (2.0 * k.db)
+            + (m * a.transpose() + a * m.transpose() - i3 * (2.0 * ma)) * k.b
     }
 }
 
