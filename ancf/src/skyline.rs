@@ -32,6 +32,7 @@ pub struct SkylineLu {
     uptr: Vec<usize>,
     lval: Vec<f64>,
     uval: Vec<f64>,
+    inv_diag: Vec<f64>,
     work: Vec<f64>,
     is_multiplier: Vec<bool>,
     last_coupled: Vec<usize>,
@@ -203,14 +204,14 @@ impl SkylineLu {
                 // U[i][j] −= L[i][lo..i] · U[lo..i][j]
                 let s = dot(&self.lval[lpi + (lo - fi)..lpi + (i - fi)], &self.uval[upj + (lo - fj)..upj + (i - fj)]);
                 self.uval[upj + (i - fj)] -= s;
-                let d = self.uval[upi + (i - fi)];
+                let inv_d = self.inv_diag[i];
                 if symmetric {
-                    self.lval[lpj + (i - fj)] = self.uval[upj + (i - fj)] / d;
+                    self.lval[lpj + (i - fj)] = self.uval[upj + (i - fj)] * inv_d;
                 } else {
                     // L[j][i] = (A[j][i] − L[j][lo..i] · U[lo..i][i]) / U[i][i]
                     let s =
                         dot(&self.lval[lpj + (lo - fj)..lpj + (i - fj)], &self.uval[upi + (lo - fi)..upi + (i - fi)]);
-                    self.lval[lpj + (i - fj)] = (self.lval[lpj + (i - fj)] - s) / d;
+                    self.lval[lpj + (i - fj)] = (self.lval[lpj + (i - fj)] - s) * inv_d;
                 }
             }
             let s = dot(&self.lval[lpj..lpj + (j - fj)], &self.uval[upj..upj + (j - fj)]);
@@ -219,6 +220,7 @@ impl SkylineLu {
             if !d.is_finite() || d.abs() <= 1e-13 * scale {
                 return false;
             }
+            self.inv_diag[j] = 1.0 / d;
         }
         true
     }
@@ -256,6 +258,7 @@ impl LinearSolver for SkylineLu {
         self.lval = vec![0.0; n * n / 6 + n];
         self.uval = vec![0.0; n * n / 6 + 2 * n];
         self.work = vec![0.0; n];
+        self.inv_diag = vec![0.0; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
         self.ordered = false;
@@ -295,7 +298,7 @@ impl LinearSolver for SkylineLu {
         for j in (0..n).rev() {
             let fj = self.first[j];
             let base = self.uptr[j];
-            let xj = y[j] / self.uval[base + (j - fj)];
+            let xj = y[j] * self.inv_diag[j];
             y[j] = xj;
             for (k, u) in (fj..j).zip(&self.uval[base..base + (j - fj)]) {
                 y[k] -= u * xj;
