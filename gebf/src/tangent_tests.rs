@@ -152,11 +152,13 @@ fn check_element(seed: u64, rot: f64) {
     let mut r = Vec24::zeros();
     add_elastic(&st, le, &sec, 2, &mut r, Some((&mut an, 1.0)));
     let e = rel_err(&an, &fd_matrix(elastic, &st, &g_a, Slot::Q));
+    println!("seed {seed}: elastic rel err {e:.2e}");
     assert!(e < TOL, "elastic tangent (seed {seed}) rel err {e:.2e}");
     assert!((an - an.transpose()).amax() < 1e-9 * an.amax(), "elastic tangent not symmetric");
     let mut an = Mat24::zeros();
     add_gravity(&st, le, sec.mass, &g_a, &mut r, Some((&mut an, 1.0)));
     let e = rel_err(&an, &fd_matrix(gravity, &st, &g_a, Slot::Q));
+    println!("seed {seed}: gravity rel err {e:.2e}");
     assert!(e < TOL, "gravity tangent (seed {seed}) rel err {e:.2e}");
 }
 
@@ -303,6 +305,7 @@ fn check_model(seed: u64, beta: f64) {
             _ => fd_q(&model, &q, n, |x, r| model.residual_inplace(0.0, x, &v, &a, r)),
         };
         let e = dense_rel_err(&an, &fd);
+        println!("model iteration matrix part {which} (seed {seed}): rel err {e:.2e}");
         assert!(e < TOL, "model iteration matrix part {which} (seed {seed}): rel err {e:.2e}");
     }
     // B = ∂psi/∂v.
@@ -310,6 +313,7 @@ fn check_model(seed: u64, beta: f64) {
     model.psi_v_inplace(0.0, &q, &mut b.view());
     let fd = fd_x(n, &v, nc, |x, r| model.psi_inplace(0.0, &q, x, r));
     let e = dense_rel_err(&b, &fd);
+    println!("B (seed {seed}): rel err {e:.2e}");
     assert!(e < TOL, "B (seed {seed}): rel err {e:.2e}");
     // psi = B v exactly (scleronomic).
     let mut psi = vec![0.0; nc];
@@ -324,6 +328,7 @@ fn check_model(seed: u64, beta: f64) {
     model.psi_q_inplace(0.0, &q, &v, &mut an.view());
     let fd = fd_q(&model, &q, nc, |x, r| model.psi_inplace(0.0, x, &v, r));
     let e = dense_rel_err(&an, &fd);
+    println!("psi_q (seed {seed}): rel err {e:.2e}");
     assert!(e < TOL, "psi_q (seed {seed}): rel err {e:.2e}");
     // ∂(Bᵀ mu)/∂q.
     let mut an = DenseMatrix::zeros(n, n);
@@ -335,6 +340,7 @@ fn check_model(seed: u64, beta: f64) {
         bm.add_mul_transpose_vec_inplace(&mu, r);
     });
     let e = dense_rel_err(&an, &fd);
+    println!("constraint force tangent (seed {seed}): rel err {e:.2e}");
     assert!(e < TOL, "constraint force tangent (seed {seed}): rel err {e:.2e}");
 }
 
@@ -392,6 +398,7 @@ fn model_tangents_with_rescaled_crvs() {
             _ => fd_q(&model, &q, n, |x, r| model.residual_inplace(0.0, x, &v, &a, r)),
         };
         let e = dense_rel_err(&an, &fd);
+        println!("rescaled CRVs, iteration matrix part {which}: rel err {e:.2e}");
         assert!(e < TOL, "rescaled CRVs, iteration matrix part {which}: rel err {e:.2e}");
     }
     // Storing an end node on the other branch changes nothing but the parametrisation of its
