@@ -17,7 +17,13 @@
 //! `q ∘ exp(·)` is the model's [`ConstrainedSystem::retract_inplace`]: plain addition for
 //! vector coordinates (ANCF), an exponential-map update for quaternion frames (GEBF).
 //! Newton iterates on the tangent increment with the scaled iteration matrix of THEORY §C.3
-//! (dynamic rows × 1/β′, velocity rows × 1/γ′, multipliers λ/β′, μ/β′).
+//! (dynamic rows × 1/β′, velocity rows × 1/γ′, multipliers λ/β′, μ/β′). The factorisation is
+//! reused across iterations and steps while Newton contracts, refreshed at the predictor for a
+//! while after a reused one failed; an iterate is accepted when the increment, or the
+//! contraction estimate θ/(1 − θ)·|Δ| (`NewtonParams::estimate_convergence`), is below the
+//! tolerance. A failed step is retried as two half steps (`NewtonParams::max_step_halvings`).
+//! The default [`DenseLu`] switches to a bordered band LU (Schur complement on the border) when
+//! the system declares a [`BandedBorder`] structure.
 //!
 //! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
 #![warn(missing_docs)]
