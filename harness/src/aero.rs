@@ -174,7 +174,8 @@ pub fn section_state<S: AeroStructure + ?Sized>(
     (p, r, vel, omega)
 }
 
-/// Build the lattice spec and stations of the current structural state.
+/// Build the lattice stations (and their velocities) of the current structural state.
+#[allow(clippy::too_many_arguments)] // model, state, map, settings and three reused buffers
 fn stations_at<S: AeroStructure + ?Sized>(
     model: &S,
     q: &[f64],

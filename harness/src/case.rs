@@ -210,9 +210,7 @@ impl Default for NewtonSettings {
             phi_tol: d.phi_tol,
             psi_tol: d.psi_tol,
             reuse_factorization: d.reuse_factorization,
-            // Off: with it, ANCF's β = 45° pendulum fails at t ≈ 1.51 s (a halved step accepted
-            // on an early estimate); see genalpha's NewtonParams.
-            estimate_convergence: false,
+            estimate_convergence: d.estimate_convergence,
             max_step_halvings: d.max_step_halvings,
         }
     }

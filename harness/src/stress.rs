@@ -151,7 +151,7 @@ pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
 fn cell_color(k: &Cell) -> RGBColor {
     if !k.ok() {
         RGBColor(214, 39, 40)
-    } else if !(k.metrics.energy_drift <= 0.1) {
+    } else if k.metrics.energy_drift.is_nan() || k.metrics.energy_drift > 0.1 {
         RGBColor(255, 160, 60)
     } else if k.metrics.energy_drift > 0.01 {
         RGBColor(240, 220, 80)
