@@ -144,6 +144,14 @@ pub enum Error {
         /// Infinity norm of the last residual.
         residual_norm: f64,
     },
+    /// A list of rigid poses whose length is not the number of bodies.
+    #[error("poses: {got} poses given, the model has {expected} bodies")]
+    PoseCount {
+        /// Number of poses given.
+        got: usize,
+        /// Number of bodies.
+        expected: usize,
+    },
     /// A singular matrix in the static solver or the modal analysis.
     #[error("singular matrix (zero pivot in row {pivot})")]
     SingularMatrix {

@@ -73,6 +73,7 @@ mod modal;
 mod model;
 mod options;
 pub mod quaternion;
+mod rigid;
 pub mod samples;
 mod section;
 pub mod simulate;
@@ -86,6 +87,7 @@ pub use loads::NodalLoad;
 pub use modal::Modes;
 pub use model::{Energies, Model};
 pub use options::Options;
+pub use rigid::RigidPose;
 pub use section::Section;
 pub use statics::{StaticOptions, StaticSolution};
 
