@@ -218,7 +218,8 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                 formulation: f,
                 ladder,
                 orders: obs,
-                truth_error_estimate_m: last / (2f64.powf(p_last) - 1.0).max(1e-12),
+                // Richardson needs an observed order clearly above zero; otherwise no estimate.
+                truth_error_estimate_m: if p_last > 0.5 { last / (2f64.powf(p_last) - 1.0) } else { f64::NAN },
             });
         }
     }

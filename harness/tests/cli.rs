@@ -104,3 +104,15 @@ fn single_formulation_run_writes_its_csv() {
     assert_eq!(lines.count(), 51); // t = 0 plus 50 steps of 0.002 s
     std::fs::remove_dir_all(out).ok();
 }
+
+#[test]
+fn committed_json_schema_is_current() {
+    let o = harness(&["schema"]);
+    assert!(o.status.success());
+    let committed = std::fs::read_to_string(root().join("cases/case.schema.json")).unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&o.stdout).trim(),
+        committed.trim(),
+        "cases/case.schema.json is stale: run `cargo run -p harness -- schema > cases/case.schema.json`"
+    );
+}
