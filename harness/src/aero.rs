@@ -46,6 +46,10 @@ pub struct AeroSettings {
     /// AoA). Default 1e-6 m.
     #[serde(default = "default_cutoff")]
     pub cutoff_radius: f64,
+    /// Close the truncated wake with semi-infinite legs along the free stream (removes the
+    /// ≈ −1.3 % lift bias of a 40-row wake); default false (the paper's and SHARPy's set-up).
+    #[serde(default)]
+    pub wake_closure: bool,
     /// Coupling iteration settings.
     #[serde(default)]
     pub coupling: Coupling,
@@ -243,6 +247,7 @@ pub fn simulate_aero<S: AeroStructure>(
     let spec = uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) };
     let mut params = uvlm::UvlmParams::new(aero.rho, aero.v_inf);
     params.n_wake_rows = aero.n_wake_rows;
+    params.wake_closure = aero.wake_closure;
     params.bound_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
     params.wake_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
     params.parallel = uvlm::Parallel::Off; // runs are parallel across cases
