@@ -179,8 +179,7 @@ mod tests {
         assert!(matches!(m.rigid_state(&[ok]), Err(Error::WrongLength { got: 1, expected: 2, .. })));
         let mut bad = ok;
         bad.rotation[(1, 0)] = 0.5;
-        assert!(
-            matches!(m.rigid_state(&[ok, bad]), Err(Error::NotOrthonormal { field, .. }) if field == "poses[1].rotation")
-        );
+        let err = m.rigid_state(&[ok, bad]).unwrap_err();
+        assert!(matches!(err, Error::NotOrthonormal { ref field, .. } if field == "poses[1].rotation"), "{err}");
     }
 }
