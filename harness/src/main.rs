@@ -105,6 +105,28 @@ enum Cmd {
     Schema,
 }
 
+/// The extra hard runs of the stress study: a 20 s pendulum and the wing at AoA 15°.
+fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String, harness::case::RunSpec)>> {
+    let mut v = Vec::new();
+    let pend = dir.join("double_pendulum_c1_beta45.json");
+    if pend.exists() {
+        let mut ov = set.to_vec();
+        ov.push("t_end=20".parse()?);
+        ov.push("output_dt=0.01".parse()?);
+        v.push(("pendulum c=1 beta=45 deg, 20 s".to_string(), CaseFile::read(&pend)?.expand(&ov)?.remove(0)));
+    }
+    let wing = dir.join("wing_aoa10.json");
+    if wing.exists() {
+        let a = 15f64.to_radians();
+        let y = format!("[0,{},{}]", a.cos(), a.sin());
+        let mut ov = set.to_vec();
+        ov.push(format!("bodies.0.y_axis={y}").parse()?);
+        ov.push(format!("bodies.1.y_axis={y}").parse()?);
+        v.push(("wing AoA 15 deg, 20 s".to_string(), CaseFile::read(&wing)?.expand(&ov)?.remove(0)));
+    }
+    Ok(v)
+}
+
 fn main() -> ExitCode {
     match real_main() {
         Ok(code) => code,
@@ -166,6 +188,8 @@ fn real_main() -> Result<ExitCode> {
                     let axes = stress::Axes::default();
                     let cells = stress::run(&spec[0], &axes, true);
                     stress::write(&out.join("stress"), &axes, &cells)?;
+                    let ex = stress::run_extras(&stress_extras(&cases, &set)?);
+                    stress::write_extras(&out.join("stress"), &ex)?;
                     for f in Formulation::ALL {
                         let (ok, n) = stress::survival(&cells, f);
                         println!("stress {f}: {ok} of {n} cells reach t_end");
@@ -262,6 +286,21 @@ fn real_main() -> Result<ExitCode> {
             for f in Formulation::ALL {
                 let (ok, n) = stress::survival(&cells, f);
                 println!("{f}: {ok} of {n} cells reach t_end");
+            }
+            let extras = stress_extras(&case.with_file_name(""), &set)?;
+            let ex = stress::run_extras(&extras);
+            stress::write_extras(&dir, &ex)?;
+            for e in &ex {
+                let m = &e.metrics;
+                println!(
+                    "{} {}: {}",
+                    e.label,
+                    e.formulation,
+                    m.error.clone().unwrap_or_else(|| format!(
+                        "ok, {:.2} Newton/step, drift {:.2e}",
+                        m.newton_per_step, m.energy_drift
+                    ))
+                );
             }
             println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
             Ok(ExitCode::SUCCESS)

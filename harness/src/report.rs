@@ -434,7 +434,7 @@ pub fn studies_html(out: &Path) -> String {
         }
     }
     if out.join("stress/stress_ancf.svg").exists() {
-        s.push_str("<h2 id=\"stress\">Stability on hard cases: the stress matrix</h2>\n<p><a href=\"stress/stress.csv\">stress.csv</a></p>\n");
+        s.push_str("<h2 id=\"stress\">Stability on hard cases: the stress matrix</h2>\n<p><a href=\"stress/stress.csv\">stress.csv</a>; extra hard runs (20 s pendulum, wing at AoA 15°): <a href=\"stress/extras.csv\">extras.csv</a></p>\n");
         for f in Formulation::ALL {
             let _ = writeln!(
                 s,

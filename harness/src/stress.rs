@@ -222,3 +222,51 @@ pub fn survival(cells: &[Cell], f: Formulation) -> (usize, usize) {
     let of_f: Vec<&Cell> = cells.iter().filter(|k| k.formulation == f).collect();
     (of_f.iter().filter(|k| k.ok()).count(), of_f.len())
 }
+
+/// One extra hard run beside the matrix (a long pendulum, a wing at high incidence).
+#[derive(Debug, Clone, Serialize)]
+pub struct Extra {
+    /// What it is.
+    pub label: String,
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Metrics (failure, time reached, Newton, drifts).
+    pub metrics: FormulationMetrics,
+}
+
+/// Run extra cases (label, case spec) with both formulations in parallel.
+pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
+    let jobs: Vec<(usize, Formulation)> =
+        (0..extras.len()).flat_map(|i| Formulation::ALL.into_iter().map(move |f| (i, f))).collect();
+    jobs.par_iter()
+        .map(|&(i, f)| {
+            let out = run_formulation(extras[i].1.case(f), f);
+            Extra { label: extras[i].0.clone(), formulation: f, metrics: FormulationMetrics::of(&out) }
+        })
+        .collect()
+}
+
+/// Write `extras.csv`.
+pub fn write_extras(dir: &Path, extras: &[Extra]) -> Result<(), Error> {
+    let mut csv = String::from(
+        "label,formulation,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure\n",
+    );
+    for e in extras {
+        let m = &e.metrics;
+        let _ = writeln!(
+            csv,
+            "\"{}\",{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.3},\"{}\"",
+            e.label,
+            e.formulation,
+            m.error.is_none(),
+            m.t_reached,
+            m.newton_per_step,
+            m.max_newton_iters,
+            m.energy_drift,
+            m.max_constraint_residual,
+            m.wall_s,
+            m.error.clone().unwrap_or_default().replace('"', "'")
+        );
+    }
+    write_file(&dir.join("extras.csv"), &csv)
+}
