@@ -415,6 +415,44 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(config())]
+
+    /// Both formulations measure a joint violation the same way (`constraint_residual`: the
+    /// hinge gap and the axis misalignment angle): body 2 of a folded free pair is moved off the
+    /// hinge by `gap` and turned by ε about a random axis, and both report
+    /// `√(|gap|² + angle(a_parent, a_child)²)`, and the same fold angle (except at β = 0, ±90°,
+    /// where the sensors' fixed vectors ⟂ a differ and so do their readings, at second order in ε).
+    #[test]
+    fn both_formulations_measure_a_joint_violation_alike(
+        input in free_input(beta()), gap in vec3(), tilt_axis in vec3(), tilt in 0.0..0.5f64,
+    ) {
+        prop_assume!(V3::from(tilt_axis).norm() > 0.1);
+        let (scene, motion) = free_case(&input);
+        let mut p = poses(&scene, &motion);
+        let tilt_rot = axis_angle(&V3::from(tilt_axis), tilt);
+        p[1].rotation = tilt_rot * p[1].rotation;
+        p[1].translation += V3::from(gap) * 0.1;
+        let a_parent = motion.r1 * scene.axis0();
+        let a_child = tilt_rot * a_parent;
+        let angle = a_parent.cross(&a_child).norm().atan2(a_parent.dot(&a_child));
+        let expected = (0.01 * V3::from(gap).norm_squared() + angle * angle).sqrt();
+        let dae = scene.ancf_model(ancf::SolvePath::Dae, Broken::Neither);
+        let g = scene.gebf_model(Broken::Neither);
+        let qa = dae.rigid_full_state(&p.map(|x| x.ancf())).unwrap().0;
+        let qg = g.rigid_state(&p.map(|x| x.gebf())).unwrap().q;
+        let (ra, rg) = (dae.constraint_residual(&qa), g.constraint_residual(&qg));
+        prop_assert!((ra - expected).abs() < 1e-13, "ANCF residual {ra} vs {expected}");
+        prop_assert!((rg - expected).abs() < 1e-13, "GEBF residual {rg} vs {expected}");
+        // The fold sensors use different fixed vectors ⟂ a only at β = 0 and ±90° (ANCF: the
+        // least aligned coordinate axis, GEBF: z); elsewhere they coincide.
+        let (fa, fg) = (dae.fold_angle(&qa, 0).unwrap(), g.fold_angle(&qg, 0).unwrap());
+        if scene.beta.abs() > 1e-6 && (scene.beta.abs() - FRAC_PI_2).abs() > 1e-6 {
+            prop_assert!((fa - fg).abs() < 1e-12, "fold ANCF {fa} vs GEBF {fg}");
+        }
+    }
+}
+
 /// The case file a scene corresponds to (harness JSON schema, β in degrees).
 fn case_json(s: &Scene, flare_deg: f64, path: &str) -> serde_json::Value {
     let sec = s.section;
