@@ -75,14 +75,23 @@ struct Body {
 }
 
 /// A two-body scene: body 1 (parent) and body 2 (child) joined by a flared hinge, optionally
-/// body 1 hinged to ground about `ground` at its start (then the flared hinge is joint 1).
+/// body 1 attached to ground at its start by `root` (then the flared hinge is joint 1).
 #[derive(Debug, Clone)]
 struct Scene {
     beta: f64,
     bodies: [Body; 2],
     section: Sec,
-    ground: Option<V3>,
+    root: Root,
     gravity: V3,
+}
+
+/// How body 1 is attached to ground.
+#[derive(Debug, Clone, Copy)]
+enum Root {
+    Free,
+    /// Ground hinge about this global axis.
+    Hinge(V3),
+    Clamp,
 }
 
 /// Which formulation gets the flare angle −β (the negative controls).
@@ -95,7 +104,7 @@ enum Broken {
 
 impl Scene {
     fn fold_joint(&self) -> usize {
-        usize::from(self.ground.is_some())
+        usize::from(!matches!(self.root, Root::Free))
     }
     /// Hinge axis a = F_P (sin β, cos β, 0), global, reference.
     fn axis0(&self) -> V3 {
@@ -120,8 +129,10 @@ impl Scene {
             })
             .collect();
         let mut joints = Vec::new();
-        if let Some(axis) = self.ground {
-            joints.push(ancf::JointSpec::GroundHinge { body: 0, axis });
+        match self.root {
+            Root::Free => {}
+            Root::Hinge(axis) => joints.push(ancf::JointSpec::GroundHinge { body: 0, axis }),
+            Root::Clamp => joints.push(ancf::JointSpec::Clamp { body: 0 }),
         }
         joints.push(ancf::JointSpec::FlaredHinge { parent: 0, child: 1, beta: self.beta_for(Broken::Ancf, broken) });
         let options = ancf::Options { path, ..Default::default() };
@@ -143,8 +154,10 @@ impl Scene {
             })
             .collect();
         let mut joints = Vec::new();
-        if let Some(axis) = self.ground {
-            joints.push(gebf::JointSpec::GroundHinge { body: 0, axis });
+        match self.root {
+            Root::Free => {}
+            Root::Hinge(axis) => joints.push(gebf::JointSpec::GroundHinge { body: 0, axis }),
+            Root::Clamp => joints.push(gebf::JointSpec::Clamp { body: 0 }),
         }
         joints.push(gebf::JointSpec::FlaredHinge { parent: 0, child: 1, beta: self.beta_for(Broken::Gebf, broken) });
         gebf::Model::new(&bodies, &joints, self.gravity, gebf::Options::default()).expect("valid GEBF scene")
@@ -368,7 +381,7 @@ fn free_case(input: &FreeInput) -> (Scene, Motion) {
         beta,
         bodies: two_bodies(rot(frame), kink, V3::from(start), lengths, n_el),
         section: Sec { mass, rho_iyy, rho_izz, c: 1.0 },
-        ground: None,
+        root: Root::Free,
         gravity: V3::new(0.0, 0.0, -9.8),
     };
     let (r1, t1, w1, v1, theta, theta_dot) = motion;
@@ -404,7 +417,7 @@ proptest! {
             beta,
             bodies: [body(0.0), body(0.5)],
             section: Sec { mass: 1.08, rho_iyy: 3.6e-5, rho_izz: 3.6e-5, c: 1.0 },
-            ground: Some(V3::y()),
+            root: Root::Hinge(V3::y()),
             gravity: V3::new(0.0, 0.0, -9.8),
         };
         let motion = Motion {
@@ -469,10 +482,12 @@ fn case_json(s: &Scene, flare_deg: f64, path: &str) -> serde_json::Value {
         })
     };
     let mut joints = Vec::new();
-    if let Some(a) = s.ground {
-        joints.push(
+    match s.root {
+        Root::Free => {}
+        Root::Hinge(a) => joints.push(
             serde_json::json!({"type": "ground_hinge", "name": "root", "body": "body0", "axis": [a.x, a.y, a.z]}),
-        );
+        ),
+        Root::Clamp => joints.push(serde_json::json!({"type": "clamp", "name": "root", "body": "body0"})),
     }
     joints.push(serde_json::json!({
         "type": "flared_hinge", "name": "fold", "parent": "body0", "child": "body1", "flare_deg": flare_deg
@@ -520,13 +535,37 @@ proptest! {
             beta: flare_deg.to_radians(),
             bodies: two_bodies(rot(frame), kink, start, lengths, n_el),
             section: Sec { mass: 1.08, rho_iyy: 3.6e-5, rho_izz: 3.6e-5, c: 1.0 },
-            ground: Some(V3::from(ground).normalize()),
+            root: Root::Hinge(V3::from(ground).normalize()),
             gravity: V3::new(0.0, 0.0, -9.8),
         };
         let axis = V3::from(ground).normalize();
         let r1 = axis_angle(&axis, phi);
         let motion = Motion { r1, t1: start, w1: axis * phi_dot, v1: V3::zeros(), theta, theta_dot };
         let v = violations_of(&scene, &case_models(&scene, flare_deg), &motion);
+        prop_assert!(v.is_empty(), "{}", v.join("\n"));
+    }
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// The paper's flared-hinge wing (DESIGN §6: inner body 12 m clamped at the root, outer
+    /// body 4 m, the wing section, any flare angle) with the wingtip folded by θ at the rate θ̇:
+    /// both formulations satisfy the clamp and the hinge and agree with the closed form.
+    #[test]
+    fn both_formulations_agree_on_the_clamped_wing(
+        beta in beta(), theta in -3.0..3.0f64, theta_dot in -2.0..2.0f64,
+        n_el in (1..=12usize, 1..=4usize, 1..=6usize, 1..=2usize),
+    ) {
+        let scene = Scene {
+            beta,
+            bodies: two_bodies(M3::identity(), [0.0; 3], V3::zeros(), (12.0, 4.0), n_el),
+            section: Sec { mass: 0.75, rho_iyy: 0.01, rho_izz: 0.09, c: 1.0 },
+            root: Root::Clamp,
+            gravity: V3::new(0.0, 0.0, -9.8),
+        };
+        let motion = Motion { r1: M3::identity(), t1: V3::zeros(), w1: V3::zeros(), v1: V3::zeros(), theta, theta_dot };
+        let v = violations(&scene, &motion, Broken::Neither);
         prop_assert!(v.is_empty(), "{}", v.join("\n"));
     }
 }
