@@ -251,10 +251,11 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         });
         let e0 = run.rows.first().map_or(0.0, |x| x.total);
         let peak = r.metrics.get(&run.formulation).map_or(1.0, |m| m.peak_kinetic).max(f64::MIN_POSITIVE);
+        let w = |x: &crate::run::Row| if x.aero_work.is_finite() { x.aero_work } else { 0.0 };
         drift.push(Series {
-            label: format!("{l} (E − E0)/max T"),
+            label: format!("{l} (E − E0 − W_aero)/max T"),
             color: run_color(run.formulation),
-            points: run.rows.iter().map(|x| (x.t, (x.total - e0) / peak)).collect(),
+            points: run.rows.iter().map(|x| (x.t, (x.total - e0 - w(x)) / peak)).collect(),
         });
     }
     panels_svg(
@@ -270,7 +271,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
             Panel {
                 title: format!("{} — energy drift", r.name),
                 x_label: "t [s]".into(),
-                y_label: "(E − E0) / max T [-]".into(),
+                y_label: "(E − E0 − W_aero) / max T [-]".into(),
                 log_y: false,
                 series: drift,
             },
@@ -310,6 +311,29 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         1,
         (900, 330),
     )?;
+    if has_aero(r) {
+        let lift: Vec<Series> = r
+            .runs
+            .iter()
+            .map(|run| Series {
+                label: label(run.formulation).into(),
+                color: run_color(run.formulation),
+                points: run.rows.iter().filter(|x| x.lift.is_finite()).map(|x| (x.t, x.lift)).collect(),
+            })
+            .collect();
+        panels_svg(
+            &dir.join("lift.svg"),
+            &[Panel {
+                title: format!("{} — total lift", r.name),
+                x_label: "t [s]".into(),
+                y_label: "lift [N]".into(),
+                log_y: false,
+                series: lift,
+            }],
+            1,
+            (900, 330),
+        )?;
+    }
     panels_svg(
         &dir.join("fold.svg"),
         &[Panel {
@@ -324,9 +348,15 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     )
 }
 
-/// Plot files of each case, with captions, in index order.
-pub const PLOTS: [(&str, &str); 5] = [
+/// Whether the case has aerodynamics (its rows carry a lift).
+fn has_aero(r: &CaseResult) -> bool {
+    r.runs.iter().any(|x| x.rows.iter().any(|y| y.lift.is_finite()))
+}
+
+/// Plot files of each case, with captions, in index order (`lift.svg` only with aerodynamics).
+pub const PLOTS: [(&str, &str); 6] = [
     ("tip.svg", "Tip position, both formulations and references"),
+    ("lift.svg", "Total aerodynamic lift"),
     ("tip_difference.svg", "Tip distance between formulations and to references"),
     ("fold.svg", "Fold angle"),
     ("energy.svg", "Energy components and drift"),
@@ -498,6 +528,9 @@ pub fn index_html(results: &[CaseResult], studies: &str) -> String {
             esc(&r.name)
         );
         for (file, caption) in PLOTS {
+            if file == "lift.svg" && !has_aero(r) {
+                continue;
+            }
             let _ = writeln!(
                 s,
                 "<figure><img src=\"{}/{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
