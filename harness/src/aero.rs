@@ -261,8 +261,7 @@ pub fn simulate_aero<S: AeroStructure>(
         .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
         .collect();
     let mut new_loads = loads.clone();
-    let origins =
-        |st: &[uvlm::SpanStation]| st.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]).collect::<Vec<_>>();
+    let mut obuf: Vec<[f64; 3]> = Vec::with_capacity(map.len());
     let (mut fbuf, mut mbuf) = (vec![[0.0; 3]; map.len()], vec![[0.0; 3]; map.len()]);
     let mut work = 0.0;
     let mut lift;
@@ -271,9 +270,9 @@ pub fn simulate_aero<S: AeroStructure>(
     r0.lift = 0.0;
     out.rows.push(r0);
     let mut qp = vec![0.0; s.q.len()];
+    let mut vel_n = Vec::with_capacity(map.len());
     let mut dq = vec![0.0; s.v.len()];
     let mut vp = vec![0.0; s.v.len()];
-    let mut n_sub = 0usize;
     for k in 1..=n_steps {
         let t1 = s.t + dt;
         // 1. Predict the structure at t_{n+1} and move the lattice there.
@@ -282,7 +281,8 @@ pub fn simulate_aero<S: AeroStructure>(
             vp[i] = s.v[i] + dt * s.v_dot[i];
         }
         model.retract_inplace(&s.q, &dq, &mut qp);
-        let vel_n = vel.clone();
+        vel_n.clear();
+        vel_n.extend_from_slice(&vel);
         stations_at(model, &qp, &vp, map, aero, &mut scratch, &mut stations, &mut vel);
         let mut solve = |uv: &mut uvlm::Uvlm,
                          stations: &[uvlm::SpanStation],
@@ -291,7 +291,9 @@ pub fn simulate_aero<S: AeroStructure>(
          -> Result<f64, String> {
             uv.update_stations(stations, Some(vel)).map_err(|e| e.to_string())?;
             let l = uv.solve_step().map_err(|e| e.to_string())?;
-            l.column_loads_inplace(&origins(stations), &mut fbuf, &mut mbuf);
+            obuf.clear();
+            obuf.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
+            l.column_loads_inplace(&obuf, &mut fbuf, &mut mbuf);
             for (j, t) in target.iter_mut().enumerate() {
                 t.force = Vector3::from(fbuf[j]);
                 t.moment = Vector3::from(mbuf[j]);
@@ -331,7 +333,6 @@ pub fn simulate_aero<S: AeroStructure>(
             if num.sqrt() <= aero.coupling.tolerance * den.sqrt().max(1e-12) {
                 break;
             }
-            n_sub += 1;
             s = s_n.clone();
             model.set_section_loads(&loads);
             st = match ga.step(model, &mut s) {
@@ -352,7 +353,6 @@ pub fn simulate_aero<S: AeroStructure>(
             out.rows.push(r);
         }
     }
-    let _ = n_sub;
     out.stats = *ga.stats();
     out.wall_s = start.elapsed().as_secs_f64();
     out.aero_wall_s = uv.stats().wall_time;
