@@ -7,6 +7,9 @@
 //!   parent's end and `a^C = Σ_b α^C_b r^C_b`, `α^C = F₀_Cᵀ F₀_P (sin β, cos β, 0)` at the child's
 //!   start (for collinear bodies with equal frames simply `sin β r^C_x + cos β r^C_y`). Full
 //!   rank for every β in [−90°, 90°]; the sixth equation also equalises the axis stretch.
+//! * Locked hinge: `r^P = r^C`, `r^P_y = Σ_b γ^y_b r^C_b`, `r^P_z = Σ_b γ^z_b r^C_b` with
+//!   `γ = F₀_Cᵀ F₀_P e`: the two sections are welded like a clamp (the centreline slopes stay
+//!   free); the fold angle is still measured about the flared axis.
 //! * Clamp: `r = r₀`, `r_y = y₀`, `r_z = z₀` at the start node: the section's position and
 //!   orientation are fixed, the centreline slope `r_x` stays free (axial and shear strain at
 //!   the root are not suppressed).
@@ -40,9 +43,27 @@ impl ConstraintRow {
 /// A joint with its precomputed data.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Joint {
-    Ground { body: usize, axis: Vector3<f64>, alpha: Vector3<f64>, r0: Vector3<f64> },
-    Flared { parent: usize, child: usize, alpha_p: Vector3<f64>, alpha_c: Vector3<f64>, rel0: Matrix3<f64> },
-    Clamp { body: usize, r0: Vector3<f64>, frame0: Matrix3<f64> },
+    Ground {
+        body: usize,
+        axis: Vector3<f64>,
+        alpha: Vector3<f64>,
+        r0: Vector3<f64>,
+    },
+    Flared {
+        parent: usize,
+        child: usize,
+        alpha_p: Vector3<f64>,
+        alpha_c: Vector3<f64>,
+        rel0: Matrix3<f64>,
+        /// Locked hinge: the child's coefficients of the parent's `r_y` and `r_z`
+        /// (`F₀_Cᵀ F₀_P y`, `F₀_Cᵀ F₀_P z`).
+        lock: Option<[Vector3<f64>; 2]>,
+    },
+    Clamp {
+        body: usize,
+        r0: Vector3<f64>,
+        frame0: Matrix3<f64>,
+    },
 }
 
 /// 3-vector block `b` (0 r, 1 r_x, 2 r_y, 3 r_z) of node `node` of `body`.
@@ -63,11 +84,13 @@ impl Joint {
                 let axis = axis.normalize();
                 Joint::Ground { body, axis, alpha: b.spec.frame.transpose() * axis, r0: b.spec.start }
             }
-            JointSpec::FlaredHinge { parent, child, beta } => {
+            JointSpec::FlaredHinge { parent, child, beta } | JointSpec::LockedHinge { parent, child, beta } => {
                 let (fp, fc) = (bodies[parent].spec.frame, bodies[child].spec.frame);
                 let alpha_p = Vector3::new(beta.sin(), beta.cos(), 0.0);
                 let alpha_c = fc.transpose() * (fp * alpha_p);
-                Joint::Flared { parent, child, alpha_p, alpha_c, rel0: fp.transpose() * fc }
+                let lock = matches!(spec, JointSpec::LockedHinge { .. })
+                    .then(|| [fc.transpose() * (fp * Vector3::y()), fc.transpose() * (fp * Vector3::z())]);
+                Joint::Flared { parent, child, alpha_p, alpha_c, rel0: fp.transpose() * fc, lock }
             }
             JointSpec::Clamp { body } => {
                 let b = &bodies[body];
@@ -92,7 +115,7 @@ impl Joint {
                     rows.push(ConstraintRow { entries, rhs: axis[i], joint: j });
                 }
             }
-            Joint::Flared { parent, child, alpha_p, alpha_c, .. } => {
+            Joint::Flared { parent, child, alpha_p, alpha_c, lock, .. } => {
                 let pe = bodies[*parent].n_nodes - 1;
                 for i in 0..3 {
                     rows.push(ConstraintRow {
@@ -101,15 +124,24 @@ impl Joint {
                         joint: j,
                     });
                 }
-                for i in 0..3 {
-                    let mut entries: Vec<(usize, f64)> = (1..4)
-                        .filter(|&b| alpha_p[b - 1] != 0.0)
-                        .map(|b| (dof(*parent, pe, b, i), alpha_p[b - 1]))
-                        .collect();
-                    entries.extend(
-                        (1..4).filter(|&b| alpha_c[b - 1] != 0.0).map(|b| (dof(*child, 0, b, i), -alpha_c[b - 1])),
-                    );
-                    rows.push(ConstraintRow { entries, rhs: 0.0, joint: j });
+                // Free: the hinge axis. Locked: the section's r_y and r_z instead (a weld of the
+                // two sections, as the clamp welds a section to ground).
+                let (y, z) = (Vector3::y(), Vector3::z());
+                let pairs: Vec<(&Vector3<f64>, &Vector3<f64>)> = match lock {
+                    None => vec![(alpha_p, alpha_c)],
+                    Some([gy, gz]) => vec![(&y, gy), (&z, gz)],
+                };
+                for (alpha_p, alpha_c) in pairs {
+                    for i in 0..3 {
+                        let mut entries: Vec<(usize, f64)> = (1..4)
+                            .filter(|&b| alpha_p[b - 1] != 0.0)
+                            .map(|b| (dof(*parent, pe, b, i), alpha_p[b - 1]))
+                            .collect();
+                        entries.extend(
+                            (1..4).filter(|&b| alpha_c[b - 1] != 0.0).map(|b| (dof(*child, 0, b, i), -alpha_c[b - 1])),
+                        );
+                        rows.push(ConstraintRow { entries, rhs: 0.0, joint: j });
+                    }
                 }
             }
             Joint::Clamp { body, r0, frame0 } => {
@@ -135,11 +167,16 @@ impl Joint {
                 let b = &bodies[*body];
                 ((node_vector(b, q, 0, 0) - r0).norm(), angle_between(&axis_vector(b, q, 0, alpha), axis))
             }
-            Joint::Flared { parent, child, alpha_p, alpha_c, .. } => {
+            Joint::Flared { parent, child, alpha_p, alpha_c, lock, .. } => {
                 let (p, c) = (&bodies[*parent], &bodies[*child]);
                 let pe = p.n_nodes - 1;
                 let gap = (node_vector(p, q, pe, 0) - node_vector(c, q, 0, 0)).norm();
-                (gap, angle_between(&axis_vector(p, q, pe, alpha_p), &axis_vector(c, q, 0, alpha_c)))
+                let axis = angle_between(&axis_vector(p, q, pe, alpha_p), &axis_vector(c, q, 0, alpha_c));
+                let locked = lock.map_or(0.0, |[gy, gz]| {
+                    let ay = angle_between(&axis_vector(p, q, pe, &Vector3::y()), &axis_vector(c, q, 0, &gy));
+                    ay.max(angle_between(&axis_vector(p, q, pe, &Vector3::z()), &axis_vector(c, q, 0, &gz)))
+                });
+                (gap, axis.max(locked))
             }
             Joint::Clamp { body, r0, frame0 } => {
                 let b = &bodies[*body];

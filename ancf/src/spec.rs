@@ -139,6 +139,17 @@ pub enum JointSpec {
         /// The body.
         body: usize,
     },
+    /// A flared hinge locked at its reference fold: the child's start section is welded to the
+    /// parent's end section (`r`, `r_y`, `r_z` continuous, as a clamp to the parent).
+    /// The fold angle is still measured about `a = sin β x + cos β y`.
+    LockedHinge {
+        /// Parent body (its end section).
+        parent: usize,
+        /// Child body (its start section).
+        child: usize,
+        /// Flare angle β of the locked hinge, rad.
+        beta: f64,
+    },
 }
 
 impl JointSpec {
@@ -161,7 +172,7 @@ impl JointSpec {
                     return Err(Error::ZeroAxis { field: format!("{field}.axis") });
                 }
             }
-            JointSpec::FlaredHinge { parent, child, beta } => {
+            JointSpec::FlaredHinge { parent, child, beta } | JointSpec::LockedHinge { parent, child, beta } => {
                 check("parent", parent)?;
                 check("child", child)?;
                 if parent == child {

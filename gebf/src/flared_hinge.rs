@@ -10,6 +10,9 @@
 //!   that are perpendicular to the axis (a rank-2 projection valid for every β, unlike
 //!   SHARPy's row picking): `N_Bᵀ (C_n C_pc omega_Ac − T(psi_n) psi_dot_n − C_n omega_Ap) = 0`.
 //!
+//! A *locked* hinge adds the third angular row along `a_B` itself (no relative rotation at all):
+//! the child is welded to the parent's end section.
+//!
 //! `B` depends on `R_n`, `psi_n` and both quaternions; `∂(B v)/∂q` and `∂(Bᵀ mu)/∂q` are
 //! assembled exactly (quaternion directions along `C^{GA} ← C^{GA} exp(δθ̃)`).
 
@@ -26,8 +29,11 @@ pub(crate) struct FlaredHinge {
     pub child: usize,
     /// Hinge axis in B_n.
     pub a_b: V3,
-    /// Fixed orthonormal pair ⟂ a_B in B_n: (z, a_B × z).
-    pub n: [V3; 2],
+    /// Fixed orthonormal directions of the angular rows in B_n: (z, a_B × z) ⟂ a_B, then a_B
+    /// itself when the hinge is locked; the first `n_ang` are used.
+    pub n: [V3; 3],
+    /// Number of angular rows: 2 (free hinge) or 3 (locked).
+    pub n_ang: usize,
     /// Hinge axis in the child's A frame.
     pub a_c: V3,
     /// Reference relative rotation C^{BnAc}_0.
@@ -55,8 +61,8 @@ fn add_m3(j: &mut MatView<'_>, i0: usize, j0: usize, m: &M3) {
     j.add_block::<3, 3>(i0, j0, m);
 }
 
-/// Add the two rows `N_Bᵀ m` of a 3×3 block `m` at (i0, j0).
-fn add_rows2(j: &mut MatView<'_>, n: &[V3; 2], i0: usize, j0: usize, m: &M3) {
+/// Add the angular rows `N_Bᵀ m` of a 3×3 block `m` at (i0, j0).
+fn add_rows2(j: &mut MatView<'_>, n: &[V3], i0: usize, j0: usize, m: &M3) {
     for (r, nr) in n.iter().enumerate() {
         let row = nr.transpose() * m;
         for c in 0..3 {
@@ -66,15 +72,23 @@ fn add_rows2(j: &mut MatView<'_>, n: &[V3; 2], i0: usize, j0: usize, m: &M3) {
 }
 
 impl FlaredHinge {
-    pub const N_ROWS: usize = 5;
-
-    pub fn new(parent: usize, child: usize, beta: f64, bp: &Body, bc: &Body) -> Self {
+    pub fn new(parent: usize, child: usize, beta: f64, locked: bool, bp: &Body, bc: &Body) -> Self {
         let a_b = V3::new(beta.sin(), beta.cos(), 0.0);
         let z = V3::z();
-        let n = [z, a_b.cross(&z)];
+        let n = [z, a_b.cross(&z), a_b];
         // Reference: psi_n = 0, so C^{GBn}_0 = C^{GAp}_0.
         let rel0 = bp.frame.transpose() * bc.frame;
-        Self { parent, child, a_b, n, a_c: rel0.transpose() * a_b, rel0 }
+        Self { parent, child, a_b, n, n_ang: if locked { 3 } else { 2 }, a_c: rel0.transpose() * a_b, rel0 }
+    }
+
+    /// Number of velocity rows: 5, or 6 when locked.
+    pub fn n_rows(&self) -> usize {
+        3 + self.n_ang
+    }
+
+    /// The angular-row directions in use.
+    fn dirs(&self) -> &[V3] {
+        &self.n[..self.n_ang]
     }
 
     fn kin(&self, bodies: &[Body], q: &[f64]) -> Kin {
@@ -108,8 +122,9 @@ impl FlaredHinge {
         out[0] = lin.x;
         out[1] = lin.y;
         out[2] = lin.z;
-        out[3] = self.n[0].dot(&rel);
-        out[4] = self.n[1].dot(&rel);
+        for (o, d) in out[3..].iter_mut().zip(self.dirs()) {
+            *o = d.dot(&rel);
+        }
     }
 
     pub fn add_b(&self, bodies: &[Body], q: &[f64], j: &mut MatView<'_>, row0: usize) {
@@ -122,9 +137,9 @@ impl FlaredHinge {
         add_m3(j, row0, nd, &(-cpc_t));
         add_m3(j, row0, fp, &(-cpc_t));
         add_m3(j, row0, fp + 3, &(cpc_t * skew(&k.r_n)));
-        add_rows2(j, &self.n, row0 + 3, fc + 3, &(k.cn * k.cpc));
-        add_rows2(j, &self.n, row0 + 3, nd + 3, &(-k.tg.t));
-        add_rows2(j, &self.n, row0 + 3, fp + 3, &(-k.cn));
+        add_rows2(j, self.dirs(), row0 + 3, fc + 3, &(k.cn * k.cpc));
+        add_rows2(j, self.dirs(), row0 + 3, nd + 3, &(-k.tg.t));
+        add_rows2(j, self.dirs(), row0 + 3, fp + 3, &(-k.cn));
     }
 
     /// `∂(B v)/∂q` at fixed `v`.
@@ -145,9 +160,9 @@ impl FlaredHinge {
         let t = k.tg.t;
         let y = k.cpc * wc;
         let d_psi = skew(&(k.cn * y)) * t - k.tg.jac(&psid_n) - skew(&(k.cn * wp)) * t;
-        add_rows2(j, &self.n, row0 + 3, nd + 3, &d_psi);
-        add_rows2(j, &self.n, row0 + 3, fp + 3, &(k.cn * skew(&y)));
-        add_rows2(j, &self.n, row0 + 3, fc + 3, &(-(k.cn * k.cpc * skew(&wc))));
+        add_rows2(j, self.dirs(), row0 + 3, nd + 3, &d_psi);
+        add_rows2(j, self.dirs(), row0 + 3, fp + 3, &(k.cn * skew(&y)));
+        add_rows2(j, self.dirs(), row0 + 3, fc + 3, &(-(k.cn * k.cpc * skew(&wc))));
     }
 
     /// `c_k ∂(Bᵀ mu)/∂q` at fixed `mu` (this joint's 5 multipliers).
@@ -157,7 +172,7 @@ impl FlaredHinge {
         let nd = bp.node_dof(k.node).expect("end node is never the clamped node 0");
         let (fp, fc) = (bp.frame_dof(), bc.frame_dof());
         let mu_l = V3::new(mu[0], mu[1], mu[2]);
-        let m = self.n[0] * mu[3] + self.n[1] * mu[4];
+        let m: V3 = self.dirs().iter().zip(&mu[3..]).map(|(d, x)| d * *x).sum();
         let t = k.tg.t;
         let z = k.cpc * mu_l;
         let zt = skew(&z);
@@ -226,10 +241,16 @@ impl FlaredHinge {
         let s = axis.norm();
         let fc = bc.frame_coord();
         q[fc..fc + 3].copy_from_slice(target.as_slice());
-        if s > 0.0 {
+        let new = if self.n_ang == 3 {
+            // Locked: the child frame is exactly its reference pose relative to B_n.
+            Some(Quaternion::from_rotation_matrix(&(k.cp * k.cn.transpose() * self.rel0)))
+        } else if s > 0.0 {
             let angle = s.atan2(a_child.dot(&a_parent));
-            let rot = Quaternion::from_rotation_vector(&(axis * (angle / s)));
-            let new = rot.mul(&chi_c).normalized();
+            Some(Quaternion::from_rotation_vector(&(axis * (angle / s))).mul(&chi_c).normalized())
+        } else {
+            None
+        };
+        if let Some(new) = new {
             new.write_to(&mut q[fc + 3..fc + 7]);
             // Keep global velocities: x_A ← C_newᵀ C_old x_A.
             let c_new = new.to_rotation_matrix();

@@ -34,6 +34,16 @@ pub enum JointSpec {
         /// The body.
         body: usize,
     },
+    /// A flared hinge locked at its reference fold: the child frame is welded to the parent's
+    /// end section (a sixth, angular row along the axis). The fold angle is still measured.
+    LockedHinge {
+        /// Parent body (its last node carries the joint).
+        parent: usize,
+        /// Child body (its frame origin is the joint point).
+        child: usize,
+        /// Flare angle β of the locked hinge, rad.
+        beta: f64,
+    },
 }
 
 /// Internal joint.
@@ -48,7 +58,7 @@ impl Joint {
     pub fn n_rows(&self) -> usize {
         match self {
             Joint::Ground(_) => GroundHinge::N_ROWS,
-            Joint::Flared(_) => FlaredHinge::N_ROWS,
+            Joint::Flared(j) => j.n_rows(),
             Joint::Clamp(_) => Clamp::N_ROWS,
         }
     }

@@ -136,7 +136,8 @@ impl Model {
                     check_body(format!("joints[{j}].body"), *body, nb)?;
                     (*body, Joint::Clamp(Clamp { body: *body }))
                 }
-                JointSpec::FlaredHinge { parent: p, child: c, beta } => {
+                JointSpec::FlaredHinge { parent: p, child: c, beta }
+                | JointSpec::LockedHinge { parent: p, child: c, beta } => {
                     check_body(format!("joints[{j}].parent"), *p, nb)?;
                     check_body(format!("joints[{j}].child"), *c, nb)?;
                     if p == c {
@@ -160,12 +161,13 @@ impl Model {
                         return Err(Error::JointGap { field: format!("joints[{j}].child"), gap });
                     }
                     parent[*c] = Some(*p);
-                    (*c, Joint::Flared(FlaredHinge::new(*p, *c, *beta, &bs[*p], &bs[*c])))
+                    let locked = matches!(spec, JointSpec::LockedHinge { .. });
+                    (*c, Joint::Flared(FlaredHinge::new(*p, *c, *beta, locked, &bs[*p], &bs[*c])))
                 }
             };
             if let Some(other) = attached[body] {
                 let field = match spec {
-                    JointSpec::FlaredHinge { .. } => format!("joints[{j}].child"),
+                    JointSpec::FlaredHinge { .. } | JointSpec::LockedHinge { .. } => format!("joints[{j}].child"),
                     _ => format!("joints[{j}].body"),
                 };
                 return Err(Error::DoublyAttached { field, body, other });
@@ -191,7 +193,7 @@ impl Model {
             .iter()
             .map(|s| match s {
                 JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } => *body,
-                JointSpec::FlaredHinge { child, .. } => *child,
+                JointSpec::FlaredHinge { child, .. } | JointSpec::LockedHinge { child, .. } => *child,
             })
             .collect();
         let mut projection_order: Vec<usize> = (0..js.len()).collect();

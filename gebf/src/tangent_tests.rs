@@ -200,7 +200,7 @@ fn mass_matrix_is_symmetric_positive_definite() {
 
 /// A two-body flared pendulum with a third free body hanging off the second: covers the ground
 /// hinge, two flared hinges and nodal loads at a random state.
-fn random_model(rng: &mut Lcg, beta: f64) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+fn random_model(rng: &mut Lcg, beta: f64, locked: bool) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let sec = unit_section();
     let f1 = rotation_matrix(&V3::new(0.1, -0.2, 0.3));
     let f2 = rotation_matrix(&V3::new(-0.3, 0.2, 0.4));
@@ -220,7 +220,11 @@ fn random_model(rng: &mut Lcg, beta: f64) -> (Model, Vec<f64>, Vec<f64>, Vec<f64
     let joints = vec![
         JointSpec::GroundHinge { body: 0, axis: V3::new(0.2, 1.0, 0.1) },
         JointSpec::FlaredHinge { parent: 0, child: 1, beta },
-        JointSpec::FlaredHinge { parent: 1, child: 2, beta: -0.3 },
+        if locked {
+            JointSpec::LockedHinge { parent: 1, child: 2, beta: -0.3 }
+        } else {
+            JointSpec::FlaredHinge { parent: 1, child: 2, beta: -0.3 }
+        },
     ];
     let mut model = Model::new(&bodies, &joints, V3::new(0.5, -1.0, -9.8), Options::default()).unwrap();
     model.set_nodal_load(1, 4, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
@@ -290,9 +294,9 @@ fn fd_x(n_in: usize, x: &[f64], n_out: usize, f: impl Fn(&[f64], &mut [f64])) ->
     m
 }
 
-fn check_model(seed: u64, beta: f64) {
+fn check_model(seed: u64, beta: f64, locked: bool) {
     let mut rng = Lcg(seed);
-    let (model, q, v, a, mu) = random_model(&mut rng, beta);
+    let (model, q, v, a, mu) = random_model(&mut rng, beta, locked);
     let n = model.n_dof();
     let nc = model.n_velocity_constraints();
     // Iteration matrix: each coefficient separately.
@@ -346,12 +350,18 @@ fn check_model(seed: u64, beta: f64) {
 
 #[test]
 fn model_tangents_match_finite_differences() {
-    check_model(3, 0.7);
+    check_model(3, 0.7, false);
+}
+
+/// The locked hinge's sixth (axial) angular row in every tangent.
+#[test]
+fn model_tangents_with_a_locked_hinge() {
+    check_model(5, 0.4, true);
 }
 
 #[test]
 fn model_tangents_at_ninety_degree_flare() {
-    check_model(8, std::f64::consts::FRAC_PI_2);
+    check_model(8, std::f64::consts::FRAC_PI_2, false);
 }
 
 proptest! {

@@ -155,6 +155,10 @@ pub enum Joint {
         child: String,
         /// Flare angle β, degrees, in [−90, 90].
         flare_deg: f64,
+        /// Lock the hinge at its reference fold (the child welded to the parent's end section):
+        /// used for the rigid-wing check. Default false.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        locked: bool,
     },
     /// The body's start section clamped to ground.
     Clamp {

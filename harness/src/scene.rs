@@ -56,11 +56,14 @@ macro_rules! specs {
                 Joint::GroundHinge { body, axis, .. } => {
                     $krate::JointSpec::GroundHinge { body: idx(body), axis: unit(*axis) }
                 }
-                Joint::FlaredHinge { parent, child, flare_deg, .. } => $krate::JointSpec::FlaredHinge {
-                    parent: idx(parent),
-                    child: idx(child),
-                    beta: flare_deg.to_radians(),
-                },
+                Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
+                    let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
+                    if *locked {
+                        $krate::JointSpec::LockedHinge { parent, child, beta }
+                    } else {
+                        $krate::JointSpec::FlaredHinge { parent, child, beta }
+                    }
+                }
                 Joint::Clamp { body, .. } => $krate::JointSpec::Clamp { body: idx(body) },
             })
             .collect();
@@ -227,8 +230,11 @@ fn gebf_element(model: &gebf::Model, body: usize, s: f64) -> Option<([usize; 3],
 }
 
 /// Rotation vector of a rotation matrix (|θ| < π).
+/// Rotation vector of a rotation matrix. Through the quaternion (Shepperd's method), accurate at
+/// every angle: an `acos` of the trace returns NaN when rounding pushes it past 3 for the tiny
+/// relative rotations of a stiff wing.
 fn log_so3(r: &Matrix3<f64>) -> Vector3<f64> {
-    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+    gebf::crv::from_rotation_matrix(r)
 }
 
 impl AeroStructure for Sensed<gebf::Model> {

@@ -50,38 +50,34 @@ fn strong_coupling_converges_as_it_tightens() {
     }
 }
 
-/// Rigid limit: a single stiff (×1e4) clamped 16 m wing, no gravity, wake closed by semi-infinite
-/// legs: after the start-up transient the coupled lift equals the UVLM's steady solution of the
-/// same lattice within 0.5 %.
+/// Rigid limit (issue 7): the paper's two-body wing with stiffness ×1e4 and the flared hinge
+/// locked, no gravity, wake closed by semi-infinite legs: after the start-up transient the
+/// coupled lift equals the UVLM's steady solution of the same (slanted-hinge) lattice within 0.5 %.
 #[test]
-fn rigid_wing_lift_matches_steady_uvlm() {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../cases/wing_aoa5.json");
-    let mut file = CaseFile::read(&p).unwrap();
-    // One 16 m body, clamped: drop the outer body and the hinge.
-    file.raw["bodies"].as_array_mut().unwrap().truncate(1);
-    file.raw["joints"].as_array_mut().unwrap().truncate(1);
-    let ov: Vec<Override> = [
-        "bodies.0.length=16",
-        "gravity=[0,0,0]",
-        "stiffness_scale=1e4",
-        "t_end=4",
-        "aero.wake_closure=true",
-        "aero.panels_per_body=[32]",
-        "ancf.elements_per_body=[16]",
-        "gebf.elements_per_body=[8]",
-    ]
-    .iter()
-    .map(|s| s.parse().unwrap())
-    .collect();
-    let spec = file.expand(&ov).unwrap().remove(0);
-    let aero = spec.ancf.aero.clone().unwrap();
-    // The UVLM's own steady solution of the undeformed lattice.
-    let a = 5f64.to_radians();
-    let frame = nalgebra::Matrix3::new(1.0, 0.0, 0.0, 0.0, a.cos(), -a.sin(), 0.0, a.sin(), a.cos());
-    let stations: Vec<uvlm::SpanStation> = (0..=32)
-        .map(|j| uvlm::SpanStation::new(nalgebra::Vector3::new(0.5 * j as f64, 0.0, 0.0), frame, 1.0, 0.5))
+fn rigid_locked_wing_lift_matches_steady_uvlm() {
+    let spec =
+        wing(&["joints.1.locked=true", "gravity=[0,0,0]", "stiffness_scale=1e4", "t_end=4", "aero.wake_closure=true"]);
+    let case = spec.case(Formulation::Ancf);
+    let aero = case.aero.clone().unwrap();
+    // The UVLM's own steady solution of the undeformed lattice, stations placed analytically.
+    let map = harness::aero::station_map(case, &aero).unwrap();
+    let stations: Vec<uvlm::SpanStation> = map
+        .iter()
+        .map(|m| {
+            let b = &case.bodies[m.body];
+            let (x, y) = (nalgebra::Vector3::from(b.x_axis), nalgebra::Vector3::from(b.y_axis));
+            let frame = nalgebra::Matrix3::from_columns(&[x, y, x.cross(&y)]);
+            let origin = nalgebra::Vector3::from(b.start) + x * m.s;
+            uvlm::SpanStation { origin, frame, chord: aero.chord, le_offset: aero.le_offset, slant: m.slant }
+        })
         .collect();
-    let lattice = uvlm::Lattice::from_stations(uvlm::LatticeSpec::new(4), &stations).unwrap();
+    let hinge = map.iter().position(|m| m.slant != 0.0).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
+    assert!(hinge.is_some(), "the lattice has its slanted hinge column");
+    let lattice = uvlm::Lattice::from_stations(
+        uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) },
+        &stations,
+    )
+    .unwrap();
     let mut params = uvlm::UvlmParams::new(aero.rho, aero.v_inf);
     params.bound_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
     params.wake_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
@@ -89,11 +85,14 @@ fn rigid_wing_lift_matches_steady_uvlm() {
     let steady = uvlm::lift_drag_of(u.solve_steady().unwrap().total_force(), aero.v_inf, [1.0, 0.0, 0.0]).0;
     for f in Formulation::ALL {
         let out = run(&spec, f);
-        let lift = out.rows.last().unwrap().lift;
+        let last = out.rows.last().unwrap();
+        let lift = last.lift;
         eprintln!(
-            "{f}: coupled lift {lift:.4} N, steady UVLM {steady:.4} N, {:+.4} %",
-            100.0 * (lift - steady) / steady
+            "{f}: coupled lift {lift:.4} N, steady UVLM {steady:.4} N, {:+.4} %, fold {:.2e} deg",
+            100.0 * (lift - steady) / steady,
+            last.fold.to_degrees()
         );
+        assert!(last.fold.abs() < 1e-3_f64.to_radians(), "{f}: locked hinge folded {} deg", last.fold.to_degrees());
         assert!(((lift - steady) / steady).abs() < 5e-3, "{f}: coupled lift {lift:.3} N vs steady UVLM {steady:.3} N");
     }
 }
