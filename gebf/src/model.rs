@@ -463,9 +463,6 @@ impl Model {
             for i in 1..b.n_nodes() {
                 let (_, psi) = b.node_state(q, i);
                 let Some(new) = crate::crv::rescale(&psi) else { continue };
-                if std::env::var("GEBF_DEBUG").is_ok() {
-                    eprintln!("rescale body node {i} |psi| {:.3}", psi.norm());
-                }
                 let k = b.node_coord(i).expect("i ≥ 1") + 3;
                 q[k..k + 3].copy_from_slice(new.as_slice());
                 if let Some((v, vd, a)) = rates.as_mut() {
