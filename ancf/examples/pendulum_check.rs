@@ -96,13 +96,15 @@ fn main() {
     }
     let st = ga.stats();
     println!(
-        "wall {:.3?} steps {} newton {} (max {}) factorizations {} | max tip error {:.3e} m at t = {:.3} | \
+        "wall {:.3?} steps {} newton {} (max {}) factorizations {} residuals {} halvings {} | max tip error {:.3e} m at t = {:.3} | \
          energy drift / T_max {:.3e} | max constraint residual {:.2e}",
         t0.elapsed(),
         st.n_steps,
         st.n_newton_iters,
         st.max_newton_iters,
         st.n_factorizations,
+        st.n_residual_evals,
+        st.n_step_halvings,
         max_err,
         t_err,
         drift / t_max,

@@ -60,9 +60,10 @@ fn scatter(plan: &StrainPlan, pf: &Fields, out: &mut [f64]) {
 
 /// Copy the upper block triangle (3×3 blocks `(a, b)`, `a ≤ b`) onto the lower one.
 pub fn mirror_upper_inplace(k: &mut ElementMatrix) {
+    let data = k.as_mut_slice(); // column-major: (i, j) at 24 j + i
     for j in 0..ELEMENT_DOF {
         for i in 3 * (j / 3 + 1)..ELEMENT_DOF {
-            k[(i, j)] = k[(j, i)];
+            data[ELEMENT_DOF * j + i] = data[ELEMENT_DOF * i + j];
         }
     }
 }
@@ -135,6 +136,10 @@ impl Element {
     /// `k += c · K_el(e)` on the upper block triangle only (3×3 blocks `(a, b)` with `a ≤ b`,
     /// diagonal blocks in full); [`mirror_upper_inplace`] completes the symmetric matrix, so that
     /// it is exactly symmetric.
+    ///
+    /// Each strain adds the rank-one term `C (A e)(A e)ᵀ` column by column as one contiguous
+    /// update over the rows from its first to the column's block (the few zero rows of unused
+    /// blocks in between cost less than the branching that would skip them).
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let f = eval_fields(&self.plan, e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS];
@@ -142,20 +147,21 @@ impl Element {
         for s in &self.plan.strains {
             let d = strain_value(s, &f) - s.reference;
             let g = strain_gradient(&self.plan, s, &f);
+            let g = g.as_slice();
             let cs = c * s.stiffness;
             let blocks = &s.blocks[..s.n_blocks];
-            for (jb, &bj) in blocks.iter().enumerate() {
-                for j in 3 * bj..3 * bj + 3 {
-                    let gj = g[j];
-                    if gj == 0.0 {
+            let Some(&first) = blocks.first() else { continue };
+            let lo = 3 * first;
+            for &bj in blocks {
+                let hi = 3 * bj + 3;
+                for j in 3 * bj..hi {
+                    let x = cs * g[j];
+                    if x == 0.0 {
                         continue;
                     }
-                    let col = &mut data[ELEMENT_DOF * j..ELEMENT_DOF * (j + 1)];
-                    for &bi in &blocks[..=jb] {
-                        let (gi, ci) = (&g.as_slice()[3 * bi..3 * bi + 3], &mut col[3 * bi..3 * bi + 3]);
-                        ci[0] += cs * (gi[0] * gj);
-                        ci[1] += cs * (gi[1] * gj);
-                        ci[2] += cs * (gi[2] * gj);
+                    let col = &mut data[ELEMENT_DOF * j + lo..ELEMENT_DOF * j + hi];
+                    for (cij, gi) in col.iter_mut().zip(&g[lo..hi]) {
+                        *cij += x * gi;
                     }
                 }
             }

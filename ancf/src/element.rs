@@ -4,6 +4,7 @@
 //! it is built once at model construction. Forces and tangents are in
 //! [`elastic_force`](crate::elastic_force).
 
+use crate::elastic_force::ElementMatrix;
 use crate::mass::{element_mass, nonzeros};
 use crate::shape::N_BLOCKS;
 use crate::strain::{StrainPlan, strain_plan};
@@ -18,6 +19,8 @@ pub struct Element {
     pub mass: [[f64; N_BLOCKS]; N_BLOCKS],
     /// Non-zeros of `mass`.
     pub mass_nz: Vec<(usize, usize, f64)>,
+    /// The full 24×24 mass matrix `m̄ ⊗ I₃`, kg (the start of every element's iteration matrix).
+    pub mass_matrix: ElementMatrix,
     /// Fields and sampled strains.
     pub plan: StrainPlan,
     /// Mass per unit length, kg/m (for gravity and point loads).
@@ -31,9 +34,18 @@ impl Element {
     pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> Self {
         let (d_yy, d_zz) = section.slope_inertias();
         let mass = element_mass(section.mass, d_yy, d_zz, l);
+        let mut mass_matrix = ElementMatrix::zeros();
+        for (a, row) in mass.iter().enumerate() {
+            for (b, m) in row.iter().enumerate() {
+                for i in 0..3 {
+                    mass_matrix[(3 * a + i, 3 * b + i)] = *m;
+                }
+            }
+        }
         Self {
             l,
             mass_nz: nonzeros(&mass),
+            mass_matrix,
             mass,
             plan: strain_plan(l, section, curvature, penalty_factor, kappa),
             mass_per_length: section.mass,

@@ -556,16 +556,9 @@ impl Model {
         for b in &self.bodies {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
-                ke.fill(0.0);
+                ke.zip_apply(&b.element.mass_matrix, |x, m| *x = c_m * m);
                 if c_k != 0.0 {
                     b.element.add_elastic_tangent_upper(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
-                }
-                if c_m != 0.0 {
-                    for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
-                        for i in 0..3 {
-                            ke[(3 * a + i, 3 * bb + i)] += c_m * m;
-                        }
-                    }
                 }
                 mirror_upper_inplace(&mut ke);
                 self.scatter_element(first, self.element_z[e_index], &ke, k);

@@ -75,6 +75,10 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// The predictor of the current attempt (for restarting Newton with a fresh matrix).
     predictor: State,
     predictor_delta: Vec<f64>,
+    /// The iterate before the last update made with a factorisation from an earlier iterate
+    /// (to step back to when that update diverged).
+    previous: State,
+    previous_delta: Vec<f64>,
     stats: Stats,
 }
 
@@ -140,6 +144,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             backup: State::at_rest(sys, 0.0, vec![0.0; n_q]),
             predictor: State::at_rest(sys, 0.0, vec![0.0; n_q]),
             predictor_delta: vec![0.0; n],
+            previous: State::at_rest(sys, 0.0, vec![0.0; n_q]),
+            previous_delta: vec![0.0; n],
             stats: Stats::default(),
         })
     }
@@ -305,6 +311,7 @@ impl<L: LinearSolver> GenAlpha<L> {
         let mut factorized_this_step = false;
         let mut inc_norm = f64::INFINITY;
         let mut prev_prev_inc = f64::INFINITY;
+        let mut step_back = false; // back at an earlier iterate: factorise here
         for iter in 1..=np.max_iter + 1 {
             // Constraints at the current iterate first: if the increment says converged, the
             // dynamic residual is not needed.
@@ -364,7 +371,21 @@ impl<L: LinearSolver> GenAlpha<L> {
                 prev_inc = f64::INFINITY;
                 continue;
             }
-            let need = !np.reuse_factorization
+            if !step_back && factorized_this_step && !fresh && contraction > 1.0 {
+                // The last update, made with this step's factorisation from an earlier
+                // iterate, diverged: it may have spoiled the iterate (modified Newton overshoots
+                // where the matrix changes fast), so step back to the iterate before it and
+                // factorise there, i.e. continue with full Newton.
+                copy_state(&self.previous, s);
+                self.delta.copy_from_slice(&self.previous_delta);
+                inc_norm = prev_inc;
+                prev_inc = prev_prev_inc;
+                prev_prev_inc = f64::INFINITY;
+                step_back = true;
+                continue;
+            }
+            let need = step_back
+                || !np.reuse_factorization
                 || !self.have_factorization
                 || (iter == 1 && self.refresh_steps_left > 0)
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
@@ -383,7 +404,10 @@ impl<L: LinearSolver> GenAlpha<L> {
                 factorized_this_step = true;
             } else {
                 fresh = false;
+                copy_state(s, &mut self.previous);
+                self.previous_delta.copy_from_slice(&self.delta);
             }
+            step_back = false;
             for i in 0..n {
                 self.rhs[i] = -self.r[i] / c.beta_prime;
             }

@@ -19,7 +19,8 @@
 //! Newton iterates on the tangent increment with the scaled iteration matrix of THEORY §C.3
 //! (dynamic rows × 1/β′, velocity rows × 1/γ′, multipliers λ/β′, μ/β′). The factorisation is
 //! reused across iterations and steps while Newton contracts, refreshed at the predictor for a
-//! while after a reused one failed; an iterate is accepted when the increment, or the
+//! while after a reused one failed; an update made with a reused factorisation that diverged is
+//! taken back and the matrix factorised at the iterate before it; an iterate is accepted when the increment, or the
 //! contraction estimate θ/(1 − θ)·|Δ| (`NewtonParams::estimate_convergence`), is below the
 //! tolerance. A failed step is retried as two half steps (`NewtonParams::max_step_halvings`).
 //! The default [`DenseLu`] switches to a bordered band LU (Schur complement on the border) when

@@ -16,7 +16,9 @@ pub struct NewtonParams {
     /// Absolute tolerance on the velocity constraints B v + b, velocity units (default 1e-8).
     pub psi_tol: f64,
     /// Reuse the factorisation across iterations and steps while Newton contracts fast
-    /// (modified Newton). Default true.
+    /// (modified Newton). Default true. An update made with a factorisation from an earlier
+    /// iterate of the step that increased the increment is taken back and the matrix factorised
+    /// at the iterate before it (one Newton iteration is counted for the step back).
     pub reuse_factorization: bool,
     /// Contraction rate above which a reused factorisation is refreshed (default 0.2).
     pub max_contraction: f64,

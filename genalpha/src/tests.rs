@@ -279,3 +279,63 @@ fn failed_step_is_retried_in_halves() {
     let failed = (0..10).any(|_| ga.step(&mut sys, &mut s).is_err());
     assert!(failed);
 }
+
+/// A hardening spring m ẍ + k x + k₃ x³ = F, with the force switched on after t = 0: the
+/// predictor sits at rest where the tangent is k, the solution far into the stiff range.
+struct SuddenlyLoadedSpring {
+    m: f64,
+    k: f64,
+    k3: f64,
+    force: f64,
+}
+
+impl ConstrainedSystem for SuddenlyLoadedSpring {
+    fn n_coords(&self) -> usize {
+        1
+    }
+    fn n_dof(&self) -> usize {
+        1
+    }
+    fn residual_inplace(&self, t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        let f = if t > 0.0 { self.force } else { 0.0 };
+        r[0] = self.m * v_dot[0] + self.k * q[0] + self.k3 * q[0].powi(3) - f;
+    }
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        q: &[f64],
+        _v: &[f64],
+        _a: &[f64],
+        c_m: f64,
+        _c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        k.add(0, 0, c_m * self.m + c_k * (self.k + 3.0 * self.k3 * q[0] * q[0]));
+    }
+}
+
+/// Modified Newton with the predictor's matrix overshoots on the sudden load (the tangent at
+/// the solution is many times the one at rest) and would spoil the iterate; stepping back to the
+/// iterate before the divergent update and factorising there converges the step at full size to
+/// the answer of full Newton.
+#[test]
+fn divergent_modified_newton_update_is_taken_back() {
+    let run = |reuse: bool| {
+        let mut sys = SuddenlyLoadedSpring { m: 1.0, k: 1.0e2, k3: 1.0e6, force: 3.0e2 };
+        let mut p = IntegratorParams::new(0.8, 0.05);
+        p.newton.reuse_factorization = reuse;
+        p.newton.max_step_halvings = 0;
+        let mut ga = GenAlpha::new(p, &sys).unwrap();
+        let mut s = State::at_rest(&sys, 0.0, vec![0.0]);
+        ga.initialize(&sys, &mut s).unwrap();
+        let st = ga.step(&mut sys, &mut s).expect("the step converges at full size");
+        (s.q[0], st)
+    };
+    let (x_full, full) = run(false);
+    let (x_mod, modified) = run(true);
+    println!("full Newton {full:?}\nmodified Newton {modified:?}");
+    assert_eq!(modified.n_substeps, 1);
+    assert!(x_full > 0.05, "the load reaches the stiff range: x = {x_full}");
+    assert_relative_eq!(x_mod, x_full, epsilon = 1e-12, max_relative = 1e-9);
+}
