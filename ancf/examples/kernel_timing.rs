@@ -39,11 +39,13 @@ fn main() {
         time("residual", 2000, || model.residual_inplace(0.0, &s.q, &s.v, &s.v_dot, &mut r));
         let mut m = DenseMatrix::zeros(n + nh, n + nh);
         time("fill_zero", 2000, || m.fill_zero());
-        time("iteration matrix", 2000, || {
+        let assemble = |m: &mut DenseMatrix| {
             m.fill_zero();
             let mut k = m.block(0, 0, n, n);
             model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 1.0 / c.beta_prime, &mut k);
-        });
+        };
+        time("iteration matrix", 2000, || assemble(&mut m));
+        assemble(&mut m);
         {
             let mut j = m.block(n, 0, nh, n);
             model.phi_q_inplace(0.0, &s.q, &mut j);

@@ -193,6 +193,9 @@ impl SkylineLu {
                 .zip(&self.uval[up..up + h])
                 .all(|(l, u)| (l - u).abs() <= 1e-10 * (l.abs() + u.abs()))
         });
+        if symmetric {
+            return self.factorize_symmetric(scale);
+        }
         // Crout, in place.
         for j in 0..n {
             let fj = self.first[j];
@@ -224,6 +227,73 @@ impl SkylineLu {
         }
         true
     }
+
+    /// Crout for symmetric values (`L = D⁻¹Uᵀ`): column `j` of `U` and row `j` of `L` from the
+    /// rows of `L` above. Two consecutive rows with the same profile start are taken together,
+    /// sharing the loads of the column (the node-ordered ANCF unknowns come in runs of 12).
+    fn factorize_symmetric(&mut self, scale: f64) -> bool {
+        let n = self.n;
+        for j in 0..n {
+            let fj = self.first[j];
+            let (lpj, upj) = (self.lptr[j], self.uptr[j]);
+            let (l_done, l_rest) = self.lval.split_at_mut(lpj);
+            let l_j = &mut l_rest[..j - fj];
+            let u_j = &mut self.uval[upj..=upj + (j - fj)];
+            let mut i = fj;
+            while i < j {
+                let fi = self.first[i];
+                let lo = fi.max(fj);
+                let lpi = self.lptr[i];
+                let l_i = &l_done[lpi + (lo - fi)..lpi + (i - fi)];
+                if i + 1 < j && self.first[i + 1] == fi {
+                    // rows i and i + 1: U[i][j], then U[i+1][j] with its term L[i+1][i] U[i][j]
+                    let lpi1 = self.lptr[i + 1];
+                    let l_i1 = &l_done[lpi1 + (lo - fi)..lpi1 + (i - fi)];
+                    let (s0, s1) = dot2(l_i, l_i1, &u_j[lo - fj..i - fj]);
+                    let u0 = u_j[i - fj] - s0;
+                    u_j[i - fj] = u0;
+                    l_j[i - fj] = u0 * self.inv_diag[i];
+                    let u1 = u_j[i + 1 - fj] - s1 - l_done[lpi1 + (i - fi)] * u0;
+                    u_j[i + 1 - fj] = u1;
+                    l_j[i + 1 - fj] = u1 * self.inv_diag[i + 1];
+                    i += 2;
+                } else {
+                    let u0 = u_j[i - fj] - dot(l_i, &u_j[lo - fj..i - fj]);
+                    u_j[i - fj] = u0;
+                    l_j[i - fj] = u0 * self.inv_diag[i];
+                    i += 1;
+                }
+            }
+            let d = u_j[j - fj] - dot(l_j, &u_j[..j - fj]);
+            u_j[j - fj] = d;
+            if !d.is_finite() || d.abs() <= 1e-13 * scale {
+                return false;
+            }
+            self.inv_diag[j] = 1.0 / d;
+        }
+        true
+    }
+}
+
+/// `(a·c, b·c)` over the length of `c`.
+#[inline]
+fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+    let n = c.len();
+    let (a, b) = (&a[..n], &b[..n]);
+    let split = n - n % 2;
+    let mut acc = [0.0; 4];
+    for ((x, y), z) in a[..split].chunks_exact(2).zip(b[..split].chunks_exact(2)).zip(c[..split].chunks_exact(2)) {
+        acc[0] += x[0] * z[0];
+        acc[1] += x[1] * z[1];
+        acc[2] += y[0] * z[0];
+        acc[3] += y[1] * z[1];
+    }
+    let (mut s0, mut s1) = (acc[0] + acc[1], acc[2] + acc[3]);
+    if split < n {
+        s0 += a[split] * c[split];
+        s1 += b[split] * c[split];
+    }
+    (s0, s1)
 }
 
 #[inline]

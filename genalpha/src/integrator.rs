@@ -58,6 +58,8 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     phi_q: DenseMatrix,
     b_mat: DenseMatrix,
     phi_q_ready: bool,
+    /// Columns of Φ_q with a non-zero entry (constraints touch few coordinates).
+    phi_q_cols: Vec<usize>,
     have_factorization: bool,
     /// Steps left during which the factorisation is refreshed at each step's predictor, because
     /// a factorisation reused from an earlier step recently failed to contract.
@@ -131,6 +133,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             phi_q: DenseMatrix::zeros(n_h, n),
             b_mat: DenseMatrix::zeros(n_v, n),
             phi_q_ready: false,
+            phi_q_cols: Vec::with_capacity(n),
             have_factorization: false,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
@@ -168,6 +171,16 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.phi_q.fill_zero();
             sys.phi_q_inplace(t, q, &mut self.phi_q.view());
             self.phi_q_ready = true;
+            // Forget the previous Φ_q in the assembled matrix: its non-zero columns may move.
+            for &j in &self.phi_q_cols {
+                for i in 0..self.n_h {
+                    *self.matrix.get_mut(self.n + i, j) = 0.0;
+                    *self.matrix.get_mut(j, self.n + i) = 0.0;
+                }
+            }
+            let phi_q = &self.phi_q;
+            self.phi_q_cols.clear();
+            self.phi_q_cols.extend((0..self.n).filter(|&j| (0..self.n_h).any(|i| phi_q.get(i, j) != 0.0)));
         }
         if self.n_v > 0 {
             self.b_mat.fill_zero();
@@ -176,19 +189,49 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// Copy Φ_q and B (and their transposes) into the assembled matrix around the K block.
+    /// Only the non-zero columns of Φ_q are written: its zero columns stay zero from the
+    /// matrix's creation (nothing else writes to the constraint rows and columns of Φ).
     fn place_constraint_blocks(&mut self) {
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
-        for j in 0..n {
+        for &j in &self.phi_q_cols {
             for i in 0..n_h {
                 let x = self.phi_q.get(i, j);
                 *self.matrix.get_mut(n + i, j) = x;
                 *self.matrix.get_mut(j, n + i) = x;
             }
-            for i in 0..n_v {
-                let x = self.b_mat.get(i, j);
-                *self.matrix.get_mut(n + n_h + i, j) += x;
-                *self.matrix.get_mut(j, n + n_h + i) = x;
+        }
+        if n_v > 0 {
+            for j in 0..n {
+                for i in 0..n_v {
+                    let x = self.b_mat.get(i, j);
+                    *self.matrix.get_mut(n + n_h + i, j) += x;
+                    *self.matrix.get_mut(j, n + n_h + i) = x;
+                }
             }
+        }
+    }
+
+    /// Zero the blocks of the assembled matrix that the model adds to (K, and the velocity
+    /// constraint rows that receive ∂Ψ/∂q); the Φ_q blocks are overwritten by
+    /// [`place_constraint_blocks`](Self::place_constraint_blocks) and the multiplier block
+    /// stays zero.
+    fn clear_added_blocks(&mut self) {
+        let (n, n_h) = (self.n, self.n_h);
+        let n_all = self.matrix.n_rows();
+        let data = self.matrix.as_mut_slice();
+        for col in data.chunks_exact_mut(n_all).take(n) {
+            col[..n].iter_mut().for_each(|x| *x = 0.0);
+            col[n + n_h..].iter_mut().for_each(|x| *x = 0.0);
+        }
+    }
+
+    /// `r += Φ_qᵀ λ + Bᵀ μ`.
+    fn add_constraint_forces(&mut self, lambda: &[f64], mu: &[f64]) {
+        for &j in &self.phi_q_cols {
+            self.r[j] += (0..self.n_h).map(|i| self.phi_q.get(i, j) * lambda[i]).sum::<f64>();
+        }
+        if self.n_v > 0 {
+            self.b_mat.add_mul_transpose_vec_inplace(mu, &mut self.r);
         }
     }
 
@@ -340,8 +383,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.update_jacobians(sys, t1, &s.q);
             sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
             self.stats.n_residual_evals += 1;
-            self.phi_q.add_mul_transpose_vec_inplace(&s.lambda, &mut self.r);
-            self.b_mat.add_mul_transpose_vec_inplace(&s.mu, &mut self.r);
+            self.add_constraint_forces(&s.lambda, &s.mu);
             let res_norm = inf_norm(&self.r) / c.beta_prime;
             stats.residual_norm = res_norm;
             if !res_norm.is_finite() {
@@ -458,7 +500,7 @@ impl<L: LinearSolver> GenAlpha<L> {
     fn assemble<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
-        self.matrix.fill_zero();
+        self.clear_added_blocks();
         {
             let mut k = self.matrix.block(0, 0, n, n);
             sys.iteration_matrix_inplace(
