@@ -66,6 +66,10 @@ pub struct Case {
     /// `harness all` also runs the refinement ladders of this case (`harness converge`).
     #[serde(default)]
     pub converge: bool,
+    /// End time of the refinement study, s (default `t_end`). An aeroelastic case's finest rungs
+    /// take 8× the steps with 8× the wake rows, so a shorter window keeps the study in minutes.
+    #[serde(default)]
+    pub converge_t_end: Option<f64>,
     /// Parameter sweep: each entry maps a `--set`-style path (e.g. `stiffness_scale`,
     /// `joints.1.flare_deg`, `ancf.dt`) to a list of values; the Cartesian product expands into
     /// named runs `<name>__<key>=<value>…`.
@@ -716,6 +720,9 @@ impl Case {
         }
         pos("stiffness_scale", self.stiffness_scale)?;
         pos("t_end", self.t_end)?;
+        if let Some(t) = self.converge_t_end {
+            pos("converge_t_end", t)?;
+        }
         if let Some(o) = self.output_dt {
             pos("output_dt", o)?;
         }

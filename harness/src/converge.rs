@@ -1,11 +1,14 @@
 //! Refinement ladders and work-precision diagrams (speed against error).
 //!
 //! For each formulation three ladders are run from the case's own settings (n elements per body,
-//! time step h):
-//! * **time**: n fixed, h·{2, 1, ½, ¼} against h/8;
-//! * **space**: h/4 fixed, elements n·{½, 1, 2} (at least 1) against 4n;
-//! * **diagonal** (work-precision): (n·2ᵏ, h/2ᵏ), k = 0..2, against the finest rung k = 3, or
+//! time step h), with L = 3 refinement levels (L = 2 for aeroelastic cases):
+//! * **time**: n fixed, h·{2, 1, ½, ¼} against h/8 (L = 2: h·{2, 1, ½} against h/4);
+//! * **space**: h·2/2ᴸ fixed, elements n·{½, 1, 2} (at least 1) against 4n (L = 2: n·{½, 1} against 2n);
+//! * **diagonal** (work-precision): (n·2ᵏ, h/2ᵏ), k < L, against the finest rung k = L, or
 //!   against an external reference marked `converged` in the case file.
+//!
+//! Aeroelastic cases keep the wake's physical length on every rung (rows scaled with 1/dt; the
+//! chordwise lattice is fixed) and may use a shorter window (`converge_t_end`).
 //!
 //! Error of a rung = max over time of the tip distance to its truth. Observed orders come from
 //! successive rungs (`log2(e_k / e_{k+1})` for halving ratios), and a Richardson estimate of the
@@ -98,15 +101,21 @@ pub struct ConvergeResult {
 
 fn rung_spec(spec: &RunSpec, f: Formulation, elements: Elements, dt: f64) -> crate::case::Case {
     let mut c = spec.case(f).clone();
+    let base_dt = match f {
+        Formulation::Ancf => std::mem::replace(&mut c.ancf.dt, dt),
+        Formulation::Gebf => std::mem::replace(&mut c.gebf.dt, dt),
+    };
     match f {
-        Formulation::Ancf => {
-            c.ancf.elements_per_body = elements;
-            c.ancf.dt = dt;
-        }
-        Formulation::Gebf => {
-            c.gebf.elements_per_body = elements;
-            c.gebf.dt = dt;
-        }
+        Formulation::Ancf => c.ancf.elements_per_body = elements,
+        Formulation::Gebf => c.gebf.elements_per_body = elements,
+    }
+    if let Some(t) = c.converge_t_end {
+        c.t_end = t.min(c.t_end);
+    }
+    // The wake sheds one row per step: keep its physical length (rows × V·dt) as dt changes, so
+    // that every rung discretises the same wake.
+    if let Some(aero) = c.aero.as_mut() {
+        aero.n_wake_rows = ((aero.n_wake_rows as f64 * base_dt / dt).round() as usize).max(1);
     }
     // Common output grid: the coarsest step of the study, so that every rung is sampled alike.
     c.output_dt = None;
@@ -122,26 +131,36 @@ fn max_distance(a: &RunOutput, truth: &Curve) -> f64 {
 /// Plan of one study: (formulation, ladder, elements, dt, is_truth).
 type Plan = Vec<(Formulation, Ladder, Elements, f64, bool)>;
 
+/// Refinement levels below the case's own settings: 3 for structural cases; 2 for aeroelastic
+/// ones, whose cost per step grows with the wake rows (∝ 1/dt), so a level costs 4× in time.
+fn levels(spec: &RunSpec) -> i32 {
+    if spec.ancf.aero.is_some() { 2 } else { 3 }
+}
+
 fn plan(spec: &RunSpec) -> Plan {
     let mut p = Vec::new();
+    let l = levels(spec);
+    let fine = 2f64.powi(l);
     for f in Formulation::ALL {
         let c = spec.case(f);
         let (n, h) = match f {
             Formulation::Ancf => (&c.ancf.elements_per_body, c.ancf.dt),
             Formulation::Gebf => (&c.gebf.elements_per_body, c.gebf.dt),
         };
-        for (k, m) in [2.0, 1.0, 0.5, 0.25, 0.125].into_iter().enumerate() {
-            p.push((f, Ladder::Time, n.clone(), h * m, k == 4));
+        // time: h·{2, 1, …, 2/fine} against h/fine
+        for k in -1..=l {
+            p.push((f, Ladder::Time, n.clone(), h / 2f64.powi(k), k == l));
         }
-        let mut space: Vec<Elements> = [0.5, 1.0, 2.0, 4.0].iter().map(|&k| n.scaled(k)).collect();
+        // space at h·2/fine: n·{½, 1, …} against n·fine/2
+        let mut space: Vec<Elements> = (-1..l).map(|k| n.scaled(2f64.powi(k))).collect();
         space.dedup();
         let last = space.len() - 1;
         for (k, e) in space.into_iter().enumerate() {
-            p.push((f, Ladder::Space, e, h / 4.0, k == last));
+            p.push((f, Ladder::Space, e, 2.0 * h / fine, k == last));
         }
-        for k in 0..4i32 {
+        for k in 0..=l {
             let s = 2f64.powi(k);
-            p.push((f, Ladder::Diagonal, n.scaled(s), h / s, k == 3));
+            p.push((f, Ladder::Diagonal, n.scaled(s), h / s, k == l));
         }
     }
     p
@@ -184,16 +203,24 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
             let truth_i = *idx.iter().find(|&&i| plan[i].4).expect("every ladder has a truth");
             let own_truth = tip_curve(&outs[truth_i].rows);
             let use_external = ladder == Ladder::Diagonal && external.is_some();
-            let (against, truth) = match (&external, use_external) {
+            let (mut against, truth) = match (&external, use_external) {
                 (Some((label, c)), true) => (label.clone(), c),
                 _ => (format!("{} rung ({} el, dt {:.3e})", f, plan[truth_i].2, plan[truth_i].3), &own_truth),
             };
+            // A failed truth measures nothing: no errors on this ladder.
+            let truth_failed = !use_external && outs[truth_i].error.is_some();
+            if truth_failed {
+                against = format!("{against}: failed");
+            }
             let mut errs = Vec::new();
             for &i in &idx {
                 let (_, _, ref e, dt, is_truth) = plan[i];
                 let o = &outs[i];
-                let error_m =
-                    if o.error.is_some() || (is_truth && !use_external) { f64::NAN } else { max_distance(o, truth) };
+                let error_m = if o.error.is_some() || truth_failed || (is_truth && !use_external) {
+                    f64::NAN
+                } else {
+                    max_distance(o, truth)
+                };
                 if !is_truth || use_external {
                     errs.push(error_m);
                 }
