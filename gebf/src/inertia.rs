@@ -16,7 +16,7 @@
 //! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, skew};
+use crate::crv::{M3, Tangent, V3, skew};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
 
 /// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
@@ -25,6 +25,12 @@ pub(crate) struct MatrixCoefficients {
     pub c_m: f64,
     pub c_c: f64,
     pub c_k: f64,
+}
+
+/// `diag(d) · a`: scales row i of `a` by `d_i`.
+#[inline]
+fn diag_mul(d: &V3, a: &M3) -> M3 {
+    M3::from_fn(|i, k| d[i] * a[(i, k)])
 }
 
 /// Add the inertial forces of one element to `res` (and their weighted tangent to `mat`);
@@ -79,39 +85,40 @@ pub(crate) fn add_inertia(
 
         if let Some((mm, c)) = mat.as_mut() {
             let c = *c;
-            let wt_ = wt;
             let rt = skew(&r);
             let wt3 = skew(&w);
             // Linear part: columns (per node: × n_l).
             let l_r = i3 * (c.c_m * m) + wt3 * (2.0 * m * c.c_c) + (skew(&wd) + wt3 * wt3) * (m * c.c_k);
             let l_v = i3 * (c.c_m * m) + wt3 * (m * c.c_c);
             let l_w = rt * (-m * c.c_m) + (skew(&rd) * 2.0 + skew(&w0) + wt3 * rt) * (-m * c.c_c);
-            // Angular part.
+            // Angular part; J is diagonal, so J·X scales the rows of X.
             let x = skew(&om) * j - skew(&jom);
             let cwt = skew(&cw);
+            let cwt_t = cwt * t;
             let omr_t = skew(&om_r);
             let d_psid = tg.jac(&psid);
-            let dom_dpsi = d_psid + cwt * t;
+            let dom_dpsi = d_psid + cwt_t;
             let domd_dpsi =
-                tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt * t + skew(&(cba * wd)) * t;
-            let domd_dpsid = tg.dir(&psid) + d_psid + cwt * t;
-            let h_psi = j * t * c.c_m + (j * domd_dpsid + x * t) * c.c_c + (j * domd_dpsi + x * dom_dpsi) * c.c_k;
-            let h_w = j * cba * c.c_m + (j * (-omr_t * cba) + x * cba) * c.c_c;
+                tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt_t + skew(&(cba * wd)) * t;
+            let domd_dpsid = tg.dir(&psid) + d_psid + cwt_t;
+            let h_psi = diag_mul(&jd, &(t * c.c_m + domd_dpsid * c.c_c + domd_dpsi * c.c_k))
+                + x * (t * c.c_c + dom_dpsi * c.c_k);
+            let h_w = diag_mul(&jd, &((cba * c.c_m) - omr_t * cba * c.c_c)) + x * cba * c.c_c;
             let tt = t.transpose();
             let ct = cba.transpose();
             let geo_psi_row = tg.jac_t(&h) * c.c_k; // ∂(Tᵀh)/∂psi at fixed h
             let geo_w_row = -(ct * skew(&h) * t) * c.c_k; // ∂(C^{AB} h)/∂psi at fixed h
             let geo_rf = -skew(&f) * c.c_k; // ∂(R × f)/∂R at fixed f
 
-            let a_rr = l_r;
             let a_pp = tt * h_psi + geo_psi_row;
             let a_wp = ct * h_psi + geo_w_row;
             let a_pw = tt * h_w;
+            let a_wr = rt * l_r + geo_rf;
             for k in 0..3 {
-                let nk = n[k] * wt_;
+                let nk = n[k] * wt;
                 for l in 0..3 {
                     let nkl = nk * n[l];
-                    add33(mm, 6 * k, 6 * l, &(a_rr * nkl));
+                    add33(mm, 6 * k, 6 * l, &(l_r * nkl));
                     add33(mm, 6 * k + 3, 6 * l + 3, &(a_pp * nkl));
                 }
                 add33(mm, 6 * k, V_OFF, &(l_v * nk));
@@ -119,13 +126,13 @@ pub(crate) fn add_inertia(
                 add33(mm, 6 * k + 3, W_OFF, &(a_pw * nk));
                 // Frame rows, node columns.
                 add33(mm, V_OFF, 6 * k, &(l_r * nk));
-                add33(mm, W_OFF, 6 * k, &((rt * l_r + geo_rf) * nk));
+                add33(mm, W_OFF, 6 * k, &(a_wr * nk));
                 add33(mm, W_OFF, 6 * k + 3, &(a_wp * nk));
             }
-            add33(mm, V_OFF, V_OFF, &(l_v * wt_));
-            add33(mm, V_OFF, W_OFF, &(l_w * wt_));
-            add33(mm, W_OFF, V_OFF, &(rt * l_v * wt_));
-            add33(mm, W_OFF, W_OFF, &((rt * l_w + ct * h_w) * wt_));
+            add33(mm, V_OFF, V_OFF, &(l_v * wt));
+            add33(mm, V_OFF, W_OFF, &(l_w * wt));
+            add33(mm, W_OFF, V_OFF, &(rt * l_v * wt));
+            add33(mm, W_OFF, W_OFF, &((rt * l_w + ct * h_w) * wt));
         }
     }
     kinetic
