@@ -9,6 +9,7 @@ fn time<F: FnMut()>(name: &str, reps: usize, mut f: F) {
     {
         return;
     }
+    let reps = std::env::var("REPS").ok().and_then(|r| r.parse().ok()).unwrap_or(reps);
     f();
     let mut best = f64::INFINITY;
     for _ in 0..20 {

@@ -170,31 +170,32 @@ impl SkylineLu {
         if lsize > self.lval.len() || usize_ > self.uval.len() {
             return false;
         }
-        // Gather the envelope of P A Pᵀ: L rows (strictly lower) and U columns (with diagonal).
+        // Gather the envelope of P A Pᵀ: U columns (with diagonal), and whether the values are
+        // symmetric up to round-off (no follower moments): then L = D⁻¹Uᵀ, half the work.
         let mut scale: f64 = 0.0;
+        let mut symmetric = true;
         for i in 0..n {
-            let (oi, fi) = (self.order[i], self.first[i]);
-            let (lp, up) = (self.lptr[i], self.uptr[i]);
-            for (k, ok) in self.order[fi..=i].iter().enumerate() {
+            let (oi, fi, up) = (self.order[i], self.first[i], self.uptr[i]);
+            let col = &a[oi * n..(oi + 1) * n]; // A[·, order[i]]
+            for (u, &ok) in self.uval[up..=up + (i - fi)].iter_mut().zip(&self.order[fi..=i]) {
                 // U column i, row fi + k: A[order[fi + k], order[i]]
-                self.uval[up + k] = a[oi * n + ok];
-                if k < i - fi {
-                    // L row i, column fi + k: A[order[i], order[fi + k]]
-                    self.lval[lp + k] = a[ok * n + oi];
-                }
+                let x = col[ok];
+                *u = x;
+                // against L row i, column fi + k: A[order[i], order[fi + k]]
+                let y = a[ok * n + oi];
+                symmetric &= (x - y).abs() <= 1e-10 * (x.abs() + y.abs());
             }
-            scale = scale.max(a[oi * n + oi].abs());
+            scale = scale.max(col[oi].abs());
         }
-        // Symmetric values up to round-off (no follower moments): L = D⁻¹Uᵀ, half the work.
-        let symmetric = (0..n).all(|i| {
-            let (lp, up, h) = (self.lptr[i], self.uptr[i], i - self.first[i]);
-            self.lval[lp..lp + h]
-                .iter()
-                .zip(&self.uval[up..up + h])
-                .all(|(l, u)| (l - u).abs() <= 1e-10 * (l.abs() + u.abs()))
-        });
         if symmetric {
             return self.factorize_symmetric(scale);
+        }
+        for i in 0..n {
+            let (oi, fi, lp) = (self.order[i], self.first[i], self.lptr[i]);
+            for (l, &ok) in self.lval[lp..lp + (i - fi)].iter_mut().zip(&self.order[fi..i]) {
+                // L row i, column fi + k: A[order[i], order[fi + k]]
+                *l = a[ok * n + oi];
+            }
         }
         // Crout, in place.
         for j in 0..n {
@@ -229,50 +230,154 @@ impl SkylineLu {
     }
 
     /// Crout for symmetric values (`L = D⁻¹Uᵀ`): column `j` of `U` and row `j` of `L` from the
-    /// rows of `L` above. Two consecutive rows with the same profile start are taken together,
-    /// sharing the loads of the column (the node-ordered ANCF unknowns come in runs of 12).
+    /// rows of `L` above. Consecutive columns, and consecutive rows, with the same profile start
+    /// are taken in pairs, so that each loaded value serves two products (the node-ordered ANCF
+    /// unknowns come in runs of 12 with a common start).
     fn factorize_symmetric(&mut self, scale: f64) -> bool {
         let n = self.n;
-        for j in 0..n {
-            let fj = self.first[j];
-            let (lpj, upj) = (self.lptr[j], self.uptr[j]);
-            let (l_done, l_rest) = self.lval.split_at_mut(lpj);
-            let l_j = &mut l_rest[..j - fj];
-            let u_j = &mut self.uval[upj..=upj + (j - fj)];
-            let mut i = fj;
-            while i < j {
-                let fi = self.first[i];
-                let lo = fi.max(fj);
-                let lpi = self.lptr[i];
-                let l_i = &l_done[lpi + (lo - fi)..lpi + (i - fi)];
-                if i + 1 < j && self.first[i + 1] == fi {
-                    // rows i and i + 1: U[i][j], then U[i+1][j] with its term L[i+1][i] U[i][j]
-                    let lpi1 = self.lptr[i + 1];
-                    let l_i1 = &l_done[lpi1 + (lo - fi)..lpi1 + (i - fi)];
-                    let (s0, s1) = dot2(l_i, l_i1, &u_j[lo - fj..i - fj]);
-                    let u0 = u_j[i - fj] - s0;
-                    u_j[i - fj] = u0;
-                    l_j[i - fj] = u0 * self.inv_diag[i];
-                    let u1 = u_j[i + 1 - fj] - s1 - l_done[lpi1 + (i - fi)] * u0;
-                    u_j[i + 1 - fj] = u1;
-                    l_j[i + 1 - fj] = u1 * self.inv_diag[i + 1];
-                    i += 2;
-                } else {
-                    let u0 = u_j[i - fj] - dot(l_i, &u_j[lo - fj..i - fj]);
-                    u_j[i - fj] = u0;
-                    l_j[i - fj] = u0 * self.inv_diag[i];
-                    i += 1;
-                }
-            }
-            let d = u_j[j - fj] - dot(l_j, &u_j[..j - fj]);
-            u_j[j - fj] = d;
-            if !d.is_finite() || d.abs() <= 1e-13 * scale {
+        let mut j = 0;
+        while j < n {
+            let pair = j + 1 < n && self.first[j + 1] == self.first[j];
+            let ok = if pair { self.symmetric_column_pair(j, scale) } else { self.symmetric_column(j, scale) };
+            if !ok {
                 return false;
             }
-            self.inv_diag[j] = 1.0 / d;
+            j += if pair { 2 } else { 1 };
         }
         true
     }
+
+    /// Pivot `j` of the symmetric factorisation from its reduced diagonal entry.
+    fn set_pivot(&mut self, j: usize, d: f64, scale: f64) -> bool {
+        if !d.is_finite() || d.abs() <= 1e-13 * scale {
+            return false;
+        }
+        self.inv_diag[j] = 1.0 / d;
+        true
+    }
+
+    /// Column `j` alone (see [`factorize_symmetric`](Self::factorize_symmetric)).
+    fn symmetric_column(&mut self, j: usize, scale: f64) -> bool {
+        let fj = self.first[j];
+        let (lpj, upj) = (self.lptr[j], self.uptr[j]);
+        let (l_done, l_rest) = self.lval.split_at_mut(lpj);
+        let l_j = &mut l_rest[..j - fj];
+        let u_j = &mut self.uval[upj..=upj + (j - fj)];
+        let mut i = fj;
+        while i < j {
+            let fi = self.first[i];
+            let lo = fi.max(fj);
+            let lpi = self.lptr[i];
+            let l_i = &l_done[lpi + (lo - fi)..lpi + (i - fi)];
+            if i + 1 < j && self.first[i + 1] == fi {
+                // rows i and i + 1: U[i][j], then U[i+1][j] with its term L[i+1][i] U[i][j]
+                let lpi1 = self.lptr[i + 1];
+                let l_i1 = &l_done[lpi1 + (lo - fi)..lpi1 + (i - fi)];
+                let (s0, s1) = dot2(l_i, l_i1, &u_j[lo - fj..i - fj]);
+                let u0 = u_j[i - fj] - s0;
+                u_j[i - fj] = u0;
+                l_j[i - fj] = u0 * self.inv_diag[i];
+                let u1 = u_j[i + 1 - fj] - s1 - l_done[lpi1 + (i - fi)] * u0;
+                u_j[i + 1 - fj] = u1;
+                l_j[i + 1 - fj] = u1 * self.inv_diag[i + 1];
+                i += 2;
+            } else {
+                let u0 = u_j[i - fj] - dot(l_i, &u_j[lo - fj..i - fj]);
+                u_j[i - fj] = u0;
+                l_j[i - fj] = u0 * self.inv_diag[i];
+                i += 1;
+            }
+        }
+        let d = u_j[j - fj] - dot(l_j, &u_j[..j - fj]);
+        u_j[j - fj] = d;
+        self.set_pivot(j, d, scale)
+    }
+
+    /// Columns `j` and `j + 1` with the same profile start `f` together.
+    fn symmetric_column_pair(&mut self, j: usize, scale: f64) -> bool {
+        let f = self.first[j];
+        let (lpj, upj, upj1) = (self.lptr[j], self.uptr[j], self.uptr[j + 1]);
+        let (l_done, l_rest) = self.lval.split_at_mut(lpj);
+        let (l_j, l_rest) = l_rest.split_at_mut(j - f);
+        let l_j1 = &mut l_rest[..j + 1 - f];
+        let (u_j, u_rest) = self.uval[upj..].split_at_mut(upj1 - upj);
+        let u_j1 = &mut u_rest[..j + 2 - f];
+        let mut i = f;
+        while i < j {
+            let fi = self.first[i];
+            let lo = fi.max(f);
+            let lpi = self.lptr[i];
+            let l_i = &l_done[lpi + (lo - fi)..lpi + (i - fi)];
+            let (di, uj, uj1) = (self.inv_diag[i], &u_j[lo - f..i - f], &u_j1[lo - f..i - f]);
+            if i + 1 < j && self.first[i + 1] == fi {
+                let lpi1 = self.lptr[i + 1];
+                let l_i1 = &l_done[lpi1 + (lo - fi)..lpi1 + (i - fi)];
+                let s = dot2x2(l_i, l_i1, uj, uj1);
+                let l_i1_i = l_done[lpi1 + (i - fi)];
+                let di1 = self.inv_diag[i + 1];
+                let a0 = u_j[i - f] - s[0];
+                let b0 = u_j1[i - f] - s[1];
+                let a1 = u_j[i + 1 - f] - s[2] - l_i1_i * a0;
+                let b1 = u_j1[i + 1 - f] - s[3] - l_i1_i * b0;
+                (u_j[i - f], u_j1[i - f], u_j[i + 1 - f], u_j1[i + 1 - f]) = (a0, b0, a1, b1);
+                (l_j[i - f], l_j1[i - f], l_j[i + 1 - f], l_j1[i + 1 - f]) = (a0 * di, b0 * di, a1 * di1, b1 * di1);
+                i += 2;
+            } else {
+                let (s0, s1) = dot2(uj, uj1, l_i);
+                let (a0, b0) = (u_j[i - f] - s0, u_j1[i - f] - s1);
+                (u_j[i - f], u_j1[i - f]) = (a0, b0);
+                (l_j[i - f], l_j1[i - f]) = (a0 * di, b0 * di);
+                i += 1;
+            }
+        }
+        // pivot j, then row j of column j + 1, then pivot j + 1
+        let d = u_j[j - f] - dot(l_j, &u_j[..j - f]);
+        u_j[j - f] = d;
+        if !d.is_finite() || d.abs() <= 1e-13 * scale {
+            return false;
+        }
+        let dj = 1.0 / d;
+        let u = u_j1[j - f] - dot(l_j, &u_j1[..j - f]);
+        u_j1[j - f] = u;
+        l_j1[j - f] = u * dj;
+        let d1 = u_j1[j + 1 - f] - dot(l_j1, &u_j1[..j + 1 - f]);
+        u_j1[j + 1 - f] = d1;
+        self.inv_diag[j] = dj;
+        self.set_pivot(j + 1, d1, scale)
+    }
+}
+
+/// `[l0·u0, l0·u1, l1·u0, l1·u1]` over the length of `u0`.
+#[inline]
+fn dot2x2(l0: &[f64], l1: &[f64], u0: &[f64], u1: &[f64]) -> [f64; 4] {
+    let n = u0.len();
+    let (l0, l1, u1) = (&l0[..n], &l1[..n], &u1[..n]);
+    let split = n - n % 2;
+    let mut acc = [0.0; 8];
+    for (((a, b), x), y) in l0[..split]
+        .chunks_exact(2)
+        .zip(l1[..split].chunks_exact(2))
+        .zip(u0[..split].chunks_exact(2))
+        .zip(u1[..split].chunks_exact(2))
+    {
+        acc[0] += a[0] * x[0];
+        acc[1] += a[1] * x[1];
+        acc[2] += a[0] * y[0];
+        acc[3] += a[1] * y[1];
+        acc[4] += b[0] * x[0];
+        acc[5] += b[1] * x[1];
+        acc[6] += b[0] * y[0];
+        acc[7] += b[1] * y[1];
+    }
+    let mut s = [acc[0] + acc[1], acc[2] + acc[3], acc[4] + acc[5], acc[6] + acc[7]];
+    if split < n {
+        let k = split;
+        s[0] += l0[k] * u0[k];
+        s[1] += l0[k] * u1[k];
+        s[2] += l1[k] * u0[k];
+        s[3] += l1[k] * u1[k];
+    }
+    s
 }
 
 /// `(a·c, b·c)` over the length of `c`.
@@ -370,8 +475,8 @@ impl LinearSolver for SkylineLu {
             let base = self.uptr[j];
             let xj = y[j] * self.inv_diag[j];
             y[j] = xj;
-            for (k, u) in (fj..j).zip(&self.uval[base..base + (j - fj)]) {
-                y[k] -= u * xj;
+            for (yk, u) in y[fj..j].iter_mut().zip(&self.uval[base..base + (j - fj)]) {
+                *yk -= u * xj;
             }
         }
         for i in 0..n {
