@@ -7,13 +7,16 @@
 //!    f = \sum_k C_k (s_k - s_k^0)\, A_k e,\qquad
 //!    K = \sum_k C_k\big[(A_k e)(A_k e)^T + (s_k - s_k^0) A_k\big]. $$
 //!
-//! `A_k e` is formed from the fields: for a term `c f_a·f_b`, `∂s/∂f_a = c f_b` and
-//! `∂s/∂f_b = c f_a`, scattered to the nodal blocks by the interpolation weights. No trigonometry,
-//! no allocation.
+//! With `A_k = a_k ⊗ I₃` (`a_k` the 8×8 scalar Hessian, a few non-zeros) everything follows from
+//! the Gram products `e_a·e_b` of the eight nodal 3-vectors: `s_k = ½ Σ_ab a_k[a][b] e_a·e_b`,
+//! `f = (Σ_k C_k (s_k − s_k^0) a_k ⊗ I₃) e`, `A_k e = (a_k ⊗ I₃) e`. The positions are taken
+//! relative to the first node (every strain is translation invariant), which keeps the Gram
+//! products of the order of the element and the strains accurate far from the origin.
+//! No trigonometry, no allocation.
 
 use crate::element::Element;
 use crate::shape::{ELEMENT_DOF, N_BLOCKS};
-use crate::strain::{MAX_FIELDS, N_STRAINS, StrainKind, StrainPlan, strain_value};
+use crate::strain::{MAX_FIELDS, N_STRAINS, SampledStrain, StrainKind, StrainPlan, dot, strain_value};
 use nalgebra::{SMatrix, SVector};
 
 /// 24×24 element matrix.
@@ -32,30 +35,72 @@ fn eval_fields(plan: &StrainPlan, e: &[f64]) -> Fields {
     f
 }
 
-/// `out[field] += scale ∂s/∂f` for every field of strain `s`.
+/// The eight nodal 3-vectors of `e` with the first node's position subtracted from both
+/// positions (blocks 0 and 4).
 #[inline]
-fn add_field_gradient(s: &crate::strain::SampledStrain, f: &Fields, scale: f64, out: &mut Fields) {
-    for &(c, a, b) in s.terms() {
-        let cs = c * scale;
-        for i in 0..3 {
-            out[a][i] += cs * f[b][i];
-            out[b][i] += cs * f[a][i];
+fn relative_blocks(e: &[f64]) -> [[f64; 3]; N_BLOCKS] {
+    let e = &e[..ELEMENT_DOF];
+    let mut b = [[0.0; 3]; N_BLOCKS];
+    for (k, bk) in b.iter_mut().enumerate() {
+        *bk = [e[3 * k], e[3 * k + 1], e[3 * k + 2]];
+    }
+    let origin = std::mem::take(&mut b[0]);
+    for (x, o) in b[4].iter_mut().zip(origin) {
+        *x -= o;
+    }
+    b
+}
+
+/// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors.
+#[inline]
+fn gram(b: &[[f64; 3]; N_BLOCKS]) -> [[f64; N_BLOCKS]; N_BLOCKS] {
+    let mut g = [[0.0; N_BLOCKS]; N_BLOCKS];
+    for a in 1..N_BLOCKS {
+        for c in a..N_BLOCKS {
+            g[a][c] = dot(&b[a], &b[c]);
         }
+    }
+    g // row and column 0 stay zero: block 0 is the origin of the relative positions
+}
+
+/// `s = Σ_{a<b} h e_a·e_b + ½ Σ_a h e_a·e_a` from the Gram products.
+#[inline]
+fn strain_from_gram(s: &SampledStrain, g: &[[f64; N_BLOCKS]; N_BLOCKS]) -> f64 {
+    s.pairs[..s.n_pairs].iter().map(|&(a, b, h)| if a == b { 0.5 * h * g[a][a] } else { h * g[a][b] }).sum()
+}
+
+/// `out += (m ⊗ I₃) x` for a symmetric 8×8 `m` given by its upper triangle.
+#[inline]
+fn add_symmetric_times(m: &[[f64; N_BLOCKS]; N_BLOCKS], x: &[[f64; 3]; N_BLOCKS], out: &mut [f64]) {
+    for a in 0..N_BLOCKS {
+        let mut acc = [0.0; 3];
+        for (c, xc) in x.iter().enumerate() {
+            let h = if a <= c { m[a][c] } else { m[c][a] };
+            acc[0] += h * xc[0];
+            acc[1] += h * xc[1];
+            acc[2] += h * xc[2];
+        }
+        out[3 * a] += acc[0];
+        out[3 * a + 1] += acc[1];
+        out[3 * a + 2] += acc[2];
     }
 }
 
-/// `out[block] += Σ_f W_f[block] P_f` over the first `n` fields.
+/// `A e = (a ⊗ I₃) e` of one strain as a 24-vector, from its Hessian entries.
 #[inline]
-fn scatter(plan: &StrainPlan, pf: &Fields, out: &mut [f64]) {
-    for (w, p) in plan.fields.iter().zip(pf) {
-        for k in 0..w.n {
-            let b = 3 * w.block[k];
-            let x = w.weight[k];
-            out[b] += x * p[0];
-            out[b + 1] += x * p[1];
-            out[b + 2] += x * p[2];
+fn strain_gradient_pairs(s: &SampledStrain, x: &[[f64; 3]; N_BLOCKS]) -> ElementVector {
+    let mut g = ElementVector::zeros();
+    for &(a, b, h) in &s.pairs[..s.n_pairs] {
+        for i in 0..3 {
+            g[3 * a + i] += h * x[b][i];
+        }
+        if a != b {
+            for i in 0..3 {
+                g[3 * b + i] += h * x[a][i];
+            }
         }
     }
+    g
 }
 
 /// Copy the upper block triangle (3×3 blocks `(a, b)`, `a ≤ b`) onto the lower one.
@@ -89,12 +134,12 @@ fn strain_gradient(plan: &StrainPlan, s: &crate::strain::SampledStrain, f: &Fiel
 impl Element {
     /// Elastic energy of one element with coordinates `e` (24 numbers), J.
     pub fn elastic_energy(&self, e: &[f64]) -> f64 {
-        let f = eval_fields(&self.plan, e);
+        let g = gram(&relative_blocks(e));
         self.plan
             .strains
             .iter()
             .map(|s| {
-                let d = strain_value(s, &f) - s.reference;
+                let d = strain_from_gram(s, &g) - s.reference;
                 0.5 * s.stiffness * d * d
             })
             .sum()
@@ -113,15 +158,19 @@ impl Element {
 
     /// `out += f_el(e)`, the elastic force of one element (24 numbers); returns its energy.
     pub fn add_elastic_force(&self, e: &[f64], out: &mut [f64]) -> f64 {
-        let f = eval_fields(&self.plan, e);
-        let mut pf = [[0.0; 3]; MAX_FIELDS];
+        let x = relative_blocks(e);
+        let g = gram(&x);
+        let mut m = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ C (s − s⁰) a, upper triangle
         let mut u = 0.0;
         for s in &self.plan.strains {
-            let d = strain_value(s, &f) - s.reference;
+            let d = strain_from_gram(s, &g) - s.reference;
             u += 0.5 * s.stiffness * d * d;
-            add_field_gradient(s, &f, s.stiffness * d, &mut pf);
+            let cd = s.stiffness * d;
+            for &(a, b, h) in &s.pairs[..s.n_pairs] {
+                m[a][b] += cd * h;
+            }
         }
-        scatter(&self.plan, &pf, out);
+        add_symmetric_times(&m, &x, out);
         u
     }
 
@@ -141,12 +190,13 @@ impl Element {
     /// update over the rows from its first to the column's block (the few zero rows of unused
     /// blocks in between cost less than the branching that would skip them).
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        let f = eval_fields(&self.plan, e);
+        let x = relative_blocks(e);
+        let gm = gram(&x);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS];
         let data = k.as_mut_slice(); // column-major 24 × 24
         for s in &self.plan.strains {
-            let d = strain_value(s, &f) - s.reference;
-            let g = strain_gradient(&self.plan, s, &f);
+            let d = strain_from_gram(s, &gm) - s.reference;
+            let g = strain_gradient_pairs(s, &x);
             let g = g.as_slice();
             let cs = c * s.stiffness;
             let blocks = &s.blocks[..s.n_blocks];
@@ -166,10 +216,8 @@ impl Element {
                 }
             }
             let sd = c * s.stiffness * d;
-            for (jb, &b) in blocks.iter().enumerate() {
-                for &a in &blocks[..=jb] {
-                    geometric[a][b] += sd * s.hessian[a][b];
-                }
+            for &(a, b, h) in &s.pairs[..s.n_pairs] {
+                geometric[a][b] += sd * h;
             }
         }
         for b in 0..N_BLOCKS {
@@ -325,6 +373,29 @@ mod tests {
                 prop_assert!(fmax < 1e-9 * f1max, "{c:?}: |f| = {fmax:e} vs {f1max:e}");
                 let u2 = el.elastic_energy(&apply_rigid(&e1, &rot, &shift));
                 prop_assert!((u2 - u1).abs() < 1e-9 * u1, "{c:?}: {u2} vs {u1}");
+            }
+        }
+    }
+
+    /// The Gram-product strains equal the field-product definition (`elastic_energy_by_kind`
+    /// evaluates the fields), and a far translation changes neither energy nor force.
+    #[test]
+    fn gram_strains_match_fields_and_translation() {
+        let l = 0.2;
+        for c in ALL_CURVATURES {
+            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let e = deformed(l, &[0.3, -0.7, 0.2, 0.9, -0.4], 0.05);
+            let u = el.elastic_energy(&e);
+            let by_kind: f64 = el.elastic_energy_by_kind(&e).iter().sum();
+            approx::assert_relative_eq!(u, by_kind, max_relative = 1e-11);
+            let far = apply_rigid(&e, &Matrix3::identity(), &Vector3::new(1.0e3, -2.0e3, 5.0e2));
+            approx::assert_relative_eq!(el.elastic_energy(&far), u, max_relative = 1e-11);
+            let (mut f, mut f_far) = ([0.0; 24], [0.0; 24]);
+            el.add_elastic_force(&e, &mut f);
+            el.add_elastic_force(&far, &mut f_far);
+            let fmax = f.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            for (a, b) in f.iter().zip(&f_far) {
+                assert!((a - b).abs() <= 1e-10 * fmax, "{c:?}: {a} vs {b}");
             }
         }
     }

@@ -86,6 +86,8 @@ pub const N_STRAINS: usize = 14;
 pub const MAX_FIELDS: usize = 32;
 /// Upper bound of terms per strain.
 pub const MAX_TERMS: usize = 4;
+/// Entries of the upper triangle of an 8×8 block Hessian.
+pub const MAX_PAIRS: usize = N_BLOCKS * (N_BLOCKS + 1) / 2;
 
 impl StrainKind {
     /// All kinds in index order.
@@ -164,6 +166,11 @@ pub struct SampledStrain {
     pub n_blocks: usize,
     /// The blocks the strain depends on (first `n_blocks` entries).
     pub blocks: [usize; N_BLOCKS],
+    /// Number of non-zero entries of the upper triangle of `hessian`.
+    pub n_pairs: usize,
+    /// The non-zero upper-triangle entries `(a, b, hessian[a][b])`, `a ≤ b` (first `n_pairs`):
+    /// `s = Σ_{a<b} h (e_a·e_b) + ½ Σ_a h (e_a·e_a)` and `∂s/∂e_a = Σ_b hessian[a][b] e_b`.
+    pub pairs: [(usize, usize, f64); MAX_PAIRS],
 }
 
 impl SampledStrain {
@@ -272,6 +279,16 @@ impl Builder {
                 n_blocks += 1;
             }
         }
+        let mut pairs = [(0, 0, 0.0); MAX_PAIRS];
+        let mut n_pairs = 0;
+        for (a, row) in hessian.iter().enumerate() {
+            for (b, &h) in row.iter().enumerate().skip(a) {
+                if h != 0.0 {
+                    pairs[n_pairs] = (a, b, h);
+                    n_pairs += 1;
+                }
+            }
+        }
         self.strains.push(SampledStrain {
             kind,
             xi,
@@ -282,6 +299,8 @@ impl Builder {
             hessian,
             n_blocks,
             blocks,
+            n_pairs,
+            pairs,
         });
     }
 }
