@@ -465,18 +465,43 @@ impl LinearSolver for SkylineLu {
         }
         let n = self.n;
         let y = &mut self.work;
-        for i in 0..n {
+        // L y = P b, rows with a common profile start in pairs
+        let mut i = 0;
+        while i < n {
             let fi = self.first[i];
-            let lrow = &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)];
-            y[i] = b[self.order[i]] - dot(lrow, &y[fi..i]);
+            let l0 = &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)];
+            if i + 1 < n && self.first[i + 1] == fi {
+                let l1 = &self.lval[self.lptr[i + 1]..self.lptr[i + 1] + (i + 1 - fi)];
+                let (s0, s1) = dot2(l0, &l1[..i - fi], &y[fi..i]);
+                let y0 = b[self.order[i]] - s0;
+                y[i] = y0;
+                y[i + 1] = b[self.order[i + 1]] - s1 - l1[i - fi] * y0;
+                i += 2;
+            } else {
+                y[i] = b[self.order[i]] - dot(l0, &y[fi..i]);
+                i += 1;
+            }
         }
-        for j in (0..n).rev() {
+        // U x = y by columns, columns with a common profile start in pairs
+        let mut j = n;
+        while j > 0 {
+            j -= 1;
             let fj = self.first[j];
-            let base = self.uptr[j];
+            let uj = &self.uval[self.uptr[j]..self.uptr[j] + (j - fj)];
             let xj = y[j] * self.inv_diag[j];
             y[j] = xj;
-            for (yk, u) in y[fj..j].iter_mut().zip(&self.uval[base..base + (j - fj)]) {
-                *yk -= u * xj;
+            if j > fj && self.first[j - 1] == fj {
+                let uj1 = &self.uval[self.uptr[j - 1]..self.uptr[j - 1] + (j - 1 - fj)];
+                let xj1 = (y[j - 1] - uj[j - 1 - fj] * xj) * self.inv_diag[j - 1];
+                y[j - 1] = xj1;
+                for ((yk, u0), u1) in y[fj..j - 1].iter_mut().zip(uj).zip(uj1) {
+                    *yk -= u0 * xj + u1 * xj1;
+                }
+                j -= 1;
+            } else {
+                for (yk, u) in y[fj..j].iter_mut().zip(uj) {
+                    *yk -= u * xj;
+                }
             }
         }
         for i in 0..n {
