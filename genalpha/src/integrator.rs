@@ -450,8 +450,9 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.previous_delta.copy_from_slice(&self.delta);
             }
             step_back = false;
-            for i in 0..n {
-                self.rhs[i] = -self.r[i] / c.beta_prime;
+            let inv_beta_prime = 1.0 / c.beta_prime;
+            for (b, r) in self.rhs[..n].iter_mut().zip(&self.r) {
+                *b = -r * inv_beta_prime;
             }
             for i in 0..n_h {
                 self.rhs[n + i] = -self.phi[i];
@@ -467,13 +468,14 @@ impl<L: LinearSolver> GenAlpha<L> {
             prev_prev_inc = prev_inc;
             prev_inc = inc_norm;
             inc_norm = 0.0;
+            let (inv_h, inv_beta_h2) = (1.0 / h, 1.0 / (c.beta * h * h)); // no divisions in the loop
             for i in 0..n {
                 let dx = self.rhs[i];
-                self.delta[i] += dx / h;
+                self.delta[i] += dx * inv_h;
                 self.hdelta[i] = h * self.delta[i];
                 s.v[i] += c.gamma_prime * dx;
                 s.v_dot[i] += c.beta_prime * dx;
-                s.a[i] += dx / (c.beta * h * h);
+                s.a[i] += dx * inv_beta_h2;
                 let w = self.weights[i];
                 let tol = np.atol + np.rtol * (self.hdelta[i] * w).abs();
                 inc_norm = inc_norm.max((dx * w).abs() / tol);
