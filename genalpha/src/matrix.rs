@@ -157,11 +157,11 @@ impl MatView<'_> {
     pub fn add_block<const R: usize, const C: usize>(&mut self, i0: usize, j0: usize, b: &SMatrix<f64, R, C>) {
         assert!(i0 + R <= self.n_rows && j0 + C <= self.n_cols);
         let n = self.m.n_rows;
-        for c in 0..C {
+        for (c, bcol) in b.as_slice().chunks_exact(R).enumerate() {
             let base = (self.col0 + j0 + c) * n + self.row0 + i0;
             let col = &mut self.m.data[base..base + R];
-            for (r, x) in col.iter_mut().enumerate() {
-                *x += self.scale * b[(r, c)];
+            for (x, y) in col.iter_mut().zip(bcol) {
+                *x += self.scale * y;
             }
         }
     }
