@@ -206,6 +206,10 @@ pub struct NewtonSettings {
     pub estimate_convergence: bool,
     /// Retry a failed step as two half steps, at most this deep.
     pub max_step_halvings: usize,
+    /// Local error control: halve a converged step whose error estimate
+    /// h²|β − 1/6|·max|Δa| (m; rotations weighted by the body length) exceeds this, within
+    /// `max_step_halvings`. 0 = off (default).
+    pub local_error_tol: f64,
 }
 
 impl Default for NewtonSettings {
@@ -220,6 +224,7 @@ impl Default for NewtonSettings {
             reuse_factorization: d.reuse_factorization,
             estimate_convergence: d.estimate_convergence,
             max_step_halvings: d.max_step_halvings,
+            local_error_tol: d.local_error_tol,
         }
     }
 }
@@ -236,6 +241,7 @@ impl NewtonSettings {
             reuse_factorization: self.reuse_factorization,
             estimate_convergence: self.estimate_convergence,
             max_step_halvings: self.max_step_halvings,
+            local_error_tol: self.local_error_tol,
             ..Default::default()
         }
     }
