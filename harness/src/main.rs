@@ -191,8 +191,10 @@ fn real_main() -> Result<ExitCode> {
                     let ex = stress::run_extras(&stress_extras(&cases, &set)?);
                     stress::write_extras(&out.join("stress"), &ex)?;
                     for f in Formulation::ALL {
-                        let (ok, n) = stress::survival(&cells, f);
-                        println!("stress {f}: {ok} of {n} cells reach t_end");
+                        let (ok, rec, n) = stress::survival(&cells, f);
+                        println!(
+                            "stress {f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control"
+                        );
                     }
                     println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
                 }
@@ -284,8 +286,8 @@ fn real_main() -> Result<ExitCode> {
             let dir = out.join("stress");
             stress::write(&dir, &axes, &cells)?;
             for f in Formulation::ALL {
-                let (ok, n) = stress::survival(&cells, f);
-                println!("{f}: {ok} of {n} cells reach t_end");
+                let (ok, rec, n) = stress::survival(&cells, f);
+                println!("{f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
             }
             let extras = stress_extras(&case.with_file_name(""), &set)?;
             let ex = stress::run_extras(&extras);
@@ -301,6 +303,15 @@ fn real_main() -> Result<ExitCode> {
                         m.newton_per_step, m.energy_drift
                     ))
                 );
+                if let Some(r) = &e.recovery {
+                    println!(
+                        "  with step control: {}",
+                        r.error.clone().unwrap_or_else(|| format!(
+                            "ok, {:.2} Newton/step, drift {:.2e}",
+                            r.newton_per_step, r.energy_drift
+                        ))
+                    );
+                }
             }
             println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
             Ok(ExitCode::SUCCESS)

@@ -57,12 +57,25 @@ pub struct Cell {
     pub rho_inf: f64,
     /// Metrics of the run (incl. failure and the time reached).
     pub metrics: FormulationMetrics,
+    /// When the fixed-step run failed: the same cell rerun with the integrator's local error
+    /// control ([`RECOVERY_ERROR_TOL`], up to [`RECOVERY_HALVINGS`] halvings of a step).
+    pub recovery: Option<FormulationMetrics>,
 }
 
+/// Local error tolerance of a recovery run, m (rotations weighted by the body length).
+pub const RECOVERY_ERROR_TOL: f64 = 1e-5;
+/// Step halvings allowed in a recovery run (down to dt/64).
+pub const RECOVERY_HALVINGS: usize = 6;
+
 impl Cell {
-    /// Whether the run reached its end time.
+    /// Whether the fixed-step run reached its end time.
     pub fn ok(&self) -> bool {
         self.metrics.error.is_none()
+    }
+
+    /// Whether the cell failed at fixed steps but reached its end time with step control.
+    pub fn recovered(&self) -> bool {
+        !self.ok() && self.recovery.as_ref().is_some_and(|m| m.error.is_none())
     }
 }
 
@@ -106,8 +119,20 @@ pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
         .map(|&(f, c, b, d, r)| {
             let case = cell_case(base.case(f), c, b, d, r);
             let out = run_formulation(&case, f);
+            // Recover a failed cell with step control: same nominal dt, steps halved where the
+            // local error estimate (or Newton) asks for it.
+            let recovery =
+                out.error.is_some().then(|| FormulationMetrics::of(&run_formulation(&with_step_control(&case), f)));
             bar.inc(1);
-            Cell { formulation: f, c, beta_deg: b, dt_factor: d, rho_inf: r, metrics: FormulationMetrics::of(&out) }
+            Cell {
+                formulation: f,
+                c,
+                beta_deg: b,
+                dt_factor: d,
+                rho_inf: r,
+                metrics: FormulationMetrics::of(&out),
+                recovery,
+            }
         })
         .collect();
     bar.finish_and_clear();
@@ -117,13 +142,13 @@ pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
 /// Write `stress.csv`, `stress.json` and one heat map per formulation (`stress_<f>.svg`).
 pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
     let mut csv = String::from(
-        "formulation,c,beta_deg,dt_factor,rho_inf,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure\n",
+        "formulation,c,beta_deg,dt_factor,rho_inf,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure,recovered,recovery_t_reached,recovery_newton_per_step,recovery_energy_drift,recovery_wall_s\n",
     );
     for k in cells {
         let m = &k.metrics;
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.4},\"{}\"",
+            "{},{},{},{},{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.4},\"{}\",{},{:.4},{:.3},{:.3e},{:.4}",
             k.formulation,
             k.c,
             k.beta_deg,
@@ -136,7 +161,12 @@ pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
             m.energy_drift,
             m.max_constraint_residual,
             m.wall_s,
-            m.error.clone().unwrap_or_default().replace('"', "'")
+            m.error.clone().unwrap_or_default().replace('"', "'"),
+            k.recovered(),
+            k.recovery.as_ref().map_or(f64::NAN, |r| r.t_reached),
+            k.recovery.as_ref().map_or(f64::NAN, |r| r.newton_per_step),
+            k.recovery.as_ref().map_or(f64::NAN, |r| r.energy_drift),
+            k.recovery.as_ref().map_or(f64::NAN, |r| r.wall_s),
         );
     }
     write_file(&dir.join("stress.csv"), &csv)?;
@@ -147,9 +177,12 @@ pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
     Ok(())
 }
 
-/// Colour of a cell: red = failed, orange = energy drift > 10 %, yellow > 1 %, green otherwise.
+/// Colour of a cell: red = failed, blue = failed at fixed steps but recovered with step control,
+/// orange = energy drift > 10 %, yellow > 1 %, green otherwise.
 fn cell_color(k: &Cell) -> RGBColor {
-    if !k.ok() {
+    if k.recovered() {
+        RGBColor(100, 150, 230)
+    } else if !k.ok() {
         RGBColor(214, 39, 40)
     } else if k.metrics.energy_drift.is_nan() || k.metrics.energy_drift > 0.1 {
         RGBColor(255, 160, 60)
@@ -196,6 +229,8 @@ fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<
                 .map_err(|e| err(e.to_string()))?;
             let label = if k.ok() {
                 format!("{:.1}", k.metrics.newton_per_step)
+            } else if k.recovered() {
+                format!("✗{:.2}↻", k.metrics.t_reached)
             } else {
                 format!("✗{:.2}", k.metrics.t_reached)
             };
@@ -208,19 +243,20 @@ fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<
         (RGBColor(240, 220, 80), "ok, drift ≤ 10 %"),
         (RGBColor(255, 160, 60), "ok, drift > 10 %"),
         (RGBColor(214, 39, 40), "failed (time reached)"),
+        (RGBColor(100, 150, 230), "↻ reached t_end with step control"),
     ];
     for (n, (col, s)) in legend.iter().enumerate() {
-        let x = 10 + 200 * n as i32;
+        let x = 10 + 170 * n as i32;
         root.draw(&Rectangle::new([(x, ly), (x + 16, ly + 14)], col.filled())).map_err(|e| err(e.to_string()))?;
         root.draw(&txt(s, x + 22, ly, 13)).map_err(|e| err(e.to_string()))?;
     }
     root.present().map_err(|e| err(e.to_string()))
 }
 
-/// Count of successful cells per formulation.
-pub fn survival(cells: &[Cell], f: Formulation) -> (usize, usize) {
+/// (cells reaching t_end at fixed steps, cells recovered with step control, cells) per formulation.
+pub fn survival(cells: &[Cell], f: Formulation) -> (usize, usize, usize) {
     let of_f: Vec<&Cell> = cells.iter().filter(|k| k.formulation == f).collect();
-    (of_f.iter().filter(|k| k.ok()).count(), of_f.len())
+    (of_f.iter().filter(|k| k.ok()).count(), of_f.iter().filter(|k| k.recovered()).count(), of_f.len())
 }
 
 /// One extra hard run beside the matrix (a long pendulum, a wing at high incidence).
@@ -232,6 +268,18 @@ pub struct Extra {
     pub formulation: Formulation,
     /// Metrics (failure, time reached, Newton, drifts).
     pub metrics: FormulationMetrics,
+    /// A failed run repeated with step control (as for the matrix cells).
+    pub recovery: Option<FormulationMetrics>,
+}
+
+/// The case rerun with local error control after a fixed-step failure.
+fn with_step_control(case: &Case) -> Case {
+    let mut k = case.clone();
+    for n in [&mut k.ancf.newton, &mut k.gebf.newton] {
+        n.local_error_tol = RECOVERY_ERROR_TOL;
+        n.max_step_halvings = RECOVERY_HALVINGS;
+    }
+    k
 }
 
 /// Run extra cases (label, case spec) with both formulations in parallel.
@@ -240,8 +288,11 @@ pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
         (0..extras.len()).flat_map(|i| Formulation::ALL.into_iter().map(move |f| (i, f))).collect();
     jobs.par_iter()
         .map(|&(i, f)| {
-            let out = run_formulation(extras[i].1.case(f), f);
-            Extra { label: extras[i].0.clone(), formulation: f, metrics: FormulationMetrics::of(&out) }
+            let case = extras[i].1.case(f);
+            let out = run_formulation(case, f);
+            let recovery =
+                out.error.is_some().then(|| FormulationMetrics::of(&run_formulation(&with_step_control(case), f)));
+            Extra { label: extras[i].0.clone(), formulation: f, metrics: FormulationMetrics::of(&out), recovery }
         })
         .collect()
 }
@@ -249,13 +300,13 @@ pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
 /// Write `extras.csv`.
 pub fn write_extras(dir: &Path, extras: &[Extra]) -> Result<(), Error> {
     let mut csv = String::from(
-        "label,formulation,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure\n",
+        "label,formulation,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure,recovered,recovery_newton_per_step,recovery_energy_drift,recovery_wall_s\n",
     );
     for e in extras {
         let m = &e.metrics;
         let _ = writeln!(
             csv,
-            "\"{}\",{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.3},\"{}\"",
+            "\"{}\",{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.3},\"{}\",{},{:.3},{:.3e},{:.3}",
             e.label,
             e.formulation,
             m.error.is_none(),
@@ -265,7 +316,11 @@ pub fn write_extras(dir: &Path, extras: &[Extra]) -> Result<(), Error> {
             m.energy_drift,
             m.max_constraint_residual,
             m.wall_s,
-            m.error.clone().unwrap_or_default().replace('"', "'")
+            m.error.clone().unwrap_or_default().replace('"', "'"),
+            e.recovery.as_ref().is_some_and(|r| r.error.is_none()),
+            e.recovery.as_ref().map_or(f64::NAN, |r| r.newton_per_step),
+            e.recovery.as_ref().map_or(f64::NAN, |r| r.energy_drift),
+            e.recovery.as_ref().map_or(f64::NAN, |r| r.wall_s),
         );
     }
     write_file(&dir.join("extras.csv"), &csv)
