@@ -94,6 +94,20 @@ impl GenAlpha<DenseLu> {
 /// Steps during which the factorisation is refreshed at the predictor after a reused one failed.
 const REFRESH_STEPS: usize = 10;
 
+/// After four iterations with a reused matrix, keep it while its contraction predicts at most
+/// this many more iterations to the tolerance (an assembly and factorisation cost about five
+/// iterations).
+const MAX_MORE_ITERATIONS: f64 = 3.0;
+
+/// Iterations a linearly contracting iteration (ratio `theta`) needs to bring the scaled
+/// increment `inc_norm` below 1.
+fn iterations_to_converge(inc_norm: f64, theta: f64) -> f64 {
+    if theta <= 0.0 {
+        return 0.0;
+    }
+    inc_norm.max(1.0).ln() / -theta.min(0.999).ln()
+}
+
 fn copy_state(from: &State, to: &mut State) {
     to.t = from.t;
     to.q.copy_from_slice(&from.q);
@@ -448,7 +462,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 || !self.have_factorization
                 || (iter == 1 && self.refresh_steps_left > 0)
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
-                || (iter > 4 && !fresh);
+                || (iter > 4 && !fresh && iterations_to_converge(inc_norm, contraction) > MAX_MORE_ITERATIONS);
             if need {
                 if iter > 1 && !factorized_this_step {
                     // The matrix of an earlier step did not contract: the matrix changes fast,
