@@ -294,24 +294,30 @@ fn fd_x(n_in: usize, x: &[f64], n_out: usize, f: impl Fn(&[f64], &mut [f64])) ->
     m
 }
 
+/// The iteration matrix against finite differences of the residual, each coefficient (c_m, c_c,
+/// c_k) separately.
+fn check_iteration_matrix(model: &Model, q: &[f64], v: &[f64], a: &[f64], label: &str) {
+    let n = model.n_dof();
+    for (which, c) in [(0, [1.0, 0.0, 0.0]), (1, [0.0, 1.0, 0.0]), (2, [0.0, 0.0, 1.0])] {
+        let mut an = DenseMatrix::zeros(n, n);
+        model.iteration_matrix_inplace(0.0, q, v, a, c[0], c[1], c[2], &mut an.view());
+        let fd = match which {
+            0 => fd_x(n, a, n, |x, r| model.residual_inplace(0.0, q, v, x, r)),
+            1 => fd_x(n, v, n, |x, r| model.residual_inplace(0.0, q, x, a, r)),
+            _ => fd_q(model, q, n, |x, r| model.residual_inplace(0.0, x, v, a, r)),
+        };
+        let e = dense_rel_err(&an, &fd);
+        println!("{label} part {which}: rel err {e:.2e}");
+        assert!(e < TOL, "{label} part {which}: rel err {e:.2e}");
+    }
+}
+
 fn check_model(seed: u64, beta: f64, locked: bool) {
     let mut rng = Lcg(seed);
     let (model, q, v, a, mu) = random_model(&mut rng, beta, locked);
     let n = model.n_dof();
     let nc = model.n_velocity_constraints();
-    // Iteration matrix: each coefficient separately.
-    for (which, c) in [(0, [1.0, 0.0, 0.0]), (1, [0.0, 1.0, 0.0]), (2, [0.0, 0.0, 1.0])] {
-        let mut an = DenseMatrix::zeros(n, n);
-        model.iteration_matrix_inplace(0.0, &q, &v, &a, c[0], c[1], c[2], &mut an.view());
-        let fd = match which {
-            0 => fd_x(n, &a, n, |x, r| model.residual_inplace(0.0, &q, &v, x, r)),
-            1 => fd_x(n, &v, n, |x, r| model.residual_inplace(0.0, &q, x, &a, r)),
-            _ => fd_q(&model, &q, n, |x, r| model.residual_inplace(0.0, x, &v, &a, r)),
-        };
-        let e = dense_rel_err(&an, &fd);
-        println!("model iteration matrix part {which} (seed {seed}): rel err {e:.2e}");
-        assert!(e < TOL, "model iteration matrix part {which} (seed {seed}): rel err {e:.2e}");
-    }
+    check_iteration_matrix(&model, &q, &v, &a, &format!("model iteration matrix (seed {seed})"));
     // B = ∂psi/∂v.
     let mut b = DenseMatrix::zeros(nc, n);
     model.psi_v_inplace(0.0, &q, &mut b.view());
@@ -399,18 +405,7 @@ fn model_tangents_with_rescaled_crvs() {
     let n = model.n_dof();
     let v: Vec<f64> = (0..n).map(|_| rng.next()).collect();
     let a: Vec<f64> = (0..n).map(|_| rng.next()).collect();
-    for (which, c) in [(0, [1.0, 0.0, 0.0]), (1, [0.0, 1.0, 0.0]), (2, [0.0, 0.0, 1.0])] {
-        let mut an = DenseMatrix::zeros(n, n);
-        model.iteration_matrix_inplace(0.0, &q, &v, &a, c[0], c[1], c[2], &mut an.view());
-        let fd = match which {
-            0 => fd_x(n, &a, n, |x, r| model.residual_inplace(0.0, &q, &v, x, r)),
-            1 => fd_x(n, &v, n, |x, r| model.residual_inplace(0.0, &q, x, &a, r)),
-            _ => fd_q(&model, &q, n, |x, r| model.residual_inplace(0.0, x, &v, &a, r)),
-        };
-        let e = dense_rel_err(&an, &fd);
-        println!("rescaled CRVs, iteration matrix part {which}: rel err {e:.2e}");
-        assert!(e < TOL, "rescaled CRVs, iteration matrix part {which}: rel err {e:.2e}");
-    }
+    check_iteration_matrix(&model, &q, &v, &a, "rescaled CRVs, iteration matrix");
     // Storing an end node on the other branch changes nothing but the parametrisation of its
     // own rows (the element maps it back onto its middle node's branch): unfold node 4 (stored
     // folded) and compare, rates transformed consistently.

@@ -75,7 +75,7 @@ impl Cell {
 
     /// Whether the cell failed at fixed steps but reached its end time with step control.
     pub fn recovered(&self) -> bool {
-        !self.ok() && self.recovery.as_ref().is_some_and(|m| m.error.is_none())
+        recovered(&self.metrics, self.recovery.as_ref())
     }
 }
 
@@ -139,35 +139,41 @@ pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
     cells
 }
 
+/// CSV columns shared by matrix cells and extra runs: the fixed-step run, then its recovery.
+const RUN_COLUMNS: &str = "ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure,recovered,recovery_t_reached,recovery_newton_per_step,recovery_energy_drift,recovery_wall_s";
+
+/// A run failed at fixed steps and its rerun with step control reached the end time.
+fn recovered(m: &FormulationMetrics, recovery: Option<&FormulationMetrics>) -> bool {
+    m.error.is_some() && recovery.is_some_and(|r| r.error.is_none())
+}
+
+/// The [`RUN_COLUMNS`] of one run and its optional recovery.
+fn run_columns(m: &FormulationMetrics, recovery: Option<&FormulationMetrics>) -> String {
+    let rec = |f: fn(&FormulationMetrics) -> f64| recovery.map_or(f64::NAN, f);
+    format!(
+        "{},{:.4},{:.3},{},{:.3e},{:.3e},{:.4},\"{}\",{},{:.4},{:.3},{:.3e},{:.4}",
+        m.error.is_none(),
+        m.t_reached,
+        m.newton_per_step,
+        m.max_newton_iters,
+        m.energy_drift,
+        m.max_constraint_residual,
+        m.wall_s,
+        m.error.clone().unwrap_or_default().replace('"', "'"),
+        recovered(m, recovery),
+        rec(|r| r.t_reached),
+        rec(|r| r.newton_per_step),
+        rec(|r| r.energy_drift),
+        rec(|r| r.wall_s),
+    )
+}
+
 /// Write `stress.csv`, `stress.json` and one heat map per formulation (`stress_<f>.svg`).
 pub fn write(dir: &Path, axes: &Axes, cells: &[Cell]) -> Result<(), Error> {
-    let mut csv = String::from(
-        "formulation,c,beta_deg,dt_factor,rho_inf,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure,recovered,recovery_t_reached,recovery_newton_per_step,recovery_energy_drift,recovery_wall_s\n",
-    );
+    let mut csv = format!("formulation,c,beta_deg,dt_factor,rho_inf,{RUN_COLUMNS}\n");
     for k in cells {
-        let m = &k.metrics;
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.4},\"{}\",{},{:.4},{:.3},{:.3e},{:.4}",
-            k.formulation,
-            k.c,
-            k.beta_deg,
-            k.dt_factor,
-            k.rho_inf,
-            k.ok(),
-            m.t_reached,
-            m.newton_per_step,
-            m.max_newton_iters,
-            m.energy_drift,
-            m.max_constraint_residual,
-            m.wall_s,
-            m.error.clone().unwrap_or_default().replace('"', "'"),
-            k.recovered(),
-            k.recovery.as_ref().map_or(f64::NAN, |r| r.t_reached),
-            k.recovery.as_ref().map_or(f64::NAN, |r| r.newton_per_step),
-            k.recovery.as_ref().map_or(f64::NAN, |r| r.energy_drift),
-            k.recovery.as_ref().map_or(f64::NAN, |r| r.wall_s),
-        );
+        let cols = run_columns(&k.metrics, k.recovery.as_ref());
+        let _ = writeln!(csv, "{},{},{},{},{},{cols}", k.formulation, k.c, k.beta_deg, k.dt_factor, k.rho_inf);
     }
     write_file(&dir.join("stress.csv"), &csv)?;
     write_file(&dir.join("stress.json"), &serde_json::to_string_pretty(cells).map_err(|e| Error::Io(e.to_string()))?)?;
@@ -299,29 +305,27 @@ pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
 
 /// Write `extras.csv`.
 pub fn write_extras(dir: &Path, extras: &[Extra]) -> Result<(), Error> {
-    let mut csv = String::from(
-        "label,formulation,ok,t_reached,newton_per_step,max_newton_iters,energy_drift,max_constraint_residual,wall_s,failure,recovered,recovery_newton_per_step,recovery_energy_drift,recovery_wall_s\n",
-    );
+    let mut csv = format!("label,formulation,{RUN_COLUMNS}\n");
     for e in extras {
-        let m = &e.metrics;
-        let _ = writeln!(
-            csv,
-            "\"{}\",{},{},{:.4},{:.3},{},{:.3e},{:.3e},{:.3},\"{}\",{},{:.3},{:.3e},{:.3}",
-            e.label,
-            e.formulation,
-            m.error.is_none(),
-            m.t_reached,
-            m.newton_per_step,
-            m.max_newton_iters,
-            m.energy_drift,
-            m.max_constraint_residual,
-            m.wall_s,
-            m.error.clone().unwrap_or_default().replace('"', "'"),
-            e.recovery.as_ref().is_some_and(|r| r.error.is_none()),
-            e.recovery.as_ref().map_or(f64::NAN, |r| r.newton_per_step),
-            e.recovery.as_ref().map_or(f64::NAN, |r| r.energy_drift),
-            e.recovery.as_ref().map_or(f64::NAN, |r| r.wall_s),
-        );
+        let _ = writeln!(csv, "\"{}\",{},{}", e.label, e.formulation, run_columns(&e.metrics, e.recovery.as_ref()));
     }
     write_file(&dir.join("extras.csv"), &csv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::RunOutput;
+
+    /// A failed run with a successful recovery: one value per header column, quoted failure text.
+    #[test]
+    fn run_columns_match_the_header() {
+        let failed = FormulationMetrics::of(&RunOutput::failed(Formulation::Gebf, "step 3: \"singular\"".into()));
+        let mut ok = failed.clone();
+        ok.error = None;
+        let row = run_columns(&failed, Some(&ok));
+        assert_eq!(row.split(',').count(), RUN_COLUMNS.split(',').count(), "{row}");
+        assert!(recovered(&failed, Some(&ok)) && !recovered(&ok, Some(&ok)) && !recovered(&failed, None));
+        assert!(row.contains("'singular'"), "{row}");
+    }
 }
