@@ -2,7 +2,10 @@
 //! settings (5 elements per body, dt = 0.002, 2 s, rho_inf = 0.8): steps, Newton iterations,
 //! factorisations, residual evaluations, step halvings, and the thread CPU time of the run.
 //!
-//! `cargo run --release -p gebf --example paper_work -- [repeats]`
+//! `cargo run --release -p gebf --example paper_work -- [repeats] [dump_dir]`
+//!
+//! With `dump_dir`, the tip trajectory of each case (t, x, y, z per step, full precision) is
+//! written to `dump_dir/tip_c{c}_beta{beta}.txt`, to compare runs before and after a change.
 use gebf::{Model, Options, samples, simulate};
 use genalpha::IntegratorParams;
 
@@ -16,6 +19,7 @@ fn thread_cpu() -> f64 {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let repeats: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let dump_dir = std::env::args().nth(2);
     for (c, beta) in samples::PAPER_CASES {
         let mut cpu = Vec::new();
         let mut wall = Vec::new();
@@ -31,6 +35,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cpu.push((thread_cpu() - c0) * 1e3);
             std::hint::black_box(z);
             stats = Some(st);
+        }
+        if let Some(dir) = &dump_dir {
+            let (b, j, g) = samples::double_pendulum(c, beta, 5);
+            let mut m = Model::new(&b, &j, g, Options::default())?;
+            let mut out = String::new();
+            simulate::run(&mut m, IntegratorParams::new(0.8, 0.002), 2.0, |m, s, _| {
+                let p = m.tip_position(&s.q);
+                out.push_str(&format!("{:.17e} {:.17e} {:.17e} {:.17e}\n", s.t, p.x, p.y, p.z));
+            })?;
+            std::fs::write(format!("{dir}/tip_c{c}_beta{beta}.txt"), out)?;
         }
         wall.sort_by(f64::total_cmp);
         cpu.sort_by(f64::total_cmp);

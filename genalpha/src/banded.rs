@@ -15,6 +15,15 @@
 //! relative to its block's diagonal, the factorisation reports it and the caller falls back to
 //! the dense LU. Cost for a beam with n nodal unknowns per block, band w and border b:
 //! O(n w² + n w b + n b²) instead of O((n + b)³).
+//!
+//! Layout choices (they decide the speed at these small sizes, where every loop is short):
+//! the band is stored by columns, so that the columns of `L` below and of `U` above the diagonal
+//! are contiguous and both triangular solves are column sweeps (`y[k+1..] -= l_k y_k`,
+//! independent updates that vectorise) instead of row dot products (one serial chain of
+//! additions per row). `X = D⁻¹E` is stored by columns and each column starts its forward sweep
+//! at its first non-zero (joint columns touch only a body's last node); each row of `F` keeps the
+//! range of its non-zeros, so the Schur product `F X` and the solve's `F y` skip the zeros.
+//! Dot products that remain use four partial sums.
 
 use crate::DenseMatrix;
 
@@ -43,105 +52,140 @@ impl BandedBorder {
     }
 }
 
+/// `Σ a_i b_i` with four partial sums: independent chains that pipeline and vectorise, where a
+/// single running sum would wait for every addition in turn.
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0; 4];
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            acc[i] += x[i] * y[i];
+        }
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// `y −= s x`.
+#[inline]
+fn sub_scaled(y: &mut [f64], s: f64, x: &[f64]) {
+    for (a, b) in y.iter_mut().zip(x) {
+        *a -= s * b;
+    }
+}
+
 /// One band block, factorised in place.
 #[derive(Debug, Clone)]
 struct Block {
     first: usize,
     m: usize,
     w: usize,
-    /// Band storage, row-major: entry (i, j) with |i − j| ≤ w at `i (2w + 1) + (j − i + w)`.
+    /// Band storage by columns: entry (i, j) with |i − j| ≤ w at `j (2w + 1) + (i − j + w)`
+    /// (slots outside the matrix stay zero and are never read).
     band: Vec<f64>,
+    /// Reciprocals of the pivots (the diagonal of `U`): the back substitution multiplies, so
+    /// that no division sits on its critical path.
+    inv_diag: Vec<f64>,
     /// Border columns (indices into the border) with a non-zero entry of `E` in this block.
     cols: Vec<usize>,
+    /// First non-zero row of each active column of `E`.
+    col_start: Vec<usize>,
     /// Border rows with a non-zero entry of `F` in this block.
     rows: Vec<usize>,
-    /// `E` then `X = D⁻¹ E` on the active columns, row-major m × cols.len().
+    /// Range `lo..hi` of the non-zero columns of each active row of `F`.
+    row_range: Vec<(usize, usize)>,
+    /// `E` then `X = D⁻¹ E` on the active columns, by columns: m × cols.len().
     x: Vec<f64>,
-    /// `F` on the active rows, row-major rows.len() × m.
+    /// `F` on the active rows, row-major rows.len() × m (only each row's range is filled).
     f: Vec<f64>,
 }
 
 impl Block {
-    /// In-place LU without pivoting; false if a pivot is tiny.
+    /// In-place LU without pivoting (right-looking, by columns); false if a pivot is tiny.
     fn factorize(&mut self) -> bool {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
-        let scale = (0..m).map(|i| self.band[i * ld + w].abs()).fold(0.0_f64, f64::max);
+        let scale = (0..m).map(|j| self.band[j * ld + w].abs()).fold(0.0_f64, f64::max);
         let tiny = 1e-13 * scale;
         for k in 0..m {
-            let p = self.band[k * ld + w];
+            let len = w.min(m - 1 - k); // rows and columns k+1..=k+len
+            let (head, tail) = self.band.split_at_mut((k + 1) * ld);
+            let col_k = &mut head[k * ld..];
+            let p = col_k[w];
             if p.abs() <= tiny || !p.is_finite() {
                 return false;
             }
-            let end = (k + w + 1).min(m);
-            let len = end - k - 1; // columns k+1..end
-            let (head, tail) = self.band.split_at_mut((k + 1) * ld);
-            // Row k, columns k+1..end, at offsets w+1..w+1+len.
-            let row_k = &head[k * ld + w + 1..k * ld + w + 1 + len];
-            for i in k + 1..end {
-                let r = &mut tail[(i - k - 1) * ld..(i - k) * ld];
-                // (i, k) at offset k − i + w; (i, j) at j − i + w.
-                let ik = k + w - i;
-                let l = r[ik] / p;
-                r[ik] = l;
-                if l != 0.0 {
-                    for (x, y) in r[ik + 1..ik + 1 + len].iter_mut().zip(row_k) {
-                        *x -= l * y;
-                    }
+            let inv_p = 1.0 / p;
+            self.inv_diag[k] = inv_p;
+            let l = &mut col_k[w + 1..w + 1 + len];
+            l.iter_mut().for_each(|x| *x *= inv_p);
+            let l = &*l;
+            // Column j = k + jj: row k at offset w − jj, rows k+1..=k+len right below it.
+            for (jj, col_j) in tail.chunks_exact_mut(ld).take(len).enumerate() {
+                let o = w - jj - 1;
+                let u = col_j[o];
+                if u != 0.0 {
+                    sub_scaled(&mut col_j[o + 1..o + 1 + len], u, l);
                 }
             }
         }
         true
     }
 
-    /// Overwrite the vector `y` (length m) with `D⁻¹ y`.
-    fn solve_vec(&self, y: &mut [f64]) {
+    /// Overwrite the vector `y` (length m, zero before `start`) with `D⁻¹ y`, by column sweeps.
+    fn solve_vec(&self, y: &mut [f64], start: usize) {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
-        for i in 1..m {
-            let lo = i.saturating_sub(w);
-            let row = &self.band[i * ld + lo + w - i..i * ld + w];
-            let s: f64 = row.iter().zip(&y[lo..i]).map(|(l, x)| l * x).sum();
-            y[i] -= s;
+        for k in start..m {
+            let yk = y[k];
+            if yk != 0.0 {
+                let len = w.min(m - 1 - k);
+                sub_scaled(&mut y[k + 1..k + 1 + len], yk, &self.band[k * ld + w + 1..k * ld + w + 1 + len]);
+            }
         }
-        for i in (0..m).rev() {
-            let hi = (i + w + 1).min(m);
-            let row = &self.band[i * ld + w + 1..i * ld + w + 1 + (hi - i - 1)];
-            let s: f64 = row.iter().zip(&y[i + 1..hi]).map(|(u, x)| u * x).sum();
-            y[i] = (y[i] - s) / self.band[i * ld + w];
+        for k in (0..m).rev() {
+            let yk = y[k] * self.inv_diag[k];
+            y[k] = yk;
+            let lo = k.saturating_sub(w);
+            sub_scaled(&mut y[lo..k], yk, &self.band[k * ld + lo + w - k..k * ld + w]);
         }
     }
 
-    /// Overwrite the row-major `m × nc` block `x` with `D⁻¹ x` (all columns at once).
-    fn solve_rows(&self, x: &mut [f64], nc: usize) {
+    /// Overwrite the columns of `x` (by columns, m × starts.len(); column c zero before
+    /// `starts[c]`) with `D⁻¹ x`. The sweeps run over the rows outside and the columns inside,
+    /// so that the columns' independent update chains overlap.
+    fn solve_cols(&self, x: &mut [f64], starts: &[usize]) {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
-        for i in 1..m {
-            let (done, rest) = x.split_at_mut(i * nc);
-            let xi = &mut rest[..nc];
-            for k in i.saturating_sub(w)..i {
-                let l = self.band[i * ld + k + w - i];
-                if l != 0.0 {
-                    for (a, b) in xi.iter_mut().zip(&done[k * nc..(k + 1) * nc]) {
-                        *a -= l * b;
-                    }
+        let nc = starts.len();
+        let x = &mut x[..m * nc];
+        let k0 = starts.iter().copied().min().unwrap_or(m);
+        for k in k0..m {
+            let len = w.min(m - 1 - k);
+            let l = &self.band[k * ld + w + 1..k * ld + w + 1 + len];
+            for (xc, &s) in x.chunks_exact_mut(m).zip(starts) {
+                let xk = xc[k];
+                if k >= s && xk != 0.0 {
+                    sub_scaled(&mut xc[k + 1..k + 1 + len], xk, l);
                 }
             }
         }
-        for i in (0..m).rev() {
-            let (head, rest) = x.split_at_mut((i + 1) * nc);
-            let xi = &mut head[i * nc..];
-            for k in i + 1..(i + w + 1).min(m) {
-                let u = self.band[i * ld + k + w - i];
-                if u != 0.0 {
-                    let xk = &rest[(k - i - 1) * nc..(k - i) * nc];
-                    for (a, b) in xi.iter_mut().zip(xk) {
-                        *a -= u * b;
-                    }
-                }
+        for k in (0..m).rev() {
+            let lo = k.saturating_sub(w);
+            let u = &self.band[k * ld + lo + w - k..k * ld + w];
+            let inv = self.inv_diag[k];
+            for xc in x.chunks_exact_mut(m) {
+                let xk = xc[k] * inv;
+                xc[k] = xk;
+                sub_scaled(&mut xc[lo..k], xk, u);
             }
-            let d = 1.0 / self.band[i * ld + w];
-            xi.iter_mut().for_each(|a| *a *= d);
         }
     }
 }
@@ -160,8 +204,8 @@ pub(crate) struct BorderedBandLu {
     tmp: Vec<f64>,
     /// Border solution, length n_b.
     xb: Vec<f64>,
-    /// Scratch flags, length n_b.
-    flags: Vec<bool>,
+    /// Scratch: range of the non-zero block columns of each border row, length n_b.
+    range: Vec<(usize, usize)>,
     /// Block of each unknown (`usize::MAX` for the border).
     owner: Vec<usize>,
 }
@@ -187,8 +231,11 @@ impl BorderedBandLu {
                 m,
                 w,
                 band: vec![0.0; m * (2 * w + 1)],
+                inv_diag: vec![0.0; m],
                 cols: Vec::with_capacity(nb),
+                col_start: Vec::with_capacity(nb),
                 rows: Vec::with_capacity(nb),
+                row_range: Vec::with_capacity(nb),
                 x: vec![0.0; m * nb],
                 f: vec![0.0; nb * m],
             })
@@ -201,7 +248,7 @@ impl BorderedBandLu {
             perm: vec![0; nb],
             tmp: vec![0.0; nb],
             xb: vec![0.0; nb],
-            flags: vec![false; nb],
+            range: vec![(0, 0); nb],
             owner,
         }
     }
@@ -227,85 +274,80 @@ impl BorderedBandLu {
     /// Factorise; `Err(row)` on a tiny band pivot or a singular Schur complement.
     pub fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize> {
         let nb = self.border.len();
-        assert!(a.n_rows() == self.n && a.n_cols() == self.n, "factorize: dimension mismatch");
+        let n = self.n;
+        assert!(a.n_rows() == n && a.n_cols() == n, "factorize: dimension mismatch");
+        let data = a.as_slice();
         // Schur complement starts as G.
-        for (r, &bi) in self.border.iter().enumerate() {
-            for (c, &bj) in self.border.iter().enumerate() {
-                self.s[r * nb + c] = a.get(bi, bj);
+        for (c, &bj) in self.border.iter().enumerate() {
+            let col = &data[bj * n..(bj + 1) * n];
+            for (r, &bi) in self.border.iter().enumerate() {
+                self.s[r * nb + c] = col[bi];
             }
         }
         for blk in &mut self.blocks {
             let (first, m, w) = (blk.first, blk.m, blk.w);
-            let data = a.as_slice();
-            let n = self.n;
             let ld = 2 * w + 1;
-            blk.band.iter_mut().for_each(|x| *x = 0.0);
+            // The band, column by column (contiguous in both storages).
             for j in 0..m {
-                let col = &data[(first + j) * n + first..(first + j) * n + first + m];
-                let lo = j.saturating_sub(w);
-                let hi = (j + w + 1).min(m);
-                for (i, x) in col.iter().enumerate().take(hi).skip(lo) {
-                    blk.band[i * ld + j + w - i] = *x;
-                }
+                let (lo, hi) = (j.saturating_sub(w), (j + w + 1).min(m));
+                let src = &data[(first + j) * n + first + lo..(first + j) * n + first + hi];
+                blk.band[j * ld + lo + w - j..j * ld + hi + w - j].copy_from_slice(src);
             }
-            // Active border rows (F) and columns (E) of this block, found on every matrix:
-            // entries that vanish at rest may not vanish later. Rows are scanned column by
-            // column of the block (contiguous in the column-major storage).
-            blk.rows.clear();
-            blk.cols.clear();
-            self.flags.iter_mut().for_each(|f| *f = false);
+            // Active border rows (F) with the range of their non-zeros, and active columns (E)
+            // with their first non-zero, found on every matrix: entries that vanish at rest may
+            // not vanish later. Rows are scanned column by column of the block (contiguous in
+            // the column-major storage).
+            self.range.iter_mut().for_each(|r| *r = (usize::MAX, 0));
             for j in 0..m {
                 let col = &data[(first + j) * n..(first + j + 1) * n];
-                for (c, &bj) in self.border.iter().enumerate() {
-                    if col[bj] != 0.0 {
-                        self.flags[c] = true;
+                for (r, &bi) in self.range.iter_mut().zip(&self.border) {
+                    if col[bi] != 0.0 {
+                        r.0 = r.0.min(j);
+                        r.1 = j + 1;
                     }
                 }
             }
+            blk.rows.clear();
+            blk.row_range.clear();
+            blk.cols.clear();
+            blk.col_start.clear();
             for (c, &bj) in self.border.iter().enumerate() {
-                if self.flags[c] {
+                let (lo, hi) = self.range[c];
+                if lo < hi {
                     blk.rows.push(c);
+                    blk.row_range.push((lo, hi));
                 }
-                if data[bj * n + first..bj * n + first + m].iter().any(|x| *x != 0.0) {
+                if let Some(s) = data[bj * n + first..bj * n + first + m].iter().position(|x| *x != 0.0) {
                     blk.cols.push(c);
+                    blk.col_start.push(s);
                 }
             }
-            let nc = blk.cols.len();
-            for j in 0..m {
-                let col = &data[(first + j) * n..(first + j + 1) * n];
-                for (r, &c) in blk.rows.iter().enumerate() {
-                    blk.f[r * m + j] = col[self.border[c]];
+            for (r, (&c, &(lo, hi))) in blk.rows.iter().zip(&blk.row_range).enumerate() {
+                let bi = self.border[c];
+                for (j, fx) in blk.f[r * m + lo..r * m + hi].iter_mut().enumerate() {
+                    *fx = data[(first + lo + j) * n + bi];
                 }
             }
             for (cc, &c) in blk.cols.iter().enumerate() {
                 let bj = self.border[c];
-                let col = &data[bj * n + first..bj * n + first + m];
-                for (i, x) in col.iter().enumerate() {
-                    blk.x[i * nc + cc] = *x;
-                }
+                blk.x[cc * m..(cc + 1) * m].copy_from_slice(&data[bj * n + first..bj * n + first + m]);
             }
             if !blk.factorize() {
                 return Err(first);
             }
-            if nc == 0 {
+            if blk.cols.is_empty() {
                 continue;
             }
-            // X = D⁻¹ E on the active columns, all at once.
+            // X = D⁻¹ E on the active columns.
             let mut x = std::mem::take(&mut blk.x);
-            blk.solve_rows(&mut x[..m * nc], nc);
+            blk.solve_cols(&mut x, &blk.col_start);
             blk.x = x;
-            // S[rows, cols] −= F X.
-            for (r, &br) in blk.rows.iter().enumerate() {
-                let frow = &blk.f[r * m..(r + 1) * m];
+            // S[rows, cols] −= F X, over each row's non-zeros.
+            for (r, (&br, &(lo, hi))) in blk.rows.iter().zip(&blk.row_range).enumerate() {
+                let frow = &blk.f[r * m + lo..r * m + hi];
                 let srow = &mut self.s[br * nb..(br + 1) * nb];
-                for (k, &fk) in frow.iter().enumerate() {
-                    if fk == 0.0 {
-                        continue;
-                    }
-                    let xrow = &blk.x[k * nc..(k + 1) * nc];
-                    for (&c, x) in blk.cols.iter().zip(xrow) {
-                        srow[c] -= fk * x;
-                    }
+                for (&c, xc) in blk.cols.iter().zip(blk.x.chunks_exact(m)) {
+                    srow[c] -= dot(frow, &xc[lo..hi]);
                 }
             }
         }
@@ -326,14 +368,14 @@ impl BorderedBandLu {
                 }
                 self.perm.swap(k, piv);
             }
-            let p = self.s[k * nb + k];
-            for i in k + 1..nb {
-                let l = self.s[i * nb + k] / p;
-                self.s[i * nb + k] = l;
+            let (head, tail) = self.s.split_at_mut((k + 1) * nb);
+            let row_k = &head[k * nb + k + 1..(k + 1) * nb];
+            let p = head[k * nb + k];
+            for row_i in tail.chunks_exact_mut(nb) {
+                let l = row_i[k] / p;
+                row_i[k] = l;
                 if l != 0.0 {
-                    for c in k + 1..nb {
-                        self.s[i * nb + c] -= l * self.s[k * nb + c];
-                    }
+                    sub_scaled(&mut row_i[k + 1..], l, row_k);
                 }
             }
         }
@@ -345,42 +387,36 @@ impl BorderedBandLu {
         let nb = self.border.len();
         // y = D⁻¹ b on the blocks.
         for blk in &self.blocks {
-            blk.solve_vec(&mut b[blk.first..blk.first + blk.m]);
+            blk.solve_vec(&mut b[blk.first..blk.first + blk.m], 0);
         }
         // b_B ← b_B − F y, into tmp.
-        for (r, &bi) in self.border.iter().enumerate() {
-            self.tmp[r] = b[bi];
+        for (t, &bi) in self.tmp.iter_mut().zip(&self.border) {
+            *t = b[bi];
         }
         for blk in &self.blocks {
             let y = &b[blk.first..blk.first + blk.m];
-            for (r, &br) in blk.rows.iter().enumerate() {
-                let frow = &blk.f[r * blk.m..(r + 1) * blk.m];
-                self.tmp[br] -= frow.iter().zip(y).map(|(f, y)| f * y).sum::<f64>();
+            for (r, (&br, &(lo, hi))) in blk.rows.iter().zip(&blk.row_range).enumerate() {
+                self.tmp[br] -= dot(&blk.f[r * blk.m + lo..r * blk.m + hi], &y[lo..hi]);
             }
         }
         // x_B = S⁻¹ (…): forward with the permutation, then back; kept in `xb`.
         let xb = &mut self.xb;
         for i in 0..nb {
-            let row = &self.s[i * nb..i * nb + i];
-            xb[i] = self.tmp[self.perm[i]] - row.iter().zip(&xb[..i]).map(|(a, b)| a * b).sum::<f64>();
+            let s = dot(&self.s[i * nb..i * nb + i], &xb[..i]);
+            xb[i] = self.tmp[self.perm[i]] - s;
         }
         for i in (0..nb).rev() {
-            let row = &self.s[i * nb + i + 1..(i + 1) * nb];
-            let s = xb[i] - row.iter().zip(&xb[i + 1..]).map(|(a, b)| a * b).sum::<f64>();
+            let s = xb[i] - dot(&self.s[i * nb + i + 1..(i + 1) * nb], &xb[i + 1..]);
             xb[i] = s / self.s[i * nb + i];
         }
-        for (r, &bi) in self.border.iter().enumerate() {
-            b[bi] = xb[r];
+        for (&x, &bi) in xb.iter().zip(&self.border) {
+            b[bi] = x;
         }
-        // x_I = y − X x_B.
+        // x_I = y − X x_B, column by column.
         for blk in &self.blocks {
-            let nc = blk.cols.len();
-            if nc == 0 {
-                continue;
-            }
-            for (i, bi) in b[blk.first..blk.first + blk.m].iter_mut().enumerate() {
-                let xrow = &blk.x[i * nc..(i + 1) * nc];
-                *bi -= xrow.iter().zip(&blk.cols).map(|(a, &c)| a * xb[c]).sum::<f64>();
+            let bi = &mut b[blk.first..blk.first + blk.m];
+            for (&c, xc) in blk.cols.iter().zip(blk.x.chunks_exact(blk.m)) {
+                sub_scaled(bi, xb[c], xc);
             }
         }
     }
