@@ -7,9 +7,7 @@ use genalpha::IntegratorParams;
 fn run(c: f64, beta: f64, path: SolvePath) -> f64 {
     let (bodies, joints, g) = samples::double_pendulum(c, beta, 5);
     let mut model = Model::new(&bodies, &joints, g, Options { path, ..Default::default() }).expect("valid case");
-    let mut params = IntegratorParams::new(0.8, 0.002);
-    // see tests/common/mod.rs: the convergence estimate breaks the β = 45° runs
-    params.newton.estimate_convergence = false;
+    let params = IntegratorParams::new(0.8, 0.002);
     let mut ga = model.integrator(params).expect("valid parameters");
     let mut s = model.initial_state();
     ga.initialize(&model, &mut s).expect("consistent start");

