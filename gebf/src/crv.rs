@@ -29,6 +29,19 @@ pub fn skew(a: &V3) -> M3 {
     M3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
+/// `diag(d) · a`: scales row i of `a` by `d_i` (a diagonal stiffness or inertia times a matrix,
+/// without the full product).
+#[inline]
+pub(crate) fn diag_mul(d: &V3, a: &M3) -> M3 {
+    M3::from_fn(|i, k| d[i] * a[(i, k)])
+}
+
+/// `a · diag(d)`: scales column k of `a` by `d_k`.
+#[inline]
+pub(crate) fn col_mul(a: &M3, d: &V3) -> M3 {
+    M3::from_fn(|i, k| a[(i, k)] * d[k])
+}
+
 /// The axial vector of the skew-symmetric part of `m`: `axial(skew(a)) = a`.
 #[inline]
 pub fn axial(m: &M3) -> V3 {

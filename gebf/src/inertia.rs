@@ -16,7 +16,7 @@
 //! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, V3, skew};
+use crate::crv::{M3, Tangent, col_mul, diag_mul, skew};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
 
 /// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
@@ -25,12 +25,6 @@ pub(crate) struct MatrixCoefficients {
     pub c_m: f64,
     pub c_c: f64,
     pub c_k: f64,
-}
-
-/// `diag(d) · a`: scales row i of `a` by `d_i`.
-#[inline]
-fn diag_mul(d: &V3, a: &M3) -> M3 {
-    M3::from_fn(|i, k| d[i] * a[(i, k)])
 }
 
 /// Add the inertial forces of one element to `res` (and their weighted tangent to `mat`);
@@ -44,9 +38,18 @@ pub(crate) fn add_inertia(
 ) -> f64 {
     let m = sec.mass;
     let jd = sec.inertia();
-    let j = M3::from_diagonal(&jd);
     let i3 = M3::identity();
     let mut kinetic = 0.0;
+    let (v, w, vd, wd) = (st.v, st.w, st.vd, st.wd);
+    let wt3 = skew(&w);
+    // The translational blocks of the rows and columns of R and v_A do not depend on the
+    // point: `l_r`, `l_v` times the consistent-mass integrals `∫ N_k N_l`, `∫ N_k`, `∫ 1`,
+    // added once after the loop.
+    let (mut n_kl, mut n_k, mut n_1) = ([[0.0; 3]; 3], [0.0; 3], 0.0);
+    let (l_r, l_v) = mat.as_ref().map_or((M3::zeros(), M3::zeros()), |(_, c)| {
+        let l_r = i3 * (c.c_m * m) + wt3 * (2.0 * m * c.c_c) + (skew(&wd) + wt3 * wt3) * (m * c.c_k);
+        (l_r, i3 * (c.c_m * m) + wt3 * (m * c.c_c))
+    });
     for &(xi, wgt) in gauss_rule(3) {
         let (n, _) = shape(xi, le);
         let wt = 0.5 * le * wgt;
@@ -56,7 +59,6 @@ pub(crate) fn add_inertia(
         let psi = interp(&n, &st.psi);
         let psid = interp(&n, &st.psid);
         let psidd = interp(&n, &st.psidd);
-        let (v, w, vd, wd) = (st.v, st.w, st.vd, st.wd);
 
         // Translation.
         let w0 = v + w.cross(&r);
@@ -86,13 +88,10 @@ pub(crate) fn add_inertia(
         if let Some((mm, c)) = mat.as_mut() {
             let c = *c;
             let rt = skew(&r);
-            let wt3 = skew(&w);
             // Linear part: columns (per node: × n_l).
-            let l_r = i3 * (c.c_m * m) + wt3 * (2.0 * m * c.c_c) + (skew(&wd) + wt3 * wt3) * (m * c.c_k);
-            let l_v = i3 * (c.c_m * m) + wt3 * (m * c.c_c);
             let l_w = rt * (-m * c.c_m) + (skew(&rd) * 2.0 + skew(&w0) + wt3 * rt) * (-m * c.c_c);
-            // Angular part; J is diagonal, so J·X scales the rows of X.
-            let x = skew(&om) * j - skew(&jom);
+            // Angular part; J is diagonal, so J·X scales the rows of X and X·J its columns.
+            let x = col_mul(&skew(&om), &jd) - skew(&jom);
             let cwt = skew(&cw);
             let cwt_t = cwt * t;
             let omr_t = skew(&om_r);
@@ -116,24 +115,33 @@ pub(crate) fn add_inertia(
             let a_wr = rt * l_r + geo_rf;
             for k in 0..3 {
                 let nk = n[k] * wt;
+                n_k[k] += nk;
                 for l in 0..3 {
                     let nkl = nk * n[l];
-                    add33(mm, 6 * k, 6 * l, &(l_r * nkl));
+                    n_kl[k][l] += nkl;
                     add33(mm, 6 * k + 3, 6 * l + 3, &(a_pp * nkl));
                 }
-                add33(mm, 6 * k, V_OFF, &(l_v * nk));
                 add33(mm, 6 * k, W_OFF, &(l_w * nk));
                 add33(mm, 6 * k + 3, W_OFF, &(a_pw * nk));
                 // Frame rows, node columns.
-                add33(mm, V_OFF, 6 * k, &(l_r * nk));
                 add33(mm, W_OFF, 6 * k, &(a_wr * nk));
                 add33(mm, W_OFF, 6 * k + 3, &(a_wp * nk));
             }
-            add33(mm, V_OFF, V_OFF, &(l_v * wt));
+            n_1 += wt;
             add33(mm, V_OFF, W_OFF, &(l_w * wt));
             add33(mm, W_OFF, V_OFF, &(rt * l_v * wt));
             add33(mm, W_OFF, W_OFF, &((rt * l_w + ct * h_w) * wt));
         }
+    }
+    if let Some((mm, _)) = mat.as_mut() {
+        for k in 0..3 {
+            for l in 0..3 {
+                add33(mm, 6 * k, 6 * l, &(l_r * n_kl[k][l]));
+            }
+            add33(mm, 6 * k, V_OFF, &(l_v * n_k[k]));
+            add33(mm, V_OFF, 6 * k, &(l_r * n_k[k]));
+        }
+        add33(mm, V_OFF, V_OFF, &(l_v * n_1));
     }
     kinetic
 }

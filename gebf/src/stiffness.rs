@@ -16,7 +16,7 @@
 //! `C^{AB}`, `T`, `D` at fixed `N`, `M` (which needs the Hessian of `Mᵀ T(psi) psi'`).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, V3, skew};
+use crate::crv::{Tangent, V3, diag_mul, skew};
 use crate::element::{ElementState, Mat24, Vec24, add3, add33, gauss_rule, interp, shape};
 
 /// Add the elastic forces of one element to `res` (and `c_k ×` their tangent to `mat`);
@@ -31,8 +31,6 @@ pub(crate) fn add_elastic(
 ) -> f64 {
     let sg = sec.force_stiffness();
     let sk = sec.moment_stiffness();
-    let sg_m = M3::from_diagonal(&sg);
-    let sk_m = M3::from_diagonal(&sk);
     let ex = V3::x();
     let mut energy = 0.0;
     for &(xi, w) in gauss_rule(n_gauss) {
@@ -64,13 +62,15 @@ pub(crate) fn add_elastic(
             let f = wt * *c_k;
             let et = skew(&e) * t; // ∂γ/∂psi
             let nt = skew(&nf);
-            // Material blocks.
-            let a1 = c.transpose() * sg_m * c;
-            let a2 = c.transpose() * sg_m * et;
-            let a3 = et.transpose() * sg_m * et;
-            let p = t.transpose() * sk_m * t;
-            let qm = t.transpose() * sk_m * d;
-            let rm = d.transpose() * sk_m * d;
+            // Material blocks (the stiffnesses are diagonal: S X scales the rows of X).
+            let (sg_c, sg_et) = (diag_mul(&sg, &c), diag_mul(&sg, &et));
+            let (sk_t, sk_d) = (diag_mul(&sk, &t), diag_mul(&sk, &d));
+            let a1 = c.transpose() * sg_c;
+            let a2 = c.transpose() * sg_et;
+            let a3 = et.transpose() * sg_et;
+            let p = t.transpose() * sk_t;
+            let qm = t.transpose() * sk_d;
+            let rm = d.transpose() * sk_d;
             // Geometric blocks.
             let g1 = -(c.transpose() * nt * t); // (R_k, psi_l) × dn_k n_l
             let g2 = tg.jac_t(&nf.cross(&e)) + t.transpose() * nt * skew(&e) * t + tg.hessian(&psi_p, &mo);
@@ -97,7 +97,7 @@ pub(crate) fn add_elastic(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::crv::{from_rotation_matrix, rotation_matrix};
+    use crate::crv::{M3, from_rotation_matrix, rotation_matrix};
     use crate::element::ElementState;
 
     fn section() -> Section {
