@@ -21,26 +21,30 @@ pub(crate) fn add_gravity(
 ) {
     let fg = g_a * mass;
     let fgt = skew(&fg);
-    let mut mat = mat;
+    // The load is linear in the shape functions: integrate them (and R) once, then add.
+    let (mut n_int, mut r_int, mut len) = ([0.0; 3], V3::zeros(), 0.0);
     for &(xi, w) in gauss_rule(3) {
         let (n, _) = shape(xi, le);
         let wt = 0.5 * le * w;
-        let r = interp(&n, &st.r);
-        for k in 0..3 {
-            add3(res, 6 * k, &(-fg * (wt * n[k])));
+        for (a, nk) in n_int.iter_mut().zip(n) {
+            *a += wt * nk;
         }
-        add3(res, V_OFF, &(-fg * wt));
-        add3(res, W_OFF, &(-r.cross(&fg) * wt));
-        if let Some((m, c_k)) = mat.as_mut() {
-            let f = *c_k * wt;
-            let a: M3 = -fgt * f;
-            for k in 0..3 {
-                add33(m, 6 * k, W_OFF, &(a * n[k]));
-                add33(m, W_OFF, 6 * k, &(fgt * (f * n[k])));
-            }
-            add33(m, V_OFF, W_OFF, &a);
-            add33(m, W_OFF, W_OFF, &(skew(&r) * a));
+        r_int += interp(&n, &st.r) * wt;
+        len += wt;
+    }
+    for (k, nk) in n_int.iter().enumerate() {
+        add3(res, 6 * k, &(-fg * *nk));
+    }
+    add3(res, V_OFF, &(-fg * len));
+    add3(res, W_OFF, &(-r_int.cross(&fg)));
+    if let Some((m, c_k)) = mat {
+        let a: M3 = -fgt * c_k;
+        for (k, nk) in n_int.iter().enumerate() {
+            add33(m, 6 * k, W_OFF, &(a * *nk));
+            add33(m, W_OFF, 6 * k, &(fgt * (c_k * nk)));
         }
+        add33(m, V_OFF, W_OFF, &(a * len));
+        add33(m, W_OFF, W_OFF, &(skew(&r_int) * a));
     }
 }
 
