@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod aero;
+pub mod bench;
 pub mod case;
 pub mod converge;
 pub mod csv;

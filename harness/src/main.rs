@@ -10,7 +10,7 @@ use harness::case::{CaseFile, Formulation, Override, json_schema};
 use harness::csv::{to_csv, write_file};
 use harness::driver::{discover, expand_all, run_all, write_reports};
 use harness::report::write_case;
-use harness::{converge, gate, stress};
+use harness::{bench, converge, gate, stress};
 
 #[derive(Parser)]
 #[command(
@@ -95,6 +95,24 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
+    /// Time each formulation on each case (median thread CPU time of repeated serial runs, ANCF on
+    /// both paths) with the work per step; writes `<out>/bench/` (bench.md, bench.json, bench.svg).
+    Bench {
+        /// Case files (default: every case in --cases without aerodynamics).
+        files: Vec<PathBuf>,
+        /// Folder of case files.
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Timed runs per configuration.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Output folder (writes `<out>/bench/`).
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
     /// List the runs the case files expand into.
     List {
         /// Folder of case files.
@@ -103,6 +121,17 @@ enum Cmd {
     },
     /// Print the JSON Schema of case files.
     Schema,
+}
+
+/// Run the benchmark on `runs` and write `<out>/bench/`; the targets apply to the cases without
+/// aerodynamics (the issues' figures are for the paper's pendulums).
+fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, out: &std::path::Path) -> Result<Vec<bench::BenchRow>> {
+    let t = std::time::Instant::now();
+    let rows = bench::run(runs, repeats, true);
+    let pendulums: Vec<&str> = runs.iter().filter(|r| r.ancf.aero.is_none()).map(|r| r.name.as_str()).collect();
+    bench::write(&out.join("bench"), &rows, |c| pendulums.contains(&c))?;
+    println!("bench: {} configurations x {repeats} runs in {:.1} s", rows.len(), t.elapsed().as_secs_f64());
+    Ok(rows)
 }
 
 /// The extra hard runs of the stress study: a 20 s pendulum and the wing at AoA 15°.
@@ -198,6 +227,8 @@ fn real_main() -> Result<ExitCode> {
                     }
                     println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
                 }
+                let pendulums: Vec<_> = runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
+                run_bench(&pendulums, 7, &out)?;
             }
             write_reports(&out, &results).context("writing reports")?;
             print!("{}", gate::table(&results));
@@ -315,6 +346,18 @@ fn real_main() -> Result<ExitCode> {
             }
             println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
             Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Bench { files, cases, repeats, out, set } => {
+            let explicit = !files.is_empty();
+            let files = if explicit { files } else { discover(&cases)? };
+            let (runs, errors) = expand_all(&files, &set);
+            for e in &errors {
+                eprintln!("error: {e}");
+            }
+            let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
+            let rows = run_bench(&runs, repeats, &out)?;
+            let failed = rows.iter().filter(|r| r.error.is_some()).count();
+            Ok(if failed == 0 && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
         }
         Cmd::Gate { files, cases, set } => {
             let files = if files.is_empty() { discover(&cases)? } else { files };

@@ -440,7 +440,8 @@ fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
-/// HTML section for the studies found on disk under `out`: `converge/<case>/` and `stress/`.
+/// HTML section for the studies found on disk under `out`: `converge/<case>/`, `bench/` and
+/// `stress/`.
 pub fn studies_html(out: &Path) -> String {
     let mut s = String::new();
     let conv = out.join("converge");
@@ -462,6 +463,9 @@ pub fn studies_html(out: &Path) -> String {
                 esc(n)
             );
         }
+    }
+    if out.join("bench/bench.svg").exists() {
+        s.push_str("<h2 id=\"bench\">Speed</h2>\n<p>Median thread CPU time of repeated serial runs at each case's own settings (ANCF on both solve paths), with the Newton work per step: <a href=\"bench/bench.md\">bench.md</a>, <a href=\"bench/bench.json\">bench.json</a>. Lines: the issues' targets for the paper's pendulums.</p>\n<figure><img src=\"bench/bench.svg\" alt=\"speed\"><figcaption>CPU time per run</figcaption></figure>\n");
     }
     if out.join("stress/stress_ancf.svg").exists() {
         s.push_str("<h2 id=\"stress\">Stability on hard cases: the stress matrix</h2>\n<p><a href=\"stress/stress.csv\">stress.csv</a>; extra hard runs (20 s pendulum, wing at AoA 15°): <a href=\"stress/extras.csv\">extras.csv</a></p>\n");

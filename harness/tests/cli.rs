@@ -115,3 +115,33 @@ fn committed_json_schema_is_current() {
         "cases/case.schema.json is stale: run `cargo run -p harness -- schema > cases/case.schema.json`"
     );
 }
+
+/// `harness bench` times ANCF on both paths and GEBF, and writes a table with the work per step.
+#[test]
+fn bench_writes_a_row_per_solver() {
+    let out = std::env::temp_dir().join(format!("harness-bench-{}", std::process::id()));
+    let o = harness(&[
+        "bench",
+        "cases/double_pendulum_c1_beta0.json",
+        "--repeats",
+        "2",
+        "--set",
+        "t_end=0.05",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(out.join("bench/bench.md")).unwrap();
+    for solver in ["ANCF DAE", "ANCF ODE", "GEBF"] {
+        let line = md.lines().find(|l| l.contains(solver)).unwrap_or_else(|| panic!("no {solver} row: {md}"));
+        // 25 steps of 2 ms at paper settings: at least one Newton iteration per step
+        let newton: f64 = line.split('|').nth(6).unwrap().trim().parse().unwrap();
+        assert!(newton >= 1.0, "{line}");
+    }
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("bench/bench.json")).unwrap()).unwrap();
+    assert_eq!(rows.as_array().unwrap().len(), 3);
+    assert!(rows[0]["cpu_median_ms"].as_f64().unwrap() > 0.0);
+    assert!(out.join("bench/bench.svg").exists());
+    std::fs::remove_dir_all(out).ok();
+}
