@@ -60,6 +60,8 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     phi_q_ready: bool,
     /// Columns of Φ_q with a non-zero entry (constraints touch few coordinates).
     phi_q_cols: Vec<usize>,
+    /// Columns of B that have been non-zero in some assembly (their Bᵀ entries are rewritten).
+    b_cols_written: Vec<bool>,
     have_factorization: bool,
     /// Per column `j < n` of the K block, the row ranges (below `n`) the model may write, from
     /// the declared [`BandedBorder`](crate::BandedBorder); empty when no structure is declared
@@ -181,6 +183,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             b_mat: DenseMatrix::zeros(n_v, n),
             phi_q_ready: false,
             phi_q_cols: Vec::with_capacity(n),
+            b_cols_written: vec![false; n],
             have_factorization: false,
             k_rows,
             refresh_steps_left: 0,
@@ -249,9 +252,15 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
         }
         if n_v > 0 {
+            // Only columns of B that are, or once were, non-zero: a velocity constraint touches
+            // a few coordinates, and a column that was never written is still zero in Bᵀ.
             for j in 0..n {
-                for i in 0..n_v {
-                    let x = self.b_mat.get(i, j);
+                let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
+                self.b_cols_written[j] |= col.iter().any(|&x| x != 0.0);
+                if !self.b_cols_written[j] {
+                    continue;
+                }
+                for (i, &x) in col.iter().enumerate() {
                     *self.matrix.get_mut(n + n_h + i, j) += x;
                     *self.matrix.get_mut(j, n + n_h + i) = x;
                 }
