@@ -16,7 +16,7 @@
 
 use crate::element::Element;
 use crate::shape::{ELEMENT_DOF, N_BLOCKS};
-use crate::strain::{MAX_FIELDS, N_STRAINS, SampledStrain, StrainKind, StrainPlan, dot, strain_value};
+use crate::strain::{MAX_FIELDS, MAX_GROUP, N_STRAINS, SampledStrain, StrainKind, StrainPlan, dot, strain_value};
 use nalgebra::{SMatrix, SVector};
 
 /// 24×24 element matrix.
@@ -86,10 +86,10 @@ fn add_symmetric_times(m: &[[f64; N_BLOCKS]; N_BLOCKS], x: &[[f64; 3]; N_BLOCKS]
     }
 }
 
-/// `A e = (a ⊗ I₃) e` of one strain as a 24-vector, from its Hessian entries.
+/// `g = A e = (a ⊗ I₃) e` of one strain as a 24-vector, from its Hessian entries.
 #[inline]
-fn strain_gradient_pairs(s: &SampledStrain, x: &[[f64; 3]; N_BLOCKS]) -> ElementVector {
-    let mut g = ElementVector::zeros();
+fn strain_gradient_inplace(s: &SampledStrain, x: &[[f64; 3]; N_BLOCKS], g: &mut [f64; ELEMENT_DOF]) {
+    *g = [0.0; ELEMENT_DOF];
     for &(a, b, h) in &s.pairs[..s.n_pairs] {
         for i in 0..3 {
             g[3 * a + i] += h * x[b][i];
@@ -100,7 +100,38 @@ fn strain_gradient_pairs(s: &SampledStrain, x: &[[f64; 3]; N_BLOCKS]) -> Element
             }
         }
     }
-    g
+}
+
+/// `K += Σ_m w_m g_m g_mᵀ` (the first `M` gradients of a group) on the upper block triangle of
+/// the group's blocks (ascending): column by column, one contiguous update over the rows from
+/// the first block to the column's block (the few zero rows of unused blocks in between cost
+/// less than the branching that would skip them).
+#[inline]
+fn add_rank_update<const M: usize>(
+    blocks: &[usize],
+    g: &[[f64; ELEMENT_DOF]; MAX_GROUP],
+    w: &[f64; MAX_GROUP],
+    cols: &mut [[f64; ELEMENT_DOF]; ELEMENT_DOF],
+) {
+    let Some(&first) = blocks.first() else { return };
+    let lo = 3 * first;
+    for &bj in blocks {
+        let hi = (3 * bj + 3).min(ELEMENT_DOF);
+        for j in 3 * bj..hi {
+            let x: [f64; M] = std::array::from_fn(|m| w[m] * g[m][j]);
+            if x.iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            let col = &mut cols[j];
+            for i in lo..hi {
+                let mut acc = 0.0;
+                for m in 0..M {
+                    acc += x[m] * g[m][i];
+                }
+                col[i] += acc;
+            }
+        }
+    }
 }
 
 /// Copy the upper block triangle (3×3 blocks `(a, b)`, `a ≤ b`) onto the lower one.
@@ -186,38 +217,36 @@ impl Element {
     /// diagonal blocks in full); [`mirror_upper_inplace`] completes the symmetric matrix, so that
     /// it is exactly symmetric.
     ///
-    /// Each strain adds the rank-one term `C (A e)(A e)ᵀ` column by column as one contiguous
-    /// update over the rows from its first to the column's block (the few zero rows of unused
-    /// blocks in between cost less than the branching that would skip them).
+    /// The rank-one terms `C (A e)(A e)ᵀ` of the strains of one [`StrainGroup`] (equal block
+    /// sets) are summed in one pass over the columns of their blocks; the geometric terms
+    /// `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8 block level and added last.
+    ///
+    /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
         let gm = gram(&x);
-        let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS];
-        let data = k.as_mut_slice(); // column-major 24 × 24
-        for s in &self.plan.strains {
-            let d = strain_from_gram(s, &gm) - s.reference;
-            let g = strain_gradient_pairs(s, &x);
-            let g = g.as_slice();
-            let cs = c * s.stiffness;
-            let blocks = &s.blocks[..s.n_blocks];
-            let Some(&first) = blocks.first() else { continue };
-            let lo = 3 * first;
-            for &bj in blocks {
-                let hi = 3 * bj + 3;
-                for j in 3 * bj..hi {
-                    let x = cs * g[j];
-                    if x == 0.0 {
-                        continue;
-                    }
-                    let col = &mut data[ELEMENT_DOF * j + lo..ELEMENT_DOF * j + hi];
-                    for (cij, gi) in col.iter_mut().zip(&g[lo..hi]) {
-                        *cij += x * gi;
-                    }
+        let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
+        let mut grads = [[0.0; ELEMENT_DOF]; MAX_GROUP]; // A e of the group's strains
+        let mut weights = [0.0; MAX_GROUP]; // c C of the group's strains
+        let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
+        for group in &self.plan.groups {
+            let members = group.members();
+            for ((&i, g), w) in members.iter().zip(&mut grads).zip(&mut weights) {
+                let s = &self.plan.strains[i];
+                let d = strain_from_gram(s, &gm) - s.reference;
+                strain_gradient_inplace(s, &x, g);
+                *w = c * s.stiffness;
+                for &(a, b, h) in &s.pairs[..s.n_pairs] {
+                    geometric[a][b] += *w * d * h;
                 }
             }
-            let sd = c * s.stiffness * d;
-            for &(a, b, h) in &s.pairs[..s.n_pairs] {
-                geometric[a][b] += sd * h;
+            let s = &self.plan.strains[members[0]];
+            let blocks = &s.blocks[..s.n_blocks];
+            match members.len() {
+                1 => add_rank_update::<1>(blocks, &grads, &weights, cols),
+                2 => add_rank_update::<2>(blocks, &grads, &weights, cols),
+                3 => add_rank_update::<3>(blocks, &grads, &weights, cols),
+                _ => add_rank_update::<MAX_GROUP>(blocks, &grads, &weights, cols),
             }
         }
         for b in 0..N_BLOCKS {
@@ -225,7 +254,7 @@ impl Element {
                 let x = geometric[a][b];
                 if x != 0.0 {
                     for i in 0..3 {
-                        data[ELEMENT_DOF * (3 * b + i) + 3 * a + i] += x;
+                        cols[3 * b + i][3 * a + i] += x;
                     }
                 }
             }

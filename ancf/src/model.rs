@@ -13,6 +13,8 @@ use crate::{BodySpec, Error, JointSpec, Options, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::RefCell;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A body with its place in the global coordinate vector.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,6 +87,9 @@ pub struct Model {
     element_z: Vec<Option<usize>>,
     work: RefCell<Workspace>,
     sensor: RefCell<(Vec<f64>, Vec<f64>)>,
+    /// Whether the iteration matrix is symmetric (no follower moments), shared with the
+    /// [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
+    symmetric: Arc<AtomicBool>,
 }
 
 impl Model {
@@ -195,6 +200,7 @@ impl Model {
             element_z,
             work: RefCell::new(Workspace { q: vec![0.0; n_full], v: vec![0.0; n_full], r: vec![0.0; n_full] }),
             sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
+            symmetric: Arc::new(AtomicBool::new(true)),
         })
     }
 
@@ -287,9 +293,11 @@ impl Model {
     }
 
     /// A [`SkylineLu`](crate::SkylineLu) that knows the structure of this model's iteration
-    /// matrix (in the integrator's layout: coordinates, then multipliers).
+    /// matrix (in the integrator's layout: coordinates, then multipliers) and, while no follower
+    /// moment is loaded, that its values are symmetric (see
+    /// [`SkylineLu::with_symmetry_hint`](crate::SkylineLu::with_symmetry_hint)).
     pub fn linear_solver(&self) -> crate::SkylineLu {
-        crate::SkylineLu::with_structure(self.n_dof(), self.adjacency())
+        crate::SkylineLu::with_structure(self.n_dof(), self.adjacency()).with_symmetry_hint(Arc::clone(&self.symmetric))
     }
 
     /// The undeformed reference configuration at rest, sized for genalpha.
@@ -496,6 +504,8 @@ impl Model {
                 self.moments.push((st, p.moment));
             }
         }
+        // a follower moment's tangent is not symmetric
+        self.symmetric.store(self.moments.is_empty(), Ordering::Relaxed);
         Ok(())
     }
 

@@ -17,6 +17,8 @@
 //! Buffers are sized once in `set_dimension`; factorising and solving do not allocate.
 
 use genalpha::{DenseLu, DenseMatrix, LinearSolver};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Skyline LU with dense fallback. See the module documentation.
 #[derive(Debug, Default)]
@@ -39,6 +41,8 @@ pub struct SkylineLu {
     ordered: bool,
     /// Known sparsity: `(n_primary, adjacency)`; indices ≥ `n_primary` are multiplier rows.
     structure: Option<(usize, Vec<Vec<usize>>)>,
+    /// Set by the model while its matrices are symmetric: the entry-by-entry check is skipped.
+    symmetric_hint: Option<Arc<AtomicBool>>,
     dense: DenseLu,
     use_dense: bool,
     /// Skyline factorisations done.
@@ -60,6 +64,14 @@ impl SkylineLu {
     /// outside the structure are ignored, so the structure must be complete.
     pub fn with_structure(n_primary: usize, adjacency: Vec<Vec<usize>>) -> Self {
         Self { structure: Some((n_primary, adjacency)), ..Self::default() }
+    }
+
+    /// Let the model vouch for the symmetry of its matrices: while `flag` is true, the values
+    /// are taken as symmetric without the entry-by-entry check (only the upper triangle of the
+    /// permuted matrix is read). While it is false, every matrix is checked.
+    pub fn with_symmetry_hint(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.symmetric_hint = Some(flag);
+        self
     }
 
     fn order_from_structure(&mut self) {
@@ -173,17 +185,25 @@ impl SkylineLu {
         // Gather the envelope of P A Pᵀ: U columns (with diagonal), and whether the values are
         // symmetric up to round-off (no follower moments): then L = D⁻¹Uᵀ, half the work.
         let mut scale: f64 = 0.0;
+        let known_symmetric = self.symmetric_hint.as_ref().is_some_and(|f| f.load(Ordering::Relaxed));
         let mut symmetric = true;
         for i in 0..n {
             let (oi, fi, up) = (self.order[i], self.first[i], self.uptr[i]);
             let col = &a[oi * n..(oi + 1) * n]; // A[·, order[i]]
-            for (u, &ok) in self.uval[up..=up + (i - fi)].iter_mut().zip(&self.order[fi..=i]) {
-                // U column i, row fi + k: A[order[fi + k], order[i]]
-                let x = col[ok];
-                *u = x;
-                // against L row i, column fi + k: A[order[i], order[fi + k]]
-                let y = a[ok * n + oi];
-                symmetric &= (x - y).abs() <= 1e-10 * (x.abs() + y.abs());
+            let u_col = self.uval[up..=up + (i - fi)].iter_mut().zip(&self.order[fi..=i]);
+            if known_symmetric {
+                for (u, &ok) in u_col {
+                    *u = col[ok];
+                }
+            } else {
+                for (u, &ok) in u_col {
+                    // U column i, row fi + k: A[order[fi + k], order[i]]
+                    let x = col[ok];
+                    *u = x;
+                    // against L row i, column fi + k: A[order[i], order[fi + k]]
+                    let y = a[ok * n + oi];
+                    symmetric &= (x - y).abs() <= 1e-10 * (x.abs() + y.abs());
+                }
             }
             scale = scale.max(col[oi].abs());
         }
@@ -570,6 +590,35 @@ mod tests {
         s.solve_in_place(&mut z);
         assert_eq!(s.n_skyline, 1);
         for (p, q) in z.iter().zip(&y) {
+            assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
+        }
+    }
+
+    #[test]
+    fn symmetry_hint_skips_the_check_only_while_set() {
+        let a = kkt(40, 4);
+        let b: Vec<f64> = (0..42).map(|i| (i as f64 * 0.21).cos()).collect();
+        let (_, y, _) = solve_both(&a, &b);
+        let adjacency: Vec<Vec<usize>> =
+            (0..42).map(|i| (0..42).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        let flag = Arc::new(AtomicBool::new(true));
+        let mut s = SkylineLu::with_structure(40, adjacency).with_symmetry_hint(Arc::clone(&flag));
+        s.set_dimension(42);
+        s.factorize(&a).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x);
+        for (p, q) in x.iter().zip(&y) {
+            assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
+        }
+        // an unsymmetric matrix with the flag cleared is checked and solved as such
+        let mut c = a.clone();
+        *c.get_mut(3, 5) += 0.25;
+        let (_, y, _) = solve_both(&c, &b);
+        flag.store(false, Ordering::Relaxed);
+        s.factorize(&c).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x);
+        for (p, q) in x.iter().zip(&y) {
             assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
         }
     }

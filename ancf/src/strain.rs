@@ -88,6 +88,8 @@ pub const MAX_FIELDS: usize = 32;
 pub const MAX_TERMS: usize = 4;
 /// Entries of the upper triangle of an 8×8 block Hessian.
 pub const MAX_PAIRS: usize = N_BLOCKS * (N_BLOCKS + 1) / 2;
+/// Upper bound of strains per [`StrainGroup`].
+pub const MAX_GROUP: usize = 4;
 
 impl StrainKind {
     /// All kinds in index order.
@@ -181,6 +183,24 @@ impl SampledStrain {
     }
 }
 
+/// Strains that depend on the same blocks (e.g. the axial strain at its three Gauss points):
+/// the tangent adds their rank-one terms `C (A e)(A e)ᵀ` in one pass over the element matrix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StrainGroup {
+    /// Number of members.
+    pub n_members: usize,
+    /// Indices into [`StrainPlan::strains`] (first `n_members`).
+    pub members: [usize; MAX_GROUP],
+}
+
+impl StrainGroup {
+    /// The member strain indices.
+    #[inline]
+    pub fn members(&self) -> &[usize] {
+        &self.members[..self.n_members]
+    }
+}
+
 /// The fields an element needs and the strains sampled from them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StrainPlan {
@@ -188,6 +208,28 @@ pub struct StrainPlan {
     pub fields: Vec<FieldWeights>,
     /// Sampled strains.
     pub strains: Vec<SampledStrain>,
+    /// The strains partitioned into groups with equal block sets (at most [`MAX_GROUP`] each),
+    /// in the order of their first member.
+    pub groups: Vec<StrainGroup>,
+}
+
+/// Partition strains into groups with equal block sets, at most [`MAX_GROUP`] per group.
+fn group_strains(strains: &[SampledStrain]) -> Vec<StrainGroup> {
+    let mut groups: Vec<StrainGroup> = Vec::new();
+    for (i, s) in strains.iter().enumerate() {
+        let same = |g: &&mut StrainGroup| {
+            let t = &strains[g.members[0]];
+            g.n_members < MAX_GROUP && t.blocks[..t.n_blocks] == s.blocks[..s.n_blocks]
+        };
+        match groups.iter_mut().find(same) {
+            Some(g) => {
+                g.members[g.n_members] = i;
+                g.n_members += 1;
+            }
+            None => groups.push(StrainGroup { n_members: 1, members: [i, 0, 0, 0] }),
+        }
+    }
+    groups
 }
 
 /// Element coordinates of a straight, unstrained element of length `l` along the global x axis.
@@ -392,7 +434,8 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
     for s in &mut bld.strains {
         s.reference = strain_value(s, &f0);
     }
-    StrainPlan { fields: bld.fields, strains: bld.strains }
+    let groups = group_strains(&bld.strains);
+    StrainPlan { fields: bld.fields, strains: bld.strains, groups }
 }
 
 #[cfg(test)]
@@ -445,6 +488,29 @@ mod tests {
                 assert_relative_eq!(s.reference, expect, epsilon = 1e-13);
             }
         }
+    }
+
+    #[test]
+    fn groups_partition_the_strains_by_block_set() {
+        for curvature in ALL_CURVATURES {
+            let plan = strain_plan(0.4, &section(), curvature, 1.0, 100.0);
+            let mut seen = vec![0; plan.strains.len()];
+            for g in &plan.groups {
+                assert!((1..=MAX_GROUP).contains(&g.n_members));
+                let first = &plan.strains[g.members[0]];
+                for &m in g.members() {
+                    seen[m] += 1;
+                    let s = &plan.strains[m];
+                    assert_eq!(s.blocks[..s.n_blocks], first.blocks[..first.n_blocks]);
+                }
+            }
+            assert!(seen.iter().all(|&n| n == 1), "{curvature:?}: {seen:?}");
+        }
+        // Hybrid: the three axial Gauss points share blocks {0, 1, 4, 5}.
+        let plan = strain_plan(0.4, &section(), Curvature::Hybrid, 1.0, 100.0);
+        let axial: Vec<usize> =
+            (0..plan.strains.len()).filter(|&i| plan.strains[i].kind == StrainKind::Axial).collect();
+        assert!(plan.groups.iter().any(|g| g.members() == axial.as_slice()));
     }
 
     #[test]
