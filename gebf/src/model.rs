@@ -599,6 +599,67 @@ impl ConstrainedSystem for Model {
         }
     }
 
+    /// One pass over the elements: the element routines produce the residual while they build
+    /// the matrix (elements whose CRVs are mapped across π take the separate residual path).
+    fn residual_and_iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        r: &mut [f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        if c_k == 0.0 {
+            self.residual_inplace(t, q, v, v_dot, r);
+            self.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
+            return;
+        }
+        r.iter_mut().for_each(|x| *x = 0.0);
+        let mut res = Vec24::zeros();
+        let mut mat = Mat24::zeros();
+        let coeffs = MatrixCoefficients { c_m, c_c, c_k };
+        let ng = self.options.n_gauss_stiffness;
+        for b in &self.bodies {
+            let g_a = self.gravity_in_frame(b, q);
+            for e in 0..b.n_elements {
+                res.as_mut_slice().fill(0.0);
+                mat.as_mut_slice().fill(0.0);
+                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
+                if st.is_mapped() {
+                    mat = self.mapped_element_matrix(b, &st, &g_a, coeffs);
+                    add_inertia(&st, b.le, &b.section, &mut res, None);
+                    add_elastic(&st, b.le, &b.section, ng, &mut res, None);
+                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
+                } else {
+                    add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
+                    add_elastic(&st, b.le, &b.section, ng, &mut res, Some((&mut mat, c_k)));
+                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
+                }
+                st.map_residual(&mut res);
+                for (lr, gr, nr) in local_ranges(b, e) {
+                    for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
+                        *x += y;
+                    }
+                }
+                scatter_matrix(b, e, &mat, k);
+            }
+        }
+        if self.n_loaded > 0 {
+            for (bi, b) in self.bodies.iter().enumerate() {
+                for (i, l) in self.loads[bi].iter().enumerate() {
+                    if !l.is_zero() {
+                        add_load(b, i, l, self.load_scale, q, r);
+                        add_load_tangent(b, i, l, self.load_scale, q, c_k, k);
+                    }
+                }
+            }
+        }
+    }
+
     fn psi_inplace(&self, _t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
         for (j, row) in self.joints.iter().zip(&self.joint_row) {
             j.psi(&self.bodies, q, v, &mut psi[*row..*row + j.n_rows()]);

@@ -465,16 +465,6 @@ impl<L: LinearSolver> GenAlpha<L> {
                 sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
                 return Ok(stats);
             }
-            // Dynamic residual at the current iterate.
-            self.update_jacobians(sys, t1, &s.q);
-            sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
-            self.stats.n_residual_evals += 1;
-            self.add_constraint_forces(&s.lambda, &s.mu);
-            let res_norm = inf_norm(&self.r) / c.beta_prime;
-            stats.residual_norm = res_norm;
-            if !res_norm.is_finite() {
-                return Err(Error::NonFinite { t: t1, iter });
-            }
             // A fresh matrix whose increments grew twice in a row: give up early (the caller
             // halves the step).
             if factorized_this_step && fresh && inc_norm > 2.0 * prev_inc && prev_inc > 2.0 * prev_prev_inc {
@@ -518,13 +508,27 @@ impl<L: LinearSolver> GenAlpha<L> {
                 || (iter == 1 && self.refresh_steps_left > 0)
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
                 || (iter > 4 && !fresh && iterations_to_converge(inc_norm, contraction) > MAX_MORE_ITERATIONS);
+            // Dynamic residual at the current iterate, with the iteration matrix when it is
+            // refactorised here (one pass over the elements).
+            self.update_jacobians(sys, t1, &s.q);
+            if need {
+                self.assemble_with_residual(sys, t1, s);
+            } else {
+                sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
+            }
+            self.stats.n_residual_evals += 1;
+            self.add_constraint_forces(&s.lambda, &s.mu);
+            let res_norm = inf_norm(&self.r) / c.beta_prime;
+            stats.residual_norm = res_norm;
+            if !res_norm.is_finite() {
+                return Err(Error::NonFinite { t: t1, iter });
+            }
             if need {
                 if iter > 1 && !factorized_this_step {
                     // The matrix of an earlier step did not contract: the matrix changes fast,
                     // so refresh it at the predictor for the next steps.
                     self.refresh_steps_left = REFRESH_STEPS;
                 }
-                self.assemble(sys, t1, s);
                 self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })?;
                 self.have_factorization = true;
                 stats.n_factorizations += 1;
@@ -584,18 +588,20 @@ impl<L: LinearSolver> GenAlpha<L> {
         })
     }
 
-    /// Assemble the scaled iteration matrix at the current iterate.
-    fn assemble<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
+    /// Assemble the scaled iteration matrix at the current iterate, and evaluate the residual
+    /// there into `self.r` (without constraint forces).
+    fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
         self.clear_added_blocks();
         {
             let mut k = self.matrix.block(0, 0, n, n);
-            sys.iteration_matrix_inplace(
+            sys.residual_and_iteration_matrix_inplace(
                 t1,
                 &s.q,
                 &s.v,
                 &s.v_dot,
+                &mut self.r,
                 1.0,
                 c.gamma_prime / c.beta_prime,
                 1.0 / c.beta_prime,

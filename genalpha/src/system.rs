@@ -55,6 +55,26 @@ pub trait ConstrainedSystem {
         k: &mut MatView<'_>,
     );
 
+    /// The residual and `k += c_m ∂r/∂v_dot + c_c ∂r/∂v + c_k ∂r/∂q` at the same state, for
+    /// models whose matrix evaluation produces the residual on the way (the integrator calls this
+    /// whenever it refactorises). Must give the same values as the two calls. Default: the two.
+    #[allow(clippy::too_many_arguments)] // the union of the two methods' arguments
+    fn residual_and_iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        r: &mut [f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        self.residual_inplace(t, q, v, v_dot, r);
+        self.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
+    }
+
     /// Holonomic constraint residual Φ(q) (length `n_holonomic`).
     fn phi_inplace(&self, _t: f64, _q: &[f64], _phi: &mut [f64]) {}
     /// `j += Φ_q`, an `n_holonomic × n_dof` view.
