@@ -51,31 +51,36 @@ fn relative_blocks(e: &[f64]) -> [[f64; 3]; N_BLOCKS] {
     b
 }
 
-/// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors.
+/// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors, with the diagonal
+/// halved (`½ e_a·e_a`), so that every strain is `s = Σ_{a≤b} h g[a][b]` over its Hessian pairs.
 #[inline]
 fn gram(b: &[[f64; 3]; N_BLOCKS]) -> [[f64; N_BLOCKS]; N_BLOCKS] {
     let mut g = [[0.0; N_BLOCKS]; N_BLOCKS];
     for a in 1..N_BLOCKS {
-        for c in a..N_BLOCKS {
+        g[a][a] = 0.5 * dot(&b[a], &b[a]);
+        for c in a + 1..N_BLOCKS {
             g[a][c] = dot(&b[a], &b[c]);
         }
     }
     g // row and column 0 stay zero: block 0 is the origin of the relative positions
 }
 
-/// `s = Σ_{a<b} h e_a·e_b + ½ Σ_a h e_a·e_a` from the Gram products.
+/// `s = Σ_{a<b} h e_a·e_b + ½ Σ_a h e_a·e_a` from the Gram products (diagonal halved).
 #[inline]
 fn strain_from_gram(s: &SampledStrain, g: &[[f64; N_BLOCKS]; N_BLOCKS]) -> f64 {
-    s.pairs[..s.n_pairs].iter().map(|&(a, b, h)| if a == b { 0.5 * h * g[a][a] } else { h * g[a][b] }).sum()
+    s.pairs[..s.n_pairs].iter().map(|&(a, b, h)| h * g[a][b]).sum()
 }
 
-/// `out += (m ⊗ I₃) x` for a symmetric 8×8 `m` given by its upper triangle.
+/// `out += (m ⊗ I₃) x` for a symmetric 8×8 `m` given by its upper triangle (the lower one is
+/// overwritten with the mirror image).
 #[inline]
-fn add_symmetric_times(m: &[[f64; N_BLOCKS]; N_BLOCKS], x: &[[f64; 3]; N_BLOCKS], out: &mut [f64]) {
-    for a in 0..N_BLOCKS {
+fn add_symmetric_times(m: &mut [[f64; N_BLOCKS]; N_BLOCKS], x: &[[f64; 3]; N_BLOCKS], out: &mut [f64]) {
+    for (a, c) in (1..N_BLOCKS).flat_map(|a| (0..a).map(move |c| (a, c))) {
+        m[a][c] = m[c][a];
+    }
+    for (a, row) in m.iter().enumerate() {
         let mut acc = [0.0; 3];
-        for (c, xc) in x.iter().enumerate() {
-            let h = if a <= c { m[a][c] } else { m[c][a] };
+        for (h, xc) in row.iter().zip(x) {
             acc[0] += h * xc[0];
             acc[1] += h * xc[1];
             acc[2] += h * xc[2];
@@ -201,7 +206,7 @@ impl Element {
                 m[a][b] += cd * h;
             }
         }
-        add_symmetric_times(&m, &x, out);
+        add_symmetric_times(&mut m, &x, out);
         u
     }
 
