@@ -1,4 +1,6 @@
 //! Time the kernels of one Newton iteration on the β = 45° pendulum, deformed state.
+use ancf::elastic_force::ElementMatrix;
+use ancf::element::Element;
 use ancf::{Model, Options, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseLu, DenseMatrix, IntegratorParams, LinearSolver};
 use std::time::Instant;
@@ -38,6 +40,18 @@ fn main() {
         let c = *ga.coefficients();
         let mut r = vec![0.0; n];
         time("residual", 2000, || model.residual_inplace(0.0, &s.q, &s.v, &s.v_dot, &mut r));
+        if path == SolvePath::Dae {
+            // one element of the first body at the deformed state
+            let o = model.options();
+            let el = Element::new(0.1, &bodies[0].section, o.curvature, o.penalty_factor, o.shear_gradient_factor);
+            let e = &s.q[12..36];
+            let mut f = [0.0; 24];
+            time("element force", 20000, || {
+                el.add_elastic_force(e, &mut f);
+            });
+            let mut ke = ElementMatrix::zeros();
+            time("element tangent (upper)", 20000, || el.add_elastic_tangent_upper(e, 1.0, &mut ke));
+        }
         let mut m = DenseMatrix::zeros(n + nh, n + nh);
         time("fill_zero", 2000, || m.fill_zero());
         let assemble = |m: &mut DenseMatrix| {

@@ -51,15 +51,25 @@ fn relative_blocks(e: &[f64]) -> [[f64; 3]; N_BLOCKS] {
     b
 }
 
-/// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors, with the diagonal
-/// halved (`½ e_a·e_a`), so that every strain is `s = Σ_{a≤b} h g[a][b]` over its Hessian pairs.
+/// A quantity of `L` elements evaluated together (one lane per element).
+type Lanes<const L: usize> = [f64; L];
+/// 8×8 block-level matrix of `L` elements.
+type BlockMatrix<const L: usize> = [[Lanes<L>; N_BLOCKS]; N_BLOCKS];
+
+/// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors of `L` elements, with the
+/// diagonal halved (`½ e_a·e_a`), so that every strain is `s = Σ_{a≤b} h g[a][b]` over its
+/// Hessian pairs.
 #[inline]
-fn gram(b: &[[f64; 3]; N_BLOCKS]) -> [[f64; N_BLOCKS]; N_BLOCKS] {
-    let mut g = [[0.0; N_BLOCKS]; N_BLOCKS];
+fn gram<const L: usize>(x: &[[[f64; 3]; N_BLOCKS]; L]) -> BlockMatrix<L> {
+    let mut g = [[[0.0; L]; N_BLOCKS]; N_BLOCKS];
     for a in 1..N_BLOCKS {
-        g[a][a] = 0.5 * dot(&b[a], &b[a]);
+        for l in 0..L {
+            g[a][a][l] = 0.5 * dot(&x[l][a], &x[l][a]);
+        }
         for c in a + 1..N_BLOCKS {
-            g[a][c] = dot(&b[a], &b[c]);
+            for l in 0..L {
+                g[a][c][l] = dot(&x[l][a], &x[l][c]);
+            }
         }
     }
     g // row and column 0 stay zero: block 0 is the origin of the relative positions
@@ -67,27 +77,37 @@ fn gram(b: &[[f64; 3]; N_BLOCKS]) -> [[f64; N_BLOCKS]; N_BLOCKS] {
 
 /// `s = Σ_{a<b} h e_a·e_b + ½ Σ_a h e_a·e_a` from the Gram products (diagonal halved).
 #[inline]
-fn strain_from_gram(s: &SampledStrain, g: &[[f64; N_BLOCKS]; N_BLOCKS]) -> f64 {
-    s.pairs[..s.n_pairs].iter().map(|&(a, b, h)| h * g[a][b]).sum()
+fn strain_from_gram<const L: usize>(s: &SampledStrain, g: &BlockMatrix<L>) -> Lanes<L> {
+    let mut v = [0.0; L];
+    for &(a, b, h) in &s.pairs[..s.n_pairs] {
+        for (vl, gl) in v.iter_mut().zip(&g[a][b]) {
+            *vl += h * gl;
+        }
+    }
+    v
 }
 
-/// `out += (m ⊗ I₃) x` for a symmetric 8×8 `m` given by its upper triangle (the lower one is
-/// overwritten with the mirror image).
+/// `out = (m ⊗ I₃) x` for symmetric 8×8 `m` given by their upper triangles (the lower ones are
+/// overwritten with the mirror image), lane by lane.
 #[inline]
-fn add_symmetric_times(m: &mut [[f64; N_BLOCKS]; N_BLOCKS], x: &[[f64; 3]; N_BLOCKS], out: &mut [f64]) {
+fn symmetric_times<const L: usize>(
+    m: &mut BlockMatrix<L>,
+    x: &[[[f64; 3]; N_BLOCKS]; L],
+    out: &mut [[f64; ELEMENT_DOF]; L],
+) {
     for (a, c) in (1..N_BLOCKS).flat_map(|a| (0..a).map(move |c| (a, c))) {
         m[a][c] = m[c][a];
     }
-    for (a, row) in m.iter().enumerate() {
-        let mut acc = [0.0; 3];
-        for (h, xc) in row.iter().zip(x) {
-            acc[0] += h * xc[0];
-            acc[1] += h * xc[1];
-            acc[2] += h * xc[2];
+    for (l, (xl, ol)) in x.iter().zip(out.iter_mut()).enumerate() {
+        for (row, oa) in m.iter().zip(ol.chunks_exact_mut(3)) {
+            let mut acc = [0.0; 3];
+            for (h, xc) in row.iter().zip(xl) {
+                acc[0] += h[l] * xc[0];
+                acc[1] += h[l] * xc[1];
+                acc[2] += h[l] * xc[2];
+            }
+            oa.copy_from_slice(&acc);
         }
-        out[3 * a] += acc[0];
-        out[3 * a + 1] += acc[1];
-        out[3 * a + 2] += acc[2];
     }
 }
 
@@ -170,12 +190,12 @@ fn strain_gradient(plan: &StrainPlan, s: &crate::strain::SampledStrain, f: &Fiel
 impl Element {
     /// Elastic energy of one element with coordinates `e` (24 numbers), J.
     pub fn elastic_energy(&self, e: &[f64]) -> f64 {
-        let g = gram(&relative_blocks(e));
+        let g = gram(&[relative_blocks(e)]);
         self.plan
             .strains
             .iter()
             .map(|s| {
-                let d = strain_from_gram(s, &g) - s.reference;
+                let d = strain_from_gram(s, &g)[0] - s.reference;
                 0.5 * s.stiffness * d * d
             })
             .sum()
@@ -194,19 +214,35 @@ impl Element {
 
     /// `out += f_el(e)`, the elastic force of one element (24 numbers); returns its energy.
     pub fn add_elastic_force(&self, e: &[f64], out: &mut [f64]) -> f64 {
-        let x = relative_blocks(e);
+        let mut f = [[0.0; ELEMENT_DOF]; 1];
+        let [u] = self.elastic_forces([e], &mut f);
+        for (o, x) in out[..ELEMENT_DOF].iter_mut().zip(&f[0]) {
+            *o += x;
+        }
+        u
+    }
+
+    /// `out[l] = f_el(e[l])`: the elastic forces of `L` elements sharing this kernel, evaluated
+    /// together (every loop over the strain plan serves all lanes); returns their energies.
+    pub fn elastic_forces<const L: usize>(&self, e: [&[f64]; L], out: &mut [[f64; ELEMENT_DOF]; L]) -> Lanes<L> {
+        let x = e.map(relative_blocks);
         let g = gram(&x);
-        let mut m = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ C (s − s⁰) a, upper triangle
-        let mut u = 0.0;
+        let mut m = [[[0.0; L]; N_BLOCKS]; N_BLOCKS]; // Σ C (s − s⁰) a, upper triangle
+        let mut u = [0.0; L];
         for s in &self.plan.strains {
-            let d = strain_from_gram(s, &g) - s.reference;
-            u += 0.5 * s.stiffness * d * d;
-            let cd = s.stiffness * d;
+            let mut cd = strain_from_gram(s, &g);
+            for (ul, c) in u.iter_mut().zip(&mut cd) {
+                let d = *c - s.reference;
+                *ul += 0.5 * s.stiffness * d * d;
+                *c = s.stiffness * d;
+            }
             for &(a, b, h) in &s.pairs[..s.n_pairs] {
-                m[a][b] += cd * h;
+                for (ml, c) in m[a][b].iter_mut().zip(&cd) {
+                    *ml += c * h;
+                }
             }
         }
-        add_symmetric_times(&mut m, &x, out);
+        symmetric_times(&mut m, &x, out);
         u
     }
 
@@ -229,7 +265,7 @@ impl Element {
     /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
-        let gm = gram(&x);
+        let gm = gram(&[x]);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
         let mut grads = [[0.0; ELEMENT_DOF]; MAX_GROUP]; // A e of the group's strains
         let mut weights = [0.0; MAX_GROUP]; // c C of the group's strains
@@ -238,7 +274,7 @@ impl Element {
             let members = group.members();
             for ((&i, g), w) in members.iter().zip(&mut grads).zip(&mut weights) {
                 let s = &self.plan.strains[i];
-                let d = strain_from_gram(s, &gm) - s.reference;
+                let d = strain_from_gram(s, &gm)[0] - s.reference;
                 strain_gradient_inplace(s, &x, g);
                 *w = c * s.stiffness;
                 for &(a, b, h) in &s.pairs[..s.n_pairs] {
@@ -430,6 +466,25 @@ mod tests {
             let fmax = f.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             for (a, b) in f.iter().zip(&f_far) {
                 assert!((a - b).abs() <= 1e-10 * fmax, "{c:?}: {a} vs {b}");
+            }
+        }
+    }
+
+    /// Four elements evaluated together give each element's force and energy exactly.
+    #[test]
+    fn lanes_equal_single_elements() {
+        let l = 0.2;
+        for c in ALL_CURVATURES {
+            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let es: Vec<[f64; 24]> =
+                (0..4).map(|k| deformed(l, &[0.3, -0.7, 0.2 * k as f64, 0.9, -0.4 + 0.1 * k as f64], 0.1)).collect();
+            let mut f = [[0.0; 24]; 4];
+            let u = el.elastic_forces([&es[0][..], &es[1], &es[2], &es[3]], &mut f);
+            for (k, e) in es.iter().enumerate() {
+                let mut single = [0.0; 24];
+                let u1 = el.add_elastic_force(e, &mut single);
+                assert_eq!(u[k], u1, "{c:?} lane {k}");
+                assert_eq!(f[k], single, "{c:?} lane {k}");
             }
         }
     }

@@ -543,12 +543,14 @@ impl Model {
             *ri = -lf * (g + p);
         }
         for b in &self.bodies {
-            for k in 0..b.n_elements() {
-                let first = b.offset + NODE_DOF * k;
-                let range = first..first + ELEMENT_DOF;
-                let out = &mut r[range.clone()];
-                b.element.add_mass_times(1.0, &v_dot[range.clone()], out);
-                b.element.add_elastic_force(&q[range], out);
+            let n = b.n_elements();
+            let mut k = 0;
+            while k + ELEMENT_LANES <= n {
+                add_element_residuals::<ELEMENT_LANES>(b, k, q, v_dot, r);
+                k += ELEMENT_LANES;
+            }
+            for k in k..n {
+                add_element_residuals::<1>(b, k, q, v_dot, r);
             }
         }
         if !self.moments.is_empty() {
@@ -666,6 +668,25 @@ impl Model {
             }
         }
         u
+    }
+}
+
+/// Elements whose elastic forces are evaluated together (see [`Element::elastic_forces`]).
+const ELEMENT_LANES: usize = 4;
+
+/// `r += M_e v̇ + f_el(q)` of the elements `k0..k0 + L` of body `b`, added element by element.
+fn add_element_residuals<const L: usize>(b: &Body, k0: usize, q: &[f64], v_dot: &[f64], r: &mut [f64]) {
+    let first = |l: usize| b.offset + NODE_DOF * (k0 + l);
+    let e: [&[f64]; L] = std::array::from_fn(|l| &q[first(l)..first(l) + ELEMENT_DOF]);
+    let mut f = [[0.0; ELEMENT_DOF]; L];
+    b.element.elastic_forces(e, &mut f);
+    for (l, fl) in f.iter().enumerate() {
+        let range = first(l)..first(l) + ELEMENT_DOF;
+        let out = &mut r[range.clone()];
+        b.element.add_mass_times(1.0, &v_dot[range], out);
+        for (o, x) in out.iter_mut().zip(fl) {
+            *o += x;
+        }
     }
 }
 
