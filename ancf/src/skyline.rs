@@ -41,6 +41,9 @@ pub struct SkylineLu {
     ordered: bool,
     /// Known sparsity: `(n_primary, adjacency)`; indices ≥ `n_primary` are multiplier rows.
     structure: Option<(usize, Vec<Vec<usize>>)>,
+    /// Whether the U column `i` gathers consecutive original rows (`order[first[i]..=i]`).
+    contiguous: Vec<bool>,
+    contiguity_known: bool,
     /// Set by the model while its matrices are symmetric: the entry-by-entry check is skipped.
     symmetric_hint: Option<Arc<AtomicBool>>,
     dense: DenseLu,
@@ -182,6 +185,13 @@ impl SkylineLu {
         if lsize > self.lval.len() || usize_ > self.uval.len() {
             return false;
         }
+        if !self.contiguity_known {
+            for (i, c) in self.contiguous.iter_mut().enumerate() {
+                *c = self.order[self.first[i]..=i].windows(2).all(|w| w[1] == w[0] + 1);
+            }
+            // fixed with the structure; found from every matrix otherwise
+            self.contiguity_known = self.structure.is_some();
+        }
         // Gather the envelope of P A Pᵀ: U columns (with diagonal), and whether the values are
         // symmetric up to round-off (no follower moments): then L = D⁻¹Uᵀ, half the work.
         let mut scale: f64 = 0.0;
@@ -192,8 +202,14 @@ impl SkylineLu {
             let col = &a[oi * n..(oi + 1) * n]; // A[·, order[i]]
             let u_col = self.uval[up..=up + (i - fi)].iter_mut().zip(&self.order[fi..=i]);
             if known_symmetric {
-                for (u, &ok) in u_col {
-                    *u = col[ok];
+                if self.contiguous[i] {
+                    // the rows fi..=i are consecutive original rows: one copy
+                    let o0 = self.order[fi];
+                    self.uval[up..=up + (i - fi)].copy_from_slice(&col[o0..=o0 + (i - fi)]);
+                } else {
+                    for (u, &ok) in u_col {
+                        *u = col[ok];
+                    }
                 }
             } else {
                 for (u, &ok) in u_col {
@@ -456,6 +472,8 @@ impl LinearSolver for SkylineLu {
         self.inv_diag = vec![0.0; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
+        self.contiguous = vec![false; n];
+        self.contiguity_known = false;
         self.ordered = false;
         self.dense.set_dimension(n);
         if let Some((_, adj)) = &self.structure {
