@@ -590,18 +590,18 @@ impl Model {
             (SolvePath::Dae, _) => k.add_block(first, first, ke),
             (SolvePath::Ode, Some(z)) => k.add_block(z, z, ke),
             (SolvePath::Ode, None) => {
-                for a in 0..ELEMENT_DOF {
-                    let ra = self.reduction.row(first + a);
+                let rows: [&[(usize, f64)]; ELEMENT_DOF] = std::array::from_fn(|a| self.reduction.row(first + a));
+                for (a, ra) in rows.iter().enumerate() {
                     if ra.is_empty() {
                         continue;
                     }
-                    for bb in 0..ELEMENT_DOF {
+                    for (bb, rb) in rows.iter().enumerate() {
                         let x = ke[(a, bb)];
                         if x == 0.0 {
                             continue;
                         }
-                        for &(za, ca) in ra {
-                            for &(zb, cb) in self.reduction.row(first + bb) {
+                        for &(za, ca) in *ra {
+                            for &(zb, cb) in *rb {
                                 k.add(za, zb, ca * cb * x);
                             }
                         }
