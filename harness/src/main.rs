@@ -43,7 +43,7 @@ enum Cmd {
         /// Override a case value: `[ancf:|gebf:]path=value`, e.g. `t_end=0.5` or `gebf:joints.1.flare_deg=40`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
-        /// Skip the refinement ladders and the stress matrix (cases only).
+        /// Skip the refinement ladders, the stress matrix and the speed benchmark (cases only).
         #[arg(long)]
         quick: bool,
     },
