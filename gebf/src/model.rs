@@ -452,6 +452,80 @@ impl Model {
         st.map_matrix(&res, &m, &g, &k, c)
     }
 
+    /// The element loop behind the residual and the iteration matrix: `r = M v̇ + g` when `r` is
+    /// given, `k += c_m ∂r/∂v̇ + c_c ∂r/∂v + c_k ∂r/∂q` when the matrix is given, both from one
+    /// evaluation of each element (elements whose CRVs are mapped across π build the matrix by
+    /// the chain rule and take the plain residual path).
+    fn element_pass(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        mut r: Option<&mut [f64]>,
+        mut matrix: Option<(MatrixCoefficients, &mut MatView<'_>)>,
+    ) {
+        if let Some(r) = r.as_deref_mut() {
+            r.fill(0.0);
+        }
+        let ng = self.options.n_gauss_stiffness;
+        let mut res = Vec24::zeros();
+        let mut mat = Mat24::zeros();
+        for b in &self.bodies {
+            let g_a = self.gravity_in_frame(b, q);
+            for e in 0..b.n_elements {
+                res.as_mut_slice().fill(0.0);
+                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
+                let mapped = st.is_mapped();
+                let plain_residual = match &matrix {
+                    None => true,
+                    Some((coeffs, _)) if mapped => {
+                        mat = self.mapped_element_matrix(b, &st, &g_a, *coeffs);
+                        r.is_some()
+                    }
+                    Some((coeffs, _)) => {
+                        mat.as_mut_slice().fill(0.0);
+                        add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, *coeffs)));
+                        // c_k = 0 leaves the stiffness out of the matrix, not out of the residual
+                        let k_part = (coeffs.c_k != 0.0).then_some(coeffs.c_k);
+                        add_elastic(&st, b.le, &b.section, ng, &mut res, k_part.map(|c| (&mut mat, c)));
+                        add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, k_part.map(|c| (&mut mat, c)));
+                        false
+                    }
+                };
+                if plain_residual {
+                    add_inertia(&st, b.le, &b.section, &mut res, None);
+                    add_elastic(&st, b.le, &b.section, ng, &mut res, None);
+                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
+                }
+                if let Some(r) = r.as_deref_mut() {
+                    st.map_residual(&mut res);
+                    for (lr, gr, nr) in local_ranges(b, e) {
+                        for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
+                            *x += y;
+                        }
+                    }
+                }
+                if let Some((_, k)) = matrix.as_mut() {
+                    scatter_matrix(b, e, &mat, k);
+                }
+            }
+        }
+        if self.n_loaded > 0 {
+            for (bi, b) in self.bodies.iter().enumerate() {
+                for (i, l) in self.loads[bi].iter().enumerate().filter(|(_, l)| !l.is_zero()) {
+                    if let Some(r) = r.as_deref_mut() {
+                        add_load(b, i, l, self.load_scale, q, r);
+                    }
+                    if let Some((coeffs, k)) = matrix.as_mut()
+                        && coeffs.c_k != 0.0
+                    {
+                        add_load_tangent(b, i, l, self.load_scale, q, coeffs.c_k, k);
+                    }
+                }
+            }
+        }
+    }
+
     /// Rescale every nodal CRV with |psi| > π to the equivalent one below π, transforming its
     /// rates (`rates = (v, v_dot, a)`) so that the angular velocity and acceleration are kept.
     /// Elements then map their end nodes back onto the middle node's branch (exact chain rule),
@@ -527,33 +601,7 @@ impl ConstrainedSystem for Model {
     }
 
     fn residual_inplace(&self, _t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
-        r.iter_mut().for_each(|x| *x = 0.0);
-        let mut res = Vec24::zeros();
-        for b in &self.bodies {
-            let g_a = self.gravity_in_frame(b, q);
-            for e in 0..b.n_elements {
-                res.as_mut_slice().fill(0.0);
-                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
-                add_inertia(&st, b.le, &b.section, &mut res, None);
-                add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
-                add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
-                st.map_residual(&mut res);
-                for (lr, gr, nr) in local_ranges(b, e) {
-                    for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
-                        *x += y;
-                    }
-                }
-            }
-        }
-        if self.n_loaded > 0 {
-            for (bi, b) in self.bodies.iter().enumerate() {
-                for (i, l) in self.loads[bi].iter().enumerate() {
-                    if !l.is_zero() {
-                        add_load(b, i, l, self.load_scale, q, r);
-                    }
-                }
-            }
-        }
+        self.element_pass(q, v, v_dot, Some(r), None);
     }
 
     fn iteration_matrix_inplace(
@@ -567,43 +615,14 @@ impl ConstrainedSystem for Model {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        let mut res = Vec24::zeros();
-        let mut mat = Mat24::zeros();
-        let coeffs = MatrixCoefficients { c_m, c_c, c_k };
-        for b in &self.bodies {
-            let g_a = self.gravity_in_frame(b, q);
-            for e in 0..b.n_elements {
-                mat.as_mut_slice().fill(0.0);
-                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
-                if st.is_mapped() {
-                    mat = self.mapped_element_matrix(b, &st, &g_a, coeffs);
-                } else {
-                    add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
-                    if c_k != 0.0 {
-                        let ng = self.options.n_gauss_stiffness;
-                        add_elastic(&st, b.le, &b.section, ng, &mut res, Some((&mut mat, c_k)));
-                        add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
-                    }
-                }
-                scatter_matrix(b, e, &mat, k);
-            }
-        }
-        if self.n_loaded > 0 && c_k != 0.0 {
-            for (bi, b) in self.bodies.iter().enumerate() {
-                for (i, l) in self.loads[bi].iter().enumerate() {
-                    if !l.is_zero() {
-                        add_load_tangent(b, i, l, self.load_scale, q, c_k, k);
-                    }
-                }
-            }
-        }
+        self.element_pass(q, v, v_dot, None, Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
     }
 
     /// One pass over the elements: the element routines produce the residual while they build
-    /// the matrix (elements whose CRVs are mapped across π take the separate residual path).
+    /// the matrix.
     fn residual_and_iteration_matrix_inplace(
         &self,
-        t: f64,
+        _t: f64,
         q: &[f64],
         v: &[f64],
         v_dot: &[f64],
@@ -613,51 +632,7 @@ impl ConstrainedSystem for Model {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        if c_k == 0.0 {
-            self.residual_inplace(t, q, v, v_dot, r);
-            self.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
-            return;
-        }
-        r.iter_mut().for_each(|x| *x = 0.0);
-        let mut res = Vec24::zeros();
-        let mut mat = Mat24::zeros();
-        let coeffs = MatrixCoefficients { c_m, c_c, c_k };
-        let ng = self.options.n_gauss_stiffness;
-        for b in &self.bodies {
-            let g_a = self.gravity_in_frame(b, q);
-            for e in 0..b.n_elements {
-                res.as_mut_slice().fill(0.0);
-                mat.as_mut_slice().fill(0.0);
-                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
-                if st.is_mapped() {
-                    mat = self.mapped_element_matrix(b, &st, &g_a, coeffs);
-                    add_inertia(&st, b.le, &b.section, &mut res, None);
-                    add_elastic(&st, b.le, &b.section, ng, &mut res, None);
-                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
-                } else {
-                    add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, coeffs)));
-                    add_elastic(&st, b.le, &b.section, ng, &mut res, Some((&mut mat, c_k)));
-                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, Some((&mut mat, c_k)));
-                }
-                st.map_residual(&mut res);
-                for (lr, gr, nr) in local_ranges(b, e) {
-                    for (x, y) in r[gr..gr + nr].iter_mut().zip(&res.as_slice()[lr..lr + nr]) {
-                        *x += y;
-                    }
-                }
-                scatter_matrix(b, e, &mat, k);
-            }
-        }
-        if self.n_loaded > 0 {
-            for (bi, b) in self.bodies.iter().enumerate() {
-                for (i, l) in self.loads[bi].iter().enumerate() {
-                    if !l.is_zero() {
-                        add_load(b, i, l, self.load_scale, q, r);
-                        add_load_tangent(b, i, l, self.load_scale, q, c_k, k);
-                    }
-                }
-            }
-        }
+        self.element_pass(q, v, v_dot, Some(r), Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
     }
 
     fn psi_inplace(&self, _t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
