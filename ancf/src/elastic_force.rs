@@ -16,7 +16,9 @@
 
 use crate::element::Element;
 use crate::shape::{ELEMENT_DOF, N_BLOCKS};
-use crate::strain::{MAX_FIELDS, MAX_GROUP, N_STRAINS, SampledStrain, StrainKind, StrainPlan, dot, strain_value};
+use crate::strain::{
+    MAX_FIELDS, MAX_GROUP, N_STRAINS, SampledStrain, StrainGroup, StrainKind, StrainPlan, dot, strain_value,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// 24×24 element matrix.
@@ -111,49 +113,57 @@ fn symmetric_times<const L: usize>(
     }
 }
 
-/// `g = A e = (a ⊗ I₃) e` of one strain as a 24-vector, from its Hessian entries.
+/// The tangent terms of the `M` strains of one group on its `NB` (compact, padded) blocks:
+///
+/// 1. the gradients `u_m = (a_m ⊗ I₃) x` on the group's blocks, from the compact Hessians
+///    (register accumulators, no scatter), and the strains `s_m = ½ x·u_m`;
+/// 2. the geometric weights `c C_m (s_m − s⁰_m)` on the Hessian pairs into `geometric`;
+/// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a ≤ b`,
+///    diagonal blocks in full) at a time with fixed-size loops.
 #[inline]
-fn strain_gradient_inplace(s: &SampledStrain, x: &[[f64; 3]; N_BLOCKS], g: &mut [f64; ELEMENT_DOF]) {
-    *g = [0.0; ELEMENT_DOF];
-    for &(a, b, h) in &s.pairs[..s.n_pairs] {
-        for i in 0..3 {
-            g[3 * a + i] += h * x[b][i];
-        }
-        if a != b {
-            for i in 0..3 {
-                g[3 * b + i] += h * x[a][i];
-            }
-        }
-    }
-}
-
-/// `K += Σ_m w_m g_m g_mᵀ` (the first `M` gradients of a group) on the upper block triangle of
-/// the group's blocks (ascending): column by column, one contiguous update over the rows from
-/// the first block to the column's block (the few zero rows of unused blocks in between cost
-/// less than the branching that would skip them).
-#[inline]
-fn add_rank_update<const M: usize>(
-    blocks: &[usize],
-    g: &[[f64; ELEMENT_DOF]; MAX_GROUP],
-    w: &[f64; MAX_GROUP],
+fn add_group_tangent<const M: usize, const NB: usize>(
+    plan: &StrainPlan,
+    group: &StrainGroup,
+    x: &[[f64; 3]; N_BLOCKS],
+    c: f64,
+    geometric: &mut [[f64; N_BLOCKS]; N_BLOCKS],
     cols: &mut [[f64; ELEMENT_DOF]; ELEMENT_DOF],
 ) {
-    let Some(&first) = blocks.first() else { return };
-    let lo = 3 * first;
-    for &bj in blocks {
-        let hi = (3 * bj + 3).min(ELEMENT_DOF);
-        for j in 3 * bj..hi {
-            let x: [f64; M] = std::array::from_fn(|m| w[m] * g[m][j]);
-            if x.iter().all(|&v| v == 0.0) {
-                continue;
-            }
-            let col = &mut cols[j];
-            for i in lo..hi {
-                let mut acc = 0.0;
-                for m in 0..M {
-                    acc += x[m] * g[m][i];
+    let blocks: [usize; NB] = std::array::from_fn(|i| group.blocks[i]);
+    let xb: [[f64; 3]; NB] = blocks.map(|b| x[b]);
+    let hessians = &plan.group_hessians[group.hessian_start..][..M * NB * NB];
+    let mut u = [[[0.0; 3]; NB]; M]; // ∂s_m/∂x on the group's blocks
+    let mut wu = [[[0.0; 3]; NB]; M]; // c C_m ∂s_m/∂x
+    for (m, h) in hessians.chunks_exact(NB * NB).enumerate() {
+        let s = &plan.strains[group.members[m]];
+        let mut value = 0.0;
+        for ((um, row), xi) in u[m].iter_mut().zip(h.chunks_exact(NB)).zip(&xb) {
+            for (hij, xj) in row.iter().zip(&xb) {
+                for (ui, xjc) in um.iter_mut().zip(xj) {
+                    *ui += hij * xjc;
                 }
-                col[i] += acc;
+            }
+            value += 0.5 * dot(xi, um);
+        }
+        let w = c * s.stiffness;
+        let wd = w * (value - s.reference);
+        for &(a, b, h) in &s.pairs[..s.n_pairs] {
+            geometric[a][b] += wd * h;
+        }
+        wu[m] = u[m].map(|v| v.map(|x| w * x));
+    }
+    for (j, &b) in blocks.iter().enumerate() {
+        for (i, &a) in blocks[..=j].iter().enumerate() {
+            for (jj, col) in cols[3 * b..3 * b + 3].iter_mut().enumerate() {
+                let mut acc = [0.0; 3];
+                for m in 0..M {
+                    for (ac, ua) in acc.iter_mut().zip(&u[m][i]) {
+                        *ac += wu[m][j][jj] * ua;
+                    }
+                }
+                for (k, ac) in col[3 * a..3 * a + 3].iter_mut().zip(acc) {
+                    *k += ac;
+                }
             }
         }
     }
@@ -258,36 +268,33 @@ impl Element {
     /// diagonal blocks in full); [`mirror_upper_inplace`] completes the symmetric matrix, so that
     /// it is exactly symmetric.
     ///
-    /// The rank-one terms `C (A e)(A e)ᵀ` of the strains of one [`StrainGroup`] (equal block
-    /// sets) are summed in one pass over the columns of their blocks; the geometric terms
-    /// `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8 block level and added last.
+    /// The strains are taken a [`StrainGroup`] (equal block sets) at a time, see
+    /// [`add_group_tangent`]; the geometric terms `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8
+    /// block level and added last.
     ///
     /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
-        let gm = gram(&[x]);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
-        let mut grads = [[0.0; ELEMENT_DOF]; MAX_GROUP]; // A e of the group's strains
-        let mut weights = [0.0; MAX_GROUP]; // c C of the group's strains
         let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
         for group in &self.plan.groups {
-            let members = group.members();
-            for ((&i, g), w) in members.iter().zip(&mut grads).zip(&mut weights) {
-                let s = &self.plan.strains[i];
-                let d = strain_from_gram(s, &gm)[0] - s.reference;
-                strain_gradient_inplace(s, &x, g);
-                *w = c * s.stiffness;
-                for &(a, b, h) in &s.pairs[..s.n_pairs] {
-                    geometric[a][b] += *w * d * h;
-                }
+            let (plan, g) = (&self.plan, &mut geometric);
+            macro_rules! members {
+                ($nb:literal) => {
+                    match group.n_members {
+                        1 => add_group_tangent::<1, $nb>(plan, group, &x, c, g, cols),
+                        2 => add_group_tangent::<2, $nb>(plan, group, &x, c, g, cols),
+                        3 => add_group_tangent::<3, $nb>(plan, group, &x, c, g, cols),
+                        _ => add_group_tangent::<MAX_GROUP, $nb>(plan, group, &x, c, g, cols),
+                    }
+                };
             }
-            let s = &self.plan.strains[members[0]];
-            let blocks = &s.blocks[..s.n_blocks];
-            match members.len() {
-                1 => add_rank_update::<1>(blocks, &grads, &weights, cols),
-                2 => add_rank_update::<2>(blocks, &grads, &weights, cols),
-                3 => add_rank_update::<3>(blocks, &grads, &weights, cols),
-                _ => add_rank_update::<MAX_GROUP>(blocks, &grads, &weights, cols),
+            match group.n_blocks {
+                1 => members!(1),
+                2 => members!(2),
+                4 => members!(4),
+                6 => members!(6),
+                _ => members!(8),
             }
         }
         for b in 0..N_BLOCKS {

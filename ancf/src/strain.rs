@@ -191,6 +191,15 @@ pub struct StrainGroup {
     pub n_members: usize,
     /// Indices into [`StrainPlan::strains`] (first `n_members`).
     pub members: [usize; MAX_GROUP],
+    /// Number of blocks of the compact block set, padded to one of 1, 2, 4, 6, 8 (the sizes the
+    /// tangent kernel is compiled for).
+    pub n_blocks: usize,
+    /// The compact block set: the members' blocks ascending, then the last one repeated as
+    /// padding (first `n_blocks` entries).
+    pub blocks: [usize; N_BLOCKS],
+    /// Start of the members' compact Hessians in [`StrainPlan::group_hessians`]: member `m`'s
+    /// `n_blocks × n_blocks` row-major block `hessian[blocks[i]][blocks[j]]` (zero on padding).
+    pub hessian_start: usize,
 }
 
 impl StrainGroup {
@@ -211,10 +220,13 @@ pub struct StrainPlan {
     /// The strains partitioned into groups with equal block sets (at most [`MAX_GROUP`] each),
     /// in the order of their first member.
     pub groups: Vec<StrainGroup>,
+    /// The compact Hessians of the groups' members (see [`StrainGroup::hessian_start`]).
+    pub group_hessians: Vec<f64>,
 }
 
-/// Partition strains into groups with equal block sets, at most [`MAX_GROUP`] per group.
-fn group_strains(strains: &[SampledStrain]) -> Vec<StrainGroup> {
+/// Partition strains into groups with equal block sets, at most [`MAX_GROUP`] per group, and
+/// lay out their compact Hessians.
+fn group_strains(strains: &[SampledStrain]) -> (Vec<StrainGroup>, Vec<f64>) {
     let mut groups: Vec<StrainGroup> = Vec::new();
     for (i, s) in strains.iter().enumerate() {
         let same = |g: &&mut StrainGroup| {
@@ -226,10 +238,32 @@ fn group_strains(strains: &[SampledStrain]) -> Vec<StrainGroup> {
                 g.members[g.n_members] = i;
                 g.n_members += 1;
             }
-            None => groups.push(StrainGroup { n_members: 1, members: [i, 0, 0, 0] }),
+            None => {
+                let n = s.n_blocks.max(1);
+                let n_blocks = if matches!(n, 1 | 2 | 4 | 6 | 8) { n } else { n + 1 };
+                let mut blocks = s.blocks;
+                for k in n..n_blocks {
+                    blocks[k] = blocks[n - 1];
+                }
+                groups.push(StrainGroup { n_members: 1, members: [i, 0, 0, 0], n_blocks, blocks, hessian_start: 0 })
+            }
         }
     }
-    groups
+    let mut hessians = Vec::new();
+    for g in &mut groups {
+        g.hessian_start = hessians.len();
+        let real = strains[g.members[0]].n_blocks;
+        for &m in g.members() {
+            let h = &strains[m].hessian;
+            for i in 0..g.n_blocks {
+                for j in 0..g.n_blocks {
+                    let inside = i < real && j < real;
+                    hessians.push(if inside { h[g.blocks[i]][g.blocks[j]] } else { 0.0 });
+                }
+            }
+        }
+    }
+    (groups, hessians)
 }
 
 /// Element coordinates of a straight, unstrained element of length `l` along the global x axis.
@@ -434,8 +468,8 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
     for s in &mut bld.strains {
         s.reference = strain_value(s, &f0);
     }
-    let groups = group_strains(&bld.strains);
-    StrainPlan { fields: bld.fields, strains: bld.strains, groups }
+    let (groups, group_hessians) = group_strains(&bld.strains);
+    StrainPlan { fields: bld.fields, strains: bld.strains, groups, group_hessians }
 }
 
 #[cfg(test)]
