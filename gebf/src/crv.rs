@@ -102,6 +102,18 @@ fn horner(c: &[f64; N_TERMS], s: f64) -> f64 {
     c[..n_terms(s)].iter().rev().fold(0.0, |acc, ck| acc * s + ck)
 }
 
+/// Several series at the same `s` in one Horner loop (the same operations as [`horner`] each).
+#[inline]
+fn horner_all<const M: usize>(c: [&[f64; N_TERMS]; M], s: f64) -> [f64; M] {
+    let mut acc = [0.0; M];
+    for i in (0..n_terms(s)).rev() {
+        for (a, ck) in acc.iter_mut().zip(&c) {
+            *a = *a * s + ck[i];
+        }
+    }
+    acc
+}
+
 /// Scalar coefficients of `T(psi) = I + a·psĩ + b·psĩ²` and their first and second derivatives
 /// with respect to `s = |psi|²`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,40 +133,56 @@ pub struct TangentCoefficients {
 }
 
 impl TangentCoefficients {
-    /// Coefficients at the CRV `psi` (all derivatives).
+    /// Coefficients at the CRV `psi` (all derivatives, one `sin_cos`).
     pub fn new(psi: &V3) -> Self {
-        let mut k = Self::first_order(psi);
-        (k.dda, k.ddb) = Self::second_order(psi.norm_squared());
-        k
+        Self::evaluate(psi.norm_squared(), true)
     }
 
     /// α, β and their first derivatives; the second derivatives are left at zero.
     pub fn first_order(psi: &V3) -> Self {
-        let s = psi.norm_squared();
+        Self::evaluate(psi.norm_squared(), false)
+    }
+
+    /// The coefficients at `s = |psi|²`, the second derivatives only if `second` (else zero).
+    fn evaluate(s: f64, second: bool) -> Self {
         let phi = s.sqrt();
         if phi < SERIES_LIMIT {
-            Self {
-                a: horner(&SERIES_A, s),
-                b: horner(&SERIES_B, s),
-                da: horner(&SERIES_DA, s),
-                db: horner(&SERIES_DB, s),
-                dda: 0.0,
-                ddb: 0.0,
+            if second {
+                let [a, b, da, db, dda, ddb] =
+                    horner_all([&SERIES_A, &SERIES_B, &SERIES_DA, &SERIES_DB, &SERIES_DDA, &SERIES_DDB], s);
+                Self { a, b, da, db, dda, ddb }
+            } else {
+                let [a, b, da, db] = horner_all([&SERIES_A, &SERIES_B, &SERIES_DA, &SERIES_DB], s);
+                Self { a, b, da, db, dda: 0.0, ddb: 0.0 }
             }
         } else {
             let (sn, c) = phi.sin_cos();
             let p3 = s * phi;
             let p4 = s * s;
             let p5 = p4 * phi;
+            let (dda, ddb) = if second { Self::closed_second(s, phi, sn, c) } else { (0.0, 0.0) };
             Self {
                 a: (c - 1.0) / s,
                 b: (phi - sn) / p3,
                 da: -sn / (2.0 * p3) - (c - 1.0) / p4,
                 db: -1.0 / p4 - c / (2.0 * p4) + 1.5 * sn / p5,
-                dda: 0.0,
-                ddb: 0.0,
+                dda,
+                ddb,
             }
         }
+    }
+
+    /// Closed-form (d²α/ds², d²β/ds²) from `s`, `phi = √s`, `sin phi`, `cos phi`.
+    #[inline]
+    fn closed_second(s: f64, phi: f64, sn: f64, c: f64) -> (f64, f64) {
+        let p4 = s * s;
+        let p5 = p4 * phi;
+        let p6 = p4 * s;
+        let p7 = p6 * phi;
+        (
+            -c / (4.0 * p4) + 1.25 * sn / p5 + 2.0 * (c - 1.0) / p6,
+            2.0 / p6 + sn / (4.0 * p5) + 1.75 * c / p6 - 3.75 * sn / p7,
+        )
     }
 
     /// (d²α/ds², d²β/ds²) at `s = |psi|²`.
@@ -164,14 +192,7 @@ impl TangentCoefficients {
             (horner(&SERIES_DDA, s), horner(&SERIES_DDB, s))
         } else {
             let (sn, c) = phi.sin_cos();
-            let p4 = s * s;
-            let p5 = p4 * phi;
-            let p6 = p4 * s;
-            let p7 = p6 * phi;
-            (
-                -c / (4.0 * p4) + 1.25 * sn / p5 + 2.0 * (c - 1.0) / p6,
-                2.0 / p6 + sn / (4.0 * p5) + 1.75 * c / p6 - 3.75 * sn / p7,
-            )
+            Self::closed_second(s, phi, sn, c)
         }
     }
 
@@ -231,25 +252,6 @@ pub fn tangent_inverse(psi: &V3) -> M3 {
     M3::identity() + p * 0.5 + p * p * c
 }
 
-/// Directional derivative of `T_σ` along `b`: `Σ_j b_j ∂T_σ/∂psi_j`.
-fn tangent_dir_with(psi: &V3, k: &TangentCoefficients, sigma: f64, b: &V3) -> M3 {
-    let p = skew(psi);
-    let bt = skew(b);
-    let pb = psi.dot(b);
-    bt * (sigma * k.a) + p * (2.0 * sigma * k.da * pb) + (bt * p + p * bt) * k.b + p * p * (2.0 * k.db * pb)
-}
-
-/// Jacobian `∂(T_σ(psi) a)/∂psi`.
-fn tangent_jacobian_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3) -> M3 {
-    let pa = psi.cross(a);
-    let ppa = psi.cross(&pa);
-    let psa = psi.dot(a);
-    skew(a) * (-sigma * k.a)
-        + pa * psi.transpose() * (2.0 * sigma * k.da)
-        + (M3::identity() * psa + psi * a.transpose() - a * psi.transpose() * 2.0) * k.b
-        + ppa * psi.transpose() * (2.0 * k.db)
-}
-
 /// `∂/∂psi [ (Σ_j b_j ∂T_σ/∂psi_j) a ]`: second derivative of `T_σ a` contracted with `b` on one
 /// derivative index.
 fn tangent_second_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3, b: &V3) -> M3 {
@@ -270,31 +272,74 @@ fn tangent_second_with(psi: &V3, k: &TangentCoefficients, sigma: f64, a: &V3, b:
     t1 + t2 + t3 + t4
 }
 
+/// `skew(a) · m` from the cross products of the columns (cheaper than the matrix product).
+#[inline]
+pub(crate) fn skew_mul(a: &V3, m: &M3) -> M3 {
+    M3::from_fn(|i, j| {
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        a[i1] * m[(i2, j)] - a[i2] * m[(i1, j)]
+    })
+}
+
+/// The outer product `u vᵀ`.
+#[inline]
+fn outer(u: &V3, v: &V3) -> M3 {
+    u * v.transpose()
+}
+
+/// `d I + skew(w)`.
+#[inline]
+fn diag_skew(d: f64, w: &V3) -> M3 {
+    M3::new(d, -w.z, w.y, w.z, d, -w.x, -w.y, w.x, d)
+}
+
 /// The tangential operator and its derivatives at one CRV, sharing the scalar coefficients.
+///
+/// Every derivative is written as `d I + skew(w) + Σ u vᵀ` with few outer products (the
+/// identities `ã b̃ = b aᵀ − (a·b) I` and `psĩ² = psi psiᵀ − s I` turn the products of skew
+/// matrices into outer products).
 #[derive(Debug, Clone, Copy)]
 pub struct Tangent {
     /// The CRV.
     pub psi: V3,
-    /// Scalar coefficients (first order; the second derivatives are evaluated on demand).
+    /// Scalar coefficients (the second derivatives only if built by [`Tangent::with_second_order`]).
     pub k: TangentCoefficients,
     /// `T(psi)`.
     pub t: M3,
+    /// `psĩ²`.
+    pp: M3,
+    /// Whether `k` holds the second derivatives.
+    second: bool,
 }
 
 impl Tangent {
-    /// Evaluate at `psi`.
+    /// Evaluate at `psi` (first-order coefficients; [`Tangent::second`] and
+    /// [`Tangent::hessian`] then evaluate the second-order ones on demand).
     pub fn new(psi: &V3) -> Self {
-        let k = TangentCoefficients::first_order(psi);
-        Self { psi: *psi, k, t: tangent_with(psi, &k, 1.0) }
+        Self::build(psi, TangentCoefficients::first_order(psi), false)
+    }
+    /// Evaluate at `psi` with all coefficients (one `sin_cos`), for the tangent matrices.
+    pub fn with_second_order(psi: &V3) -> Self {
+        Self::build(psi, TangentCoefficients::new(psi), true)
+    }
+    fn build(psi: &V3, k: TangentCoefficients, second: bool) -> Self {
+        // psĩ² = psi psiᵀ − s I
+        let pp = outer(psi, psi) - M3::identity() * psi.norm_squared();
+        Self { psi: *psi, k, t: diag_skew(1.0, &(psi * k.a)) + pp * k.b, pp, second }
     }
     /// The rotation matrix `C(psi)` (C^{AB}), from the same coefficients.
     #[inline]
     pub fn rotation(&self) -> M3 {
-        self.k.rotation(&self.psi)
+        let s = self.psi.norm_squared();
+        diag_skew(1.0, &(self.psi * (1.0 - s * self.k.b))) - self.pp * self.k.a
     }
     /// `dT[b] = Σ_j b_j ∂T/∂psi_j`, so that `dT[b] a = ∂(T a)/∂psi · b`.
     pub fn dir(&self, b: &V3) -> M3 {
-        tangent_dir_with(&self.psi, &self.k, 1.0, b)
+        let (k, p) = (&self.k, &self.psi);
+        let pb = p.dot(b);
+        diag_skew(-2.0 * k.b * pb, &(b * k.a + p * (2.0 * k.da * pb)))
+            + (outer(b, p) + outer(p, b)) * k.b
+            + self.pp * (2.0 * k.db * pb)
     }
     /// The vector `dT[b] a` (cheaper than `dir(b) * a`).
     pub fn dir_vec(&self, b: &V3, a: &V3) -> V3 {
@@ -306,22 +351,50 @@ impl Tangent {
             + (b.cross(&pa) + p.cross(&b.cross(a))) * k.b
             + p.cross(&pa) * (2.0 * k.db * pb)
     }
+    /// `∂(T_σ a)/∂psi` (σ = 1: T, σ = −1: Tᵀ).
+    fn jac_with(&self, sigma: f64, a: &V3) -> M3 {
+        let (k, p) = (&self.k, &self.psi);
+        let pa = p.cross(a);
+        let u = pa * (2.0 * sigma * k.da) + p.cross(&pa) * (2.0 * k.db) - a * (2.0 * k.b);
+        diag_skew(k.b * p.dot(a), &(a * (-sigma * k.a))) + outer(&u, p) + outer(p, a) * k.b
+    }
     /// `∂(T a)/∂psi`.
     pub fn jac(&self, a: &V3) -> M3 {
-        tangent_jacobian_with(&self.psi, &self.k, 1.0, a)
+        self.jac_with(1.0, a)
     }
     /// `∂(Tᵀ b)/∂psi`.
     pub fn jac_t(&self, b: &V3) -> M3 {
-        tangent_jacobian_with(&self.psi, &self.k, -1.0, b)
+        self.jac_with(-1.0, b)
     }
     fn full(&self) -> TangentCoefficients {
         let mut k = self.k;
-        (k.dda, k.ddb) = TangentCoefficients::second_order(self.psi.norm_squared());
+        if !self.second {
+            (k.dda, k.ddb) = TangentCoefficients::second_order(self.psi.norm_squared());
+        }
         k
     }
     /// `∂/∂psi [dT[b] a]` (a, b fixed).
     pub fn second(&self, a: &V3, b: &V3) -> M3 {
         tangent_second_with(&self.psi, &self.full(), 1.0, a, b)
+    }
+    /// `∂/∂psi [T c + dT[a] a]`: the Jacobian of the rotational acceleration
+    /// `T psi_ddot + dT[psi_dot] psi_dot` for `a = psi_dot`, `c = psi_ddot` (equal to
+    /// `jac(c) + second(a, a)`, collected into three outer products).
+    pub fn acceleration_jac(&self, a: &V3, c: &V3) -> M3 {
+        let k = self.full();
+        let p = &self.psi;
+        let (pa, pc) = (p.cross(a), p.cross(c));
+        let ppa = p.cross(&pa);
+        let (psa, aa) = (p.dot(a), a.dot(a));
+        let u = pc * (2.0 * k.da) + p.cross(&pc) * (2.0 * k.db) - c * (2.0 * k.b)
+            + pa * (4.0 * k.dda * psa)
+            + p * (2.0 * k.db * aa)
+            - a * (6.0 * k.db * psa)
+            + ppa * (4.0 * k.ddb * psa);
+        let v = pa * (2.0 * k.da) - a * k.b + p * (2.0 * k.db * psa) + ppa * (2.0 * k.db);
+        let d = k.b * (p.dot(c) + aa) + 2.0 * k.db * psa * psa;
+        let w = c * (-k.a) - a * (2.0 * k.da * psa);
+        diag_skew(d, &w) + outer(&u, p) + outer(p, c) * k.b + outer(&v, a)
     }
     /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar
     /// `f = mᵀ T a = mᵀa + α L + β Q` with `L = psi·(a × m)` and
@@ -329,18 +402,16 @@ impl Tangent {
     pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
         let k = self.full();
         let p = &self.psi;
-        let i3 = M3::identity();
         let axm = a.cross(m);
         let (ma, mp, pa) = (m.dot(a), m.dot(p), p.dot(a));
         let l = p.dot(&axm);
         let q = mp * pa - p.norm_squared() * ma;
         let grad_q = m * pa + a * mp - p * (2.0 * ma);
-        let ppt = p * p.transpose();
-        (i3 * (2.0 * k.da) + ppt * (4.0 * k.dda)) * l
-            + (p * axm.transpose() + axm * p.transpose()) * (2.0 * k.da)
-            + (i3 * (2.0 * k.db) + ppt * (4.0 * k.ddb)) * q
-            + (p * grad_q.transpose() + grad_q * p.transpose()) * (2.0 * k.db)
-            + (m * a.transpose() + a * m.transpose() - i3 * (2.0 * ma)) * k.b
+        // 2α'(L I + psi axmᵀ + axm psiᵀ) + 4α'' L psi psiᵀ + (the same in β, Q, grad Q)
+        //   + β (m aᵀ + a mᵀ − 2 (m·a) I), the psi psiᵀ terms split between the two outer products.
+        let z = axm * (2.0 * k.da) + grad_q * (2.0 * k.db) + p * (2.0 * (k.dda * l + k.ddb * q));
+        let d = 2.0 * k.da * l + 2.0 * k.db * q - 2.0 * k.b * ma;
+        M3::identity() * d + outer(p, &z) + outer(&z, p) + (outer(m, a) + outer(a, m)) * k.b
     }
 }
 
@@ -578,6 +649,24 @@ mod tests {
             let an = t.hessian(&a, &b);
             assert!((an - fd).norm() < 1e-7 * (1.0 + an.norm()), "hessian at {psi:?}");
             assert_relative_eq!(an, an.transpose(), epsilon = 1e-12 * (1.0 + an.norm()));
+        }
+    }
+
+    #[test]
+    fn acceleration_jacobian_matches_finite_differences() {
+        let a = V3::new(0.4, -1.3, 0.8);
+        let c = V3::new(-0.6, 0.2, 1.1);
+        for psi in samples() {
+            let t = Tangent::with_second_order(&psi);
+            let an = t.acceleration_jac(&a, &c);
+            let fd = fd_jac(|p| tangent(p) * c + Tangent::new(p).dir_vec(&a, &a), &psi);
+            assert!((an - fd).norm() < 1e-7 * (1.0 + an.norm()), "acceleration_jac at {psi:?}: {an} vs {fd}");
+            let sum = t.jac(&c) + t.second(&a, &a);
+            assert_relative_eq!(an, sum, epsilon = 1e-13 * (1.0 + an.norm()));
+            // Both constructors give the same operators.
+            let t1 = Tangent::new(&psi);
+            assert_relative_eq!(t1.hessian(&a, &c), t.hessian(&a, &c), epsilon = 1e-14 * (1.0 + an.norm()));
+            assert_relative_eq!(t1.rotation(), rotation_matrix(&psi), epsilon = 1e-14);
         }
     }
 

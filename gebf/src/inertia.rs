@@ -16,7 +16,7 @@
 //! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
 
 use crate::Section;
-use crate::crv::{M3, Tangent, col_mul, diag_mul, skew};
+use crate::crv::{M3, Tangent, V3, col_mul, diag_mul, skew, skew_mul};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
 
 /// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
@@ -44,8 +44,10 @@ pub(crate) fn add_inertia(
     let wt3 = skew(&w);
     // The translational blocks of the rows and columns of R and v_A do not depend on the
     // point: `l_r`, `l_v` times the consistent-mass integrals `∫ N_k N_l`, `∫ N_k`, `∫ 1`,
-    // added once after the loop.
+    // added once after the loop; so are the lever arms `R × (l_r δR)`, `R × (l_v δv_A)` of the
+    // omega_A rows, through `∫ N_k R` and `∫ R`.
     let (mut n_kl, mut n_k, mut n_1) = ([[0.0; 3]; 3], [0.0; 3], 0.0);
+    let (mut rn_k, mut r_1) = ([V3::zeros(); 3], V3::zeros());
     let (l_r, l_v) = mat.as_ref().map_or((M3::zeros(), M3::zeros()), |(_, c)| {
         let l_r = i3 * (c.c_m * m) + wt3 * (2.0 * m * c.c_c) + (skew(&wd) + wt3 * wt3) * (m * c.c_k);
         (l_r, i3 * (c.c_m * m) + wt3 * (m * c.c_c))
@@ -66,82 +68,98 @@ pub(crate) fn add_inertia(
         let f = (vd + rdd + wd.cross(&r) + w.cross(&rd) * 2.0 + w.cross(&w0)) * m;
         let rf = r.cross(&f);
         // Rotation.
-        let tg = Tangent::new(&psi);
+        let tg = if mat.is_some() { Tangent::with_second_order(&psi) } else { Tangent::new(&psi) };
         let t = tg.t;
-        let cba = tg.rotation().transpose();
+        let cab = tg.rotation(); // C^{AB}; C^{BA} x = cab.tr_mul(x)
         let om_r = t * psid;
-        let cw = cba * w;
+        let cw = cab.tr_mul(&w);
+        let cwd = cab.tr_mul(&wd);
         let om = om_r + cw;
         let jom = jd.component_mul(&om);
-        let om_d = t * psidd + tg.dir_vec(&psid, &psid) + cw.cross(&om_r) + cba * wd;
+        let om_d = t * psidd + tg.dir_vec(&psid, &psid) + cw.cross(&om_r) + cwd;
         let h = jd.component_mul(&om_d) + om.cross(&jom);
         kinetic += 0.5 * wt * (m * vel.norm_squared() + om.dot(&jom));
 
-        let tth = t.transpose() * h;
+        let tth = t.tr_mul(&h);
         for k in 0..3 {
-            add3(res, 6 * k, &(f * (wt * n[k])));
-            add3(res, 6 * k + 3, &(tth * (wt * n[k])));
+            // The middle Gauss point lies on the middle node: the end nodes' weights are zero.
+            if n[k] != 0.0 {
+                add3(res, 6 * k, &(f * (wt * n[k])));
+                add3(res, 6 * k + 3, &(tth * (wt * n[k])));
+            }
         }
         add3(res, V_OFF, &(f * wt));
-        add3(res, W_OFF, &((rf + cba.transpose() * h) * wt));
+        add3(res, W_OFF, &((rf + cab * h) * wt));
 
         if let Some((mm, c)) = mat.as_mut() {
             let c = *c;
-            let rt = skew(&r);
-            // Linear part: columns (per node: × n_l).
-            let l_w = rt * (-m * c.c_m) + (skew(&rd) * 2.0 + skew(&w0) + wt3 * rt) * (-m * c.c_c);
+            // Linear part: columns of omega_A (rows × n_k), with w̃ R̃ = R wᵀ − (w·R) I.
+            let l_w = skew(&(r * (-m * c.c_m) + (rd * 2.0 + w0) * (-m * c.c_c)))
+                + (r * w.transpose() - i3 * w.dot(&r)) * (-m * c.c_c);
             // Angular part; J is diagonal, so J·X scales the rows of X and X·J its columns.
             let x = col_mul(&skew(&om), &jd) - skew(&jom);
-            let cwt = skew(&cw);
-            let cwt_t = cwt * t;
-            let omr_t = skew(&om_r);
+            let cwt_t = skew_mul(&cw, &t);
             let d_psid = tg.jac(&psid);
             let dom_dpsi = d_psid + cwt_t;
-            let domd_dpsi =
-                tg.jac(&psidd) + tg.second(&psid, &psid) + cwt * d_psid - omr_t * cwt_t + skew(&(cba * wd)) * t;
-            let domd_dpsid = tg.dir(&psid) + d_psid + cwt_t;
+            let domd_dpsi = tg.acceleration_jac(&psid, &psidd) + skew_mul(&cw, &d_psid) - skew_mul(&om_r, &cwt_t)
+                + skew_mul(&cwd, &t);
+            let domd_dpsid = tg.dir(&psid) + dom_dpsi;
             let h_psi = diag_mul(&jd, &(t * c.c_m + domd_dpsid * c.c_c + domd_dpsi * c.c_k))
                 + x * (t * c.c_c + dom_dpsi * c.c_k);
-            let h_w = diag_mul(&jd, &((cba * c.c_m) - omr_t * cba * c.c_c)) + x * cba * c.c_c;
-            let tt = t.transpose();
-            let ct = cba.transpose();
+            // ∂h/∂omega_A = (J c_m + (X − J om_r~) c_c) C^{BA}.
+            let h_w = (M3::from_diagonal(&(jd * c.c_m)) + (x - diag_mul(&jd, &skew(&om_r))) * c.c_c) * cab.transpose();
             let geo_psi_row = tg.jac_t(&h) * c.c_k; // ∂(Tᵀh)/∂psi at fixed h
-            let geo_w_row = -(ct * skew(&h) * t) * c.c_k; // ∂(C^{AB} h)/∂psi at fixed h
+            let geo_w_row = -(cab * skew_mul(&h, &t)) * c.c_k; // ∂(C^{AB} h)/∂psi at fixed h
             let geo_rf = -skew(&f) * c.c_k; // ∂(R × f)/∂R at fixed f
 
-            let a_pp = tt * h_psi + geo_psi_row;
-            let a_wp = ct * h_psi + geo_w_row;
-            let a_pw = tt * h_w;
-            let a_wr = rt * l_r + geo_rf;
+            let a_pp = t.tr_mul(&h_psi) + geo_psi_row;
+            let a_wp = cab * h_psi + geo_w_row;
+            let a_pw = t.tr_mul(&h_w);
             for k in 0..3 {
                 let nk = n[k] * wt;
+                if nk == 0.0 {
+                    continue;
+                }
                 n_k[k] += nk;
-                for l in 0..3 {
+                rn_k[k] += r * nk;
+                // The weights of (k, l) and (l, k) are equal: one scaled block for both.
+                for l in k..3 {
                     let nkl = nk * n[l];
-                    n_kl[k][l] += nkl;
-                    add33(mm, 6 * k + 3, 6 * l + 3, &(a_pp * nkl));
+                    if nkl != 0.0 {
+                        let blk = a_pp * nkl;
+                        n_kl[k][l] += nkl;
+                        add33(mm, 6 * k + 3, 6 * l + 3, &blk);
+                        if l != k {
+                            n_kl[l][k] += nkl;
+                            add33(mm, 6 * l + 3, 6 * k + 3, &blk);
+                        }
+                    }
                 }
                 add33(mm, 6 * k, W_OFF, &(l_w * nk));
                 add33(mm, 6 * k + 3, W_OFF, &(a_pw * nk));
-                // Frame rows, node columns.
-                add33(mm, W_OFF, 6 * k, &(a_wr * nk));
+                // Frame rows, node columns (the lever arm R̃ l_r is added after the loop).
+                add33(mm, W_OFF, 6 * k, &(geo_rf * nk));
                 add33(mm, W_OFF, 6 * k + 3, &(a_wp * nk));
             }
             n_1 += wt;
+            r_1 += r * wt;
             add33(mm, V_OFF, W_OFF, &(l_w * wt));
-            add33(mm, W_OFF, V_OFF, &(rt * l_v * wt));
-            add33(mm, W_OFF, W_OFF, &((rt * l_w + ct * h_w) * wt));
+            add33(mm, W_OFF, W_OFF, &((skew_mul(&r, &l_w) + cab * h_w) * wt));
         }
     }
     if let Some((mm, _)) = mat.as_mut() {
         for k in 0..3 {
             for l in 0..3 {
-                add33(mm, 6 * k, 6 * l, &(l_r * n_kl[k][l]));
+                if n_kl[k][l] != 0.0 {
+                    add33(mm, 6 * k, 6 * l, &(l_r * n_kl[k][l]));
+                }
             }
             add33(mm, 6 * k, V_OFF, &(l_v * n_k[k]));
             add33(mm, V_OFF, 6 * k, &(l_r * n_k[k]));
+            add33(mm, W_OFF, 6 * k, &skew_mul(&rn_k[k], &l_r));
         }
         add33(mm, V_OFF, V_OFF, &(l_v * n_1));
+        add33(mm, W_OFF, V_OFF, &skew_mul(&r_1, &l_v));
     }
     kinetic
 }

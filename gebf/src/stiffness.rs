@@ -16,7 +16,7 @@
 //! `C^{AB}`, `T`, `D` at fixed `N`, `M` (which needs the Hessian of `Mᵀ T(psi) psi'`).
 
 use crate::Section;
-use crate::crv::{Tangent, V3, diag_mul, skew};
+use crate::crv::{M3, Tangent, V3, diag_mul, skew_mul};
 use crate::element::{ElementState, Mat24, Vec24, add3, add33, gauss_rule, interp, shape};
 
 /// Add the elastic forces of one element to `res` (and `c_k ×` their tangent to `mat`);
@@ -33,16 +33,20 @@ pub(crate) fn add_elastic(
     let sk = sec.moment_stiffness();
     let ex = V3::x();
     let mut energy = 0.0;
+    // The tangent is the Hessian of U in the nodal unknowns, so symmetric: only the node pairs
+    // k ≤ l are accumulated, as (R_k, R_l), (R_k, psi_l), (psi_k, R_l), (psi_k, psi_l) blocks,
+    // and mirrored after the loop.
+    let mut kb = [[[M3::zeros(); 4]; 3]; 3];
     for &(xi, w) in gauss_rule(n_gauss) {
         let (n, dn) = shape(xi, le);
         let wt = 0.5 * le * w;
         let r_p = interp(&dn, &st.r);
         let psi = interp(&n, &st.psi);
         let psi_p = interp(&dn, &st.psi);
-        let tg = Tangent::new(&psi);
+        let tg = if mat.is_some() { Tangent::with_second_order(&psi) } else { Tangent::new(&psi) };
         let t = tg.t;
-        let c = tg.rotation().transpose(); // C^{BA}
-        let e = c * r_p;
+        let cab = tg.rotation(); // C^{AB}
+        let e = cab.tr_mul(&r_p);
         let gamma = e - ex;
         let kappa = t * psi_p;
         let nf = sg.component_mul(&gamma);
@@ -50,43 +54,59 @@ pub(crate) fn add_elastic(
         energy += 0.5 * wt * (gamma.dot(&nf) + kappa.dot(&mo));
 
         let d = tg.jac(&psi_p);
-        let f_r = c.transpose() * nf; // × dn_k
-        let f_psi_n = t.transpose() * nf.cross(&e) + d.transpose() * mo; // × n_k
-        let f_psi_dn = t.transpose() * mo; // × dn_k
+        let nxe = nf.cross(&e);
+        let f_r = cab * nf; // × dn_k
+        let f_psi_n = t.tr_mul(&nxe) + d.tr_mul(&mo); // × n_k
+        let f_psi_dn = t.tr_mul(&mo); // × dn_k
         for k in 0..3 {
             add3(res, 6 * k, &(f_r * (wt * dn[k])));
             add3(res, 6 * k + 3, &((f_psi_n * n[k] + f_psi_dn * dn[k]) * wt));
         }
 
-        if let Some((m, c_k)) = mat.as_mut() {
+        if let Some((_, c_k)) = mat.as_ref() {
             let f = wt * *c_k;
-            let et = skew(&e) * t; // ∂γ/∂psi
-            let nt = skew(&nf);
-            // Material blocks (the stiffnesses are diagonal: S X scales the rows of X).
-            let (sg_c, sg_et) = (diag_mul(&sg, &c), diag_mul(&sg, &et));
-            let (sk_t, sk_d) = (diag_mul(&sk, &t), diag_mul(&sk, &d));
-            let a1 = c.transpose() * sg_c;
-            let a2 = c.transpose() * sg_et;
-            let a3 = et.transpose() * sg_et;
-            let p = t.transpose() * sk_t;
-            let qm = t.transpose() * sk_d;
-            let rm = d.transpose() * sk_d;
-            // Geometric blocks.
-            let g1 = -(c.transpose() * nt * t); // (R_k, psi_l) × dn_k n_l
-            let g2 = tg.jac_t(&nf.cross(&e)) + t.transpose() * nt * skew(&e) * t + tg.hessian(&psi_p, &mo);
-            let g3 = tg.jac_t(&mo); // (psi_k, psi_l) × dn_k n_l
-            let rp_blk = a2 + g1; // (R_k, psi_l) × dn_k n_l
+            let et = skew_mul(&e, &t); // ∂γ/∂psi
+            // S_γ ∂γ/∂psi − Ñ T: with it, the (R, psi) block is C^{AB} y (material + geometric)
+            // and yᵀ ẽT = (ẽT)ᵀ S_γ ẽT + Tᵀ Ñ ẽ T.
+            let y = diag_mul(&sg, &et) - skew_mul(&nf, &t);
+            let sk_d = diag_mul(&sk, &d);
+            let a1 = cab * diag_mul(&sg, &cab.transpose()); // (R_k, R_l) × dn_k dn_l
+            let rp = cab * y; // (R_k, psi_l) × dn_k n_l
+            let p = t.tr_mul(&diag_mul(&sk, &t)); // (psi_k, psi_l) × dn_k dn_l
+            let z = t.tr_mul(&sk_d) + tg.jac_t(&mo); // (psi_k, psi_l) × dn_k n_l
+            // (psi_k, psi_l) × n_k n_l
+            let x = y.tr_mul(&et) + d.tr_mul(&sk_d) + tg.jac_t(&nxe) + tg.hessian(&psi_p, &mo);
+            let (rpt, zt) = (rp.transpose(), z.transpose());
+            // Column factors of node l, then each block is a combination over n_k, dn_k.
+            let cols: [[M3; 5]; 3] = std::array::from_fn(|l| {
+                let (nl, dl) = (f * n[l], f * dn[l]);
+                [a1 * dl, rp * nl, rpt * dl, x * nl + zt * dl, z * nl + p * dl]
+            });
             for k in 0..3 {
-                for l in 0..3 {
-                    let (nk, nl, dk, dl) = (n[k], n[l], dn[k], dn[l]);
-                    add33(m, 6 * k, 6 * l, &(a1 * (f * dk * dl)));
-                    add33(m, 6 * k, 6 * l + 3, &(rp_blk * (f * dk * nl)));
-                    add33(m, 6 * k + 3, 6 * l, &(rp_blk.transpose() * (f * nk * dl)));
-                    let pp = (a3 + rm + g2) * (nk * nl)
-                        + p * (dk * dl)
-                        + (qm + g3).transpose() * (nk * dl)
-                        + (qm + g3) * (dk * nl);
-                    add33(m, 6 * k + 3, 6 * l + 3, &(pp * f));
+                let (nk, dk) = (n[k], dn[k]);
+                for (l, c) in cols.iter().enumerate().skip(k) {
+                    let b = &mut kb[k][l];
+                    b[0] += c[0] * dk;
+                    b[1] += c[1] * dk;
+                    b[2] += c[2] * nk;
+                    b[3] += c[3] * nk + c[4] * dk;
+                }
+            }
+        }
+    }
+    if let Some((m, _)) = mat.as_mut() {
+        for k in 0..3 {
+            for l in k..3 {
+                let b = &kb[k][l];
+                add33(m, 6 * k, 6 * l, &b[0]);
+                add33(m, 6 * k, 6 * l + 3, &b[1]);
+                add33(m, 6 * k + 3, 6 * l, &b[2]);
+                add33(m, 6 * k + 3, 6 * l + 3, &b[3]);
+                if l > k {
+                    add33(m, 6 * l, 6 * k, &b[0].transpose());
+                    add33(m, 6 * l, 6 * k + 3, &b[2].transpose());
+                    add33(m, 6 * l + 3, 6 * k, &b[1].transpose());
+                    add33(m, 6 * l + 3, 6 * k + 3, &b[3].transpose());
                 }
             }
         }
@@ -97,7 +117,7 @@ pub(crate) fn add_elastic(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::crv::{M3, from_rotation_matrix, rotation_matrix};
+    use crate::crv::{from_rotation_matrix, rotation_matrix};
     use crate::element::ElementState;
 
     fn section() -> Section {
