@@ -39,7 +39,7 @@ fn eval_fields(plan: &StrainPlan, e: &[f64]) -> Fields {
 
 /// The eight nodal 3-vectors of `e` with the first node's position subtracted from both
 /// positions (blocks 0 and 4).
-#[inline]
+#[inline(always)]
 fn relative_blocks(e: &[f64]) -> [[f64; 3]; N_BLOCKS] {
     let e = &e[..ELEMENT_DOF];
     let mut b = [[0.0; 3]; N_BLOCKS];
@@ -61,7 +61,7 @@ type BlockMatrix<const L: usize> = [[Lanes<L>; N_BLOCKS]; N_BLOCKS];
 /// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors of `L` elements, with the
 /// diagonal halved (`½ e_a·e_a`), so that every strain is `s = Σ_{a≤b} h g[a][b]` over its
 /// Hessian pairs.
-#[inline]
+#[inline(always)]
 fn gram<const L: usize>(x: &[[[f64; 3]; N_BLOCKS]; L]) -> BlockMatrix<L> {
     let mut g = [[[0.0; L]; N_BLOCKS]; N_BLOCKS];
     for a in 1..N_BLOCKS {
@@ -78,7 +78,7 @@ fn gram<const L: usize>(x: &[[[f64; 3]; N_BLOCKS]; L]) -> BlockMatrix<L> {
 }
 
 /// `s = Σ_{a<b} h e_a·e_b + ½ Σ_a h e_a·e_a` from the Gram products (diagonal halved).
-#[inline]
+#[inline(always)]
 fn strain_from_gram<const L: usize>(s: &SampledStrain, g: &BlockMatrix<L>) -> Lanes<L> {
     let mut v = [0.0; L];
     for &(a, b, h) in &s.pairs[..s.n_pairs] {
@@ -91,7 +91,7 @@ fn strain_from_gram<const L: usize>(s: &SampledStrain, g: &BlockMatrix<L>) -> La
 
 /// `out = (m ⊗ I₃) x` for symmetric 8×8 `m` given by their upper triangles (the lower ones are
 /// overwritten with the mirror image), lane by lane.
-#[inline]
+#[inline(always)]
 fn symmetric_times<const L: usize>(
     m: &mut BlockMatrix<L>,
     x: &[[[f64; 3]; N_BLOCKS]; L],
@@ -120,7 +120,7 @@ fn symmetric_times<const L: usize>(
 /// 2. the geometric weights `c C_m (s_m − s⁰_m)` on the Hessian pairs into `geometric`;
 /// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a ≤ b`,
 ///    diagonal blocks in full) at a time with fixed-size loops.
-#[inline]
+#[inline(always)]
 fn add_group_tangent<const M: usize, const NB: usize>(
     plan: &StrainPlan,
     group: &StrainGroup,
@@ -130,20 +130,26 @@ fn add_group_tangent<const M: usize, const NB: usize>(
     cols: &mut [[f64; ELEMENT_DOF]; ELEMENT_DOF],
 ) {
     let blocks: [usize; NB] = std::array::from_fn(|i| group.blocks[i]);
-    let xb: [[f64; 3]; NB] = blocks.map(|b| x[b]);
+    // positions component by component, so that the gradient loops run over the blocks
+    let xt: [[f64; NB]; 3] = std::array::from_fn(|k| blocks.map(|b| x[b][k]));
     let hessians = &plan.group_hessians[group.hessian_start..][..M * NB * NB];
     let mut u = [[[0.0; 3]; NB]; M]; // ∂s_m/∂x on the group's blocks
     let mut wu = [[[0.0; 3]; NB]; M]; // c C_m ∂s_m/∂x
     for (m, h) in hessians.chunks_exact(NB * NB).enumerate() {
         let s = &plan.strains[group.members[m]];
-        let mut value = 0.0;
-        for ((um, row), xi) in u[m].iter_mut().zip(h.chunks_exact(NB)).zip(&xb) {
-            for (hij, xj) in row.iter().zip(&xb) {
-                for (ui, xjc) in um.iter_mut().zip(xj) {
-                    *ui += hij * xjc;
+        // u_k = a x_k for each component k (a symmetric: row j is column j)
+        let mut ut = [[0.0; NB]; 3];
+        for (j, col) in h.chunks_exact(NB).enumerate() {
+            for (uk, xk) in ut.iter_mut().zip(&xt) {
+                for (ui, aij) in uk.iter_mut().zip(col) {
+                    *ui += aij * xk[j];
                 }
             }
-            value += 0.5 * dot(xi, um);
+        }
+        let mut value = 0.0; // s = ½ x·u
+        for (i, um) in u[m].iter_mut().enumerate() {
+            *um = [ut[0][i], ut[1][i], ut[2][i]];
+            value += 0.5 * (xt[0][i] * um[0] + xt[1][i] * um[1] + xt[2][i] * um[2]);
         }
         let w = c * s.stiffness;
         let wd = w * (value - s.reference);
@@ -235,6 +241,22 @@ impl Element {
     /// `out[l] = f_el(e[l])`: the elastic forces of `L` elements sharing this kernel, evaluated
     /// together (every loop over the strain plan serves all lanes); returns their energies.
     pub fn elastic_forces<const L: usize>(&self, e: [&[f64]; L], out: &mut [[f64; ELEMENT_DOF]; L]) -> Lanes<L> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.forces_avx2(e, out) };
+        }
+        self.forces_generic(e, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn forces_avx2<const L: usize>(&self, e: [&[f64]; L], out: &mut [[f64; ELEMENT_DOF]; L]) -> Lanes<L> {
+        self.forces_generic(e, out)
+    }
+
+    #[inline(always)]
+    fn forces_generic<const L: usize>(&self, e: [&[f64]; L], out: &mut [[f64; ELEMENT_DOF]; L]) -> Lanes<L> {
         let x = e.map(relative_blocks);
         let g = gram(&x);
         let mut m = [[[0.0; L]; N_BLOCKS]; N_BLOCKS]; // Σ C (s − s⁰) a, upper triangle
@@ -274,6 +296,23 @@ impl Element {
     ///
     /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            unsafe { self.tangent_avx2(e, c, k) };
+            return;
+        }
+        self.tangent_generic(e, c, k)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn tangent_avx2(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.tangent_generic(e, c, k)
+    }
+
+    #[inline(always)]
+    fn tangent_generic(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
         let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
