@@ -315,6 +315,7 @@ pub struct Tangent {
 impl Tangent {
     /// Evaluate at `psi` (first-order coefficients; [`Tangent::second`] and
     /// [`Tangent::hessian`] then evaluate the second-order ones on demand).
+    #[inline]
     pub fn new(psi: &V3) -> Self {
         Self::build(psi, TangentCoefficients::first_order(psi), false)
     }
@@ -357,6 +358,13 @@ impl Tangent {
         let pa = p.cross(a);
         let u = pa * (2.0 * sigma * k.da) + p.cross(&pa) * (2.0 * k.db) - a * (2.0 * k.b);
         diag_skew(k.b * p.dot(a), &(a * (-sigma * k.a))) + outer(&u, p) + outer(p, a) * k.b
+    }
+    /// The vector `(∂(T a)/∂psi)ᵀ m` (without the matrix).
+    pub fn jac_tr_vec(&self, a: &V3, m: &V3) -> V3 {
+        let (k, p) = (&self.k, &self.psi);
+        let pa = p.cross(a);
+        let u = pa * (2.0 * k.da) + p.cross(&pa) * (2.0 * k.db) - a * (2.0 * k.b);
+        a.cross(m) * k.a + p * u.dot(m) + a * (k.b * p.dot(m)) + m * (k.b * p.dot(a))
     }
     /// `∂(T a)/∂psi`.
     pub fn jac(&self, a: &V3) -> M3 {
@@ -637,6 +645,7 @@ mod tests {
             assert!((t.jac(&a) - fd).norm() < 1e-8 * scale, "jac at {psi:?}");
             let fd = fd_jac(|p| tangent(p).transpose() * b, &psi);
             assert!((t.jac_t(&b) - fd).norm() < 1e-8 * scale, "jac_t at {psi:?}");
+            assert_relative_eq!(t.jac_tr_vec(&a, &b), t.jac(&a).transpose() * b, epsilon = 1e-13 * scale);
             // dT[b] a = jac(a) b
             assert_relative_eq!(t.dir(&b) * a, t.jac(&a) * b, epsilon = 1e-13 * scale);
             assert_relative_eq!(t.dir_vec(&b, &a), t.dir(&b) * a, epsilon = 1e-13 * scale);

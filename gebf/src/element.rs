@@ -84,23 +84,28 @@ pub(crate) struct ElementState {
 impl ElementState {
     /// Gather element `e` of `body`. `v`, `v_dot` may be `None` (treated as zero).
     pub fn gather(body: &Body, e: usize, q: &[f64], v: Option<&[f64]>, v_dot: Option<&[f64]>) -> Self {
-        let mut s = Self::default();
-        for k in 0..3 {
-            let i = 2 * e + k;
-            (s.r[k], s.psi[k]) = body.node_state(q, i);
-            if let Some(v) = v {
-                (s.rd[k], s.psid[k]) = body.node_rates(v, i);
-            }
-            if let Some(a) = v_dot {
-                (s.rdd[k], s.psidd[k]) = body.node_rates(a, i);
-            }
-        }
-        if let Some(v) = v {
-            (s.v, s.w) = body.frame_rates(v);
-        }
-        if let Some(a) = v_dot {
-            (s.vd, s.wd) = body.frame_rates(a);
-        }
+        // Built field by field (not a zeroed default overwritten: this runs per element and call).
+        let zero = (V3::zeros(), V3::zeros());
+        let nodes: [(V3, V3); 3] = std::array::from_fn(|k| body.node_state(q, 2 * e + k));
+        let rates = |x: Option<&[f64]>| x.map_or([zero; 3], |x| std::array::from_fn(|k| body.node_rates(x, 2 * e + k)));
+        let (vel, acc) = (rates(v), rates(v_dot));
+        let ((fv, fw), (fvd, fwd)) =
+            (v.map_or(zero, |x| body.frame_rates(x)), v_dot.map_or(zero, |x| body.frame_rates(x)));
+        let mut s = Self {
+            r: nodes.map(|x| x.0),
+            psi: nodes.map(|x| x.1),
+            rd: vel.map(|x| x.0),
+            psid: vel.map(|x| x.1),
+            rdd: acc.map(|x| x.0),
+            psidd: acc.map(|x| x.1),
+            v: fv,
+            w: fw,
+            vd: fvd,
+            wd: fwd,
+            branch: [None; 3],
+            psid_stored: [V3::zeros(); 3],
+            psidd_stored: [V3::zeros(); 3],
+        };
         // Bring the end nodes onto the middle node's branch (stored CRVs are rescaled to
         // |psi| ≤ π node by node): psi' = u(psi), psi_dot' = J psi_dot,
         // psi_ddot' = J psi_ddot + dJ[psi_dot] psi_dot.

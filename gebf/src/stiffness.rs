@@ -36,7 +36,8 @@ pub(crate) fn add_elastic(
     // The tangent is the Hessian of U in the nodal unknowns, so symmetric: only the node pairs
     // k ≤ l are accumulated, as (R_k, R_l), (R_k, psi_l), (psi_k, R_l), (psi_k, psi_l) blocks,
     // and mirrored after the loop.
-    let mut kb = [[[M3::zeros(); 4]; 3]; 3];
+    // (Only when the matrix is wanted: the residual path does not clear the 2.6 kB.)
+    let mut kb = mat.as_ref().map(|_| [[[M3::zeros(); 4]; 3]; 3]);
     for &(xi, w) in gauss_rule(n_gauss) {
         let (n, dn) = shape(xi, le);
         let wt = 0.5 * le * w;
@@ -53,18 +54,18 @@ pub(crate) fn add_elastic(
         let mo = sk.component_mul(&kappa);
         energy += 0.5 * wt * (gamma.dot(&nf) + kappa.dot(&mo));
 
-        let d = tg.jac(&psi_p);
         let nxe = nf.cross(&e);
         let f_r = cab * nf; // × dn_k
-        let f_psi_n = t.tr_mul(&nxe) + d.tr_mul(&mo); // × n_k
+        let f_psi_n = t.tr_mul(&nxe) + tg.jac_tr_vec(&psi_p, &mo); // × n_k
         let f_psi_dn = t.tr_mul(&mo); // × dn_k
         for k in 0..3 {
             add3(res, 6 * k, &(f_r * (wt * dn[k])));
             add3(res, 6 * k + 3, &((f_psi_n * n[k] + f_psi_dn * dn[k]) * wt));
         }
 
-        if let Some((_, c_k)) = mat.as_ref() {
+        if let (Some((_, c_k)), Some(kb)) = (mat.as_ref(), kb.as_mut()) {
             let f = wt * *c_k;
+            let d = tg.jac(&psi_p); // ∂κ/∂psi
             let et = skew_mul(&e, &t); // ∂γ/∂psi
             // S_γ ∂γ/∂psi − Ñ T: with it, the (R, psi) block is C^{AB} y (material + geometric)
             // and yᵀ ẽT = (ẽT)ᵀ S_γ ẽT + Tᵀ Ñ ẽ T.
@@ -94,7 +95,7 @@ pub(crate) fn add_elastic(
             }
         }
     }
-    if let Some((m, _)) = mat.as_mut() {
+    if let (Some((m, _)), Some(kb)) = (mat.as_mut(), kb.as_ref()) {
         for k in 0..3 {
             for l in k..3 {
                 let b = &kb[k][l];
