@@ -109,11 +109,11 @@ pub(crate) fn add_inertia(
             // ∂h/∂omega_A = (J c_m + (X − J om_r~) c_c) C^{BA}.
             let h_w = (M3::from_diagonal(&(jd * c.c_m)) + (x - diag_mul(&jd, &skew(&om_r))) * c.c_c) * cab.transpose();
             let geo_psi_row = tg.jac_t(&h) * c.c_k; // ∂(Tᵀh)/∂psi at fixed h
-            let geo_w_row = -(cab * skew_mul(&h, &t)) * c.c_k; // ∂(C^{AB} h)/∂psi at fixed h
             let geo_rf = -skew(&f) * c.c_k; // ∂(R × f)/∂R at fixed f
 
             let a_pp = t.tr_mul(&h_psi) + geo_psi_row;
-            let a_wp = cab * h_psi + geo_w_row;
+            // ∂(C^{AB} h)/∂psi = C^{AB} (∂h/∂psi − h̃ T) (the second term at fixed h).
+            let a_wp = cab * (h_psi - skew_mul(&h, &t) * c.c_k);
             let a_pw = t.tr_mul(&h_w);
             for k in 0..3 {
                 let nk = n[k] * wt;
