@@ -49,6 +49,10 @@ fn main() {
             time("element force", 20000, || {
                 el.add_elastic_force(e, &mut f);
             });
+            let mut f4 = [[0.0; 24]; 4];
+            time("element force x4 (lanes)", 20000, || {
+                el.elastic_forces([e, e, e, e], &mut f4);
+            });
             let mut ke = ElementMatrix::zeros();
             time("element tangent (upper)", 20000, || el.add_elastic_tangent_upper(e, 1.0, &mut ke));
         }

@@ -548,6 +548,33 @@ mod tests {
     }
 
     #[test]
+    fn group_hessians_are_the_members_hessians_on_the_compact_blocks() {
+        for curvature in ALL_CURVATURES {
+            let plan = strain_plan(0.4, &section(), curvature, 1.0, 100.0);
+            for g in &plan.groups {
+                let nb = g.n_blocks;
+                assert!(matches!(nb, 1 | 2 | 4 | 6 | 8), "{curvature:?}: {nb} blocks");
+                let real = plan.strains[g.members[0]].n_blocks;
+                assert_eq!(g.blocks[..real], plan.strains[g.members[0]].blocks[..real]);
+                assert!(g.blocks[real..nb].iter().all(|&b| b == g.blocks[real - 1]));
+                for (m, &member) in g.members().iter().enumerate() {
+                    let h = &plan.group_hessians[g.hessian_start + m * nb * nb..][..nb * nb];
+                    for i in 0..nb {
+                        for j in 0..nb {
+                            let expect = if i < real && j < real {
+                                plan.strains[member].hessian[g.blocks[i]][g.blocks[j]]
+                            } else {
+                                0.0
+                            };
+                            assert_eq!(h[i * nb + j], expect, "{curvature:?} member {member} ({i}, {j})");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn hessian_reproduces_the_quadratic_form() {
         // s(e) = ½ eᵀ (a ⊗ I₃) e for every sampled strain, at an arbitrary e.
         let e: [f64; 24] = std::array::from_fn(|i| ((i * 7 + 3) % 11) as f64 * 0.1 - 0.4);
