@@ -57,6 +57,15 @@ struct Workspace {
     r: Vec<f64>,
 }
 
+/// An element with dependent coordinates on the ODE path: its matrix `k_e` enters the reduced
+/// coordinates as `Rᵀ k_e R` over the (sorted) independent indices `z` it reaches; `rows[a]` lists
+/// `(position in z, coefficient)` of local coordinate `a`.
+#[derive(Debug, Clone)]
+struct ReducedElement {
+    z: Vec<usize>,
+    rows: Vec<Vec<(usize, f64)>>,
+}
+
 /// The ANCF multibody model. Implements [`genalpha::ConstrainedSystem`] in the form chosen by
 /// [`Options::path`]:
 ///
@@ -85,6 +94,10 @@ pub struct Model {
     /// Per element (bodies in order): z index of its first coordinate when all 24 are
     /// independent and hence contiguous in z.
     element_z: Vec<Option<usize>>,
+    /// Per element whose `element_z` is `None`: how its matrix reaches the reduced coordinates.
+    element_reduced: Vec<Option<ReducedElement>>,
+    /// The reduced matrix of an element with dependent coordinates (ODE path), n_z × n_z.
+    reduced_block: RefCell<Vec<f64>>,
     work: RefCell<Workspace>,
     sensor: RefCell<(Vec<f64>, Vec<f64>)>,
     /// Whether the iteration matrix is symmetric (no follower moments), shared with the
@@ -172,6 +185,7 @@ impl Model {
         }
 
         let mut element_z = Vec::new();
+        let mut element_reduced = Vec::new();
         for b in &bodies {
             for k in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * k;
@@ -179,8 +193,22 @@ impl Model {
                 let contiguous =
                     z0.is_some_and(|z0| (0..ELEMENT_DOF).all(|a| reduction.z_of(first + a) == Some(z0 + a)));
                 element_z.push(if contiguous { z0 } else { None });
+                element_reduced.push((!contiguous).then(|| {
+                    let mut z: Vec<usize> =
+                        (first..first + ELEMENT_DOF).flat_map(|a| reduction.row(a).iter().map(|&(z, _)| z)).collect();
+                    z.sort_unstable();
+                    z.dedup();
+                    let rows = (first..first + ELEMENT_DOF)
+                        .map(|a| {
+                            let pos = |zi: usize| z.binary_search(&zi).expect("z collected above");
+                            reduction.row(a).iter().map(|&(zi, c)| (pos(zi), c)).collect()
+                        })
+                        .collect();
+                    ReducedElement { z, rows }
+                }));
             }
         }
+        let max_reduced = element_reduced.iter().flatten().map(|e| e.z.len()).max().unwrap_or(0);
 
         let n_red = reduction.n_reduced();
         Ok(Model {
@@ -198,6 +226,8 @@ impl Model {
             load_factor: 1.0,
             weights,
             element_z,
+            element_reduced,
+            reduced_block: RefCell::new(vec![0.0; max_reduced * max_reduced]),
             work: RefCell::new(Workspace { q: vec![0.0; n_full], v: vec![0.0; n_full], r: vec![0.0; n_full] }),
             sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
             symmetric: Arc::new(AtomicBool::new(true)),
@@ -572,8 +602,7 @@ impl Model {
                 if c_k != 0.0 {
                     b.element.add_elastic_tangent_upper(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
                 }
-                mirror_upper_inplace(&mut ke);
-                self.scatter_element(first, self.element_z[e_index], &ke, k);
+                self.scatter_element(first, e_index, &mut ke, k);
                 e_index += 1;
             }
         }
@@ -585,29 +614,34 @@ impl Model {
         }
     }
 
-    fn scatter_element(&self, first: usize, z_first: Option<usize>, ke: &ElementMatrix, k: &mut MatView<'_>) {
-        match (self.options.path, z_first) {
-            (SolvePath::Dae, _) => k.add_block(first, first, ke),
-            (SolvePath::Ode, Some(z)) => k.add_block(z, z, ke),
-            (SolvePath::Ode, None) => {
-                let rows: [&[(usize, f64)]; ELEMENT_DOF] = std::array::from_fn(|a| self.reduction.row(first + a));
-                for (a, ra) in rows.iter().enumerate() {
-                    if ra.is_empty() {
-                        continue;
-                    }
-                    for (bb, rb) in rows.iter().enumerate() {
+    /// Add a symmetric element matrix, given by its upper triangle (the lower one is overwritten
+    /// when the ODE reduction needs the whole matrix).
+    fn scatter_element(&self, first: usize, e_index: usize, ke: &mut ElementMatrix, k: &mut MatView<'_>) {
+        match (self.options.path, self.element_z[e_index], &self.element_reduced[e_index]) {
+            (SolvePath::Dae, _, _) => k.add_symmetric_upper(first, ke),
+            (SolvePath::Ode, Some(z), _) => k.add_symmetric_upper(z, ke),
+            (SolvePath::Ode, None, Some(red)) => {
+                mirror_upper_inplace(ke);
+                let nz = red.z.len();
+                let mut buffer = self.reduced_block.borrow_mut();
+                let block = &mut buffer[..nz * nz];
+                block.fill(0.0);
+                for (bb, rb) in red.rows.iter().enumerate() {
+                    for (a, ra) in red.rows.iter().enumerate() {
                         let x = ke[(a, bb)];
                         if x == 0.0 {
                             continue;
                         }
-                        for &(za, ca) in *ra {
-                            for &(zb, cb) in *rb {
-                                k.add(za, zb, ca * cb * x);
+                        for &(pb, cb) in rb {
+                            for &(pa, ca) in ra {
+                                block[pb * nz + pa] += ca * cb * x;
                             }
                         }
                     }
                 }
+                k.add_symmetric_indexed(&red.z, block);
             }
+            (SolvePath::Ode, None, None) => unreachable!("every element off the contiguous map has a reduction"),
         }
     }
 

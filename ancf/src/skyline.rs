@@ -16,7 +16,7 @@
 //!
 //! Buffers are sized once in `set_dimension`; factorising and solving do not allocate.
 
-use genalpha::{DenseLu, DenseMatrix, LinearSolver};
+use genalpha::{Assembled, AssemblyTarget, DenseLu, DenseMatrix, LinearSolver};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -48,6 +48,13 @@ pub struct SkylineLu {
     symmetric_hint: Option<Arc<AtomicBool>>,
     dense: DenseLu,
     use_dense: bool,
+    /// Direct assembly ([`AssemblyTarget`]): offered when the structure is known and its profile
+    /// fits; `direct_symmetric` is the symmetry hint read at `clear` (then only U is assembled);
+    /// `direct_outside` records an entry outside the profile (the assembly is then redone densely,
+    /// and direct assembly is no longer offered).
+    direct_ok: bool,
+    direct_symmetric: bool,
+    direct_outside: bool,
     /// Skyline factorisations done.
     pub n_skyline: usize,
     /// Dense fallback factorisations done.
@@ -173,16 +180,7 @@ impl SkylineLu {
                 }
             }
         }
-        let (mut lsize, mut usize_) = (0, 0);
-        for i in 0..n {
-            self.lptr[i] = lsize;
-            self.uptr[i] = usize_;
-            lsize += i - self.first[i];
-            usize_ += i - self.first[i] + 1;
-        }
-        self.lptr[n] = lsize;
-        self.uptr[n] = usize_;
-        if lsize > self.lval.len() || usize_ > self.uval.len() {
+        if !self.set_pointers() {
             return false;
         }
         if !self.contiguity_known {
@@ -194,7 +192,6 @@ impl SkylineLu {
         }
         // Gather the envelope of P A Pᵀ: U columns (with diagonal), and whether the values are
         // symmetric up to round-off (no follower moments): then L = D⁻¹Uᵀ, half the work.
-        let mut scale: f64 = 0.0;
         let known_symmetric = self.symmetric_hint.as_ref().is_some_and(|f| f.load(Ordering::Relaxed));
         let mut symmetric = true;
         for i in 0..n {
@@ -221,17 +218,42 @@ impl SkylineLu {
                     symmetric &= (x - y).abs() <= 1e-10 * (x.abs() + y.abs());
                 }
             }
-            scale = scale.max(col[oi].abs());
         }
+        if !symmetric {
+            for i in 0..n {
+                let (oi, fi, lp) = (self.order[i], self.first[i], self.lptr[i]);
+                for (l, &ok) in self.lval[lp..lp + (i - fi)].iter_mut().zip(&self.order[fi..i]) {
+                    // L row i, column fi + k: A[order[i], order[fi + k]]
+                    *l = a[ok * n + oi];
+                }
+            }
+        }
+        self.factor_in_place(symmetric)
+    }
+
+    /// Offsets of the U columns and L rows in `uval`/`lval` from the profile; false when the
+    /// profile does not fit the buffers (then the dense LU is used).
+    fn set_pointers(&mut self) -> bool {
+        let n = self.n;
+        let (mut lsize, mut usize_) = (0, 0);
+        for i in 0..n {
+            self.lptr[i] = lsize;
+            self.uptr[i] = usize_;
+            lsize += i - self.first[i];
+            usize_ += i - self.first[i] + 1;
+        }
+        self.lptr[n] = lsize;
+        self.uptr[n] = usize_;
+        lsize <= self.lval.len() && usize_ <= self.uval.len()
+    }
+
+    /// Factorise the envelope held in `uval` (U columns with the diagonal) and, unless
+    /// `symmetric`, `lval` (L rows); false on a tiny pivot.
+    fn factor_in_place(&mut self, symmetric: bool) -> bool {
+        let n = self.n;
+        let scale = (0..n).map(|i| self.uval[self.uptr[i] + (i - self.first[i])].abs()).fold(0.0_f64, f64::max);
         if symmetric {
             return self.factorize_symmetric(scale);
-        }
-        for i in 0..n {
-            let (oi, fi, lp) = (self.order[i], self.first[i], self.lptr[i]);
-            for (l, &ok) in self.lval[lp..lp + (i - fi)].iter_mut().zip(&self.order[fi..i]) {
-                // L row i, column fi + k: A[order[i], order[fi + k]]
-                *l = a[ok * n + oi];
-            }
         }
         // Crout, in place.
         for j in 0..n {
@@ -457,6 +479,129 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
+/// Direct assembly into the envelope: entry (i, j) of the original numbering goes to U column
+/// `inverse[j]` (rows at or above the diagonal) or L row `inverse[i]` (below it). While the model
+/// vouches for symmetry only U is kept, and lower entries are dropped (they mirror U).
+impl AssemblyTarget for SkylineLu {
+    fn clear(&mut self) {
+        self.direct_symmetric = self.symmetric_hint.as_ref().is_some_and(|f| f.load(Ordering::Relaxed));
+        self.direct_outside = false;
+        let n = self.n;
+        self.uval[..self.uptr[n]].fill(0.0);
+        if !self.direct_symmetric {
+            self.lval[..self.lptr[n]].fill(0.0);
+        }
+    }
+
+    #[inline]
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        let (a, b) = (self.inverse[i], self.inverse[j]);
+        if a <= b {
+            if a < self.first[b] {
+                self.direct_outside |= v != 0.0;
+                return;
+            }
+            self.uval[self.uptr[b] + (a - self.first[b])] += v;
+        } else if !self.direct_symmetric {
+            if b < self.first[a] {
+                self.direct_outside |= v != 0.0;
+                return;
+            }
+            self.lval[self.lptr[a] + (b - self.first[a])] += v;
+        }
+    }
+
+    fn add_symmetric_upper(&mut self, i0: usize, n_b: usize, block: &[f64], s: f64) {
+        let a0 = self.inverse[i0];
+        // No multiplier row sits between the block's coordinates: U column segments are contiguous.
+        let contiguous = self.inverse[i0 + n_b - 1] == a0 + n_b - 1;
+        if !self.direct_symmetric {
+            for c in 0..n_b {
+                for r in 0..=c {
+                    let x = s * block[c * n_b + r];
+                    self.add(i0 + r, i0 + c, x);
+                    if r != c {
+                        self.add(i0 + c, i0 + r, x);
+                    }
+                }
+            }
+            return;
+        }
+        if !contiguous {
+            // coordinates keep their order (multiplier rows are only inserted between them), so
+            // row r ≤ column c of the block stays in U
+            for c in 0..n_b {
+                let b = self.inverse[i0 + c];
+                let (fb, ub) = (self.first[b], self.uptr[b]);
+                for (r, x) in block[c * n_b..=c * n_b + c].iter().enumerate() {
+                    let a = self.inverse[i0 + r];
+                    if a < fb {
+                        self.direct_outside |= *x != 0.0;
+                        continue;
+                    }
+                    self.uval[ub + (a - fb)] += s * x;
+                }
+            }
+            return;
+        }
+        for c in 0..n_b {
+            let (b, col) = (a0 + c, &block[c * n_b..=c * n_b + c]);
+            let fb = self.first[b];
+            if a0 < fb {
+                // the block reaches above the profile: only zeros may lie there
+                let (above, inside) = col.split_at((fb - a0).min(c + 1));
+                self.direct_outside |= above.iter().any(|&x| x != 0.0);
+                let start = self.uptr[b];
+                for (u, x) in self.uval[start..start + inside.len()].iter_mut().zip(inside) {
+                    *u += s * x;
+                }
+                continue;
+            }
+            let start = self.uptr[b] + (a0 - fb);
+            for (u, x) in self.uval[start..=start + c].iter_mut().zip(col) {
+                *u += s * x;
+            }
+        }
+    }
+
+    fn add_symmetric_indexed(&mut self, idx: &[usize], block: &[f64], s: f64) {
+        let n = idx.len();
+        if !self.direct_symmetric {
+            for (c, &j) in idx.iter().enumerate() {
+                for (r, &i) in idx.iter().enumerate() {
+                    self.add(i, j, s * block[c * n + r]);
+                }
+            }
+            return;
+        }
+        // increasing coordinates keep their order in the new numbering: rows r ≤ c are in U
+        for (c, &j) in idx.iter().enumerate() {
+            let b = self.inverse[j];
+            let (fb, ub) = (self.first[b], self.uptr[b]);
+            for (&i, x) in idx[..=c].iter().zip(&block[c * n..=c * n + c]) {
+                let a = self.inverse[i];
+                if a < fb {
+                    self.direct_outside |= *x != 0.0;
+                    continue;
+                }
+                self.uval[ub + (a - fb)] += s * x;
+            }
+        }
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        let (a, b) = (self.inverse[i], self.inverse[j]);
+        let (a, b, upper) = if a <= b || self.direct_symmetric { (a.min(b), a.max(b), true) } else { (a, b, false) };
+        if upper {
+            if a < self.first[b] { 0.0 } else { self.uval[self.uptr[b] + (a - self.first[b])] }
+        } else if b < self.first[a] {
+            0.0
+        } else {
+            self.lval[self.lptr[a] + (b - self.first[a])]
+        }
+    }
+}
+
 impl LinearSolver for SkylineLu {
     fn set_dimension(&mut self, n: usize) {
         self.n = n;
@@ -479,6 +624,7 @@ impl LinearSolver for SkylineLu {
         if let Some((_, adj)) = &self.structure {
             assert_eq!(adj.len(), n, "SkylineLu: the structure has the wrong dimension");
             self.order_from_structure();
+            self.direct_ok = self.set_pointers();
         }
     }
 
@@ -493,6 +639,27 @@ impl LinearSolver for SkylineLu {
             self.n_dense += 1;
             self.dense.factorize(a)
         }
+    }
+
+    fn assembly_target(&mut self) -> Option<&mut dyn AssemblyTarget> {
+        if self.direct_ok { Some(self) } else { None }
+    }
+
+    fn factorize_assembled(&mut self) -> Result<Assembled, usize> {
+        if self.direct_outside {
+            // the structure given by the model is incomplete: scan dense matrices from now on
+            self.direct_ok = false;
+            self.structure = None;
+            self.ordered = false;
+            self.contiguity_known = false;
+            return Ok(Assembled::UseDense);
+        }
+        if !self.factor_in_place(self.direct_symmetric) {
+            return Ok(Assembled::UseDense); // tiny pivot: the dense path retries and falls back
+        }
+        self.use_dense = false;
+        self.n_skyline += 1;
+        Ok(Assembled::Factorized)
     }
 
     fn solve_in_place(&mut self, b: &mut [f64]) {
@@ -639,6 +806,69 @@ mod tests {
         for (p, q) in x.iter().zip(&y) {
             assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
         }
+    }
+
+    /// The KKT matrix assembled straight into the envelope (symmetric blocks by their upper
+    /// triangle, the rest entry by entry) solves bit for bit like the gathered one, with the
+    /// symmetry hint set and cleared; an entry outside the structure asks for the dense path.
+    #[test]
+    fn direct_assembly_matches_the_gather() {
+        let a = kkt(40, 4);
+        let b: Vec<f64> = (0..42).map(|i| (i as f64 * 0.13).sin()).collect();
+        let adjacency: Vec<Vec<usize>> =
+            (0..42).map(|i| (0..42).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        for (symmetric, unsymmetric_entry) in [(true, 0.0), (false, 0.0), (false, 0.25)] {
+            let mut c = a.clone();
+            *c.get_mut(3, 5) += unsymmetric_entry;
+            let flag = Arc::new(AtomicBool::new(symmetric));
+            let mut gathered = SkylineLu::with_structure(40, adjacency.clone()).with_symmetry_hint(Arc::clone(&flag));
+            gathered.set_dimension(42);
+            gathered.factorize(&c).unwrap();
+            let mut x_gathered = b.clone();
+            gathered.solve_in_place(&mut x_gathered);
+
+            let mut direct = SkylineLu::with_structure(40, adjacency.clone()).with_symmetry_hint(Arc::clone(&flag));
+            direct.set_dimension(42);
+            let target = direct.assembly_target().expect("a known structure offers direct assembly");
+            target.clear();
+            // the coordinate block as 8 × 8 symmetric blocks on the diagonal (upper triangle) plus
+            // the couplings between them, then the constraint rows and columns
+            // (the unsymmetric matrix goes entry by entry)
+            let blocks = if unsymmetric_entry == 0.0 { 5 } else { 0 };
+            let mut blk = vec![0.0; 64];
+            for k in 0..blocks {
+                for cc in 0..8 {
+                    for r in 0..8 {
+                        blk[cc * 8 + r] = if r <= cc { c.get(8 * k + r, 8 * k + cc) } else { f64::NAN };
+                    }
+                }
+                target.add_symmetric_upper(8 * k, 8, &blk, 1.0);
+            }
+            for j in 0..42 {
+                for i in 0..42 {
+                    let same_block = i < 8 * blocks && j < 8 * blocks && i / 8 == j / 8;
+                    let x = c.get(i, j);
+                    if !same_block && x != 0.0 {
+                        target.add(i, j, x);
+                    }
+                }
+            }
+            if !symmetric {
+                // lower triangles are kept while the hint is off
+                assert_eq!(target.get(5, 3), c.get(5, 3));
+            }
+            assert_eq!(direct.factorize_assembled(), Ok(Assembled::Factorized));
+            let mut x_direct = b.clone();
+            direct.solve_in_place(&mut x_direct);
+            assert_eq!(x_direct, x_gathered, "symmetric hint {symmetric}, extra entry {unsymmetric_entry}");
+        }
+        let mut s = SkylineLu::with_structure(40, adjacency);
+        s.set_dimension(42);
+        let target = s.assembly_target().unwrap();
+        target.clear();
+        target.add(0, 30, 1.0);
+        assert_eq!(s.factorize_assembled(), Ok(Assembled::UseDense));
+        assert!(s.assembly_target().is_none());
     }
 
     #[test]

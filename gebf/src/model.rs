@@ -72,11 +72,8 @@ fn scatter_matrix(b: &Body, e: usize, mat: &Mat24, k: &mut MatView<'_>) {
     let ranges = local_ranges(b, e);
     let data = mat.as_slice();
     for &(lc, gc, nc) in &ranges {
-        for c in 0..nc {
-            let col = &data[24 * (lc + c)..24 * (lc + c + 1)];
-            for &(lr, gr, nr) in &ranges {
-                k.add_slice(gr, gc + c, nr, 1, &col[lr..lr + nr], 1.0);
-            }
+        for &(lr, gr, nr) in &ranges {
+            k.add_submatrix(gr, gc, nr, nc, &data[24 * lc + lr..], 24, 1.0);
         }
     }
 }

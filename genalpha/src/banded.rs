@@ -106,6 +106,8 @@ struct Block {
     rows: Vec<usize>,
     /// Range `lo..hi` of the non-zero columns of each active row of `F`.
     row_range: Vec<(usize, usize)>,
+    /// `E`, all border columns, by columns: m × n_b (as assembled).
+    e: Vec<f64>,
     /// `E` then `X = D⁻¹ E` on the active columns, by columns: m × cols.len().
     x: Vec<f64>,
     /// `F`, row-major n_b × m (all border rows; only the active ones are used).
@@ -249,6 +251,13 @@ pub(crate) struct BorderedBandLu {
     xb: Vec<f64>,
     /// Block of each unknown (`usize::MAX` for the border).
     owner: Vec<usize>,
+    /// Position of each unknown in the border (`usize::MAX` inside a block).
+    border_pos: Vec<usize>,
+    /// Direct assembly met a non-zero entry outside the structure.
+    outside: bool,
+    /// Every block's active `E` columns and `F` rows are those of the stored values (the last
+    /// factorisation went through all blocks).
+    active_known: bool,
 }
 
 impl BorderedBandLu {
@@ -264,6 +273,10 @@ impl BorderedBandLu {
             owner[first..first + len].iter_mut().for_each(|o| *o = bi);
         }
         let nb = border.len();
+        let mut border_pos = vec![usize::MAX; n];
+        for (c, &b) in border.iter().enumerate() {
+            border_pos[b] = c;
+        }
         let blocks = structure
             .blocks
             .iter()
@@ -280,6 +293,7 @@ impl BorderedBandLu {
                 col_start: Vec::with_capacity(nb),
                 rows: Vec::with_capacity(nb),
                 row_range: Vec::with_capacity(nb),
+                e: vec![0.0; m * nb],
                 x: vec![0.0; m * nb],
                 f: vec![0.0; nb * m],
             })
@@ -293,6 +307,9 @@ impl BorderedBandLu {
             tmp: vec![0.0; nb],
             xb: vec![0.0; nb],
             owner,
+            border_pos,
+            outside: false,
+            active_known: false,
         }
     }
 
@@ -316,10 +333,10 @@ impl BorderedBandLu {
 
     /// Factorise; `Err(row)` on a tiny band pivot or a singular Schur complement.
     pub fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize> {
-        let nb = self.border.len();
         let n = self.n;
         assert!(a.n_rows() == n && a.n_cols() == n, "factorize: dimension mismatch");
         let data = a.as_slice();
+        let nb = self.border.len();
         // Schur complement starts as G.
         for (c, &bj) in self.border.iter().enumerate() {
             let col = &data[bj * n..(bj + 1) * n];
@@ -337,34 +354,259 @@ impl BorderedBandLu {
                 blk.band[j * ld + lo + w - j..j * ld + hi + w - j].copy_from_slice(src);
             }
             // All border rows of F, column by column of the block (contiguous in the
-            // column-major storage); then the active rows with the range of their non-zeros,
-            // and the active columns of E with their first non-zero, found on every matrix:
-            // entries that vanish at rest may not vanish later.
+            // column-major storage), and all border columns of E.
             for j in 0..m {
                 let col = &data[(first + j) * n..(first + j + 1) * n];
                 for (c, &bi) in self.border.iter().enumerate() {
                     blk.f[c * m + j] = col[bi];
                 }
             }
+            for (c, &bj) in self.border.iter().enumerate() {
+                blk.e[c * m..(c + 1) * m].copy_from_slice(&data[bj * n + first..bj * n + first + m]);
+            }
+        }
+        self.factorize_gathered()
+    }
+
+    /// Zero the storage before a direct assembly ([`AssemblyTarget`]). After a complete
+    /// factorisation only the columns of `E` and rows of `F` it found non-zero need zeroing.
+    pub fn clear(&mut self) {
+        self.outside = false;
+        self.s.fill(0.0);
+        let tracked = std::mem::replace(&mut self.active_known, false);
+        for blk in &mut self.blocks {
+            blk.band.fill(0.0);
+            let m = blk.m;
+            if tracked {
+                blk.cols.iter().for_each(|&c| blk.e[c * m..(c + 1) * m].fill(0.0));
+                blk.rows.iter().for_each(|&r| blk.f[r * m..(r + 1) * m].fill(0.0));
+            } else {
+                blk.e.fill(0.0);
+                blk.f.fill(0.0);
+            }
+        }
+    }
+
+    /// A(i, j) += v in the block storage (a non-zero outside the structure is recorded, see
+    /// [`assembled_outside`](Self::assembled_outside)).
+    #[inline]
+    pub fn add(&mut self, i: usize, j: usize, v: f64) {
+        let (oi, oj) = (self.owner[i], self.owner[j]);
+        let nb = self.border.len();
+        match (oi != usize::MAX, oj != usize::MAX) {
+            (true, true) => {
+                let blk = &mut self.blocks[oi];
+                if oi != oj || i.abs_diff(j) > blk.w {
+                    self.outside |= v != 0.0;
+                    return;
+                }
+                let (il, jl) = (i - blk.first, j - blk.first);
+                blk.band[jl * (2 * blk.w + 1) + il + blk.w - jl] += v;
+            }
+            (true, false) => {
+                let blk = &mut self.blocks[oi];
+                blk.e[self.border_pos[j] * blk.m + i - blk.first] += v;
+            }
+            (false, true) => {
+                let blk = &mut self.blocks[oj];
+                blk.f[self.border_pos[i] * blk.m + j - blk.first] += v;
+            }
+            (false, false) => self.s[self.border_pos[i] * nb + self.border_pos[j]] += v,
+        }
+    }
+
+    /// `A[i0.., j0..] += s · block` (column-major `n_r × n_c`); contiguous band and `E` column
+    /// segments are added as slices.
+    pub fn add_slice(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, block: &[f64], s: f64) {
+        if n_r == 0 {
+            return;
+        }
+        let (oi, oi_last) = (self.owner[i0], self.owner[i0 + n_r - 1]);
+        let rows_in_one_block = oi != usize::MAX && oi == oi_last;
+        for c in 0..n_c {
+            let j = j0 + c;
+            let src = &block[c * n_r..(c + 1) * n_r];
+            let oj = self.owner[j];
+            if rows_in_one_block && (oj == oi || oj == usize::MAX) {
+                let blk = &mut self.blocks[oi];
+                let il0 = i0 - blk.first;
+                let dst = if oj == oi {
+                    let (jl, w) = (j - blk.first, blk.w);
+                    if i0 + w < j || j + w < i0 + n_r - 1 {
+                        // part of the column is outside the band: entry by entry
+                        for (r, x) in src.iter().enumerate() {
+                            self.add(i0 + r, j, s * x);
+                        }
+                        continue;
+                    }
+                    let o = jl * (2 * w + 1) + il0 + w - jl;
+                    &mut blk.band[o..o + n_r]
+                } else {
+                    let o = self.border_pos[j] * blk.m + il0;
+                    &mut blk.e[o..o + n_r]
+                };
+                for (d, x) in dst.iter_mut().zip(src) {
+                    *d += s * x;
+                }
+            } else if oi == usize::MAX
+                && oi_last == usize::MAX
+                && self.border_pos[i0 + n_r - 1] == self.border_pos[i0] + n_r - 1
+            {
+                // consecutive border rows: a strided segment of F (column j in a block) or of G
+                let p0 = self.border_pos[i0];
+                let (dst, stride) = if oj == usize::MAX {
+                    let nb = self.border.len();
+                    (&mut self.s[p0 * nb + self.border_pos[j]..], nb)
+                } else {
+                    let blk = &mut self.blocks[oj];
+                    (&mut blk.f[p0 * blk.m + j - blk.first..], blk.m)
+                };
+                for (d, x) in dst.iter_mut().step_by(stride).zip(src) {
+                    *d += s * x;
+                }
+            } else {
+                for (r, x) in src.iter().enumerate() {
+                    self.add(i0 + r, j, s * x);
+                }
+            }
+        }
+    }
+
+    /// The block all of `i0..i0 + n` lie in, or `usize::MAX` if they are consecutive border
+    /// unknowns, or `None` for a mixed range.
+    fn range_owner(&self, i0: usize, n: usize) -> Option<usize> {
+        let (o0, o1) = (self.owner[i0], self.owner[i0 + n - 1]);
+        if o0 != o1 {
+            return None;
+        }
+        if o0 == usize::MAX && self.border_pos[i0 + n - 1] != self.border_pos[i0] + n - 1 {
+            return None;
+        }
+        Some(o0)
+    }
+
+    /// `A[i0 + r, j0 + c] += s · data[c · ld + r]`: a sub-block of a column-major matrix with
+    /// leading dimension `ld`, classified once (band, `E`, `F` or `G` part) and added by
+    /// contiguous runs; mixed ranges go column by column.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_submatrix(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, data: &[f64], ld: usize, s: f64) {
+        if n_r == 0 || n_c == 0 {
+            return;
+        }
+        let nb = self.border.len();
+        match (self.range_owner(i0, n_r), self.range_owner(j0, n_c)) {
+            (Some(bi), Some(bj)) if bi != usize::MAX && bi == bj => {
+                let blk = &mut self.blocks[bi];
+                let (w, ld_b) = (blk.w, 2 * blk.w + 1);
+                let il0 = i0 - blk.first;
+                if i0 + w < j0 + n_c - 1 || j0 + w < i0 + n_r - 1 {
+                    // part of the block is outside the band
+                    for c in 0..n_c {
+                        self.add_slice(i0, j0 + c, n_r, 1, &data[c * ld..c * ld + n_r], s);
+                    }
+                    return;
+                }
+                for c in 0..n_c {
+                    let jl = j0 + c - blk.first;
+                    let o = jl * ld_b + il0 + w - jl;
+                    for (d, x) in blk.band[o..o + n_r].iter_mut().zip(&data[c * ld..c * ld + n_r]) {
+                        *d += s * x;
+                    }
+                }
+            }
+            (Some(bi), Some(usize::MAX)) if bi != usize::MAX => {
+                let blk = &mut self.blocks[bi];
+                let (m, il0, p0) = (blk.m, i0 - blk.first, self.border_pos[j0]);
+                for c in 0..n_c {
+                    let o = (p0 + c) * m + il0;
+                    for (d, x) in blk.e[o..o + n_r].iter_mut().zip(&data[c * ld..c * ld + n_r]) {
+                        *d += s * x;
+                    }
+                }
+            }
+            (Some(usize::MAX), Some(bj)) if bj != usize::MAX => {
+                let blk = &mut self.blocks[bj];
+                let (m, jl0, p0) = (blk.m, j0 - blk.first, self.border_pos[i0]);
+                for r in 0..n_r {
+                    let o = (p0 + r) * m + jl0;
+                    for (c, d) in blk.f[o..o + n_c].iter_mut().enumerate() {
+                        *d += s * data[c * ld + r];
+                    }
+                }
+            }
+            (Some(usize::MAX), Some(usize::MAX)) => {
+                let (p0, q0) = (self.border_pos[i0], self.border_pos[j0]);
+                for r in 0..n_r {
+                    let o = (p0 + r) * nb + q0;
+                    for (c, d) in self.s[o..o + n_c].iter_mut().enumerate() {
+                        *d += s * data[c * ld + r];
+                    }
+                }
+            }
+            _ => {
+                for c in 0..n_c {
+                    self.add_slice(i0, j0 + c, n_r, 1, &data[c * ld..c * ld + n_r], s);
+                }
+            }
+        }
+    }
+
+    /// Entry (i, j) as assembled (0 outside the structure).
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        let (oi, oj) = (self.owner[i], self.owner[j]);
+        let nb = self.border.len();
+        match (oi != usize::MAX, oj != usize::MAX) {
+            (true, true) => {
+                let blk = &self.blocks[oi];
+                if oi != oj || i.abs_diff(j) > blk.w {
+                    return 0.0;
+                }
+                let (il, jl) = (i - blk.first, j - blk.first);
+                blk.band[jl * (2 * blk.w + 1) + il + blk.w - jl]
+            }
+            (true, false) => {
+                let blk = &self.blocks[oi];
+                blk.e[self.border_pos[j] * blk.m + i - blk.first]
+            }
+            (false, true) => {
+                let blk = &self.blocks[oj];
+                blk.f[self.border_pos[i] * blk.m + j - blk.first]
+            }
+            (false, false) => self.s[self.border_pos[i] * nb + self.border_pos[j]],
+        }
+    }
+
+    /// Whether a direct assembly met a non-zero entry outside the structure.
+    pub fn assembled_outside(&self) -> bool {
+        self.outside
+    }
+
+    /// Factorise the gathered or directly assembled storage (band, `E`, `F`, `G` in `s`).
+    pub fn factorize_gathered(&mut self) -> Result<(), usize> {
+        let nb = self.border.len();
+        for blk in &mut self.blocks {
+            let (first, m) = (blk.first, blk.m);
+            // The active rows of F with the range of their non-zeros, and the active columns
+            // of E with their first non-zero, found on every matrix: entries that vanish at
+            // rest may not vanish later.
             blk.rows.clear();
             blk.row_range.clear();
             blk.cols.clear();
             blk.col_start.clear();
-            for (c, &bj) in self.border.iter().enumerate() {
+            for c in 0..nb {
                 let frow = &blk.f[c * m..(c + 1) * m];
                 if let Some(lo) = frow.iter().position(|x| *x != 0.0) {
                     let hi = frow.iter().rposition(|x| *x != 0.0).map_or(lo + 1, |j| j + 1);
                     blk.rows.push(c);
                     blk.row_range.push((lo, hi));
                 }
-                if let Some(s) = data[bj * n + first..bj * n + first + m].iter().position(|x| *x != 0.0) {
+                if let Some(s) = blk.e[c * m..(c + 1) * m].iter().position(|x| *x != 0.0) {
                     blk.cols.push(c);
                     blk.col_start.push(s);
                 }
             }
             for (cc, &c) in blk.cols.iter().enumerate() {
-                let bj = self.border[c];
-                blk.x[cc * m..(cc + 1) * m].copy_from_slice(&data[bj * n + first..bj * n + first + m]);
+                blk.x[cc * m..(cc + 1) * m].copy_from_slice(&blk.e[c * m..(c + 1) * m]);
             }
             if !blk.factorize() {
                 return Err(first);
@@ -385,6 +627,7 @@ impl BorderedBandLu {
                 }
             }
         }
+        self.active_known = true;
         // Dense LU of S with partial pivoting.
         let scale = self.s.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         for (i, p) in self.perm.iter_mut().enumerate() {
@@ -498,6 +741,86 @@ mod tests {
         // An entry outside the structure is detected.
         *a.get_mut(2, 12) = 1.0;
         assert!(!lu.fits(&a));
+    }
+
+    /// Direct assembly (entry by entry, by slices and by strided sub-blocks, twice with a clear
+    /// in between) factorises to the same solution as the dense gather, bit for bit, and an entry
+    /// outside the structure is reported.
+    #[test]
+    fn direct_assembly_matches_the_dense_gather() {
+        let n = 40;
+        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
+        let mut a = DenseMatrix::zeros(n, n);
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let owner = |i: usize| st.blocks.iter().position(|&(f, m, _)| i >= f && i < f + m);
+        for j in 0..n {
+            for i in 0..n {
+                let keep = match (owner(i), owner(j)) {
+                    (Some(bi), Some(bj)) => bi == bj && i.abs_diff(j) <= st.blocks[bi].2,
+                    _ => rnd() > 0.0,
+                };
+                if keep {
+                    *a.get_mut(i, j) = rnd();
+                }
+            }
+            *a.get_mut(j, j) += 6.0;
+        }
+        let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let mut b = vec![0.0; n];
+        a.mul_vec_inplace(&x_true, &mut b);
+        let mut dense = BorderedBandLu::new(n, &st);
+        dense.factorize(&a).unwrap();
+        let mut x_dense = b.clone();
+        dense.solve_in_place(&mut x_dense);
+
+        let mut direct = BorderedBandLu::new(n, &st);
+        // first a different matrix, so that clearing is exercised
+        direct.clear();
+        for i in 0..n {
+            direct.add(i, i, 3.0);
+        }
+        direct.factorize_gathered().unwrap();
+        direct.clear();
+        let data = a.as_slice();
+        // columns 0..10 entry by entry, 10..18 as slices of whole columns, the rest as strided
+        // sub-blocks over row ranges that split at the block boundaries
+        for j in 0..10 {
+            for i in 0..n {
+                let x = a.get(i, j);
+                if x != 0.0 {
+                    direct.add(i, j, x);
+                }
+            }
+        }
+        for j in 10..18 {
+            direct.add_slice(0, j, n, 1, &data[j * n..(j + 1) * n], 1.0);
+        }
+        for (r0, r1) in [(0, 15), (15, 18), (18, 35), (35, 40)] {
+            for (c0, c1) in [(18, 35), (35, 40)] {
+                let (nr, nc) = (r1 - r0, c1 - c0);
+                // only what is inside the structure (outside entries are zero in `a` anyway)
+                direct.add_submatrix(r0, c0, nr, nc, &data[c0 * n + r0..], n, 1.0);
+            }
+        }
+        assert!(!direct.assembled_outside());
+        for (i, j) in [(0, 0), (3, 5), (20, 40 - 1), (16, 2), (17, 30)] {
+            assert_eq!(direct.get(i, j), a.get(i, j), "entry ({i}, {j})");
+        }
+        direct.factorize_gathered().unwrap();
+        let mut x_direct = b.clone();
+        direct.solve_in_place(&mut x_direct);
+        assert_eq!(x_direct, x_dense);
+        for (x, y) in x_direct.iter().zip(&x_true) {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
+        // An entry outside the structure (two blocks coupled) is recorded.
+        direct.clear();
+        direct.add(2, 20, 1.0);
+        assert!(direct.assembled_outside());
     }
 
     /// The pattern of a chain of three-node elements with 2 unknowns per node (an element

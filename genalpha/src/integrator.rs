@@ -1,7 +1,8 @@
 //! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
 
 use crate::{
-    Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, Stats, StepStats,
+    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, MatView,
+    Stats, StepStats,
 };
 
 /// The integrator's state at one instant.
@@ -63,6 +64,11 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// Columns of B that have been non-zero in some assembly (their Bᵀ entries are rewritten).
     b_cols_written: Vec<bool>,
     have_factorization: bool,
+    /// Assemble into the solver's storage when it offers one (see
+    /// [`LinearSolver::assembly_target`]).
+    direct: bool,
+    /// The last assembly went to the solver's storage.
+    assembled_direct: bool,
     /// Per column `j < n` of the K block, the row ranges (below `n`) the model may write, from
     /// the declared [`BandedBorder`](crate::BandedBorder); empty when no structure is declared
     /// (then the whole block is cleared).
@@ -185,6 +191,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             phi_q_cols: Vec::with_capacity(n),
             b_cols_written: vec![false; n],
             have_factorization: false,
+            direct: true,
+            assembled_direct: false,
             k_rows,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
@@ -529,7 +537,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                     // so refresh it at the predictor for the next steps.
                     self.refresh_steps_left = REFRESH_STEPS;
                 }
-                self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })?;
+                self.factorize_iteration_matrix(sys, t1, s)?;
                 self.have_factorization = true;
                 stats.n_factorizations += 1;
                 fresh = true;
@@ -589,30 +597,78 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// Assemble the scaled iteration matrix at the current iterate, and evaluate the residual
-    /// there into `self.r` (without constraint forces).
+    /// there into `self.r` (without constraint forces): into the solver's own storage when it
+    /// offers one ([`LinearSolver::assembly_target`]), else into the dense matrix.
     fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        let (c_m, c_c, c_k) = (1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime);
+        if self.direct
+            && let Some(target) = self.solver.assembly_target()
+        {
+            target.clear();
+            {
+                let mut k = MatView::direct(&mut *target, 0, 0, n, n);
+                sys.residual_and_iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
+                sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, c_k, &mut k);
+            }
+            if n_v > 0 {
+                let mut j = MatView::direct(&mut *target, n + n_h, 0, n_v, n);
+                sys.psi_q_inplace(t1, &s.q, &s.v, &mut j.scaled(1.0 / c.gamma_prime));
+            }
+            for &j in &self.phi_q_cols {
+                for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
+                    let x = self.phi_q.get(i, j);
+                    target.add(n + i, j, x);
+                    target.add(j, n + i, x);
+                }
+            }
+            if n_v > 0 {
+                for j in 0..n {
+                    let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
+                    for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+                        target.add(n + n_h + i, j, x);
+                        target.add(j, n + n_h + i, x);
+                    }
+                }
+            }
+            self.assembled_direct = true;
+            return;
+        }
+        self.assembled_direct = false;
         self.clear_added_blocks();
         {
             let mut k = self.matrix.block(0, 0, n, n);
-            sys.residual_and_iteration_matrix_inplace(
-                t1,
-                &s.q,
-                &s.v,
-                &s.v_dot,
-                &mut self.r,
-                1.0,
-                c.gamma_prime / c.beta_prime,
-                1.0 / c.beta_prime,
-                &mut k,
-            );
-            sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, 1.0 / c.beta_prime, &mut k);
+            sys.residual_and_iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
+            sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, c_k, &mut k);
         }
         if n_v > 0 {
             let mut j = self.matrix.block(n + n_h, 0, n_v, n);
             sys.psi_q_inplace(t1, &s.q, &s.v, &mut j.scaled(1.0 / c.gamma_prime));
         }
         self.place_constraint_blocks();
+    }
+
+    /// Factorise the matrix of the last [`assemble_with_residual`](Self::assemble_with_residual).
+    /// When the solver's own storage asks for the dense path, the same matrix is assembled
+    /// densely (the residual is recomputed, with the same values) and factorised (a solver whose
+    /// storage met an entry outside its structure stops offering it).
+    fn factorize_iteration_matrix<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t1: f64,
+        s: &State,
+    ) -> Result<(), Error> {
+        if self.assembled_direct {
+            match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: t1, pivot })? {
+                Assembled::Factorized => return Ok(()),
+                Assembled::UseDense => {
+                    self.direct = false;
+                    self.assemble_with_residual(sys, t1, s);
+                    self.direct = true;
+                }
+            }
+        }
+        self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })
     }
 }

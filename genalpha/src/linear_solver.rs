@@ -1,8 +1,8 @@
 //! The linear-solver seam: symbolic set-up once, numeric factorisation per Newton matrix,
 //! solve in place. faer types never leave this file.
 
-use crate::DenseMatrix;
 use crate::banded::{BandedBorder, BorderedBandLu};
+use crate::{AssemblyTarget, DenseMatrix};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::{PartialPivLuParams, lu_in_place, lu_in_place_scratch};
 use faer::linalg::lu::partial_pivoting::solve::{solve_in_place, solve_in_place_scratch};
@@ -19,6 +19,58 @@ pub trait LinearSolver {
     fn factorize(&mut self, a: &DenseMatrix) -> Result<(), usize>;
     /// Overwrite `b` with `A⁻¹ b` for the last factorised `A`.
     fn solve_in_place(&mut self, b: &mut [f64]);
+    /// The solver's own storage, if it lets the integrator assemble the iteration matrix into
+    /// it directly (then [`factorize_assembled`](Self::factorize_assembled) factorises it).
+    /// Default: none — the integrator assembles a [`DenseMatrix`] and calls
+    /// [`factorize`](Self::factorize).
+    fn assembly_target(&mut self) -> Option<&mut dyn AssemblyTarget> {
+        None
+    }
+    /// Factorise what was assembled into [`assembly_target`](Self::assembly_target) since its
+    /// last `clear`. [`Assembled::UseDense`] asks the integrator to assemble the same matrix
+    /// densely and call [`factorize`](Self::factorize) instead (an entry fell outside the
+    /// storage, or the structured factorisation met a tiny pivot and wants its dense fallback).
+    fn factorize_assembled(&mut self) -> Result<Assembled, usize> {
+        Ok(Assembled::UseDense)
+    }
+}
+
+/// Outcome of [`LinearSolver::factorize_assembled`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Assembled {
+    /// Factorised; solves may follow.
+    Factorized,
+    /// Not factorised: assemble densely and call [`LinearSolver::factorize`].
+    UseDense,
+}
+
+/// Direct assembly into the bordered band storage (offered only with a declared structure that a
+/// dense matrix has confirmed).
+impl AssemblyTarget for DenseLu {
+    fn clear(&mut self) {
+        if let Some(s) = &mut self.structured {
+            s.clear();
+        }
+    }
+    #[inline]
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        if let Some(s) = &mut self.structured {
+            s.add(i, j, v);
+        }
+    }
+    fn add_slice(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, block: &[f64], s: f64) {
+        if let Some(st) = &mut self.structured {
+            st.add_slice(i0, j0, n_r, n_c, block, s);
+        }
+    }
+    fn add_submatrix(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, data: &[f64], ld: usize, s: f64) {
+        if let Some(st) = &mut self.structured {
+            st.add_submatrix(i0, j0, n_r, n_c, data, ld, s);
+        }
+    }
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.structured.as_ref().map_or(0.0, |s| s.get(i, j))
+    }
 }
 
 /// Dense LU with partial pivoting (faer, sequential, in place, no allocation after set-up).
@@ -108,6 +160,24 @@ impl LinearSolver for DenseLu {
             }
         }
         Ok(())
+    }
+
+    fn assembly_target(&mut self) -> Option<&mut dyn AssemblyTarget> {
+        // once a dense matrix has confirmed the declared structure
+        if self.structure_checked && self.structured.is_some() { Some(self) } else { None }
+    }
+
+    fn factorize_assembled(&mut self) -> Result<Assembled, usize> {
+        let Some(s) = &mut self.structured else { return Ok(Assembled::UseDense) };
+        if s.assembled_outside() {
+            self.structured = None; // the declared structure is incomplete
+            return Ok(Assembled::UseDense);
+        }
+        if s.factorize_gathered().is_err() {
+            return Ok(Assembled::UseDense); // the dense path retries and falls back to the dense LU
+        }
+        self.use_structured = true;
+        Ok(Assembled::Factorized)
     }
 
     fn solve_in_place(&mut self, b: &mut [f64]) {
