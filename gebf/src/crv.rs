@@ -144,6 +144,7 @@ impl TangentCoefficients {
     }
 
     /// The coefficients at `s = |psi|²`, the second derivatives only if `second` (else zero).
+    #[inline]
     fn evaluate(s: f64, second: bool) -> Self {
         let phi = s.sqrt();
         if phi < SERIES_LIMIT {
@@ -320,9 +321,11 @@ impl Tangent {
         Self::build(psi, TangentCoefficients::first_order(psi), false)
     }
     /// Evaluate at `psi` with all coefficients (one `sin_cos`), for the tangent matrices.
+    #[inline]
     pub fn with_second_order(psi: &V3) -> Self {
         Self::build(psi, TangentCoefficients::new(psi), true)
     }
+    #[inline]
     fn build(psi: &V3, k: TangentCoefficients, second: bool) -> Self {
         // psĩ² = psi psiᵀ − s I
         let pp = outer(psi, psi) - M3::identity() * psi.norm_squared();
@@ -335,6 +338,7 @@ impl Tangent {
         diag_skew(1.0, &(self.psi * (1.0 - s * self.k.b))) - self.pp * self.k.a
     }
     /// `dT[b] = Σ_j b_j ∂T/∂psi_j`, so that `dT[b] a = ∂(T a)/∂psi · b`.
+    #[inline]
     pub fn dir(&self, b: &V3) -> M3 {
         let (k, p) = (&self.k, &self.psi);
         let pb = p.dot(b);
@@ -343,6 +347,7 @@ impl Tangent {
             + self.pp * (2.0 * k.db * pb)
     }
     /// The vector `dT[b] a` (cheaper than `dir(b) * a`).
+    #[inline]
     pub fn dir_vec(&self, b: &V3, a: &V3) -> V3 {
         let (k, p) = (&self.k, &self.psi);
         let pb = p.dot(b);
@@ -353,6 +358,7 @@ impl Tangent {
             + p.cross(&pa) * (2.0 * k.db * pb)
     }
     /// `∂(T_σ a)/∂psi` (σ = 1: T, σ = −1: Tᵀ).
+    #[inline]
     fn jac_with(&self, sigma: f64, a: &V3) -> M3 {
         let (k, p) = (&self.k, &self.psi);
         let pa = p.cross(a);
@@ -360,6 +366,7 @@ impl Tangent {
         diag_skew(k.b * p.dot(a), &(a * (-sigma * k.a))) + outer(&u, p) + outer(p, a) * k.b
     }
     /// The vector `(∂(T a)/∂psi)ᵀ m` (without the matrix).
+    #[inline]
     pub fn jac_tr_vec(&self, a: &V3, m: &V3) -> V3 {
         let (k, p) = (&self.k, &self.psi);
         let pa = p.cross(a);
@@ -367,13 +374,16 @@ impl Tangent {
         a.cross(m) * k.a + p * u.dot(m) + a * (k.b * p.dot(m)) + m * (k.b * p.dot(a))
     }
     /// `∂(T a)/∂psi`.
+    #[inline]
     pub fn jac(&self, a: &V3) -> M3 {
         self.jac_with(1.0, a)
     }
     /// `∂(Tᵀ b)/∂psi`.
+    #[inline]
     pub fn jac_t(&self, b: &V3) -> M3 {
         self.jac_with(-1.0, b)
     }
+    #[inline]
     fn full(&self) -> TangentCoefficients {
         let mut k = self.k;
         if !self.second {
@@ -388,6 +398,7 @@ impl Tangent {
     /// `∂/∂psi [T c + dT[a] a]`: the Jacobian of the rotational acceleration
     /// `T psi_ddot + dT[psi_dot] psi_dot` for `a = psi_dot`, `c = psi_ddot` (equal to
     /// `jac(c) + second(a, a)`, collected into three outer products).
+    #[inline]
     pub fn acceleration_jac(&self, a: &V3, c: &V3) -> M3 {
         let k = self.full();
         let p = &self.psi;
@@ -407,6 +418,7 @@ impl Tangent {
     /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar
     /// `f = mᵀ T a = mᵀa + α L + β Q` with `L = psi·(a × m)` and
     /// `Q = (m·psi)(psi·a) − s (m·a)` (symmetric).
+    #[inline]
     pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
         let k = self.full();
         let p = &self.psi;

@@ -34,6 +34,36 @@ pub(crate) fn add_inertia(
     le: f64,
     sec: &Section,
     res: &mut Vec24,
+    mat: Option<(&mut Mat24, MatrixCoefficients)>,
+) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        return unsafe { add_inertia_avx2(st, le, sec, res, mat) };
+    }
+    add_inertia_generic(st, le, sec, res, mat)
+}
+
+/// The same code compiled with AVX2 (wider vectors, no FMA: the same arithmetic, so the same
+/// results bit for bit).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn add_inertia_avx2(
+    st: &ElementState,
+    le: f64,
+    sec: &Section,
+    res: &mut Vec24,
+    mat: Option<(&mut Mat24, MatrixCoefficients)>,
+) -> f64 {
+    add_inertia_generic(st, le, sec, res, mat)
+}
+
+#[inline(always)]
+fn add_inertia_generic(
+    st: &ElementState,
+    le: f64,
+    sec: &Section,
+    res: &mut Vec24,
     mut mat: Option<(&mut Mat24, MatrixCoefficients)>,
 ) -> f64 {
     let m = sec.mass;
