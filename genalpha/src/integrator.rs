@@ -157,6 +157,26 @@ fn copy_state(from: &State, to: &mut State) {
     to.mu.copy_from_slice(&from.mu);
 }
 
+/// `max_i |Δx_i w_i| / (atol + rtol |h δ_i w_i|)`: the increment against its tolerance (all
+/// values finite). Four running maxima, so that the divisions of consecutive entries overlap
+/// instead of waiting for each other through one running maximum (the maximum does not depend on
+/// the order).
+fn increment_norm(dx: &[f64], w: &[f64], hdelta: &[f64], atol: f64, rtol: f64) -> f64 {
+    let ratio = |((d, w), hd): ((&f64, &f64), &f64)| (d * w).abs() / (atol + rtol * (hd * w).abs());
+    let mut m = [0.0_f64; 4];
+    let n4 = dx.len() - dx.len() % 4;
+    for (k, e) in dx[..n4].iter().zip(&w[..n4]).zip(&hdelta[..n4]).enumerate() {
+        let x = ratio(e);
+        let slot = &mut m[k % 4];
+        *slot = if x > *slot { x } else { *slot };
+    }
+    for e in dx[n4..].iter().zip(&w[n4..]).zip(&hdelta[n4..]) {
+        let x = ratio(e);
+        m[0] = if x > m[0] { x } else { m[0] };
+    }
+    m[0].max(m[1]).max(m[2].max(m[3]))
+}
+
 fn inf_norm(x: &[f64]) -> f64 {
     x.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) })
 }
@@ -565,19 +585,22 @@ impl<L: LinearSolver> GenAlpha<L> {
             // Update.
             prev_prev_inc = prev_inc;
             prev_inc = inc_norm;
-            inc_norm = 0.0;
             let (inv_h, inv_beta_h2) = (1.0 / h, 1.0 / (c.beta * h * h)); // no divisions in the loop
-            for i in 0..n {
-                let dx = self.rhs[i];
-                self.delta[i] += dx * inv_h;
-                self.hdelta[i] = h * self.delta[i];
-                s.v[i] += c.gamma_prime * dx;
-                s.v_dot[i] += c.beta_prime * dx;
-                s.a[i] += dx * inv_beta_h2;
-                let w = self.weights[i];
-                let tol = np.atol + np.rtol * (self.hdelta[i] * w).abs();
-                inc_norm = inc_norm.max((dx * w).abs() / tol);
+            let dxs = &self.rhs[..n];
+            for (((d, hd), dx), (v, (v_dot, a))) in self
+                .delta
+                .iter_mut()
+                .zip(self.hdelta.iter_mut())
+                .zip(dxs)
+                .zip(s.v.iter_mut().zip(s.v_dot.iter_mut().zip(s.a.iter_mut())))
+            {
+                *d += dx * inv_h;
+                *hd = h * *d;
+                *v += c.gamma_prime * dx;
+                *v_dot += c.beta_prime * dx;
+                *a += dx * inv_beta_h2;
             }
+            inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
             for i in 0..n_h {
                 s.lambda[i] += c.beta_prime * self.rhs[n + i];
             }
