@@ -20,9 +20,11 @@
 //! the band is stored by columns, so that the columns of `L` below and of `U` above the diagonal
 //! are contiguous and both triangular solves are column sweeps (`y[k+1..] -= l_k y_k`,
 //! independent updates that vectorise) instead of row dot products (one serial chain of
-//! additions per row). `X = D⁻¹E` is stored by columns and each column starts its forward sweep
-//! at its first non-zero (joint columns touch only a body's last node); each row of `F` keeps the
-//! range of its non-zeros, so the Schur product `F X` and the solve's `F y` skip the zeros.
+//! additions per row). The Schur complement is formed as `S = G − Z Y` with `Y = L⁻¹E` (by
+//! columns, each starting its forward sweep at its first non-zero) and `Z = F U⁻¹` (by rows,
+//! each starting at its first non-zero): joint columns and rows touch only a body's last node,
+//! so they need no full backward sweep and their products with `Z`, `Y` are a few terms long.
+//! The solve follows: `c = L⁻¹ b_I`, `S x_B = b_B − Z c`, `x_I = U⁻¹ (c − Y x_B)`.
 //! Dot products that remain use four partial sums.
 
 use crate::DenseMatrix;
@@ -108,8 +110,10 @@ struct Block {
     row_range: Vec<(usize, usize)>,
     /// `E`, all border columns, by columns: m × n_b (as assembled).
     e: Vec<f64>,
-    /// `E` then `X = D⁻¹ E` on the active columns, by columns: m × cols.len().
+    /// `E` then `Y = L⁻¹ E` on the active columns, by columns: m × cols.len().
     x: Vec<f64>,
+    /// `Z = F U⁻¹` on the active rows, by rows: rows.len() × m.
+    z: Vec<f64>,
     /// `F`, row-major n_b × m (all border rows; only the active ones are used).
     f: Vec<f64>,
 }
@@ -184,17 +188,23 @@ impl Block {
         true
     }
 
-    /// Overwrite the vector `y` (length m, zero before `start`) with `D⁻¹ y`, by column sweeps.
-    fn solve_vec(&self, y: &mut [f64], start: usize) {
-        let (m, w) = (self.m, self.w);
-        let ld = 2 * w + 1;
-        for k in start..m {
+    /// Overwrite the vector `y` (length m) with `L⁻¹ y`, by column sweeps.
+    fn forward_vec(&self, y: &mut [f64]) {
+        let ld = 2 * self.w + 1;
+        for k in 0..self.m {
             let yk = y[k];
             if yk != 0.0 {
                 let len = self.len_l[k];
-                sub_scaled(&mut y[k + 1..k + 1 + len], yk, &self.band[k * ld + w + 1..k * ld + w + 1 + len]);
+                let o = k * ld + self.w + 1;
+                sub_scaled(&mut y[k + 1..k + 1 + len], yk, &self.band[o..o + len]);
             }
         }
+    }
+
+    /// Overwrite the vector `y` (length m) with `U⁻¹ y`, by column sweeps.
+    fn backward_vec(&self, y: &mut [f64]) {
+        let (m, w) = (self.m, self.w);
+        let ld = 2 * w + 1;
         for k in (0..m).rev() {
             let yk = y[k] * self.inv_diag[k];
             y[k] = yk;
@@ -203,14 +213,16 @@ impl Block {
         }
     }
 
-    /// Overwrite the columns of `x` (by columns, m × starts.len(); column c zero before
-    /// `starts[c]`) with `D⁻¹ x`. The sweeps run over the rows outside and the columns inside,
-    /// so that the columns' independent update chains overlap.
-    fn solve_cols(&self, x: &mut [f64], starts: &[usize]) {
+    /// `Y = L⁻¹ E` on the active columns of `E`, stored by columns in `x` (m × cols.len(); each
+    /// column is zero before its first non-zero, so its sweep starts there). The sweep runs over
+    /// the rows outside and the columns inside, so that the columns' independent update chains
+    /// overlap.
+    fn forward_cols(&mut self) {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
-        let nc = starts.len();
-        let x = &mut x[..m * nc];
+        let nc = self.cols.len();
+        let x = &mut self.x[..m * nc];
+        let starts = &self.col_start;
         let k0 = starts.iter().copied().min().unwrap_or(m);
         for k in k0..m {
             let len = self.len_l[k];
@@ -222,14 +234,31 @@ impl Block {
                 }
             }
         }
-        for k in (0..m).rev() {
-            let lo = self.u_top[k];
-            let u = &self.band[k * ld + lo + w - k..k * ld + w];
-            let inv = self.inv_diag[k];
-            for xc in x.chunks_exact_mut(m) {
-                let xk = xc[k] * inv;
-                xc[k] = xk;
-                sub_scaled(&mut xc[lo..k], xk, u);
+    }
+
+    /// `Z = F U⁻¹` on the active rows of `F`, stored by rows in `z` (rows.len() × m; row r is
+    /// zero before `row_range[r].0`). Left-looking, so that each step reads a contiguous column
+    /// of `U`: `z_j = (f_j − Σ_{i<j} z_i U_ij) / U_jj`; the rows run inside, so that their
+    /// independent chains overlap.
+    fn right_solve_rows(&mut self) {
+        let (m, w) = (self.m, self.w);
+        let ld = 2 * w + 1;
+        let z = &mut self.z[..m * self.rows.len()];
+        for ((zr, &r), &(lo, _)) in z.chunks_exact_mut(m).zip(&self.rows).zip(&self.row_range) {
+            zr[..lo].fill(0.0);
+            zr[lo..].copy_from_slice(&self.f[r * m + lo..(r + 1) * m]);
+        }
+        let j0 = self.row_range.iter().map(|r| r.0).min().unwrap_or(m);
+        for j in j0..m {
+            let top = self.u_top[j];
+            let ucol = &self.band[j * ld + top + w - j..j * ld + w];
+            let inv = self.inv_diag[j];
+            for (zr, &(lo, _)) in z.chunks_exact_mut(m).zip(&self.row_range) {
+                if j >= lo {
+                    let a = top.max(lo);
+                    let (done, rest) = zr.split_at_mut(j);
+                    rest[0] = (rest[0] - dot(&done[a..], &ucol[a - top..])) * inv;
+                }
             }
         }
     }
@@ -295,6 +324,7 @@ impl BorderedBandLu {
                 row_range: Vec::with_capacity(nb),
                 e: vec![0.0; m * nb],
                 x: vec![0.0; m * nb],
+                z: vec![0.0; nb * m],
                 f: vec![0.0; nb * m],
             })
             .collect();
@@ -611,19 +641,16 @@ impl BorderedBandLu {
             if !blk.factorize() {
                 return Err(first);
             }
-            if blk.cols.is_empty() {
-                continue;
-            }
-            // X = D⁻¹ E on the active columns.
-            let mut x = std::mem::take(&mut blk.x);
-            blk.solve_cols(&mut x, &blk.col_start);
-            blk.x = x;
-            // S[rows, cols] −= F X, over each row's non-zeros.
-            for (&br, &(lo, hi)) in blk.rows.iter().zip(&blk.row_range) {
-                let frow = &blk.f[br * m + lo..br * m + hi];
+            // S = G − F D⁻¹ E = G − Z Y with Y = L⁻¹ E, Z = F U⁻¹: Y is zero above each
+            // column's first non-zero and Z left of each row's, so a product runs from the later
+            // of the two to the end (joint columns and rows touch only a body's last node).
+            blk.forward_cols();
+            blk.right_solve_rows();
+            for (zr, (&br, &(lo, _))) in blk.z.chunks_exact(m).zip(blk.rows.iter().zip(&blk.row_range)) {
                 let srow = &mut self.s[br * nb..(br + 1) * nb];
-                for (&c, xc) in blk.cols.iter().zip(blk.x.chunks_exact(m)) {
-                    srow[c] -= dot(frow, &xc[lo..hi]);
+                for ((&c, yc), &st) in blk.cols.iter().zip(blk.x.chunks_exact(m)).zip(&blk.col_start) {
+                    let a = lo.max(st);
+                    srow[c] -= dot(&zr[a..], &yc[a..]);
                 }
             }
         }
@@ -662,18 +689,15 @@ impl BorderedBandLu {
     /// Overwrite `b` with `A⁻¹ b`.
     pub fn solve_in_place(&mut self, b: &mut [f64]) {
         let nb = self.border.len();
-        // y = D⁻¹ b on the blocks.
-        for blk in &self.blocks {
-            blk.solve_vec(&mut b[blk.first..blk.first + blk.m], 0);
-        }
-        // b_B ← b_B − F y, into tmp.
+        // c = L⁻¹ b on the blocks, and b_B − Z c into tmp.
         for (t, &bi) in self.tmp.iter_mut().zip(&self.border) {
             *t = b[bi];
         }
         for blk in &self.blocks {
-            let y = &b[blk.first..blk.first + blk.m];
-            for (&br, &(lo, hi)) in blk.rows.iter().zip(&blk.row_range) {
-                self.tmp[br] -= dot(&blk.f[br * blk.m + lo..br * blk.m + hi], &y[lo..hi]);
+            let c = &mut b[blk.first..blk.first + blk.m];
+            blk.forward_vec(c);
+            for (zr, (&br, &(lo, _))) in blk.z.chunks_exact(blk.m).zip(blk.rows.iter().zip(&blk.row_range)) {
+                self.tmp[br] -= dot(&zr[lo..], &c[lo..]);
             }
         }
         // x_B = S⁻¹ (…): forward with the permutation, then back; kept in `xb`.
@@ -689,12 +713,13 @@ impl BorderedBandLu {
         for (&x, &bi) in xb.iter().zip(&self.border) {
             b[bi] = x;
         }
-        // x_I = y − X x_B, column by column.
+        // x_I = U⁻¹ (c − Y x_B).
         for blk in &self.blocks {
-            let bi = &mut b[blk.first..blk.first + blk.m];
-            for (&c, xc) in blk.cols.iter().zip(blk.x.chunks_exact(blk.m)) {
-                sub_scaled(bi, xb[c], xc);
+            let c = &mut b[blk.first..blk.first + blk.m];
+            for ((&col, yc), &st) in blk.cols.iter().zip(blk.x.chunks_exact(blk.m)).zip(&blk.col_start) {
+                sub_scaled(&mut c[st..], xb[col], &yc[st..]);
             }
+            blk.backward_vec(c);
         }
     }
 }
