@@ -289,20 +289,44 @@ impl SkylineLu {
 
     /// Crout for symmetric values (`L = D⁻¹Uᵀ`): column `j` of `U` and row `j` of `L` from the
     /// rows of `L` above. Consecutive columns, and consecutive rows, with the same profile start
-    /// are taken in pairs, so that each loaded value serves two products (the node-ordered ANCF
-    /// unknowns come in runs of 12 with a common start).
+    /// are taken together (columns in fours, else pairs; rows in pairs), so that each loaded value
+    /// serves several products (the node-ordered ANCF unknowns come in runs of 12 with a common
+    /// start).
     fn factorize_symmetric(&mut self, scale: f64) -> bool {
         let n = self.n;
         let mut j = 0;
         while j < n {
-            let pair = j + 1 < n && self.first[j + 1] == self.first[j];
-            let ok = if pair { self.symmetric_column_pair(j, scale) } else { self.symmetric_column(j, scale) };
+            let f = self.first[j];
+            let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
+            let (ok, width) = match run {
+                4 if self.quad_pairs_rows_like_pairs(j) => (self.symmetric_column_quad(j, scale), 4),
+                4 => (self.symmetric_column_pair(j, scale), 2),
+                2 | 3 => (self.symmetric_column_pair(j, scale), 2),
+                _ => (self.symmetric_column(j, scale), 1),
+            };
             if !ok {
                 return false;
             }
-            j += if pair { 2 } else { 1 };
+            j += width;
         }
         true
+    }
+
+    /// Whether the rows above column `j` pair up (consecutive rows with a common profile
+    /// start) in the same way for the columns `j, j + 1` as for `j + 2, j + 3`, i.e. unless the
+    /// greedy pairing over `first[j] .. j` leaves row `j - 1` alone while it could pair with row
+    /// `j`. Then [`symmetric_column_quad`](Self::symmetric_column_quad) sums exactly like two
+    /// [`symmetric_column_pair`](Self::symmetric_column_pair) calls.
+    fn quad_pairs_rows_like_pairs(&self, j: usize) -> bool {
+        let f = self.first[j];
+        if j == f || self.first[j - 1] != f {
+            return true;
+        }
+        let mut i = f;
+        while i + 1 < j {
+            i += if self.first[i + 1] == self.first[i] { 2 } else { 1 };
+        }
+        i == j // row j - 1 was paired with row j - 2
     }
 
     /// Pivot `j` of the symmetric factorisation from its reduced diagonal entry.
@@ -403,6 +427,178 @@ impl SkylineLu {
         self.inv_diag[j] = dj;
         self.set_pivot(j + 1, d1, scale)
     }
+    /// Columns `j .. j + 4` with the same profile start `f` together: the rows above `j` in
+    /// pairs against all four columns (eight products per loaded pair of `L` values), then the
+    /// 4 × 4 diagonal block as two column pairs. Every product is summed in the same order as
+    /// in [`symmetric_column_pair`](Self::symmetric_column_pair) on the pairs `(j, j + 1)` and
+    /// `(j + 2, j + 3)`, so both give the same factors bit for bit.
+    fn symmetric_column_quad(&mut self, j: usize, scale: f64) -> bool {
+        let f = self.first[j];
+        let m = j - f;
+        // the L rows j .. j + 4 and the U columns j .. j + 4 follow each other in storage
+        let (l_done, l_rest) = self.lval.split_at_mut(self.lptr[j]);
+        let (l0, l_rest) = l_rest.split_at_mut(m);
+        let (l1, l_rest) = l_rest.split_at_mut(m + 1);
+        let (l2, l_rest) = l_rest.split_at_mut(m + 2);
+        let l3 = &mut l_rest[..m + 3];
+        let (u0, u_rest) = self.uval[self.uptr[j]..].split_at_mut(m + 1);
+        let (u1, u_rest) = u_rest.split_at_mut(m + 2);
+        let (u2, u_rest) = u_rest.split_at_mut(m + 3);
+        let u3 = &mut u_rest[..m + 4];
+        let mut i = f;
+        while i < j {
+            let fi = self.first[i];
+            let lo = fi.max(f);
+            let lpi = self.lptr[i];
+            let l_i = &l_done[lpi + (lo - fi)..lpi + (i - fi)];
+            let (k0, k) = (lo - f, i - f);
+            let di = self.inv_diag[i];
+            if i + 1 < j && self.first[i + 1] == fi {
+                let lpi1 = self.lptr[i + 1];
+                let l_i1 = &l_done[lpi1 + (lo - fi)..lpi1 + (i - fi)];
+                let s = dot4x2(l_i, l_i1, [&u0[k0..k], &u1[k0..k], &u2[k0..k], &u3[k0..k]]);
+                let l_i1_i = l_done[lpi1 + (i - fi)];
+                let di1 = self.inv_diag[i + 1];
+                for (c, (u, l)) in
+                    [(&mut *u0, &mut *l0), (&mut *u1, &mut *l1), (&mut *u2, &mut *l2), (&mut *u3, &mut *l3)]
+                        .into_iter()
+                        .enumerate()
+                {
+                    let a = u[k] - s[c];
+                    let b = u[k + 1] - s[4 + c] - l_i1_i * a;
+                    (u[k], u[k + 1]) = (a, b);
+                    (l[k], l[k + 1]) = (a * di, b * di1);
+                }
+                i += 2;
+            } else {
+                let s = dot4x1(l_i, [&u0[k0..k], &u1[k0..k], &u2[k0..k], &u3[k0..k]]);
+                for (c, (u, l)) in
+                    [(&mut *u0, &mut *l0), (&mut *u1, &mut *l1), (&mut *u2, &mut *l2), (&mut *u3, &mut *l3)]
+                        .into_iter()
+                        .enumerate()
+                {
+                    let a = u[k] - s[c];
+                    u[k] = a;
+                    l[k] = a * di;
+                }
+                i += 1;
+            }
+        }
+        // pivots j, j + 1
+        let Some((dj, dj1)) = pair_diagonal(l0, l1, u0, u1, m, scale) else { return false };
+        (self.inv_diag[j], self.inv_diag[j + 1]) = (dj, dj1);
+        // rows j, j + 1 of columns j + 2, j + 3
+        let s = dot2x2(l0, &l1[..m], &u2[..m], &u3[..m]);
+        let l_i1_i = l1[m];
+        let a0 = u2[m] - s[0];
+        let b0 = u3[m] - s[1];
+        let a1 = u2[m + 1] - s[2] - l_i1_i * a0;
+        let b1 = u3[m + 1] - s[3] - l_i1_i * b0;
+        (u2[m], u3[m], u2[m + 1], u3[m + 1]) = (a0, b0, a1, b1);
+        (l2[m], l3[m], l2[m + 1], l3[m + 1]) = (a0 * dj, b0 * dj, a1 * dj1, b1 * dj1);
+        // pivots j + 2, j + 3
+        let Some((dj2, dj3)) = pair_diagonal(l2, l3, u2, u3, m + 2, scale) else { return false };
+        (self.inv_diag[j + 2], self.inv_diag[j + 3]) = (dj2, dj3);
+        true
+    }
+}
+
+/// The 2 × 2 diagonal block of a column pair whose rows above it are reduced: pivot `m` of
+/// column `u0` (L row `l0`, length `m`), row `m` of column `u1` (giving `l1[m]`), pivot `m + 1`
+/// of `u1` (L row `l1`, length `m + 1`). The inverse pivots, or `None` for a tiny pivot.
+#[inline]
+fn pair_diagonal(
+    l0: &[f64],
+    l1: &mut [f64],
+    u0: &mut [f64],
+    u1: &mut [f64],
+    m: usize,
+    scale: f64,
+) -> Option<(f64, f64)> {
+    let d = u0[m] - dot(l0, &u0[..m]);
+    u0[m] = d;
+    if !d.is_finite() || d.abs() <= 1e-13 * scale {
+        return None;
+    }
+    let dj = 1.0 / d;
+    let u = u1[m] - dot(l0, &u1[..m]);
+    u1[m] = u;
+    l1[m] = u * dj;
+    let d1 = u1[m + 1] - dot(&l1[..m + 1], &u1[..m + 1]);
+    u1[m + 1] = d1;
+    if !d1.is_finite() || d1.abs() <= 1e-13 * scale {
+        return None;
+    }
+    Some((dj, 1.0 / d1))
+}
+
+/// `[l0·u0, l0·u1, l0·u2, l0·u3, l1·u0, …, l1·u3]` over the length of `l0`, each product summed
+/// as in [`dot2x2`] (even and odd terms apart, then the odd last term).
+#[inline]
+fn dot4x2(l0: &[f64], l1: &[f64], u: [&[f64]; 4]) -> [f64; 8] {
+    let n = l0.len();
+    let l1 = &l1[..n];
+    let [u0, u1, u2, u3] = u.map(|c| &c[..n]);
+    let split = n - n % 2;
+    let (mut e, mut o) = ([0.0; 8], [0.0; 8]);
+    for (((((a, b), x0), x1), x2), x3) in l0[..split]
+        .chunks_exact(2)
+        .zip(l1[..split].chunks_exact(2))
+        .zip(u0[..split].chunks_exact(2))
+        .zip(u1[..split].chunks_exact(2))
+        .zip(u2[..split].chunks_exact(2))
+        .zip(u3[..split].chunks_exact(2))
+    {
+        for (c, x) in [x0, x1, x2, x3].into_iter().enumerate() {
+            e[c] += a[0] * x[0];
+            o[c] += a[1] * x[1];
+            e[4 + c] += b[0] * x[0];
+            o[4 + c] += b[1] * x[1];
+        }
+    }
+    let mut s = [0.0; 8];
+    for c in 0..8 {
+        s[c] = e[c] + o[c];
+    }
+    if split < n {
+        let k = split;
+        for (c, x) in [u0, u1, u2, u3].into_iter().enumerate() {
+            s[c] += l0[k] * x[k];
+            s[4 + c] += l1[k] * x[k];
+        }
+    }
+    s
+}
+
+/// `[l·u0, l·u1, l·u2, l·u3]` over the length of `l`, each summed as in [`dot2`].
+#[inline]
+fn dot4x1(l: &[f64], u: [&[f64]; 4]) -> [f64; 4] {
+    let n = l.len();
+    let [u0, u1, u2, u3] = u.map(|c| &c[..n]);
+    let split = n - n % 2;
+    let (mut e, mut o) = ([0.0; 4], [0.0; 4]);
+    for ((((a, x0), x1), x2), x3) in l[..split]
+        .chunks_exact(2)
+        .zip(u0[..split].chunks_exact(2))
+        .zip(u1[..split].chunks_exact(2))
+        .zip(u2[..split].chunks_exact(2))
+        .zip(u3[..split].chunks_exact(2))
+    {
+        for (c, x) in [x0, x1, x2, x3].into_iter().enumerate() {
+            e[c] += x[0] * a[0];
+            o[c] += x[1] * a[1];
+        }
+    }
+    let mut s = [0.0; 4];
+    for c in 0..4 {
+        s[c] = e[c] + o[c];
+    }
+    if split < n {
+        for (c, x) in [u0, u1, u2, u3].into_iter().enumerate() {
+            s[c] += x[split] * l[split];
+        }
+    }
+    s
 }
 
 /// `[l0·u0, l0·u1, l1·u0, l1·u1]` over the length of `u0`.
@@ -670,12 +866,41 @@ impl LinearSolver for SkylineLu {
         }
         let n = self.n;
         let y = &mut self.work;
-        // L y = P b, rows with a common profile start in pairs
+        // L y = P b, rows with a common profile start in fours or pairs (fours only where they
+        // sum like two pairs: an even number of terms before the first row)
         let mut i = 0;
         while i < n {
             let fi = self.first[i];
             let l0 = &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)];
-            if i + 1 < n && self.first[i + 1] == fi {
+            let run = self.first[i..n.min(i + 4)].iter().take_while(|&&x| x == fi).count();
+            if run == 4 && (i - fi).is_multiple_of(2) {
+                let m = i - fi;
+                let row = |r: usize| &self.lval[self.lptr[i + r]..self.lptr[i + r] + (m + r)];
+                let (l1, l2, l3) = (row(1), row(2), row(3));
+                let (mut e, mut o) = ([0.0; 4], [0.0; 4]);
+                for ((((a, b), c), d), z) in l0
+                    .chunks_exact(2)
+                    .zip(l1.chunks_exact(2))
+                    .zip(l2.chunks_exact(2))
+                    .zip(l3.chunks_exact(2))
+                    .zip(y[fi..i].chunks_exact(2))
+                {
+                    for (r, x) in [a, b, c, d].into_iter().enumerate() {
+                        e[r] += x[0] * z[0];
+                        o[r] += x[1] * z[1];
+                    }
+                }
+                let y0 = b[self.order[i]] - (e[0] + o[0]);
+                let y1 = b[self.order[i + 1]] - (e[1] + o[1]) - l1[m] * y0;
+                e[2] += l2[m] * y0;
+                o[2] += l2[m + 1] * y1;
+                e[3] += l3[m] * y0;
+                o[3] += l3[m + 1] * y1;
+                let y2 = b[self.order[i + 2]] - (e[2] + o[2]);
+                let y3 = b[self.order[i + 3]] - (e[3] + o[3]) - l3[m + 2] * y2;
+                y[i..i + 4].copy_from_slice(&[y0, y1, y2, y3]);
+                i += 4;
+            } else if run >= 2 {
                 let l1 = &self.lval[self.lptr[i + 1]..self.lptr[i + 1] + (i + 1 - fi)];
                 let (s0, s1) = dot2(l0, &l1[..i - fi], &y[fi..i]);
                 let y0 = b[self.order[i]] - s0;
@@ -687,16 +912,34 @@ impl LinearSolver for SkylineLu {
                 i += 1;
             }
         }
-        // U x = y by columns, columns with a common profile start in pairs
+        // U x = y by columns, columns with a common profile start in fours or pairs (a four
+        // updates every entry in the same order as two pairs)
         let mut j = n;
         while j > 0 {
             j -= 1;
             let fj = self.first[j];
-            let uj = &self.uval[self.uptr[j]..self.uptr[j] + (j - fj)];
+            let col = |c: usize| &self.uval[self.uptr[c]..self.uptr[c] + (c - fj)];
+            let uj = col(j);
             let xj = y[j] * self.inv_diag[j];
             y[j] = xj;
-            if j > fj && self.first[j - 1] == fj {
-                let uj1 = &self.uval[self.uptr[j - 1]..self.uptr[j - 1] + (j - 1 - fj)];
+            let same = |c: usize| self.first[c] == fj;
+            if j > fj + 2 && same(j - 1) && same(j - 2) && same(j - 3) {
+                let (uj1, uj2, uj3) = (col(j - 1), col(j - 2), col(j - 3));
+                let xj1 = (y[j - 1] - uj[j - 1 - fj] * xj) * self.inv_diag[j - 1];
+                y[j - 1] = xj1;
+                for k in [j - 2, j - 3] {
+                    y[k] -= uj[k - fj] * xj + uj1[k - fj] * xj1;
+                }
+                let xj2 = y[j - 2] * self.inv_diag[j - 2];
+                y[j - 2] = xj2;
+                let xj3 = (y[j - 3] - uj2[j - 3 - fj] * xj2) * self.inv_diag[j - 3];
+                y[j - 3] = xj3;
+                for ((((yk, u0), u1), u2), u3) in y[fj..j - 3].iter_mut().zip(uj).zip(uj1).zip(uj2).zip(uj3) {
+                    *yk = (*yk - (u0 * xj + u1 * xj1)) - (u2 * xj2 + u3 * xj3);
+                }
+                j -= 3;
+            } else if j > fj && same(j - 1) {
+                let uj1 = col(j - 1);
                 let xj1 = (y[j - 1] - uj[j - 1 - fj] * xj) * self.inv_diag[j - 1];
                 y[j - 1] = xj1;
                 for ((yk, u0), u1) in y[fj..j - 1].iter_mut().zip(uj).zip(uj1) {
@@ -869,6 +1112,55 @@ mod tests {
         target.add(0, 30, 1.0);
         assert_eq!(s.factorize_assembled(), Ok(Assembled::UseDense));
         assert!(s.assembly_target().is_none());
+    }
+
+    /// A block-tridiagonal SPD matrix in `nb` blocks of `bs` unknowns (like node-ordered ANCF
+    /// coordinates: every unknown of block k couples to blocks k − 1..=k + 1), with two
+    /// multiplier rows coupling to a few unknowns in the middle of blocks 0 and 2.
+    fn block_kkt(nb: usize, bs: usize) -> DenseMatrix {
+        let n = nb * bs;
+        let mut a = DenseMatrix::zeros(n + 2, n + 2);
+        for i in 0..n {
+            for j in 0..n {
+                if i.abs_diff(j) < 2 * bs && (i / bs).abs_diff(j / bs) <= 1 {
+                    let v = if i == j { 20.0 + (i % 7) as f64 } else { 1.0 / (2.0 + ((i * j) % 11) as f64) };
+                    *a.get_mut(i, j) = v;
+                }
+            }
+        }
+        for (row, cols) in [(n, [1usize, 3]), (n + 1, [2 * bs + 2, 2 * bs + 5])] {
+            for (k, c) in cols.iter().enumerate() {
+                *a.get_mut(row, *c) = 1.0 + k as f64;
+                *a.get_mut(*c, row) = 1.0 + k as f64;
+            }
+        }
+        a
+    }
+
+    /// Runs of columns with a common profile start (panels of 4 to 12 columns, pairs, single
+    /// columns after the multiplier rows) solve like the dense LU, through the symmetric path.
+    #[test]
+    fn panels_of_node_blocks_match_dense_lu() {
+        for (nb, bs) in [(12, 12), (12, 7), (12, 5), (12, 3), (12, 16)] {
+            let a = block_kkt(nb, bs);
+            let m = nb * bs + 2;
+            let b: Vec<f64> = (0..m).map(|i| (i as f64 * 0.29).sin()).collect();
+            let (_, y, _) = solve_both(&a, &b);
+            let adjacency: Vec<Vec<usize>> =
+                (0..m).map(|i| (0..m).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+            for hint in [true, false] {
+                let flag = Arc::new(AtomicBool::new(hint));
+                let mut s = SkylineLu::with_structure(nb * bs, adjacency.clone()).with_symmetry_hint(flag);
+                s.set_dimension(m);
+                s.factorize(&a).unwrap();
+                assert_eq!(s.n_skyline, 1, "blocks {nb} x {bs}: the skyline path must be taken");
+                let mut x = b.clone();
+                s.solve_in_place(&mut x);
+                for (p, q) in x.iter().zip(&y) {
+                    assert_relative_eq!(p, q, epsilon = 1e-13, max_relative = 1e-11);
+                }
+            }
+        }
     }
 
     #[test]
