@@ -598,7 +598,13 @@ impl Model {
         for b in &self.bodies {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
-                ke.zip_apply(&b.element.mass_matrix, |x, m| *x = c_m * m);
+                // c_m M_e on the upper block triangle (what the scatter reads), diagonal blocks in full
+                ke.fill(0.0);
+                for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
+                    for i in 0..3 {
+                        ke[(3 * a + i, 3 * bb + i)] = c_m * m;
+                    }
+                }
                 if c_k != 0.0 {
                     b.element.add_elastic_tangent_upper(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
                 }
