@@ -599,7 +599,7 @@ impl Model {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
                 // c_m M_e on the upper block triangle (what the scatter reads), diagonal blocks in full
-                ke.fill(0.0);
+                ke.as_mut_slice().fill(0.0); // a memset (nalgebra's `fill` walks the matrix entry by entry)
                 for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
                     for i in 0..3 {
                         ke[(3 * a + i, 3 * bb + i)] = c_m * m;
@@ -675,7 +675,7 @@ impl Model {
         for b in &self.bodies {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
-                ke.fill(0.0);
+                ke.as_mut_slice().fill(0.0);
                 for &(a, bb, m) in &b.element.mass_nz {
                     for i in 0..3 {
                         ke[(3 * a + i, 3 * bb + i)] += c_m * m;
