@@ -123,8 +123,8 @@ fn symmetric_times<const L: usize>(
 /// 1. the gradients `u_m = (a_m ⊗ I₃) x` on the group's blocks, from the compact Hessians
 ///    (register accumulators, no scatter), and the strains `s_m = ½ x·u_m`;
 /// 2. the geometric weights `c C_m (s_m − s⁰_m)` on the Hessian pairs into `geometric`;
-/// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a ≤ b`,
-///    diagonal blocks in full) at a time with fixed-size loops.
+/// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a < b`;
+///    diagonal blocks `a = b` on and above their diagonal only) at a time with fixed-size loops.
 #[inline(always)]
 fn add_group_tangent<const M: usize, const NB: usize>(
     plan: &StrainPlan,
@@ -164,7 +164,7 @@ fn add_group_tangent<const M: usize, const NB: usize>(
         wu[m] = u[m].map(|v| v.map(|x| w * x));
     }
     for (j, &b) in blocks.iter().enumerate() {
-        for (i, &a) in blocks[..=j].iter().enumerate() {
+        for (i, &a) in blocks[..j].iter().enumerate() {
             for (jj, col) in cols[3 * b..3 * b + 3].iter_mut().enumerate() {
                 let mut acc = [0.0; 3];
                 for m in 0..M {
@@ -177,14 +177,26 @@ fn add_group_tangent<const M: usize, const NB: usize>(
                 }
             }
         }
+        // the diagonal block on and above its diagonal
+        for (jj, col) in cols[3 * b..3 * b + 3].iter_mut().enumerate() {
+            let mut acc = [0.0; 3];
+            for m in 0..M {
+                for (ac, ua) in acc[..=jj].iter_mut().zip(&u[m][j]) {
+                    *ac += wu[m][j][jj] * ua;
+                }
+            }
+            for (k, ac) in col[3 * b..=3 * b + jj].iter_mut().zip(acc) {
+                *k += ac;
+            }
+        }
     }
 }
 
-/// Copy the upper block triangle (3×3 blocks `(a, b)`, `a ≤ b`) onto the lower one.
+/// Copy the upper triangle onto the strictly lower one.
 pub fn mirror_upper_inplace(k: &mut ElementMatrix) {
     let data = k.as_mut_slice(); // column-major: (i, j) at 24 j + i
     for j in 0..ELEMENT_DOF {
-        for i in 3 * (j / 3 + 1)..ELEMENT_DOF {
+        for i in j + 1..ELEMENT_DOF {
             data[ELEMENT_DOF * j + i] = data[ELEMENT_DOF * i + j];
         }
     }
@@ -292,9 +304,9 @@ impl Element {
         *k += upper;
     }
 
-    /// `k += c · K_el(e)` on the upper block triangle only (3×3 blocks `(a, b)` with `a ≤ b`,
-    /// diagonal blocks in full); [`mirror_upper_inplace`] completes the symmetric matrix, so that
-    /// it is exactly symmetric.
+    /// `k += c · K_el(e)` on the upper triangle (the strictly lower entries are not meaningful
+    /// afterwards); [`mirror_upper_inplace`] completes the symmetric matrix, so that it is
+    /// exactly symmetric.
     ///
     /// The strains are taken a [`StrainGroup`] (equal block sets) at a time, see
     /// [`add_group_tangent`]; the geometric terms `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8
@@ -571,6 +583,31 @@ mod tests {
             let mut k = ElementMatrix::zeros();
             el.add_elastic_tangent(&e, 1.0, &mut k);
             assert!((k - k.transpose()).amax() < 1e-12 * k.amax());
+        }
+    }
+
+    /// The upper-triangle kernel leaves the strictly lower triangle alone (the padding blocks
+    /// of a group add exact zeros there), and the mirrored tangent is symmetric bit for bit.
+    #[test]
+    fn upper_kernel_fills_only_the_upper_triangle() {
+        let l = 0.2;
+        for c in ALL_CURVATURES {
+            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let e = deformed(l, &[0.3, -0.7, 0.2, 0.9, -0.4], 0.2);
+            let mut full = ElementMatrix::zeros();
+            el.add_elastic_tangent(&e, 1.0, &mut full);
+            assert_eq!(full, full.transpose(), "{c:?}");
+            let mut k = ElementMatrix::from_fn(|i, j| if i > j { f64::NAN } else { 0.0 });
+            el.add_elastic_tangent_upper(&e, 1.0, &mut k);
+            for j in 0..ELEMENT_DOF {
+                for i in 0..ELEMENT_DOF {
+                    if i > j {
+                        assert!(k[(i, j)].is_nan(), "{c:?} ({i}, {j})");
+                    } else {
+                        assert_eq!(k[(i, j)], full[(i, j)], "{c:?} ({i}, {j})");
+                    }
+                }
+            }
         }
     }
 }

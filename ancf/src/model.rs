@@ -598,7 +598,7 @@ impl Model {
         for b in &self.bodies {
             for el in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * el;
-                // c_m M_e on the upper block triangle (what the scatter reads), diagonal blocks in full
+                // c_m M_e on the upper triangle (what the scatter reads; M_e is zero off its diagonal inside a 3×3 block)
                 ke.as_mut_slice().fill(0.0); // a memset (nalgebra's `fill` walks the matrix entry by entry)
                 for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
                     for i in 0..3 {
