@@ -980,6 +980,12 @@ mod tests {
 
     /// A banded SPD matrix with a saddle-point border (two multiplier rows coupling to the
     /// first and the middle unknowns), like a constrained ANCF iteration matrix.
+    /// The symmetric non-zero structure of `a`, as `SkylineLu::with_structure` takes it.
+    fn adjacency_of(a: &DenseMatrix) -> Vec<Vec<usize>> {
+        let n = a.n_rows();
+        (0..n).map(|i| (0..n).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect()
+    }
+
     fn kkt(n: usize, bw: usize) -> DenseMatrix {
         let m = n + 2;
         let mut a = DenseMatrix::zeros(m, m);
@@ -1009,8 +1015,7 @@ mod tests {
             assert_relative_eq!(p, q, epsilon = 1e-12, max_relative = 1e-10);
         }
         // the same with the structure given up front
-        let adjacency: Vec<Vec<usize>> =
-            (0..62).map(|i| (0..62).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        let adjacency = adjacency_of(&a);
         let mut s = SkylineLu::with_structure(60, adjacency);
         s.set_dimension(62);
         s.factorize(&a).unwrap();
@@ -1027,8 +1032,7 @@ mod tests {
         let a = kkt(40, 4);
         let b: Vec<f64> = (0..42).map(|i| (i as f64 * 0.21).cos()).collect();
         let (_, y, _) = solve_both(&a, &b);
-        let adjacency: Vec<Vec<usize>> =
-            (0..42).map(|i| (0..42).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        let adjacency = adjacency_of(&a);
         let flag = Arc::new(AtomicBool::new(true));
         let mut s = SkylineLu::with_structure(40, adjacency).with_symmetry_hint(Arc::clone(&flag));
         s.set_dimension(42);
@@ -1058,8 +1062,7 @@ mod tests {
     fn direct_assembly_matches_the_gather() {
         let a = kkt(40, 4);
         let b: Vec<f64> = (0..42).map(|i| (i as f64 * 0.13).sin()).collect();
-        let adjacency: Vec<Vec<usize>> =
-            (0..42).map(|i| (0..42).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+        let adjacency = adjacency_of(&a);
         for (symmetric, unsymmetric_entry) in [(true, 0.0), (false, 0.0), (false, 0.25)] {
             let mut c = a.clone();
             *c.get_mut(3, 5) += unsymmetric_entry;
@@ -1146,8 +1149,7 @@ mod tests {
             let m = nb * bs + 2;
             let b: Vec<f64> = (0..m).map(|i| (i as f64 * 0.29).sin()).collect();
             let (_, y, _) = solve_both(&a, &b);
-            let adjacency: Vec<Vec<usize>> =
-                (0..m).map(|i| (0..m).filter(|&j| a.get(i, j) != 0.0 || a.get(j, i) != 0.0).collect()).collect();
+            let adjacency = adjacency_of(&a);
             for hint in [true, false] {
                 let flag = Arc::new(AtomicBool::new(hint));
                 let mut s = SkylineLu::with_structure(nb * bs, adjacency.clone()).with_symmetry_hint(flag);

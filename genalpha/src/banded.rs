@@ -756,14 +756,11 @@ impl BorderedBandLu {
 mod tests {
     use super::*;
 
-    /// A random diagonally dominant bordered band matrix, solved both ways.
-    #[test]
-    fn matches_dense_solve() {
-        let n = 40;
-        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
-        assert!(st.is_valid(n));
+    /// A random diagonally dominant `n × n` matrix with the structure `st`: random values in
+    /// each block's band, random values and sparsity in the border rows and columns.
+    fn random_bordered(n: usize, st: &BandedBorder, seed: u64) -> DenseMatrix {
         let mut a = DenseMatrix::zeros(n, n);
-        let mut seed = 7u64;
+        let mut seed = seed;
         let mut rnd = || {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
@@ -781,6 +778,16 @@ mod tests {
             }
             *a.get_mut(j, j) += 6.0;
         }
+        a
+    }
+
+    /// A random diagonally dominant bordered band matrix, solved both ways.
+    #[test]
+    fn matches_dense_solve() {
+        let n = 40;
+        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
+        assert!(st.is_valid(n));
+        let a = random_bordered(n, &st, 7);
         let mut lu = BorderedBandLu::new(n, &st);
         assert!(lu.fits(&a));
         lu.factorize(&a).unwrap();
@@ -792,6 +799,7 @@ mod tests {
             assert!((x - y).abs() < 1e-12, "{x} vs {y}");
         }
         // An entry outside the structure is detected.
+        let mut a = a;
         *a.get_mut(2, 12) = 1.0;
         assert!(!lu.fits(&a));
     }
@@ -803,25 +811,7 @@ mod tests {
     fn direct_assembly_matches_the_dense_gather() {
         let n = 40;
         let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
-        let mut a = DenseMatrix::zeros(n, n);
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let owner = |i: usize| st.blocks.iter().position(|&(f, m, _)| i >= f && i < f + m);
-        for j in 0..n {
-            for i in 0..n {
-                let keep = match (owner(i), owner(j)) {
-                    (Some(bi), Some(bj)) => bi == bj && i.abs_diff(j) <= st.blocks[bi].2,
-                    _ => rnd() > 0.0,
-                };
-                if keep {
-                    *a.get_mut(i, j) = rnd();
-                }
-            }
-            *a.get_mut(j, j) += 6.0;
-        }
+        let a = random_bordered(n, &st, 11);
         let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
         let mut b = vec![0.0; n];
         a.mul_vec_inplace(&x_true, &mut b);

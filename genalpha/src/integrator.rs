@@ -64,9 +64,6 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// Columns of B that have been non-zero in some assembly (their Bᵀ entries are rewritten).
     b_cols_written: Vec<bool>,
     have_factorization: bool,
-    /// Assemble into the solver's storage when it offers one (see
-    /// [`LinearSolver::assembly_target`]).
-    direct: bool,
     /// The last assembly went to the solver's storage.
     assembled_direct: bool,
     /// Per column `j < n` of the K block, the row ranges (below `n`) the model may write, from
@@ -211,7 +208,6 @@ impl<L: LinearSolver> GenAlpha<L> {
             phi_q_cols: Vec::with_capacity(n),
             b_cols_written: vec![false; n],
             have_factorization: false,
-            direct: true,
             assembled_direct: false,
             k_rows,
             refresh_steps_left: 0,
@@ -540,7 +536,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             // refactorised here (one pass over the elements).
             self.update_jacobians(sys, t1, &s.q);
             if need {
-                self.assemble_with_residual(sys, t1, s);
+                self.assemble_with_residual(sys, t1, s, true);
             } else {
                 sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
             }
@@ -620,15 +616,14 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// Assemble the scaled iteration matrix at the current iterate, and evaluate the residual
-    /// there into `self.r` (without constraint forces): into the solver's own storage when it
-    /// offers one ([`LinearSolver::assembly_target`]), else into the dense matrix.
-    fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State) {
+    /// there into `self.r` (without constraint forces): into the solver's own storage when
+    /// `direct` is allowed and the solver offers one ([`LinearSolver::assembly_target`]), else into
+    /// the dense matrix.
+    fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State, direct: bool) {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
         let (c_m, c_c, c_k) = (1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime);
-        if self.direct
-            && let Some(target) = self.solver.assembly_target()
-        {
+        if direct && let Some(target) = self.solver.assembly_target() {
             target.clear();
             {
                 let mut k = MatView::direct(&mut *target, 0, 0, n, n);
@@ -686,9 +681,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: t1, pivot })? {
                 Assembled::Factorized => return Ok(()),
                 Assembled::UseDense => {
-                    self.direct = false;
-                    self.assemble_with_residual(sys, t1, s);
-                    self.direct = true;
+                    self.assemble_with_residual(sys, t1, s, false);
                 }
             }
         }

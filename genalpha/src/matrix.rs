@@ -293,20 +293,8 @@ impl MatView<'_> {
     /// # Panics
     /// When the block does not fit or the slice has the wrong length.
     pub fn add_slice(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, block: &[f64], s: f64) {
-        assert!(i0 + n_r <= self.n_rows && j0 + n_c <= self.n_cols && block.len() == n_r * n_c);
-        match &mut self.m {
-            Target::Dense(m) => {
-                let n = m.n_rows;
-                for c in 0..n_c {
-                    let base = (self.col0 + j0 + c) * n + self.row0 + i0;
-                    let col = &mut m.data[base..base + n_r];
-                    for (x, b) in col.iter_mut().zip(&block[c * n_r..(c + 1) * n_r]) {
-                        *x += self.scale * s * b;
-                    }
-                }
-            }
-            Target::Direct(t) => t.add_slice(self.row0 + i0, self.col0 + j0, n_r, n_c, block, self.scale * s),
-        }
+        assert!(block.len() == n_r * n_c, "a {n_r}x{n_c} block from {} values", block.len());
+        self.add_submatrix(i0, j0, n_r, n_c, block, n_r, s);
     }
     /// Add `s · data[c · ld + r]` at (i0 + r, j0 + c) for `r < n_r`, `c < n_c`: a sub-block of a
     /// column-major matrix with leading dimension `ld` (e.g. some rows and columns of an element
