@@ -90,6 +90,11 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// (to step back to when that update diverged).
     previous: State,
     previous_delta: Vec<f64>,
+    /// The steps `s_0, s_1, …` taken with the current factorisation in this step, `n_all` each
+    /// (Broyden's update, see [`broyden_correct`](Self::broyden_correct)).
+    broyden_steps: Vec<f64>,
+    /// Their squared norms.
+    broyden_norms: Vec<f64>,
     stats: Stats,
 }
 
@@ -224,6 +229,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             predictor_delta: vec![0.0; n],
             previous: State::at_rest(sys, 0.0, vec![0.0; n_q]),
             previous_delta: vec![0.0; n],
+            broyden_steps: Vec::with_capacity(n_all * (params.newton.max_iter + 1)),
+            broyden_norms: Vec::with_capacity(params.newton.max_iter + 1),
             stats: Stats::default(),
         })
     }
@@ -429,6 +436,47 @@ impl<L: LinearSolver> GenAlpha<L> {
         k * est > tol
     }
 
+    fn forget_broyden_steps(&mut self) {
+        self.broyden_steps.clear();
+        self.broyden_norms.clear();
+    }
+
+    /// Broyden's ("good") rank-one updates of a reused factorisation `A₀`, applied to the
+    /// modified-Newton step `z = −A₀⁻¹F` in `self.rhs` without forming any matrix (Kelley,
+    /// *Iterative Methods for Linear and Nonlinear Equations*, SIAM 1995, §7.3, `brsol`): with
+    /// `s_0 … s_k` the steps taken since the factorisation (all full steps),
+    /// `z ← z + s_{j+1} (s_jᵀz)/|s_j|²` for `j < k`, then `s_{k+1} = z / (1 − s_kᵀz/|s_k|²)`.
+    /// The first step after a factorisation is plain Newton. Each later one costs `k + 1`
+    /// dot products and axpys on the unknowns, against a linear contraction of the reused
+    /// matrix where the iteration matrix drifts within a step (the torsion of the paper's
+    /// flexible pendulums; GEBF's soft root rotation about the hinge). The step is recorded
+    /// for the next correction.
+    fn broyden_correct(&mut self) {
+        let m = self.rhs.len();
+        let k = self.broyden_norms.len();
+        if k > 0 {
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+            for j in 0..k - 1 {
+                let c = dot(&self.broyden_steps[j * m..(j + 1) * m], &self.rhs) / self.broyden_norms[j];
+                for (z, s) in self.rhs.iter_mut().zip(&self.broyden_steps[(j + 1) * m..(j + 2) * m]) {
+                    *z += c * s;
+                }
+            }
+            let c = dot(&self.broyden_steps[(k - 1) * m..k * m], &self.rhs) / self.broyden_norms[k - 1];
+            let f = 1.0 / (1.0 - c);
+            if f.is_finite() {
+                self.rhs.iter_mut().for_each(|z| *z *= f);
+            }
+        }
+        if k <= self.params.newton.max_iter {
+            let norm2 = self.rhs.iter().map(|x| x * x).sum::<f64>();
+            if norm2 > 0.0 && norm2.is_finite() {
+                self.broyden_steps.extend_from_slice(&self.rhs);
+                self.broyden_norms.push(norm2);
+            }
+        }
+    }
+
     /// One Newton solve for a step of the current size `self.c.h`.
     fn attempt<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
         let c = self.c;
@@ -460,6 +508,7 @@ impl<L: LinearSolver> GenAlpha<L> {
         let mut inc_norm = f64::INFINITY;
         let mut prev_prev_inc = f64::INFINITY;
         let mut step_back = false; // back at an earlier iterate: factorise here
+        self.forget_broyden_steps();
         for iter in 1..=np.max_iter + 1 {
             // Constraints at the current iterate first: if the increment says converged, the
             // dynamic residual is not needed.
@@ -511,6 +560,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.refresh_steps_left = REFRESH_STEPS;
                 inc_norm = f64::INFINITY;
                 prev_inc = f64::INFINITY;
+                self.forget_broyden_steps();
                 continue;
             }
             if !step_back && factorized_this_step && !fresh && contraction > 1.0 {
@@ -524,6 +574,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 prev_inc = prev_prev_inc;
                 prev_prev_inc = f64::INFINITY;
                 step_back = true;
+                self.forget_broyden_steps();
                 continue;
             }
             let need = step_back
@@ -575,6 +626,12 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.rhs[n + n_h + i] = -self.psi[i] / c.gamma_prime;
             }
             self.solver.solve_in_place(&mut self.rhs);
+            if np.broyden && np.reuse_factorization {
+                if need {
+                    self.forget_broyden_steps(); // the sequence restarts from the new matrix
+                }
+                self.broyden_correct();
+            }
             if !self.rhs.iter().all(|x| x.is_finite()) {
                 return Err(Error::NonFinite { t: t1, iter });
             }

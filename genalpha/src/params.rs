@@ -34,6 +34,10 @@ pub struct NewtonParams {
     /// Default true: 0.9–1.0 fewer solves per step on the paper pendulums, trajectories within
     /// 4e-6 of the tip excursion of the confirmed iterate.
     pub estimate_convergence: bool,
+    /// Correct the steps made with a reused factorisation by Broyden's rank-one updates
+    /// (superlinear instead of linear contraction; no extra factorisation or solve). Default
+    /// true; only active with `reuse_factorization`.
+    pub broyden: bool,
     /// Local error control: a converged step whose error estimate
     /// `h²|β − 1/6|·max_i w_i |a_{n+1,i} − a_{n,i}|` (coordinate units, `w` the increment
     /// weights) exceeds this is redone as two half steps, within `max_step_halvings`; counted
@@ -54,6 +58,7 @@ impl Default for NewtonParams {
             max_contraction: 0.2,
             max_step_halvings: 4,
             estimate_convergence: true,
+            broyden: true,
             local_error_tol: 0.0,
         }
     }

@@ -237,6 +237,34 @@ fn convergence_estimate_saves_iterations() {
     }
 }
 
+/// Broyden's corrections of the reused factorisation: fewer iterations (and no more
+/// factorisations) on a pendulum swinging through large angles with a coarse step, and the
+/// same answer to within the Newton tolerance's effect (the time discretisation error is ~1e-2
+/// at this step).
+#[test]
+fn broyden_corrections_save_iterations() {
+    let run = |broyden: bool| {
+        let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
+        let mut p = IntegratorParams::new(0.8, 1e-2);
+        p.newton.broyden = broyden;
+        let mut ga = GenAlpha::new(p, &sys).unwrap();
+        let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+        ga.initialize(&sys, &mut s).unwrap();
+        for _ in 0..300 {
+            ga.step(&mut sys, &mut s).unwrap();
+        }
+        (s, *ga.stats())
+    };
+    let (a, sa) = run(false);
+    let (b, sb) = run(true);
+    println!("plain: {sa:?}\nbroyden: {sb:?}");
+    assert!(sb.n_newton_iters < sa.n_newton_iters, "{sb:?} vs {sa:?}");
+    assert!(sb.n_factorizations <= sa.n_factorizations, "{sb:?} vs {sa:?}");
+    for (x, y) in a.q.iter().zip(&b.q) {
+        assert!((x - y).abs() < 1e-6, "{x} vs {y}");
+    }
+}
+
 #[test]
 fn invalid_parameters_name_the_field() {
     let sys = Oscillator { m: 1.0, k: 1.0 };

@@ -204,6 +204,8 @@ pub struct NewtonSettings {
     /// Stop Newton when the RADAU5-style convergence estimate θ/(1−θ)·|Δ| is below tolerance
     /// (saves an iteration per step).
     pub estimate_convergence: bool,
+    /// Broyden rank-one corrections of the steps made with a reused factorisation.
+    pub broyden: bool,
     /// Retry a failed step as two half steps, at most this deep.
     pub max_step_halvings: usize,
     /// Local error control: halve a converged step whose error estimate
@@ -223,6 +225,7 @@ impl Default for NewtonSettings {
             psi_tol: d.psi_tol,
             reuse_factorization: d.reuse_factorization,
             estimate_convergence: d.estimate_convergence,
+            broyden: d.broyden,
             max_step_halvings: d.max_step_halvings,
             local_error_tol: d.local_error_tol,
         }
@@ -240,6 +243,7 @@ impl NewtonSettings {
             psi_tol: self.psi_tol,
             reuse_factorization: self.reuse_factorization,
             estimate_convergence: self.estimate_convergence,
+            broyden: self.broyden,
             max_step_halvings: self.max_step_halvings,
             local_error_tol: self.local_error_tol,
             ..Default::default()
