@@ -110,8 +110,10 @@ const REFRESH_STEPS: usize = 10;
 
 /// After four iterations with a reused matrix, keep it while its contraction predicts at most
 /// this many more iterations to the tolerance (an assembly and factorisation cost about five
-/// iterations).
-const MAX_MORE_ITERATIONS: f64 = 3.0;
+/// iterations). The prediction extrapolates the last contraction linearly, which is pessimistic
+/// once Broyden's corrections make it superlinear: 5 rather than 3 saves 2.4 % of the work on
+/// GEBF's c = 0.01 pendulum, 0.3–1.5 % on the other soft cases, and moves the rest by < 0.7 %.
+const MAX_MORE_ITERATIONS: f64 = 5.0;
 
 /// Iterations a linearly contracting iteration (ratio `theta`) needs to bring the scaled
 /// increment `inc_norm` below 1.
