@@ -181,8 +181,27 @@ fn increment_norm(dx: &[f64], w: &[f64], hdelta: &[f64], atol: f64, rtol: f64) -
     m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
+/// `max_i |x_i|`, NaN if any entry is NaN. Four running maxima and a NaN flag, all without
+/// branches, so that consecutive entries do not wait for each other (the previous fold also
+/// forgot a NaN that was followed by a number: `f64::max` ignores NaN).
 fn inf_norm(x: &[f64]) -> f64 {
-    x.iter().fold(0.0_f64, |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) })
+    let mut m = [0.0_f64; 4];
+    let mut nan = false;
+    let chunks = x.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for i in 0..4 {
+            let a = c[i].abs();
+            m[i] = if a > m[i] { a } else { m[i] };
+            nan |= c[i].is_nan();
+        }
+    }
+    for v in rest {
+        let a = v.abs();
+        m[0] = if a > m[0] { a } else { m[0] };
+        nan |= v.is_nan();
+    }
+    if nan { f64::NAN } else { m[0].max(m[1]).max(m[2].max(m[3])) }
 }
 
 impl<L: LinearSolver> GenAlpha<L> {
@@ -745,5 +764,24 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
         }
         self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })
+    }
+}
+
+#[cfg(test)]
+mod norm_tests {
+    use super::inf_norm;
+
+    #[test]
+    fn inf_norm_is_the_largest_magnitude_and_keeps_nan() {
+        assert_eq!(inf_norm(&[]), 0.0);
+        assert_eq!(inf_norm(&[1.0, -7.5, 3.0, 2.0, -0.5, 6.0]), 7.5);
+        assert_eq!(inf_norm(&[1.0, 2.0, 3.0, 4.0, 5.0, -9.0, 7.0]), 9.0);
+        assert_eq!(inf_norm(&[f64::NEG_INFINITY, 1.0]), f64::INFINITY);
+        // NaN anywhere, also followed by numbers (in a chunk of four and in the remainder)
+        for k in 0..7 {
+            let mut x = vec![1.0; 7];
+            x[k] = f64::NAN;
+            assert!(inf_norm(&x).is_nan(), "NaN at {k}");
+        }
     }
 }
