@@ -469,9 +469,10 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// `z ← z + s_{j+1} (s_jᵀz)/|s_j|²` for `j < k`, then `s_{k+1} = z / (1 − s_kᵀz/|s_k|²)`.
     /// The first step after a factorisation is plain Newton. Each later one costs `k + 1`
     /// dot products and axpys on the unknowns, against a linear contraction of the reused
-    /// matrix where the iteration matrix drifts within a step (the torsion of the paper's
-    /// flexible pendulums; GEBF's soft root rotation about the hinge). The step is recorded
-    /// for the next correction.
+    /// matrix where the iteration matrix drifts within a step (the tip torsion of the paper's
+    /// flexible pendulums; GEBF's root section rotating against its floating frame, a stiff,
+    /// nearly massless direction whose entries follow the frame's velocity). The step is
+    /// recorded for the next correction.
     fn broyden_correct(&mut self) {
         let m = self.rhs.len();
         let k = self.broyden_norms.len();
