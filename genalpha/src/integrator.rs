@@ -1,8 +1,8 @@
 //! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
 
 use crate::{
-    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, LinearSolver, MatView,
-    Stats, StepStats,
+    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, IterationRecord,
+    LinearSolver, MatView, Stats, StepStats,
 };
 
 /// The integrator's state at one instant.
@@ -95,6 +95,8 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     broyden_steps: Vec<f64>,
     /// Their squared norms.
     broyden_norms: Vec<f64>,
+    /// Per-iteration records while tracing is on.
+    trace: Option<Vec<IterationRecord>>,
     stats: Stats,
 }
 
@@ -252,6 +254,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             previous_delta: vec![0.0; n],
             broyden_steps: Vec::with_capacity(n_all * (params.newton.max_iter + 1)),
             broyden_norms: Vec::with_capacity(params.newton.max_iter + 1),
+            trace: None,
             stats: Stats::default(),
         })
     }
@@ -267,6 +270,18 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// Accumulated statistics.
     pub fn stats(&self) -> &Stats {
         &self.stats
+    }
+
+    /// Record every Newton iteration from now on ([`take_trace`](Self::take_trace)), or stop
+    /// recording and drop the records. Off by default; when on, the records grow without bound
+    /// (a few per step), so it is meant for diagnosing convergence, not for long runs.
+    pub fn set_trace(&mut self, on: bool) {
+        self.trace = on.then(Vec::new);
+    }
+
+    /// The iterations recorded since tracing was switched on or last taken (empty when off).
+    pub fn take_trace(&mut self) -> Vec<IterationRecord> {
+        self.trace.as_mut().map(std::mem::take).unwrap_or_default()
     }
 
     fn update_jacobians<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t: f64, q: &[f64]) {
@@ -676,6 +691,23 @@ impl<L: LinearSolver> GenAlpha<L> {
                 *a += dx * inv_beta_h2;
             }
             inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
+            if let Some(trace) = &mut self.trace {
+                let ratio = |i: usize| {
+                    (dxs[i] * self.weights[i]).abs() / (np.atol + np.rtol * (self.hdelta[i] * self.weights[i]).abs())
+                };
+                let worst_unknown = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
+                trace.push(IterationRecord {
+                    t: t1,
+                    h,
+                    iter,
+                    factorized: need,
+                    residual_norm: res_norm,
+                    phi_norm: stats.phi_norm,
+                    psi_norm: stats.psi_norm,
+                    increment_norm: inc_norm,
+                    worst_unknown,
+                });
+            }
             for i in 0..n_h {
                 s.lambda[i] += c.beta_prime * self.rhs[n + i];
             }

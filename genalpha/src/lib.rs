@@ -44,7 +44,7 @@ pub use integrator::{GenAlpha, State};
 pub use linear_solver::{Assembled, DenseLu, LinearSolver};
 pub use matrix::{AssemblyTarget, DenseMatrix, MatView};
 pub use params::{Coefficients, IntegratorParams, NewtonParams};
-pub use stats::{Stats, StepStats};
+pub use stats::{IterationRecord, Stats, StepStats};
 pub use system::ConstrainedSystem;
 
 #[cfg(test)]

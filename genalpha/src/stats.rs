@@ -44,3 +44,28 @@ impl Stats {
         self.n_factorizations += s.n_factorizations;
     }
 }
+
+/// One Newton iteration, recorded when tracing is on ([`GenAlpha::set_trace`](crate::GenAlpha::set_trace)):
+/// what the iteration did and how far it still was from convergence. Attempts that failed and
+/// were retried as half steps are recorded too (their `h` is the attempted step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationRecord {
+    /// End time of the attempted step, s.
+    pub t: f64,
+    /// Attempted step size, s.
+    pub h: f64,
+    /// Iteration number within the attempt (1 = at the predictor).
+    pub iter: usize,
+    /// The iteration matrix was assembled and factorised at this iterate.
+    pub factorized: bool,
+    /// Scaled infinity norm of the dynamic residual before the update.
+    pub residual_norm: f64,
+    /// Infinity norm of Φ before the update.
+    pub phi_norm: f64,
+    /// Infinity norm of B v + b before the update.
+    pub psi_norm: f64,
+    /// Weighted increment against its tolerance (converged at ≤ 1).
+    pub increment_norm: f64,
+    /// The unknown (tangent index) with the largest weighted increment ratio.
+    pub worst_unknown: usize,
+}

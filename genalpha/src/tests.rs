@@ -265,6 +265,32 @@ fn broyden_corrections_save_iterations() {
     }
 }
 
+/// The Newton trace holds one record per solve, numbered from 1 in every step, with the
+/// factorisations marked, and nothing when tracing is off.
+#[test]
+fn newton_trace_records_every_iteration() {
+    let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
+    let mut ga = GenAlpha::new(IntegratorParams::new(0.8, 1e-2), &sys).unwrap();
+    let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+    ga.initialize(&sys, &mut s).unwrap();
+    ga.step(&mut sys, &mut s).unwrap();
+    assert!(ga.take_trace().is_empty(), "off by default");
+    ga.set_trace(true);
+    let before = *ga.stats();
+    for _ in 0..50 {
+        ga.step(&mut sys, &mut s).unwrap();
+    }
+    let st = *ga.stats();
+    let trace = ga.take_trace();
+    assert_eq!(st.n_step_halvings, 0, "the count below assumes no failed attempt");
+    assert_eq!(trace.len(), st.n_residual_evals - before.n_residual_evals);
+    assert_eq!(trace.iter().filter(|r| r.factorized).count(), st.n_factorizations - before.n_factorizations);
+    assert_eq!(trace.iter().filter(|r| r.iter == 1).count(), 50);
+    assert!(trace.windows(2).all(|w| w[1].iter == 1 || (w[1].iter == w[0].iter + 1 && w[1].t == w[0].t)));
+    assert!(trace.iter().all(|r| r.h == 1e-2 && r.worst_unknown < 2 && r.increment_norm.is_finite()));
+    assert!(ga.take_trace().is_empty(), "taken");
+}
+
 #[test]
 fn invalid_parameters_name_the_field() {
     let sys = Oscillator { m: 1.0, k: 1.0 };
