@@ -4,9 +4,9 @@ use crate::*;
 use approx::assert_relative_eq;
 
 /// Linear oscillator m ẍ + k x = 0 (one dof, no constraints).
-struct Oscillator {
-    m: f64,
-    k: f64,
+pub(crate) struct Oscillator {
+    pub(crate) m: f64,
+    pub(crate) k: f64,
 }
 
 impl ConstrainedSystem for Oscillator {
