@@ -169,12 +169,18 @@ fn copy_state(from: &State, to: &mut State) {
     to.mu.copy_from_slice(&from.mu);
 }
 
+/// One unknown's weighted increment against its tolerance, `|Δx w| / (atol + rtol |h δ w|)`.
+#[inline]
+fn increment_ratio(dx: f64, w: f64, hdelta: f64, atol: f64, rtol: f64) -> f64 {
+    (dx * w).abs() / (atol + rtol * (hdelta * w).abs())
+}
+
 /// `max_i |Δx_i w_i| / (atol + rtol |h δ_i w_i|)`: the increment against its tolerance (all
 /// values finite). Four running maxima, so that the divisions of consecutive entries overlap
 /// instead of waiting for each other through one running maximum (the maximum does not depend on
 /// the order).
 fn increment_norm(dx: &[f64], w: &[f64], hdelta: &[f64], atol: f64, rtol: f64) -> f64 {
-    let ratio = |((d, w), hd): ((&f64, &f64), &f64)| (d * w).abs() / (atol + rtol * (hd * w).abs());
+    let ratio = |((d, w), hd): ((&f64, &f64), &f64)| increment_ratio(*d, *w, *hd, atol, rtol);
     let mut m = [0.0_f64; 4];
     let n4 = dx.len() - dx.len() % 4;
     for (k, e) in dx[..n4].iter().zip(&w[..n4]).zip(&hdelta[..n4]).enumerate() {
@@ -706,9 +712,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
             inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
             if let Some(trace) = &mut self.trace {
-                let ratio = |i: usize| {
-                    (dxs[i] * self.weights[i]).abs() / (np.atol + np.rtol * (self.hdelta[i] * self.weights[i]).abs())
-                };
+                let ratio = |i: usize| increment_ratio(dxs[i], self.weights[i], self.hdelta[i], np.atol, np.rtol);
                 let worst_unknown = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
                 trace.push(IterationRecord {
                     t: t1,

@@ -212,22 +212,28 @@ fn consistent_initial_multiplier() {
     assert_relative_eq!(s.lambda[0], 0.0, epsilon = 1e-12);
 }
 
+/// The velocity-level pendulum released horizontally, `steps` steps with parameters `p`: the
+/// final state and the integrator's statistics.
+fn swing_pendulum(p: IntegratorParams, steps: usize) -> (State, Stats) {
+    let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
+    let mut ga = GenAlpha::new(p, &sys).unwrap();
+    let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+    ga.initialize(&sys, &mut s).unwrap();
+    for _ in 0..steps {
+        ga.step(&mut sys, &mut s).unwrap();
+    }
+    (s, *ga.stats())
+}
+
 /// The contraction estimate saves the confirming iteration; accepting each step within the
 /// Newton tolerance changes the answer after 500 steps far less than the time discretisation
 /// error (~1e-3 here, see `pendulum_velocity_level_matches_index3`).
 #[test]
 fn convergence_estimate_saves_iterations() {
     let run = |estimate: bool| {
-        let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
         let mut p = IntegratorParams::new(0.8, 1e-3);
         p.newton.estimate_convergence = estimate;
-        let mut ga = GenAlpha::new(p, &sys).unwrap();
-        let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
-        ga.initialize(&sys, &mut s).unwrap();
-        for _ in 0..500 {
-            ga.step(&mut sys, &mut s).unwrap();
-        }
-        (s, *ga.stats())
+        swing_pendulum(p, 500)
     };
     let (a, sa) = run(false);
     let (b, sb) = run(true);
@@ -244,16 +250,9 @@ fn convergence_estimate_saves_iterations() {
 #[test]
 fn broyden_corrections_save_iterations() {
     let run = |broyden: bool| {
-        let mut sys = Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: true };
         let mut p = IntegratorParams::new(0.8, 1e-2);
         p.newton.broyden = broyden;
-        let mut ga = GenAlpha::new(p, &sys).unwrap();
-        let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
-        ga.initialize(&sys, &mut s).unwrap();
-        for _ in 0..300 {
-            ga.step(&mut sys, &mut s).unwrap();
-        }
-        (s, *ga.stats())
+        swing_pendulum(p, 300)
     };
     let (a, sa) = run(false);
     let (b, sb) = run(true);

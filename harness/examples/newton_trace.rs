@@ -12,9 +12,9 @@
 //! only; overrides as `harness run --set` (e.g. `gebf.newton.broyden=false`).
 use anyhow::{Context, Result, bail};
 use genalpha::{GenAlpha, IterationRecord, LinearSolver};
-use harness::case::{Case, CaseFile, Override};
+use harness::case::{CaseFile, Formulation, Override};
 use harness::run::Structure;
-use harness::scene::{Sensed, build_ancf, build_gebf};
+use harness::scene::{Sensed, build_ancf, build_gebf, settings};
 
 fn trace<S: Structure>(sys: &mut S, params: genalpha::IntegratorParams, t_end: f64) -> Result<Vec<IterationRecord>>
 where
@@ -32,17 +32,6 @@ where
         }
     }
     Ok(ga.take_trace())
-}
-
-fn params_of(case: &Case, gebf: bool) -> genalpha::IntegratorParams {
-    let (dt, rho, newton) = if gebf {
-        (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton)
-    } else {
-        (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton)
-    };
-    let mut p = genalpha::IntegratorParams::new(rho, dt);
-    p.newton = newton.to_params();
-    p
 }
 
 fn main() -> Result<()> {
@@ -63,11 +52,11 @@ fn main() -> Result<()> {
         bail!("{}: cases with aerodynamics are not traced", spec.name);
     }
     let fold_joint = case.fold_joint_index();
-    let params = params_of(case, gebf);
+    let run = settings(case, if gebf { Formulation::Gebf } else { Formulation::Ancf });
     let records = if gebf {
-        trace(&mut Sensed { model: build_gebf(case)?, fold_joint }, params, case.t_end)?
+        trace(&mut Sensed { model: build_gebf(case)?, fold_joint }, run.params, run.t_end)?
     } else {
-        trace(&mut Sensed { model: build_ancf(case)?, fold_joint }, params, case.t_end)?
+        trace(&mut Sensed { model: build_ancf(case)?, fold_joint }, run.params, run.t_end)?
     };
     println!("t,h,iter,factorized,residual_norm,phi_norm,psi_norm,increment_norm,worst_unknown");
     for r in &records {

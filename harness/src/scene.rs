@@ -270,7 +270,8 @@ impl AeroStructure for Sensed<gebf::Model> {
     }
 }
 
-fn settings(case: &Case, f: Formulation) -> RunSettings {
+/// The integrator parameters, end time and output interval of formulation `f` of a case.
+pub fn settings(case: &Case, f: Formulation) -> RunSettings {
     let (dt, rho, newton) = match f {
         Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton),
         Formulation::Gebf => (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton),
