@@ -2,7 +2,7 @@
 
 use crate::{
     Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, IterationRecord,
-    LinearSolver, MatView, Stats, StepStats,
+    LinearSolver, MatView, Predictor, Stats, StepStats,
 };
 
 /// The integrator's state at one instant.
@@ -99,6 +99,12 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     broyden_plain: Vec<f64>,
     /// Per-iteration records while tracing is on.
     trace: Option<Vec<IterationRecord>>,
+    /// v̇ at the start of the current attempt, and at the start of the last converged step
+    /// (for [`Predictor::ExtrapolatedAcceleration`]).
+    v_dot_n: Vec<f64>,
+    v_dot_previous: Vec<f64>,
+    /// (end time, size bits) of the last converged step.
+    last_step: Option<(f64, u64)>,
     stats: Stats,
 }
 
@@ -268,6 +274,9 @@ impl<L: LinearSolver> GenAlpha<L> {
             broyden_norms: Vec::with_capacity(params.newton.max_iter + 1),
             broyden_plain: vec![0.0; n_all],
             trace: None,
+            v_dot_n: vec![0.0; n],
+            v_dot_previous: vec![0.0; n],
+            last_step: None,
             stats: Stats::default(),
         })
     }
@@ -541,11 +550,22 @@ impl<L: LinearSolver> GenAlpha<L> {
         let np = self.params.newton;
         let t1 = s.t + h;
 
-        // Predictor: constant acceleration v̇_{n+1} = v̇_n.
+        // Predictor: v̇_{n+1} = v̇_n, or extrapolated from v̇_{n−1} when the last step was
+        // contiguous and of the same size.
         self.q_n.copy_from_slice(&s.q);
+        let extrapolate =
+            np.predictor == Predictor::ExtrapolatedAcceleration && self.last_step == Some((s.t, h.to_bits()));
+        self.v_dot_n.copy_from_slice(&s.v_dot);
         for i in 0..n {
             let a_n = s.a[i];
-            let a1 = (s.v_dot[i] - c.alpha_m * a_n) / (1.0 - c.alpha_m);
+            // a_{n+1} from (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) v̇_{n+1} + α_f v̇_n.
+            let v_dot_n = s.v_dot[i];
+            let a1 = if extrapolate {
+                s.v_dot[i] = 2.0 * v_dot_n - self.v_dot_previous[i];
+                ((1.0 - c.alpha_f) * s.v_dot[i] + c.alpha_f * v_dot_n - c.alpha_m * a_n) / (1.0 - c.alpha_m)
+            } else {
+                (v_dot_n - c.alpha_m * a_n) / (1.0 - c.alpha_m)
+            };
             self.delta[i] = s.v[i] + h * (0.5 - c.beta) * a_n + h * c.beta * a1;
             s.v[i] += h * (1.0 - c.gamma) * a_n + h * c.gamma * a1;
             s.a[i] = a1;
@@ -591,6 +611,10 @@ impl<L: LinearSolver> GenAlpha<L> {
             if iter > 1 && small && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
                 stats.n_newton_iters = iter - 1;
                 self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);
+                if np.predictor == Predictor::ExtrapolatedAcceleration {
+                    std::mem::swap(&mut self.v_dot_previous, &mut self.v_dot_n);
+                    self.last_step = Some((t1, h.to_bits()));
+                }
                 s.t = t1;
                 sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
                 return Ok(stats);

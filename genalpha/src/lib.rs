@@ -43,7 +43,7 @@ pub use error::Error;
 pub use integrator::{GenAlpha, State};
 pub use linear_solver::{Assembled, DenseLu, LinearSolver};
 pub use matrix::{AssemblyTarget, DenseMatrix, MatView};
-pub use params::{Coefficients, IntegratorParams, NewtonParams};
+pub use params::{Coefficients, IntegratorParams, NewtonParams, Predictor};
 pub use stats::{IterationRecord, Stats, StepStats};
 pub use system::ConstrainedSystem;
 

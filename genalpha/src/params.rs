@@ -44,6 +44,22 @@ pub struct NewtonParams {
     /// like a Newton-failure halving. Default 0: off (every step has the nominal size unless
     /// Newton fails).
     pub local_error_tol: f64,
+    /// How each step's Newton iteration starts (default [`Predictor::ConstantAcceleration`]).
+    pub predictor: Predictor,
+}
+
+/// The predictor: the first Newton iterate of a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Predictor {
+    /// `v̇_{n+1} = v̇_n`, with `v_{n+1}`, `q_{n+1}` and `a_{n+1}` from the Newmark relations.
+    #[default]
+    ConstantAcceleration,
+    /// `v̇_{n+1} = 2 v̇_n − v̇_{n−1}`: the acceleration extrapolated linearly from the last two
+    /// steps (when the last step had the same size and ended where this one starts; otherwise
+    /// as [`ConstantAcceleration`](Self::ConstantAcceleration)). One order more accurate in h,
+    /// which pays where the residual is strongly nonlinear in the velocities: GEBF's gyroscopic
+    /// terms of fast-spinning floating frames.
+    ExtrapolatedAcceleration,
 }
 
 impl Default for NewtonParams {
@@ -60,6 +76,7 @@ impl Default for NewtonParams {
             estimate_convergence: true,
             broyden: true,
             local_error_tol: 0.0,
+            predictor: Predictor::ConstantAcceleration,
         }
     }
 }

@@ -212,6 +212,20 @@ pub struct NewtonSettings {
     /// h²|β − 1/6|·max|Δa| (m; rotations weighted by the body length) exceeds this, within
     /// `max_step_halvings`. 0 = off (default).
     pub local_error_tol: f64,
+    /// Newton's starting point in each step. Default: `extrapolated_acceleration` for GEBF
+    /// (its floating frames' gyroscopic terms make Newton sensitive to the predicted
+    /// velocities), `constant_acceleration` for ANCF.
+    pub predictor: Option<PredictorSetting>,
+}
+
+/// Newton's starting point in each step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PredictorSetting {
+    /// The acceleration of the last step.
+    ConstantAcceleration,
+    /// The acceleration extrapolated linearly from the last two steps.
+    ExtrapolatedAcceleration,
 }
 
 impl Default for NewtonSettings {
@@ -228,14 +242,20 @@ impl Default for NewtonSettings {
             broyden: d.broyden,
             max_step_halvings: d.max_step_halvings,
             local_error_tol: d.local_error_tol,
+            predictor: None,
         }
     }
 }
 
 impl NewtonSettings {
-    /// As genalpha parameters.
-    pub fn to_params(self) -> genalpha::NewtonParams {
+    /// As genalpha parameters, with `default_predictor` where the case sets none.
+    pub fn to_params(self, default_predictor: genalpha::Predictor) -> genalpha::NewtonParams {
         genalpha::NewtonParams {
+            predictor: match self.predictor {
+                None => default_predictor,
+                Some(PredictorSetting::ConstantAcceleration) => genalpha::Predictor::ConstantAcceleration,
+                Some(PredictorSetting::ExtrapolatedAcceleration) => genalpha::Predictor::ExtrapolatedAcceleration,
+            },
             max_iter: self.max_iter,
             rtol: self.rtol,
             atol: self.atol,
