@@ -817,7 +817,7 @@ impl ConstrainedSystem for Model {
                 vec![(0, self.reduction.n_reduced(), w)]
             }
         };
-        Some(genalpha::BandedBorder { blocks })
+        Some(genalpha::BandedBorder { blocks, node_bandwidth: None })
     }
 
     fn increment_weight(&self, i: usize) -> f64 {

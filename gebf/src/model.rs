@@ -676,7 +676,11 @@ impl ConstrainedSystem for Model {
     /// Each body's nodal unknowns form a band block (an element couples 3 consecutive nodes:
     /// half-bandwidth 17); the frame velocities and the joint rows form the border.
     fn matrix_structure(&self) -> Option<genalpha::BandedBorder> {
-        Some(genalpha::BandedBorder { blocks: self.bodies.iter().map(|b| (b.dof0, 12 * b.n_elements, 17)).collect() })
+        // Nodes of six unknowns (R, psi); a three-node element couples nodes at most two apart.
+        Some(genalpha::BandedBorder {
+            blocks: self.bodies.iter().map(|b| (b.dof0, 12 * b.n_elements, 17)).collect(),
+            node_bandwidth: Some(2),
+        })
     }
 
     /// Positions in m weigh 1; rotations weigh the body length (a rotation δ moves the far end

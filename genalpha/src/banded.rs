@@ -28,6 +28,7 @@
 //! Dot products that remain use four partial sums.
 
 use crate::DenseMatrix;
+use crate::node_lu::NodeBand;
 
 /// The declared structure: diagonal blocks `(first, len, half_bandwidth)` of the unknowns
 /// (tangent indices); every index in no block belongs to the border, and so do all constraint
@@ -36,6 +37,11 @@ use crate::DenseMatrix;
 pub struct BandedBorder {
     /// `(first index, number of unknowns, half-bandwidth)` of each block; blocks must not overlap.
     pub blocks: Vec<(usize, usize, usize)>,
+    /// The blocks are node-banded: their unknowns come in nodes of six (a beam's position and
+    /// rotation) and nodes further apart than this never couple (two for three-node elements).
+    /// The LU then works on 6×6 node blocks ([`NodeBand`]); a matrix with a non-zero outside
+    /// that pattern is factorised as a scalar band. `None`: a scalar band.
+    pub node_bandwidth: Option<usize>,
 }
 
 impl BandedBorder {
@@ -144,6 +150,10 @@ struct Block {
     z: Vec<f64>,
     /// `F`, row-major n_b × m (all border rows; only the active ones are used).
     f: Vec<f64>,
+    /// Node-block factors when the structure declares nodes ([`BandedBorder::node_bandwidth`]).
+    nodal: Option<NodeBand>,
+    /// The last factorisation went through `nodal`.
+    use_nodal: bool,
 }
 
 impl Block {
@@ -190,6 +200,13 @@ impl Block {
         let ld = 2 * w + 1;
         let scale = (0..m).map(|j| self.band[j * ld + w].abs()).fold(0.0_f64, f64::max);
         let tiny = 1e-13 * scale;
+        self.use_nodal = false;
+        if let Some(nb) = &mut self.nodal
+            && nb.gather(&self.band, w)
+        {
+            self.use_nodal = true;
+            return nb.factorize(tiny);
+        }
         self.envelope();
         for k in 0..m {
             let (len, len_u) = (self.len_l[k], self.len_u[k]); // rows k+1..=k+len, columns k+1..=k+len_u
@@ -218,6 +235,9 @@ impl Block {
 
     /// Overwrite the vector `y` (length m) with `L⁻¹ y`, by column sweeps.
     fn forward_vec(&self, y: &mut [f64]) {
+        if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
+            return nb.forward(y, 0);
+        }
         let ld = 2 * self.w + 1;
         for k in 0..self.m {
             let yk = y[k];
@@ -231,6 +251,9 @@ impl Block {
 
     /// Overwrite the vector `y` (length m) with `U⁻¹ y`, by column sweeps.
     fn backward_vec(&self, y: &mut [f64]) {
+        if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
+            return nb.backward(y);
+        }
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
         for k in (0..m).rev() {
@@ -251,6 +274,12 @@ impl Block {
         let nc = self.cols.len();
         let x = &mut self.x[..m * nc];
         let starts = &self.col_start;
+        if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
+            for (xc, &s) in x.chunks_exact_mut(m).zip(starts) {
+                nb.forward(xc, s);
+            }
+            return;
+        }
         let k0 = starts.iter().copied().min().unwrap_or(m);
         for k in k0..m {
             let len = self.len_l[k];
@@ -275,6 +304,12 @@ impl Block {
         for ((zr, &r), &(lo, _)) in z.chunks_exact_mut(m).zip(&self.rows).zip(&self.row_range) {
             zr[..lo].fill(0.0);
             zr[lo..].copy_from_slice(&self.f[r * m + lo..(r + 1) * m]);
+        }
+        if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
+            for (zr, &(lo, _)) in z.chunks_exact_mut(m).zip(&self.row_range) {
+                nb.right_solve(zr, lo);
+            }
+            return;
         }
         let j0 = self.row_range.iter().map(|r| r.0).min().unwrap_or(m);
         for j in j0..m {
@@ -354,6 +389,8 @@ impl BorderedBandLu {
                 x: vec![0.0; m * nb],
                 z: vec![0.0; nb * m],
                 f: vec![0.0; nb * m],
+                nodal: structure.node_bandwidth.and_then(|kb| NodeBand::new(m, kb)),
+                use_nodal: false,
             })
             .collect();
         Self {
@@ -785,7 +822,7 @@ mod tests {
     #[test]
     fn matches_dense_solve() {
         let n = 40;
-        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
+        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)], node_bandwidth: None };
         assert!(st.is_valid(n));
         let a = random_bordered(n, &st, 7);
         let mut lu = BorderedBandLu::new(n, &st);
@@ -810,7 +847,7 @@ mod tests {
     #[test]
     fn direct_assembly_matches_the_dense_gather() {
         let n = 40;
-        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)] };
+        let st = BandedBorder { blocks: vec![(0, 15, 3), (18, 17, 5)], node_bandwidth: None };
         let a = random_bordered(n, &st, 11);
         let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
         let mut b = vec![0.0; n];
@@ -876,7 +913,7 @@ mod tests {
         let m = 2 * n_el * dpn; // nodes 1..=2 n_el (node 0 is not an unknown)
         let nb = 3;
         let n = m + nb;
-        let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)] };
+        let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: None };
         let mut a = DenseMatrix::zeros(n, n);
         let mut seed = 11u64;
         let mut rnd = || {
@@ -928,6 +965,82 @@ mod tests {
         }
     }
 
+    /// A chain of three-node elements with six unknowns per node (a beam), declared
+    /// node-banded: the node-block LU solves like the dense LU, skips the zero blocks between
+    /// middle nodes, and a matrix with a non-zero outside the node band (inside the scalar band)
+    /// is factorised by the scalar band LU instead, with the same solution.
+    #[test]
+    fn node_blocks_of_an_element_chain_match_dense_solve() {
+        let (n_el, dpn) = (5, 6);
+        let m = 2 * n_el * dpn;
+        let nb = 4;
+        let n = m + nb;
+        let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: Some(2) };
+        let mut a = DenseMatrix::zeros(n, n);
+        let mut seed = 5u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let node = |i: usize| i / dpn + 1;
+        for j in 0..m {
+            for i in 0..m {
+                let (ni, nj) = (node(i), node(j));
+                let same = (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
+                if same {
+                    *a.get_mut(i, j) = rnd();
+                }
+            }
+            *a.get_mut(j, j) += 6.0;
+            *a.get_mut(m, j) = rnd(); // a frame-like border row and column
+            *a.get_mut(j, m) = rnd();
+            if node(j) == 2 * n_el {
+                *a.get_mut(m + 1, j) = rnd(); // a joint at the last node
+                *a.get_mut(j, m + 2) = rnd();
+            }
+        }
+        for j in m..n {
+            *a.get_mut(j, j) = 3.0 + rnd();
+        }
+        let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.43).sin()).collect();
+        let mut b = vec![0.0; n];
+        a.mul_vec_inplace(&x_true, &mut b);
+        let solve = |a: &DenseMatrix| {
+            let mut lu = BorderedBandLu::new(n, &st);
+            assert!(lu.fits(a));
+            lu.factorize(a).unwrap();
+            let mut x = b.clone();
+            lu.solve_in_place(&mut x);
+            (x, lu.blocks[0].use_nodal)
+        };
+        let (x, nodal) = solve(&a);
+        assert!(nodal);
+        for (x, y) in x.iter().zip(&x_true) {
+            approx::assert_relative_eq!(*x, *y, epsilon = 1e-12);
+        }
+        // Node 1 and node 3 (middle nodes of elements 0 and 1) do not couple: the block is
+        // skipped, also after the fill-in.
+        let lu = {
+            let mut lu = BorderedBandLu::new(n, &st);
+            lu.factorize(&a).unwrap();
+            lu
+        };
+        let band = lu.blocks[0].nodal.as_ref().unwrap();
+        assert!(!band.is_nonzero(0, 2) && !band.is_nonzero(2, 0) && band.is_nonzero(1, 3));
+        // Nodes 1 and 4 coupled (three apart, inside the scalar band 17): scalar band LU.
+        let mut a2 = a.clone();
+        *a2.get_mut(5, 3 * dpn) = 0.25;
+        let mut b2 = vec![0.0; n];
+        a2.mul_vec_inplace(&x_true, &mut b2);
+        let mut lu2 = BorderedBandLu::new(n, &st);
+        lu2.factorize(&a2).unwrap();
+        assert!(!lu2.blocks[0].use_nodal);
+        lu2.solve_in_place(&mut b2);
+        for (x, y) in b2.iter().zip(&x_true) {
+            approx::assert_relative_eq!(*x, *y, epsilon = 1e-12);
+        }
+    }
+
     /// The grouped scans find the first and last non-zero wherever they are, including in the
     /// partial group and in none.
     #[test]
@@ -953,7 +1066,7 @@ mod tests {
     #[test]
     fn tiny_band_pivot_is_reported() {
         let n = 6;
-        let st = BandedBorder { blocks: vec![(0, 4, 1)] };
+        let st = BandedBorder { blocks: vec![(0, 4, 1)], node_bandwidth: None };
         let mut a = DenseMatrix::zeros(n, n);
         for i in 0..n {
             *a.get_mut(i, i) = 2.0;

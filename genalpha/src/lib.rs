@@ -34,6 +34,7 @@ mod error;
 mod integrator;
 mod linear_solver;
 mod matrix;
+mod node_lu;
 mod params;
 mod stats;
 mod system;

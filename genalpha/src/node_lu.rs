@@ -1,0 +1,282 @@
+//! LU of a *node-banded* block: the band of a beam whose unknowns come in nodes of [`P`] = 6
+//! (position and rotation) and whose elements couple nodes at most `kb` apart (two for
+//! three-node elements). It is the elimination of the scalar band LU of
+//! [`banded`](crate::banded), without pivoting and in the same order, carried out on 6×6 node
+//! blocks: fixed-size kernels that the compiler unrolls and vectorises, where the scalar band
+//! LU spends most of its instructions on loop control over columns of 5–17 entries. Structurally
+//! zero node blocks (two middle nodes of neighbouring elements) are skipped.
+//!
+//! Blocks are stored column-major (`b[c][r]` is row `r`, column `c`), so that every kernel
+//! sweeps contiguous columns.
+
+// The kernels index rows and columns of fixed-size blocks as the algebra writes them.
+#![allow(clippy::needless_range_loop)]
+
+/// Unknowns per node.
+pub(crate) const P: usize = 6;
+
+/// A node block, column-major.
+type Blk = [[f64; P]; P];
+
+/// The node-block factors of one band block.
+#[derive(Debug, Clone)]
+pub(crate) struct NodeBand {
+    /// Nodes.
+    nn: usize,
+    /// Node bandwidth: node blocks (i, j) with |i − j| ≤ kb may be non-zero.
+    kb: usize,
+    /// Block (i, j) at [`idx`](Self::idx): the matrix, then `L` (unit lower, strictly below the
+    /// diagonal) and `U` (upper) in place.
+    a: Vec<Blk>,
+    /// Whether block (i, j) is non-zero (after the fill-in of the factorisation).
+    nz: Vec<bool>,
+    /// Reciprocals of the pivots.
+    inv_diag: Vec<f64>,
+}
+
+/// `y[..P] −= x · s`.
+#[inline(always)]
+fn axpy(y: &mut [f64; P], s: f64, x: &[f64; P]) {
+    for r in 0..P {
+        y[r] -= x[r] * s;
+    }
+}
+
+/// `y −= B x` (B a node block).
+#[inline(always)]
+fn sub_mul_vec(y: &mut [f64; P], b: &Blk, x: &[f64; P]) {
+    for c in 0..P {
+        axpy(y, x[c], &b[c]);
+    }
+}
+
+/// `A −= L U` (node blocks).
+#[inline(always)]
+fn sub_mul(a: &mut Blk, l: &Blk, u: &Blk) {
+    for c in 0..P {
+        for k in 0..P {
+            axpy(&mut a[c], u[c][k], &l[k]);
+        }
+    }
+}
+
+impl NodeBand {
+    /// Set up for a band block of `m` unknowns whose nodes couple at most `kb` apart; `None`
+    /// when `m` is not a whole number of nodes.
+    pub fn new(m: usize, kb: usize) -> Option<Self> {
+        if !m.is_multiple_of(P) || m == 0 || kb == 0 {
+            return None;
+        }
+        let nn = m / P;
+        let nb = nn * (2 * kb + 1);
+        Some(Self { nn, kb, a: vec![[[0.0; P]; P]; nb], nz: vec![false; nb], inv_diag: vec![0.0; m] })
+    }
+
+    #[inline(always)]
+    fn idx(&self, i: usize, j: usize) -> usize {
+        i * (2 * self.kb + 1) + j + self.kb - i
+    }
+
+    /// Copy a scalar band (by columns, entry (i, j) at `j (2w + 1) + i − j + w`) into node
+    /// blocks; false if a non-zero lies outside the node band (then this cannot factorise it).
+    pub fn gather(&mut self, band: &[f64], w: usize) -> bool {
+        let (nn, kb, ld) = (self.nn, self.kb, 2 * w + 1);
+        let m = nn * P;
+        for j in 0..m {
+            let (nj, c) = (j / P, j % P);
+            let col = &band[j * ld..(j + 1) * ld];
+            // Rows of the scalar band in this column: lo..hi.
+            let (lo, hi) = (j.saturating_sub(w), (j + w + 1).min(m));
+            for ni in nj.saturating_sub(kb)..(nj + kb + 1).min(nn) {
+                let k = self.idx(ni, nj);
+                let dst = &mut self.a[k][c];
+                let (r0, r1) = (ni * P, ni * P + P);
+                if r0 >= lo && r1 <= hi {
+                    dst.copy_from_slice(&col[r0 + w - j..r1 + w - j]);
+                } else {
+                    for (r, d) in dst.iter_mut().enumerate() {
+                        let i = r0 + r;
+                        *d = if i >= lo && i < hi { col[i + w - j] } else { 0.0 };
+                    }
+                }
+            }
+            // Entries of the scalar band outside the node band must be zero.
+            let (in_lo, in_hi) = (nj.saturating_sub(kb) * P, ((nj + kb + 1).min(nn)) * P);
+            if col[lo + w - j..in_lo.max(lo) + w - j].iter().any(|x| *x != 0.0)
+                || col[in_hi.min(hi) + w - j..hi + w - j].iter().any(|x| *x != 0.0)
+            {
+                return false;
+            }
+        }
+        for k in 0..self.a.len() {
+            self.nz[k] = self.a[k].iter().flatten().any(|x| *x != 0.0);
+        }
+        true
+    }
+
+    /// In-place block LU without pivoting; false if a pivot is at most `tiny` in magnitude.
+    pub fn factorize(&mut self, tiny: f64) -> bool {
+        let (nn, kb) = (self.nn, self.kb);
+        for i in 0..nn {
+            let di = self.idx(i, i);
+            // The diagonal block: L_ii U_ii.
+            let mut d = self.a[di];
+            for k in 0..P {
+                let p = d[k][k];
+                if p.abs() <= tiny || !p.is_finite() {
+                    return false;
+                }
+                let inv = 1.0 / p;
+                self.inv_diag[i * P + k] = inv;
+                for r in k + 1..P {
+                    d[k][r] *= inv;
+                }
+                for c in k + 1..P {
+                    let u = d[c][k];
+                    for r in k + 1..P {
+                        d[c][r] -= d[k][r] * u;
+                    }
+                }
+            }
+            self.a[di] = d;
+            let last = (i + kb).min(nn - 1);
+            // U_ij = L_ii⁻¹ A_ij (column sweeps).
+            for j in i + 1..=last {
+                let k = self.idx(i, j);
+                if !self.nz[k] {
+                    continue;
+                }
+                let x = &mut self.a[k];
+                for col in x.iter_mut() {
+                    for kk in 0..P {
+                        let xk = col[kk];
+                        for r in kk + 1..P {
+                            col[r] -= d[kk][r] * xk;
+                        }
+                    }
+                }
+            }
+            // L_ji = A_ji U_ii⁻¹: column k is (A[k] − Σ_{l<k} X[l] U_lk) / U_kk.
+            let inv = &self.inv_diag[i * P..i * P + P];
+            for j in i + 1..=last {
+                let k = self.idx(j, i);
+                if !self.nz[k] {
+                    continue;
+                }
+                let mut x = self.a[k];
+                for kk in 0..P {
+                    for l in 0..kk {
+                        let u = d[kk][l];
+                        let xl = x[l];
+                        axpy(&mut x[kk], u, &xl);
+                    }
+                    for r in 0..P {
+                        x[kk][r] *= inv[kk];
+                    }
+                }
+                self.a[k] = x;
+            }
+            // Schur updates A_ab −= L_ai U_ib.
+            for a in i + 1..=last {
+                let la = self.idx(a, i);
+                if !self.nz[la] {
+                    continue;
+                }
+                let l = self.a[la];
+                for b in i + 1..=last {
+                    let ub = self.idx(i, b);
+                    if !self.nz[ub] {
+                        continue;
+                    }
+                    let u = self.a[ub];
+                    let ab = self.idx(a, b);
+                    sub_mul(&mut self.a[ab], &l, &u);
+                    self.nz[ab] = true;
+                }
+            }
+        }
+        true
+    }
+
+    /// Whether node block (i, j) is non-zero (after the fill-in of the last factorisation).
+    #[cfg(test)]
+    pub fn is_nonzero(&self, i: usize, j: usize) -> bool {
+        i.abs_diff(j) <= self.kb && self.nz[self.idx(i, j)]
+    }
+
+    /// Node `i` of a vector as a block-sized array.
+    #[inline(always)]
+    fn seg(y: &[f64], i: usize) -> [f64; P] {
+        y[i * P..i * P + P].try_into().expect("a node")
+    }
+
+    /// Overwrite `y` with `L⁻¹ y`; `y` is zero before unknown `start`.
+    pub fn forward(&self, y: &mut [f64], start: usize) {
+        let (nn, kb) = (self.nn, self.kb);
+        let n0 = start / P;
+        for i in n0..nn {
+            let mut yi = Self::seg(y, i);
+            for j in i.saturating_sub(kb).max(n0)..i {
+                let k = self.idx(i, j);
+                if self.nz[k] {
+                    sub_mul_vec(&mut yi, &self.a[k], &Self::seg(y, j));
+                }
+            }
+            let d = &self.a[self.idx(i, i)];
+            for kk in 0..P {
+                let yk = yi[kk];
+                for r in kk + 1..P {
+                    yi[r] -= d[kk][r] * yk;
+                }
+            }
+            y[i * P..i * P + P].copy_from_slice(&yi);
+        }
+    }
+
+    /// Overwrite `y` with `U⁻¹ y`.
+    pub fn backward(&self, y: &mut [f64]) {
+        let (nn, kb) = (self.nn, self.kb);
+        for i in (0..nn).rev() {
+            let mut yi = Self::seg(y, i);
+            for j in i + 1..(i + kb + 1).min(nn) {
+                let k = self.idx(i, j);
+                if self.nz[k] {
+                    sub_mul_vec(&mut yi, &self.a[k], &Self::seg(y, j));
+                }
+            }
+            let d = &self.a[self.idx(i, i)];
+            for kk in (0..P).rev() {
+                let yk = yi[kk] * self.inv_diag[i * P + kk];
+                yi[kk] = yk;
+                for r in 0..kk {
+                    yi[r] -= d[kk][r] * yk;
+                }
+            }
+            y[i * P..i * P + P].copy_from_slice(&yi);
+        }
+    }
+
+    /// Overwrite the row vector `z` with `z U⁻¹`; `z` is zero before unknown `start`.
+    pub fn right_solve(&self, z: &mut [f64], start: usize) {
+        let (nn, kb) = (self.nn, self.kb);
+        let n0 = start / P;
+        for j in n0..nn {
+            let mut zj = Self::seg(z, j);
+            for i in j.saturating_sub(kb).max(n0)..j {
+                let k = self.idx(i, j);
+                if self.nz[k] {
+                    let (u, zi) = (&self.a[k], Self::seg(z, i));
+                    for (c, x) in zj.iter_mut().enumerate() {
+                        *x -= (0..P).map(|r| zi[r] * u[c][r]).sum::<f64>();
+                    }
+                }
+            }
+            let d = &self.a[self.idx(j, j)];
+            for kk in 0..P {
+                let s: f64 = (0..kk).map(|l| zj[l] * d[kk][l]).sum();
+                zj[kk] = (zj[kk] - s) * self.inv_diag[j * P + kk];
+            }
+            z[j * P..j * P + P].copy_from_slice(&zj);
+        }
+    }
+}
