@@ -84,28 +84,25 @@ pub(crate) struct ElementState {
 impl ElementState {
     /// Gather element `e` of `body`. `v`, `v_dot` may be `None` (treated as zero).
     pub fn gather(body: &Body, e: usize, q: &[f64], v: Option<&[f64]>, v_dot: Option<&[f64]>) -> Self {
-        // Built field by field (not a zeroed default overwritten: this runs per element and call).
+        let mut s = Self::default();
+        s.gather_into(body, e, q, v, v_dot);
+        s
+    }
+
+    /// [`gather`](Self::gather) into `self` (the hot loops reuse one state: no copy of the
+    /// returned struct).
+    pub fn gather_into(&mut self, body: &Body, e: usize, q: &[f64], v: Option<&[f64]>, v_dot: Option<&[f64]>) {
         let zero = (V3::zeros(), V3::zeros());
-        let nodes: [(V3, V3); 3] = std::array::from_fn(|k| body.node_state(q, 2 * e + k));
-        let rates = |x: Option<&[f64]>| x.map_or([zero; 3], |x| std::array::from_fn(|k| body.node_rates(x, 2 * e + k)));
-        let (vel, acc) = (rates(v), rates(v_dot));
-        let ((fv, fw), (fvd, fwd)) =
-            (v.map_or(zero, |x| body.frame_rates(x)), v_dot.map_or(zero, |x| body.frame_rates(x)));
-        let mut s = Self {
-            r: nodes.map(|x| x.0),
-            psi: nodes.map(|x| x.1),
-            rd: vel.map(|x| x.0),
-            psid: vel.map(|x| x.1),
-            rdd: acc.map(|x| x.0),
-            psidd: acc.map(|x| x.1),
-            v: fv,
-            w: fw,
-            vd: fvd,
-            wd: fwd,
-            branch: [None; 3],
-            psid_stored: [V3::zeros(); 3],
-            psidd_stored: [V3::zeros(); 3],
-        };
+        for k in 0..3 {
+            let i = 2 * e + k;
+            (self.r[k], self.psi[k]) = body.node_state(q, i);
+            (self.rd[k], self.psid[k]) = v.map_or(zero, |x| body.node_rates(x, i));
+            (self.rdd[k], self.psidd[k]) = v_dot.map_or(zero, |x| body.node_rates(x, i));
+            self.branch[k] = None;
+        }
+        (self.v, self.w) = v.map_or(zero, |x| body.frame_rates(x));
+        (self.vd, self.wd) = v_dot.map_or(zero, |x| body.frame_rates(x));
+        let s = self;
         // Bring the end nodes onto the middle node's branch (stored CRVs are rescaled to
         // |psi| ≤ π node by node): psi' = u(psi), psi_dot' = J psi_dot,
         // psi_ddot' = J psi_ddot + dJ[psi_dot] psi_dot.
@@ -120,7 +117,6 @@ impl ElementState {
                 s.branch[k] = Some(m);
             }
         }
-        s
     }
 
     /// Whether a node was mapped to another branch.

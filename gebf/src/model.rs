@@ -467,11 +467,12 @@ impl Model {
         let ng = self.options.n_gauss_stiffness;
         let mut res = Vec24::zeros();
         let mut mat = Mat24::zeros();
+        let mut st = ElementState::default();
         for b in &self.bodies {
             let g_a = self.gravity_in_frame(b, q);
             for e in 0..b.n_elements {
                 res.as_mut_slice().fill(0.0);
-                let st = ElementState::gather(b, e, q, Some(v), Some(v_dot));
+                st.gather_into(b, e, q, Some(v), Some(v_dot));
                 let mapped = st.is_mapped();
                 let plain_residual = match &matrix {
                     None => true,
