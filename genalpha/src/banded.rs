@@ -154,6 +154,8 @@ struct Block {
     nodal: Option<NodeBand>,
     /// The last factorisation went through `nodal`.
     use_nodal: bool,
+    /// The matrix was assembled straight into `nodal`'s blocks (`band` is not filled).
+    nodal_direct: bool,
 }
 
 impl Block {
@@ -198,15 +200,18 @@ impl Block {
     fn factorize(&mut self) -> bool {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
+        if let Some(nb) = &mut self.nodal {
+            if self.nodal_direct || nb.gather(&self.band, w) {
+                self.use_nodal = true;
+                let tiny = 1e-13 * nb.max_abs_diag();
+                return nb.factorize(tiny);
+            }
+            // A non-zero outside the node band: the scalar band LU from now on.
+            self.nodal = None;
+        }
+        self.use_nodal = false;
         let scale = (0..m).map(|j| self.band[j * ld + w].abs()).fold(0.0_f64, f64::max);
         let tiny = 1e-13 * scale;
-        self.use_nodal = false;
-        if let Some(nb) = &mut self.nodal
-            && nb.gather(&self.band, w)
-        {
-            self.use_nodal = true;
-            return nb.factorize(tiny);
-        }
         self.envelope();
         for k in 0..m {
             let (len, len_u) = (self.len_l[k], self.len_u[k]); // rows k+1..=k+len, columns k+1..=k+len_u
@@ -391,6 +396,7 @@ impl BorderedBandLu {
                 f: vec![0.0; nb * m],
                 nodal: structure.node_bandwidth.and_then(|kb| NodeBand::new(m, kb)),
                 use_nodal: false,
+                nodal_direct: false,
             })
             .collect();
         Self {
@@ -442,6 +448,7 @@ impl BorderedBandLu {
         for blk in &mut self.blocks {
             let (first, m, w) = (blk.first, blk.m, blk.w);
             let ld = 2 * w + 1;
+            blk.nodal_direct = false;
             // The band, column by column (contiguous in both storages).
             for j in 0..m {
                 let (lo, hi) = (j.saturating_sub(w), (j + w + 1).min(m));
@@ -470,7 +477,12 @@ impl BorderedBandLu {
         self.s.fill(0.0);
         let tracked = std::mem::replace(&mut self.active_known, false);
         for blk in &mut self.blocks {
-            blk.band.fill(0.0);
+            if let Some(nb) = &mut blk.nodal {
+                nb.clear();
+                blk.nodal_direct = true;
+            } else {
+                blk.band.fill(0.0);
+            }
             let m = blk.m;
             if tracked {
                 blk.cols.iter().for_each(|&c| blk.e[c * m..(c + 1) * m].fill(0.0));
@@ -496,6 +508,10 @@ impl BorderedBandLu {
                     return;
                 }
                 let (il, jl) = (i - blk.first, j - blk.first);
+                if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
+                    self.outside |= !nb.add_column(il, jl, &[v], 1.0);
+                    return;
+                }
                 blk.band[jl * (2 * blk.w + 1) + il + blk.w - jl] += v;
             }
             (true, false) => {
@@ -527,6 +543,10 @@ impl BorderedBandLu {
                 let il0 = i0 - blk.first;
                 let dst = if oj == oi {
                     let (jl, w) = (j - blk.first, blk.w);
+                    if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
+                        self.outside |= !nb.add_column(il0, jl, src, s);
+                        continue;
+                    }
                     if i0 + w < j || j + w < i0 + n_r - 1 {
                         // part of the column is outside the band: entry by entry
                         for (r, x) in src.iter().enumerate() {
@@ -594,6 +614,17 @@ impl BorderedBandLu {
                 let blk = &mut self.blocks[bi];
                 let (w, ld_b) = (blk.w, 2 * blk.w + 1);
                 let il0 = i0 - blk.first;
+                if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
+                    let jl0 = j0 - blk.first;
+                    if [il0, jl0, n_r, n_c].iter().all(|x| x.is_multiple_of(crate::node_lu::P)) {
+                        self.outside |= !nb.add_nodes(il0, jl0, n_r, n_c, data, ld, s);
+                        return;
+                    }
+                    for c in 0..n_c {
+                        self.outside |= !nb.add_column(il0, jl0 + c, &data[c * ld..c * ld + n_r], s);
+                    }
+                    return;
+                }
                 if i0 + w < j0 + n_c - 1 || j0 + w < i0 + n_r - 1 {
                     // part of the block is outside the band
                     for c in 0..n_c {
@@ -657,6 +688,9 @@ impl BorderedBandLu {
                     return 0.0;
                 }
                 let (il, jl) = (i - blk.first, j - blk.first);
+                if let (true, Some(nb)) = (blk.nodal_direct, &blk.nodal) {
+                    return nb.get(il, jl);
+                }
                 blk.band[jl * (2 * blk.w + 1) + il + blk.w - jl]
             }
             (true, false) => {
@@ -1027,6 +1061,39 @@ mod tests {
         };
         let band = lu.blocks[0].nodal.as_ref().unwrap();
         assert!(!band.is_nonzero(0, 2) && !band.is_nonzero(2, 0) && band.is_nonzero(1, 3));
+        // Direct assembly into the node blocks (whole nodes as sub-blocks, a misaligned range
+        // column by column, the border entry by entry) gives the same solution bit for bit.
+        let mut direct = BorderedBandLu::new(n, &st);
+        direct.factorize(&a).unwrap(); // the first factorisation goes through the dense gather
+        direct.clear();
+        let data = a.as_slice();
+        for (r0, r1) in [(0, 24), (24, 60)] {
+            for (c0, c1) in [(0, 30), (30, 60)] {
+                if (c0, c1) == (30, 60) && r0 == 24 {
+                    direct.add_submatrix(r0 + 1, c0, r1 - r0 - 1, c1 - c0, &data[c0 * n + r0 + 1..], n, 1.0);
+                    direct.add_submatrix(r0, c0, 1, c1 - c0, &data[c0 * n + r0..], n, 1.0);
+                } else {
+                    direct.add_submatrix(r0, c0, r1 - r0, c1 - c0, &data[c0 * n + r0..], n, 1.0);
+                }
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                if (i >= m || j >= m) && a.get(i, j) != 0.0 {
+                    direct.add(i, j, a.get(i, j));
+                }
+            }
+        }
+        assert!(!direct.assembled_outside());
+        assert_eq!(direct.get(7, 13), a.get(7, 13));
+        direct.factorize_gathered().unwrap();
+        assert!(direct.blocks[0].use_nodal);
+        let mut x_direct = b.clone();
+        direct.solve_in_place(&mut x_direct);
+        assert_eq!(x_direct, x);
+        direct.clear();
+        direct.add(5, 3 * dpn, 1.0); // nodes 1 and 4, inside the scalar band: outside the node band
+        assert!(direct.assembled_outside());
         // Nodes 1 and 4 coupled (three apart, inside the scalar band 17): scalar band LU.
         let mut a2 = a.clone();
         *a2.get_mut(5, 3 * dpn) = 0.25;

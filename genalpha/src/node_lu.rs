@@ -77,6 +77,82 @@ impl NodeBand {
         i * (2 * self.kb + 1) + j + self.kb - i
     }
 
+    /// Zero the blocks before a direct assembly.
+    pub fn clear(&mut self) {
+        self.a.iter_mut().for_each(|b| *b = [[0.0; P]; P]);
+    }
+
+    /// Entry (i, j) of the block (local indices), 0 outside the node band.
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        let (ni, nj) = (i / P, j / P);
+        if ni.abs_diff(nj) > self.kb { 0.0 } else { self.a[self.idx(ni, nj)][j % P][i % P] }
+    }
+
+    /// `A[i0 + r, j] += s · src[r]` (local indices); false if a non-zero falls outside the node
+    /// band (it is dropped).
+    #[inline]
+    pub fn add_column(&mut self, i0: usize, j: usize, src: &[f64], s: f64) -> bool {
+        let (nj, c) = (j / P, j % P);
+        let mut inside = true;
+        let mut i = i0;
+        let mut rest = src;
+        while !rest.is_empty() {
+            let (ni, r0) = (i / P, i % P);
+            let len = (P - r0).min(rest.len());
+            let (seg, tail) = rest.split_at(len);
+            if ni.abs_diff(nj) <= self.kb {
+                let k = self.idx(ni, nj);
+                for (d, x) in self.a[k][c][r0..r0 + len].iter_mut().zip(seg) {
+                    *d += s * x;
+                }
+            } else {
+                inside &= seg.iter().all(|x| *x == 0.0);
+            }
+            i += len;
+            rest = tail;
+        }
+        inside
+    }
+
+    /// `A[i0 + r, j0 + c] += s · data[c · ld + r]` for a sub-block of whole nodes (`i0`, `j0`,
+    /// `n_r`, `n_c` multiples of [`P`]; local indices); false if a non-zero falls outside the
+    /// node band (it is dropped).
+    #[allow(clippy::too_many_arguments)] // the signature of AssemblyTarget::add_submatrix
+    pub fn add_nodes(&mut self, i0: usize, j0: usize, n_r: usize, n_c: usize, data: &[f64], ld: usize, s: f64) -> bool {
+        debug_assert!([i0, j0, n_r, n_c].iter().all(|x| x.is_multiple_of(P)));
+        let mut inside = true;
+        for bj in 0..n_c / P {
+            let nj = j0 / P + bj;
+            for bi in 0..n_r / P {
+                let ni = i0 / P + bi;
+                let src = |c: usize| {
+                    let o = (bj * P + c) * ld + bi * P;
+                    &data[o..o + P]
+                };
+                if ni.abs_diff(nj) > self.kb {
+                    inside &= (0..P).all(|c| src(c).iter().all(|x| *x == 0.0));
+                    continue;
+                }
+                let k = self.idx(ni, nj);
+                for c in 0..P {
+                    let col: &[f64; P] = src(c).try_into().expect("a node");
+                    let dst = &mut self.a[k][c];
+                    for r in 0..P {
+                        dst[r] += s * col[r];
+                    }
+                }
+            }
+        }
+        inside
+    }
+
+    /// The largest pivot candidate: max |A_ii| before the factorisation.
+    pub fn max_abs_diag(&self) -> f64 {
+        (0..self.nn)
+            .flat_map(|i| (0..P).map(move |k| (i, k)))
+            .fold(0.0_f64, |m, (i, k)| m.max(self.a[self.idx(i, i)][k][k].abs()))
+    }
+
     /// Copy a scalar band (by columns, entry (i, j) at `j (2w + 1) + i − j + w`) into node
     /// blocks; false if a non-zero lies outside the node band (then this cannot factorise it).
     pub fn gather(&mut self, band: &[f64], w: usize) -> bool {
