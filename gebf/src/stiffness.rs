@@ -111,10 +111,12 @@ fn add_elastic_generic(
             let x = y.tr_mul(&et) + d.tr_mul(&sk_d) + tg.jac_t(&nxe) + tg.hessian(&psi_p, &mo);
             let (rpt, zt) = (rp.transpose(), z.transpose());
             // Column factors of node l, then each block is a combination over n_k, dn_k.
-            let cols: [[M3; 5]; 3] = std::array::from_fn(|l| {
+            // (An explicit array: `std::array::from_fn` here was an out-of-line call.)
+            let col = |l: usize| {
                 let (nl, dl) = (f * n[l], f * dn[l]);
                 [a1 * dl, rp * nl, rpt * dl, x * nl + zt * dl, z * nl + p * dl]
-            });
+            };
+            let cols: [[M3; 5]; 3] = [col(0), col(1), col(2)];
             for k in 0..3 {
                 let (nk, dk) = (n[k], dn[k]);
                 for (l, c) in cols.iter().enumerate().skip(k) {
