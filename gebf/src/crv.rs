@@ -144,7 +144,7 @@ impl TangentCoefficients {
     }
 
     /// The coefficients at `s = |psi|²`, the second derivatives only if `second` (else zero).
-    #[inline]
+    #[inline(always)]
     fn evaluate(s: f64, second: bool) -> Self {
         let phi = s.sqrt();
         if phi < SERIES_LIMIT {
@@ -398,7 +398,7 @@ impl Tangent {
     /// `∂/∂psi [T c + dT[a] a]`: the Jacobian of the rotational acceleration
     /// `T psi_ddot + dT[psi_dot] psi_dot` for `a = psi_dot`, `c = psi_ddot` (equal to
     /// `jac(c) + second(a, a)`, collected into three outer products).
-    #[inline]
+    #[inline(always)]
     pub fn acceleration_jac(&self, a: &V3, c: &V3) -> M3 {
         let k = self.full();
         let p = &self.psi;
@@ -418,7 +418,7 @@ impl Tangent {
     /// `∂/∂psi [ (∂(T a)/∂psi)ᵀ m ]`: the Hessian of the scalar
     /// `f = mᵀ T a = mᵀa + α L + β Q` with `L = psi·(a × m)` and
     /// `Q = (m·psi)(psi·a) − s (m·a)` (symmetric).
-    #[inline]
+    #[inline(always)]
     pub fn hessian(&self, a: &V3, m: &V3) -> M3 {
         let k = self.full();
         let p = &self.psi;

@@ -111,12 +111,13 @@ fn add_elastic_generic(
             let x = y.tr_mul(&et) + d.tr_mul(&sk_d) + tg.jac_t(&nxe) + tg.hessian(&psi_p, &mo);
             let (rpt, zt) = (rp.transpose(), z.transpose());
             // Column factors of node l, then each block is a combination over n_k, dn_k.
-            // (An explicit array: `std::array::from_fn` here was an out-of-line call.)
-            let col = |l: usize| {
+            // (Filled in a loop of this function: `std::array::from_fn` or a closure here is an
+            // out-of-line call, compiled without AVX2.)
+            let mut cols = [[M3::zeros(); 5]; 3];
+            for (l, c) in cols.iter_mut().enumerate() {
                 let (nl, dl) = (f * n[l], f * dn[l]);
-                [a1 * dl, rp * nl, rpt * dl, x * nl + zt * dl, z * nl + p * dl]
-            };
-            let cols: [[M3; 5]; 3] = [col(0), col(1), col(2)];
+                *c = [a1 * dl, rp * nl, rpt * dl, x * nl + zt * dl, z * nl + p * dl];
+            }
             for k in 0..3 {
                 let (nk, dk) = (n[k], dn[k]);
                 for (l, c) in cols.iter().enumerate().skip(k) {
