@@ -92,16 +92,28 @@ impl ElementState {
     /// [`gather`](Self::gather) into `self` (the hot loops reuse one state: no copy of the
     /// returned struct).
     pub fn gather_into(&mut self, body: &Body, e: usize, q: &[f64], v: Option<&[f64]>, v_dot: Option<&[f64]>) {
-        let zero = (V3::zeros(), V3::zeros());
+        // Each pair straight from its slice (node 0 of a body is clamped to the frame: zero).
+        let pair = |x: &[f64], at: Option<usize>, a: &mut V3, b: &mut V3| match at {
+            Some(k) => {
+                *a = V3::new(x[k], x[k + 1], x[k + 2]);
+                *b = V3::new(x[k + 3], x[k + 4], x[k + 5]);
+            }
+            None => {
+                *a = V3::zeros();
+                *b = V3::zeros();
+            }
+        };
         for k in 0..3 {
             let i = 2 * e + k;
-            (self.r[k], self.psi[k]) = body.node_state(q, i);
-            (self.rd[k], self.psid[k]) = v.map_or(zero, |x| body.node_rates(x, i));
-            (self.rdd[k], self.psidd[k]) = v_dot.map_or(zero, |x| body.node_rates(x, i));
+            pair(q, body.node_coord(i), &mut self.r[k], &mut self.psi[k]);
+            let dof = body.node_dof(i);
+            pair(v.unwrap_or(&[]), v.and(dof), &mut self.rd[k], &mut self.psid[k]);
+            pair(v_dot.unwrap_or(&[]), v_dot.and(dof), &mut self.rdd[k], &mut self.psidd[k]);
             self.branch[k] = None;
         }
-        (self.v, self.w) = v.map_or(zero, |x| body.frame_rates(x));
-        (self.vd, self.wd) = v_dot.map_or(zero, |x| body.frame_rates(x));
+        let f = Some(body.frame_dof());
+        pair(v.unwrap_or(&[]), v.and(f), &mut self.v, &mut self.w);
+        pair(v_dot.unwrap_or(&[]), v_dot.and(f), &mut self.vd, &mut self.wd);
         let s = self;
         // Bring the end nodes onto the middle node's branch (stored CRVs are rescaled to
         // |psi| ≤ π node by node): psi' = u(psi), psi_dot' = J psi_dot,
