@@ -63,6 +63,8 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     phi_q_cols: Vec<usize>,
     /// Columns of B that have been non-zero in some assembly (their Bᵀ entries are rewritten).
     b_cols_written: Vec<bool>,
+    /// Columns of B that were non-zero at its last evaluation.
+    b_nz_cols: Vec<usize>,
     have_factorization: bool,
     /// The last assembly went to the solver's storage.
     assembled_direct: bool,
@@ -253,6 +255,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             phi_q_ready: false,
             phi_q_cols: Vec::with_capacity(n),
             b_cols_written: vec![false; n],
+            b_nz_cols: Vec::with_capacity(n),
             have_factorization: false,
             assembled_direct: false,
             k_rows,
@@ -323,8 +326,19 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.phi_q_cols.extend((0..self.n).filter(|&j| (0..self.n_h).any(|i| phi_q.get(i, j) != 0.0)));
         }
         if self.n_v > 0 {
-            self.b_mat.fill_zero();
+            // Only the columns found non-zero last time need zeroing (the others still are);
+            // the non-zero columns are listed again for Bᵀμ (a joint touches a few unknowns).
+            let n_v = self.n_v;
+            let data = self.b_mat.as_mut_slice();
+            for &j in &self.b_nz_cols {
+                data[j * n_v..(j + 1) * n_v].fill(0.0);
+            }
             sys.psi_v_inplace(t, q, &mut self.b_mat.view());
+            let data = self.b_mat.as_slice();
+            self.b_nz_cols.clear();
+            self.b_nz_cols.extend(
+                (0..self.n).filter(|&j| data[j * n_v..(j + 1) * n_v].iter().fold(false, |a, x| a | (*x != 0.0))),
+            );
         }
     }
 
@@ -384,7 +398,10 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.r[j] += (0..self.n_h).map(|i| self.phi_q.get(i, j) * lambda[i]).sum::<f64>();
         }
         if self.n_v > 0 {
-            self.b_mat.add_mul_transpose_vec_inplace(mu, &mut self.r);
+            let (n_v, data) = (self.n_v, self.b_mat.as_slice());
+            for &j in &self.b_nz_cols {
+                self.r[j] += data[j * n_v..(j + 1) * n_v].iter().zip(mu).map(|(a, b)| a * b).sum::<f64>();
+            }
         }
     }
 
@@ -795,7 +812,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 }
             }
             if n_v > 0 {
-                for j in 0..n {
+                for &j in &self.b_nz_cols {
                     let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
                     for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
                         target.add(n + n_h + i, j, x);
