@@ -7,7 +7,10 @@
 //! zero node blocks (two middle nodes of neighbouring elements) are skipped.
 //!
 //! Blocks are stored column-major (`b[c][r]` is row `r`, column `c`), so that every kernel
-//! sweeps contiguous columns.
+//! sweeps contiguous columns. They are also the assembly storage: a direct assembly adds whole
+//! nodes of an element matrix straight into them ([`NodeBand::add_nodes`]), so the scalar band is
+//! neither filled nor gathered; a matrix given densely is gathered from the band
+//! ([`NodeBand::gather`]).
 
 // The kernels index rows and columns of fixed-size blocks as the algebra writes them.
 #![allow(clippy::needless_range_loop)]
