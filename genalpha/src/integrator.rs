@@ -410,6 +410,7 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// (scleronomic constraints: ∂b/∂t = 0). Sets `a = v̇`.
     pub fn initialize<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &mut State) -> Result<(), Error> {
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        self.last_step = None; // a new start: nothing to extrapolate from
         self.update_jacobians(sys, s.t, &s.q);
         self.matrix.fill_zero();
         sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));

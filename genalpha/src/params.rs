@@ -58,7 +58,9 @@ pub enum Predictor {
     /// steps (when the last step had the same size and ended where this one starts; otherwise
     /// as [`ConstantAcceleration`](Self::ConstantAcceleration)). One order more accurate in h,
     /// which pays where the residual is strongly nonlinear in the velocities: GEBF's gyroscopic
-    /// terms of fast-spinning floating frames.
+    /// terms of fast-spinning floating frames. (A model whose `post_step` changes how the rates
+    /// are represented, as GEBF's rescaling of rotation vectors past π does, makes the next
+    /// prediction poorer for those unknowns, not wrong: Newton corrects it.)
     ExtrapolatedAcceleration,
 }
 
