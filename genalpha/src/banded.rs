@@ -44,8 +44,11 @@ pub struct BandedBorder {
     pub blocks: Vec<(usize, usize, usize)>,
     /// The blocks are node-banded: their unknowns come in nodes of six (a beam's position and
     /// rotation) and nodes further apart than this never couple (two for three-node elements).
-    /// The LU then works on 6×6 node blocks (the `node_lu` module); a matrix with a non-zero outside
-    /// that pattern is factorised as a scalar band. `None`: a scalar band.
+    /// The LU then works on 6×6 node blocks (the `node_lu` module). A non-zero outside that
+    /// pattern (but inside the band) sends a block to the scalar band LU for good when the matrix
+    /// is given densely; in a direct assembly it is reported like any entry outside the
+    /// structure ([`assembled_outside`](BorderedBandLu::assembled_outside)), so the caller falls
+    /// back to the dense path. `None`: a scalar band.
     pub node_bandwidth: Option<usize>,
 }
 
@@ -206,7 +209,13 @@ impl Block {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
         if let Some(nb) = &mut self.nodal {
-            if self.nodal_direct || nb.gather(&self.band, w) {
+            let assembled = if self.nodal_direct {
+                nb.find_nonzero_blocks();
+                true
+            } else {
+                nb.gather(&self.band, w)
+            };
+            if assembled {
                 self.use_nodal = true;
                 let tiny = 1e-13 * nb.max_abs_diag();
                 return nb.factorize(tiny);
@@ -1111,6 +1120,69 @@ mod tests {
         for (x, y) in b2.iter().zip(&x_true) {
             approx::assert_relative_eq!(*x, *y, epsilon = 1e-12);
         }
+    }
+
+    /// Direct assembly into node blocks whose pattern differs from the last dense matrix's (here:
+    /// no dense matrix before it, and a block-diagonal one before it, as a lumped mass in
+    /// `initialize` would give) still solves exactly: the non-zero blocks are found on every
+    /// matrix, not kept from the last gather.
+    #[test]
+    fn direct_node_assembly_finds_its_own_nonzero_blocks() {
+        let (n_el, dpn) = (3, 6);
+        let m = 2 * n_el * dpn;
+        let n = m + 2;
+        let chain = |couple: bool, seed0: u64| {
+            let mut a = DenseMatrix::zeros(n, n);
+            let mut seed = seed0;
+            let mut rnd = || {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            };
+            let node = |i: usize| i / dpn + 1;
+            for j in 0..m {
+                for i in 0..m {
+                    let (ni, nj) = (node(i), node(j));
+                    let same =
+                        (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
+                    if same && (couple || ni == nj) {
+                        *a.get_mut(i, j) = rnd();
+                    }
+                }
+                *a.get_mut(j, j) += 6.0;
+                *a.get_mut(m, j) = rnd();
+                *a.get_mut(j, m) = rnd();
+            }
+            for j in m..n {
+                *a.get_mut(j, j) = 3.0 + rnd();
+            }
+            a
+        };
+        let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: Some(2) };
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin()).collect();
+        let residual = |lu: &mut BorderedBandLu, a: &DenseMatrix| {
+            lu.clear();
+            for j in 0..n {
+                for i in 0..n {
+                    if a.get(i, j) != 0.0 {
+                        lu.add(i, j, a.get(i, j));
+                    }
+                }
+            }
+            assert!(!lu.assembled_outside());
+            lu.factorize_gathered().unwrap();
+            assert!(lu.blocks[0].use_nodal);
+            let mut x = b.clone();
+            lu.solve_in_place(&mut x);
+            let mut ax = vec![0.0; n];
+            a.mul_vec_inplace(&x, &mut ax);
+            ax.iter().zip(&b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max)
+        };
+        let a = chain(true, 4);
+        let mut fresh = BorderedBandLu::new(n, &st);
+        assert!(residual(&mut fresh, &a) < 1e-12);
+        let mut after_diagonal = BorderedBandLu::new(n, &st);
+        after_diagonal.factorize(&chain(false, 3)).unwrap();
+        assert!(residual(&mut after_diagonal, &a) < 1e-12);
     }
 
     /// The grouped scans find the first and last non-zero wherever they are, including in the

@@ -31,7 +31,9 @@ pub(crate) struct NodeBand {
     /// Block (i, j) at [`idx`](Self::idx): the matrix, then `L` (unit lower, strictly below the
     /// diagonal) and `U` (upper) in place.
     a: Vec<Blk>,
-    /// Whether block (i, j) is non-zero (after the fill-in of the factorisation).
+    /// Whether block (i, j) is non-zero: set from the assembled blocks ([`gather`](Self::gather)
+    /// or [`find_nonzero_blocks`](Self::find_nonzero_blocks)), then extended by the fill-in of
+    /// the factorisation.
     nz: Vec<bool>,
     /// Reciprocals of the pivots.
     inv_diag: Vec<f64>,
@@ -187,10 +189,16 @@ impl NodeBand {
                 return false;
             }
         }
-        for k in 0..self.a.len() {
-            self.nz[k] = self.a[k].iter().flatten().any(|x| *x != 0.0);
-        }
+        self.find_nonzero_blocks();
         true
+    }
+
+    /// Mark the blocks that hold a non-zero (before [`factorize`](Self::factorize): the
+    /// assembled pattern may change from one matrix to the next).
+    pub fn find_nonzero_blocks(&mut self) {
+        for (nz, b) in self.nz.iter_mut().zip(&self.a) {
+            *nz = b.iter().flatten().any(|x| *x != 0.0);
+        }
     }
 
     /// In-place block LU without pivoting; false if a pivot is at most `tiny` in magnitude.

@@ -185,7 +185,7 @@ impl Joint {
     }
 }
 
-/// Newton settings (defaults as genalpha's).
+/// Newton settings (defaults as genalpha's, except `predictor`: see its field).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct NewtonSettings {
