@@ -45,10 +45,9 @@ pub struct BandedBorder {
     /// The blocks are node-banded: their unknowns come in nodes of six (a beam's position and
     /// rotation) and nodes further apart than this never couple (two for three-node elements).
     /// The LU then works on 6×6 node blocks (the `node_lu` module). A non-zero outside that
-    /// pattern (but inside the band) sends a block to the scalar band LU for good when the matrix
-    /// is given densely; in a direct assembly it is reported like any entry outside the
-    /// structure ([`assembled_outside`](BorderedBandLu::assembled_outside)), so the caller falls
-    /// back to the dense path. `None`: a scalar band.
+    /// pattern (but inside the band) sends its block to the scalar band LU for good: at once when
+    /// the matrix is given densely, after one dense matrix when it is assembled in place.
+    /// `None`: a scalar band.
     pub node_bandwidth: Option<usize>,
 }
 
@@ -366,6 +365,9 @@ pub(crate) struct BorderedBandLu {
     border_pos: Vec<usize>,
     /// Direct assembly met a non-zero entry outside the structure.
     outside: bool,
+    /// Direct assembly met a non-zero inside the band but outside the node band: the matrix must
+    /// be given densely once, which sends that block to the scalar band.
+    node_overflow: bool,
     /// Every block's active `E` columns and `F` rows are those of the stored values (the last
     /// factorisation went through all blocks).
     active_known: bool,
@@ -424,6 +426,7 @@ impl BorderedBandLu {
             owner,
             border_pos,
             outside: false,
+            node_overflow: false,
             active_known: false,
         }
     }
@@ -488,6 +491,7 @@ impl BorderedBandLu {
     /// factorisation only the columns of `E` and rows of `F` it found non-zero need zeroing.
     pub fn clear(&mut self) {
         self.outside = false;
+        self.node_overflow = false;
         self.s.fill(0.0);
         let tracked = std::mem::replace(&mut self.active_known, false);
         for blk in &mut self.blocks {
@@ -523,7 +527,7 @@ impl BorderedBandLu {
                 }
                 let (il, jl) = (i - blk.first, j - blk.first);
                 if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
-                    self.outside |= !nb.add_column(il, jl, &[v], 1.0);
+                    self.node_overflow |= !nb.add_column(il, jl, &[v], 1.0);
                     return;
                 }
                 blk.band[jl * (2 * blk.w + 1) + il + blk.w - jl] += v;
@@ -558,7 +562,7 @@ impl BorderedBandLu {
                 let dst = if oj == oi {
                     let (jl, w) = (j - blk.first, blk.w);
                     if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
-                        self.outside |= !nb.add_column(il0, jl, src, s);
+                        self.node_overflow |= !nb.add_column(il0, jl, src, s);
                         continue;
                     }
                     if i0 + w < j || j + w < i0 + n_r - 1 {
@@ -631,11 +635,11 @@ impl BorderedBandLu {
                 if let (true, Some(nb)) = (blk.nodal_direct, &mut blk.nodal) {
                     let jl0 = j0 - blk.first;
                     if [il0, jl0, n_r, n_c].iter().all(|x| x.is_multiple_of(crate::node_lu::P)) {
-                        self.outside |= !nb.add_nodes(il0, jl0, n_r, n_c, data, ld, s);
+                        self.node_overflow |= !nb.add_nodes(il0, jl0, n_r, n_c, data, ld, s);
                         return;
                     }
                     for c in 0..n_c {
-                        self.outside |= !nb.add_column(il0, jl0 + c, &data[c * ld..c * ld + n_r], s);
+                        self.node_overflow |= !nb.add_column(il0, jl0 + c, &data[c * ld..c * ld + n_r], s);
                     }
                     return;
                 }
@@ -722,6 +726,13 @@ impl BorderedBandLu {
     /// Whether a direct assembly met a non-zero entry outside the structure.
     pub fn assembled_outside(&self) -> bool {
         self.outside
+    }
+
+    /// Whether a direct assembly met a non-zero inside the band but outside a block's node band
+    /// (it was dropped): give the matrix densely instead, which moves that block to the scalar
+    /// band LU for good.
+    pub fn assembled_outside_nodes(&self) -> bool {
+        self.node_overflow
     }
 
     /// Factorise the gathered or directly assembled storage (band, `E`, `F`, `G` in `s`).
@@ -1107,7 +1118,7 @@ mod tests {
         assert_eq!(x_direct, x);
         direct.clear();
         direct.add(5, 3 * dpn, 1.0); // nodes 1 and 4, inside the scalar band: outside the node band
-        assert!(direct.assembled_outside());
+        assert!(direct.assembled_outside_nodes() && !direct.assembled_outside());
         // Nodes 1 and 4 coupled (three apart, inside the scalar band 17): scalar band LU.
         let mut a2 = a.clone();
         *a2.get_mut(5, 3 * dpn) = 0.25;
@@ -1116,8 +1127,28 @@ mod tests {
         let mut lu2 = BorderedBandLu::new(n, &st);
         lu2.factorize(&a2).unwrap();
         assert!(!lu2.blocks[0].use_nodal);
+        let rhs2 = b2.clone();
         lu2.solve_in_place(&mut b2);
         for (x, y) in b2.iter().zip(&x_true) {
+            approx::assert_relative_eq!(*x, *y, epsilon = 1e-12);
+        }
+        // The direct assembly that met that coupling, given densely once, continues in place on
+        // the scalar band.
+        direct.factorize(&a2).unwrap();
+        assert!(!direct.blocks[0].use_nodal && direct.blocks[0].nodal.is_none());
+        direct.clear();
+        for j in 0..n {
+            for i in 0..n {
+                if a2.get(i, j) != 0.0 {
+                    direct.add(i, j, a2.get(i, j));
+                }
+            }
+        }
+        assert!(!direct.assembled_outside_nodes() && !direct.assembled_outside());
+        direct.factorize_gathered().unwrap();
+        let mut x2 = rhs2;
+        direct.solve_in_place(&mut x2);
+        for (x, y) in x2.iter().zip(&x_true) {
             approx::assert_relative_eq!(*x, *y, epsilon = 1e-12);
         }
     }

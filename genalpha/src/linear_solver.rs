@@ -173,6 +173,11 @@ impl LinearSolver for DenseLu {
             self.structured = None; // the declared structure is incomplete
             return Ok(Assembled::UseDense);
         }
+        if s.assembled_outside_nodes() {
+            // A coupling beyond a block's node band: the dense matrix moves that block to the
+            // scalar band (see `BorderedBandLu::factorize`), then direct assembly resumes.
+            return Ok(Assembled::UseDense);
+        }
         if s.factorize_gathered().is_err() {
             return Ok(Assembled::UseDense); // the dense path retries and falls back to the dense LU
         }
