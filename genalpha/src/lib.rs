@@ -24,7 +24,9 @@
 //! contraction estimate θ/(1 − θ)·|Δ| (`NewtonParams::estimate_convergence`), is below the
 //! tolerance. A failed step is retried as two half steps (`NewtonParams::max_step_halvings`).
 //! The default [`DenseLu`] switches to a bordered band LU (Schur complement on the border) when
-//! the system declares a [`BandedBorder`] structure.
+//! the system declares a [`BandedBorder`] structure, on 6×6 node blocks when it declares nodes.
+//! Newton starts from a predictor: constant or linearly extrapolated acceleration
+//! (`NewtonParams::predictor`).
 //!
 //! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
 #![warn(missing_docs)]

@@ -76,8 +76,9 @@ impl AssemblyTarget for DenseLu {
 /// Dense LU with partial pivoting (faer, sequential, in place, no allocation after set-up).
 ///
 /// If the system declares a [`BandedBorder`] structure, the matrix is factorised by the
-/// bordered band LU instead (block-banded part without pivoting, dense Schur complement of the
-/// border); a tiny band pivot makes that factorisation fall back to the dense one.
+/// bordered band LU instead (block-banded part without pivoting, by 6×6 node blocks when the
+/// structure declares nodes; dense Schur complement of the border); a tiny band pivot makes that
+/// factorisation fall back to the dense one.
 pub struct DenseLu {
     n: usize,
     structured: Option<BorderedBandLu>,
