@@ -852,15 +852,62 @@ impl BorderedBandLu {
 mod tests {
     use super::*;
 
+    /// Pseudo-random numbers in [−0.5, 0.5) from a linear congruential sequence.
+    fn lcg(seed: u64) -> impl FnMut() -> f64 {
+        let mut seed = seed;
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
+
+    /// The pattern of a chain of `n_el` three-node elements with `dpn` unknowns per node (nodes
+    /// 1..=2 n_el; node 0 is not an unknown; an element couples nodes 2e..=2e+2) and `nb` border
+    /// unknowns after them: random entries where two nodes share an element (only inside a node
+    /// unless `couple`), `diag` added to the block diagonal, a full frame-like border row and
+    /// column `m`, with `joint` a joint row `m + 1` and column `m + 2` touching only the last
+    /// node, and 3 + noise on the border diagonal. Returns the matrix and `m`.
+    fn element_chain(
+        n_el: usize,
+        dpn: usize,
+        nb: usize,
+        seed: u64,
+        diag: f64,
+        couple: bool,
+        joint: bool,
+    ) -> (DenseMatrix, usize) {
+        let m = 2 * n_el * dpn;
+        let n = m + nb;
+        let mut a = DenseMatrix::zeros(n, n);
+        let mut rnd = lcg(seed);
+        let node = |i: usize| i / dpn + 1;
+        for j in 0..m {
+            for i in 0..m {
+                let (ni, nj) = (node(i), node(j));
+                let same = (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
+                if same && (couple || ni == nj) {
+                    *a.get_mut(i, j) = rnd();
+                }
+            }
+            *a.get_mut(j, j) += diag;
+            *a.get_mut(m, j) = rnd();
+            *a.get_mut(j, m) = rnd();
+            if joint && node(j) == 2 * n_el {
+                *a.get_mut(m + 1, j) = rnd();
+                *a.get_mut(j, m + 2) = rnd();
+            }
+        }
+        for j in m..n {
+            *a.get_mut(j, j) = 3.0 + rnd();
+        }
+        (a, m)
+    }
+
     /// A random diagonally dominant `n × n` matrix with the structure `st`: random values in
     /// each block's band, random values and sparsity in the border rows and columns.
     fn random_bordered(n: usize, st: &BandedBorder, seed: u64) -> DenseMatrix {
         let mut a = DenseMatrix::zeros(n, n);
-        let mut seed = seed;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = lcg(seed);
         let owner = |i: usize| st.blocks.iter().position(|&(f, m, _)| i >= f && i < f + m);
         for j in 0..n {
             for i in 0..n {
@@ -969,38 +1016,10 @@ mod tests {
     #[test]
     fn envelope_of_an_element_chain_matches_dense_solve() {
         let (n_el, dpn) = (4, 2);
-        let m = 2 * n_el * dpn; // nodes 1..=2 n_el (node 0 is not an unknown)
         let nb = 3;
+        let (mut a, m) = element_chain(n_el, dpn, nb, 11, 4.0, true, true);
         let n = m + nb;
         let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: None };
-        let mut a = DenseMatrix::zeros(n, n);
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let node = |i: usize| i / dpn + 1;
-        for j in 0..m {
-            for i in 0..m {
-                let (ni, nj) = (node(i), node(j));
-                // Same element: both nodes in 2e..=2e+2 for some e.
-                let same = (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
-                if same {
-                    *a.get_mut(i, j) = rnd();
-                }
-            }
-            *a.get_mut(j, j) += 4.0;
-            // Border: a full frame-like row and column, and a joint touching only the last node.
-            *a.get_mut(m, j) = rnd();
-            *a.get_mut(j, m) = rnd();
-            if node(j) == 2 * n_el {
-                *a.get_mut(m + 1, j) = rnd();
-                *a.get_mut(j, m + 2) = rnd();
-            }
-        }
-        for j in m..n {
-            *a.get_mut(j, j) = 3.0 + rnd();
-        }
         *a.get_mut(m + 1, m + 2) = 0.5;
         *a.get_mut(m + 2, m + 1) = 0.7;
         let mut lu = BorderedBandLu::new(n, &st);
@@ -1031,36 +1050,10 @@ mod tests {
     #[test]
     fn node_blocks_of_an_element_chain_match_dense_solve() {
         let (n_el, dpn) = (5, 6);
-        let m = 2 * n_el * dpn;
         let nb = 4;
+        let (a, m) = element_chain(n_el, dpn, nb, 5, 6.0, true, true);
         let n = m + nb;
         let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: Some(2) };
-        let mut a = DenseMatrix::zeros(n, n);
-        let mut seed = 5u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let node = |i: usize| i / dpn + 1;
-        for j in 0..m {
-            for i in 0..m {
-                let (ni, nj) = (node(i), node(j));
-                let same = (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
-                if same {
-                    *a.get_mut(i, j) = rnd();
-                }
-            }
-            *a.get_mut(j, j) += 6.0;
-            *a.get_mut(m, j) = rnd(); // a frame-like border row and column
-            *a.get_mut(j, m) = rnd();
-            if node(j) == 2 * n_el {
-                *a.get_mut(m + 1, j) = rnd(); // a joint at the last node
-                *a.get_mut(j, m + 2) = rnd();
-            }
-        }
-        for j in m..n {
-            *a.get_mut(j, j) = 3.0 + rnd();
-        }
         let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.43).sin()).collect();
         let mut b = vec![0.0; n];
         a.mul_vec_inplace(&x_true, &mut b);
@@ -1160,34 +1153,9 @@ mod tests {
     #[test]
     fn direct_node_assembly_finds_its_own_nonzero_blocks() {
         let (n_el, dpn) = (3, 6);
+        let chain = |couple: bool, seed: u64| element_chain(n_el, dpn, 2, seed, 6.0, couple, false).0;
         let m = 2 * n_el * dpn;
         let n = m + 2;
-        let chain = |couple: bool, seed0: u64| {
-            let mut a = DenseMatrix::zeros(n, n);
-            let mut seed = seed0;
-            let mut rnd = || {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            };
-            let node = |i: usize| i / dpn + 1;
-            for j in 0..m {
-                for i in 0..m {
-                    let (ni, nj) = (node(i), node(j));
-                    let same =
-                        (0..n_el).any(|e| (2 * e..=2 * e + 2).contains(&ni) && (2 * e..=2 * e + 2).contains(&nj));
-                    if same && (couple || ni == nj) {
-                        *a.get_mut(i, j) = rnd();
-                    }
-                }
-                *a.get_mut(j, j) += 6.0;
-                *a.get_mut(m, j) = rnd();
-                *a.get_mut(j, m) = rnd();
-            }
-            for j in m..n {
-                *a.get_mut(j, j) = 3.0 + rnd();
-            }
-            a
-        };
         let st = BandedBorder { blocks: vec![(0, m, 3 * dpn - 1)], node_bandwidth: Some(2) };
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin()).collect();
         let residual = |lu: &mut BorderedBandLu, a: &DenseMatrix| {

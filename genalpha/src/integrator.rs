@@ -573,7 +573,9 @@ impl<L: LinearSolver> GenAlpha<L> {
         self.q_n.copy_from_slice(&s.q);
         let extrapolate =
             np.predictor == Predictor::ExtrapolatedAcceleration && self.last_step == Some((s.t, h.to_bits()));
-        self.v_dot_n.copy_from_slice(&s.v_dot);
+        if np.predictor == Predictor::ExtrapolatedAcceleration {
+            self.v_dot_n.copy_from_slice(&s.v_dot); // becomes v̇_{n−1} for the next step
+        }
         for i in 0..n {
             let a_n = s.a[i];
             // a_{n+1} from (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) v̇_{n+1} + α_f v̇_n.
