@@ -1,7 +1,7 @@
 //! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
 
 use crate::{
-    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, IntegratorParams, IterationRecord,
+    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, Form, IntegratorParams, IterationRecord,
     LinearSolver, MatView, Predictor, Stats, StepStats,
 };
 
@@ -14,7 +14,7 @@ pub struct State {
     pub q: Vec<f64>,
     /// Velocities (tangent, length `n_dof`).
     pub v: Vec<f64>,
-    /// Accelerations v̇.
+    /// Accelerations v̇ (in the [`Form::ChungHulbert`] form, v̇ at the step's weighted instant).
     pub v_dot: Vec<f64>,
     /// Generalized-α pseudo-accelerations a.
     pub a: Vec<f64>,
@@ -56,15 +56,34 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     n_v: usize,
     solver: L,
     matrix: DenseMatrix,
+    /// Φ_q and B at the end of the step: the constraint rows (and, in the Arnold–Brüls form,
+    /// the constraint forces).
     phi_q: DenseMatrix,
     b_mat: DenseMatrix,
+    /// Φ_q and B at the weighted state `q_α` of the Chung–Hulbert form: the constraint forces
+    /// (empty in the Arnold–Brüls form).
+    phi_q_alpha: DenseMatrix,
+    b_alpha: DenseMatrix,
     phi_q_ready: bool,
     /// Columns of Φ_q with a non-zero entry (constraints touch few coordinates).
     phi_q_cols: Vec<usize>,
+    /// Columns of `phi_q_alpha` with a non-zero entry.
+    phi_q_alpha_cols: Vec<usize>,
     /// Columns of B that have been non-zero in some assembly (their Bᵀ entries are rewritten).
     b_cols_written: Vec<bool>,
     /// Columns of B that were non-zero at its last evaluation.
     b_nz_cols: Vec<usize>,
+    /// Columns of `b_alpha` that were non-zero at its last evaluation.
+    b_alpha_nz_cols: Vec<usize>,
+    /// The Chung–Hulbert form is in use: forces at the weighted state below.
+    weighted: bool,
+    /// The weighted state `t_α`, `q_α`, `v_α` of the current iterate, the tangent increment
+    /// `(1 − α_f) h Δq_n` that gives `q_α`, and `v_n`.
+    t_alpha: f64,
+    q_alpha: Vec<f64>,
+    v_alpha: Vec<f64>,
+    hdelta_alpha: Vec<f64>,
+    v_n: Vec<f64>,
     have_factorization: bool,
     /// The last assembly went to the solver's storage.
     assembled_direct: bool,
@@ -177,6 +196,35 @@ fn copy_state(from: &State, to: &mut State) {
     to.mu.copy_from_slice(&from.mu);
 }
 
+/// `phi_q = Φ_q(t, q)` and the list of its non-zero columns.
+fn eval_phi_q<S: ConstrainedSystem + ?Sized>(
+    sys: &S,
+    t: f64,
+    q: &[f64],
+    phi_q: &mut DenseMatrix,
+    cols: &mut Vec<usize>,
+) {
+    phi_q.fill_zero();
+    sys.phi_q_inplace(t, q, &mut phi_q.view());
+    let (n_h, n) = (phi_q.n_rows(), phi_q.n_cols());
+    cols.clear();
+    cols.extend((0..n).filter(|&j| (0..n_h).any(|i| phi_q.get(i, j) != 0.0)));
+}
+
+/// `b = B(t, q)` and the list of its non-zero columns. Only the columns found non-zero last
+/// time need zeroing (the others still are): a joint touches a few unknowns.
+fn eval_b<S: ConstrainedSystem + ?Sized>(sys: &S, t: f64, q: &[f64], b: &mut DenseMatrix, nz_cols: &mut Vec<usize>) {
+    let (n_v, n) = (b.n_rows(), b.n_cols());
+    let data = b.as_mut_slice();
+    for &j in nz_cols.iter() {
+        data[j * n_v..(j + 1) * n_v].fill(0.0);
+    }
+    sys.psi_v_inplace(t, q, &mut b.view());
+    let data = b.as_slice();
+    nz_cols.clear();
+    nz_cols.extend((0..n).filter(|&j| data[j * n_v..(j + 1) * n_v].iter().fold(false, |a, x| a | (*x != 0.0))));
+}
+
 /// One unknown's weighted increment against its tolerance, `|Δx w| / (atol + rtol |h δ w|)`.
 #[inline]
 fn increment_ratio(dx: f64, w: f64, hdelta: f64, atol: f64, rtol: f64) -> f64 {
@@ -242,6 +290,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             solver.set_structure(st);
         }
         let k_rows = structure.filter(|st| st.is_valid(n)).map(|st| k_block_rows(&st, n)).unwrap_or_default();
+        let weighted = params.form == Form::ChungHulbert;
+        let (n_hw, n_vw, n_w, n_qw) = if weighted { (n_h, n_v, n, n_q) } else { (0, 0, 0, 0) };
         Ok(Self {
             params,
             c: params.coefficients(),
@@ -252,10 +302,20 @@ impl<L: LinearSolver> GenAlpha<L> {
             matrix: DenseMatrix::zeros(n_all, n_all),
             phi_q: DenseMatrix::zeros(n_h, n),
             b_mat: DenseMatrix::zeros(n_v, n),
+            phi_q_alpha: DenseMatrix::zeros(n_hw, n_w),
+            b_alpha: DenseMatrix::zeros(n_vw, n_w),
             phi_q_ready: false,
             phi_q_cols: Vec::with_capacity(n),
+            phi_q_alpha_cols: Vec::with_capacity(n_w),
             b_cols_written: vec![false; n],
             b_nz_cols: Vec::with_capacity(n),
+            b_alpha_nz_cols: Vec::with_capacity(n_w),
+            weighted,
+            t_alpha: 0.0,
+            q_alpha: vec![0.0; n_qw],
+            v_alpha: vec![0.0; n_w],
+            hdelta_alpha: vec![0.0; n_w],
+            v_n: vec![0.0; n_w],
             have_factorization: false,
             assembled_direct: false,
             k_rows,
@@ -309,49 +369,57 @@ impl<L: LinearSolver> GenAlpha<L> {
         self.trace.as_mut().map(std::mem::take).unwrap_or_default()
     }
 
-    fn update_jacobians<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t: f64, q: &[f64]) {
+    /// Φ_q and B at the end of the step `(t, q)` and, in the Chung–Hulbert form, at the weighted
+    /// state (`self.t_alpha`, `self.q_alpha`, which the caller has set). In that form the
+    /// end-of-step B only enters the matrix's constraint rows, so it is evaluated only when
+    /// `assembling` (the constraint residual Ψ is the model's own function).
+    fn update_jacobians<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t: f64, q: &[f64], assembling: bool) {
         if self.n_h > 0 && !(self.phi_q_ready && sys.phi_q_is_constant()) {
-            self.phi_q.fill_zero();
-            sys.phi_q_inplace(t, q, &mut self.phi_q.view());
-            self.phi_q_ready = true;
             // Forget the previous Φ_q in the assembled matrix: its non-zero columns may move.
+            let (n, n_h) = (self.n, self.n_h);
             for &j in &self.phi_q_cols {
-                for i in 0..self.n_h {
-                    *self.matrix.get_mut(self.n + i, j) = 0.0;
-                    *self.matrix.get_mut(j, self.n + i) = 0.0;
-                }
+                (0..n_h).for_each(|i| *self.matrix.get_mut(n + i, j) = 0.0);
             }
-            let phi_q = &self.phi_q;
-            self.phi_q_cols.clear();
-            self.phi_q_cols.extend((0..self.n).filter(|&j| (0..self.n_h).any(|i| phi_q.get(i, j) != 0.0)));
+            let force_cols = if self.weighted { &self.phi_q_alpha_cols } else { &self.phi_q_cols };
+            for &j in force_cols {
+                (0..n_h).for_each(|i| *self.matrix.get_mut(j, n + i) = 0.0);
+            }
+            eval_phi_q(sys, t, q, &mut self.phi_q, &mut self.phi_q_cols);
+            if self.weighted {
+                eval_phi_q(sys, self.t_alpha, &self.q_alpha, &mut self.phi_q_alpha, &mut self.phi_q_alpha_cols);
+            }
+            self.phi_q_ready = true;
         }
         if self.n_v > 0 {
-            // Only the columns found non-zero last time need zeroing (the others still are);
-            // the non-zero columns are listed again for Bᵀμ (a joint touches a few unknowns).
-            let n_v = self.n_v;
-            let data = self.b_mat.as_mut_slice();
-            for &j in &self.b_nz_cols {
-                data[j * n_v..(j + 1) * n_v].fill(0.0);
+            if assembling || !self.weighted {
+                eval_b(sys, t, q, &mut self.b_mat, &mut self.b_nz_cols);
             }
-            sys.psi_v_inplace(t, q, &mut self.b_mat.view());
-            let data = self.b_mat.as_slice();
-            self.b_nz_cols.clear();
-            self.b_nz_cols.extend(
-                (0..self.n).filter(|&j| data[j * n_v..(j + 1) * n_v].iter().fold(false, |a, x| a | (*x != 0.0))),
-            );
+            if self.weighted {
+                eval_b(sys, self.t_alpha, &self.q_alpha, &mut self.b_alpha, &mut self.b_alpha_nz_cols);
+            }
         }
     }
 
-    /// Copy Φ_q and B (and their transposes) into the assembled matrix around the K block.
-    /// Only the non-zero columns of Φ_q are written: its zero columns stay zero from the
-    /// matrix's creation (nothing else writes to the constraint rows and columns of Φ).
+    /// Copy Φ_q and B into the constraint rows of the assembled matrix, and the force
+    /// Jacobians' transposes into its multiplier columns. Only the non-zero columns of Φ_q are
+    /// written: its zero columns stay zero from the matrix's creation (nothing else writes to the
+    /// constraint rows and columns of Φ).
     fn place_constraint_blocks(&mut self) {
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        let weighted = self.weighted;
+        let (phi_f, phi_f_cols, b_f) = if weighted {
+            (&self.phi_q_alpha, &self.phi_q_alpha_cols, &self.b_alpha)
+        } else {
+            (&self.phi_q, &self.phi_q_cols, &self.b_mat)
+        };
         for &j in &self.phi_q_cols {
             for i in 0..n_h {
-                let x = self.phi_q.get(i, j);
-                *self.matrix.get_mut(n + i, j) = x;
-                *self.matrix.get_mut(j, n + i) = x;
+                *self.matrix.get_mut(n + i, j) = self.phi_q.get(i, j);
+            }
+        }
+        for &j in phi_f_cols {
+            for i in 0..n_h {
+                *self.matrix.get_mut(j, n + i) = phi_f.get(i, j);
             }
         }
         if n_v > 0 {
@@ -359,13 +427,14 @@ impl<L: LinearSolver> GenAlpha<L> {
             // a few coordinates, and a column that was never written is still zero in Bᵀ.
             for j in 0..n {
                 let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
-                self.b_cols_written[j] |= col.iter().any(|&x| x != 0.0);
+                let col_f = &b_f.as_slice()[j * n_v..(j + 1) * n_v];
+                self.b_cols_written[j] |= col.iter().chain(col_f).any(|&x| x != 0.0);
                 if !self.b_cols_written[j] {
                     continue;
                 }
-                for (i, &x) in col.iter().enumerate() {
+                for (i, (&x, &xf)) in col.iter().zip(col_f).enumerate() {
                     *self.matrix.get_mut(n + n_h + i, j) += x;
-                    *self.matrix.get_mut(j, n + n_h + i) = x;
+                    *self.matrix.get_mut(j, n + n_h + i) = xf;
                 }
             }
         }
@@ -392,14 +461,20 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
     }
 
-    /// `r += Φ_qᵀ λ + Bᵀ μ`.
+    /// `r += Φ_qᵀ λ + Bᵀ μ` (the force Jacobians).
     fn add_constraint_forces(&mut self, lambda: &[f64], mu: &[f64]) {
-        for &j in &self.phi_q_cols {
-            self.r[j] += (0..self.n_h).map(|i| self.phi_q.get(i, j) * lambda[i]).sum::<f64>();
+        let (n_h, n_v) = (self.n_h, self.n_v);
+        let (phi_f, phi_f_cols, b_f, b_f_cols) = if self.weighted {
+            (&self.phi_q_alpha, &self.phi_q_alpha_cols, &self.b_alpha, &self.b_alpha_nz_cols)
+        } else {
+            (&self.phi_q, &self.phi_q_cols, &self.b_mat, &self.b_nz_cols)
+        };
+        for &j in phi_f_cols {
+            self.r[j] += (0..n_h).map(|i| phi_f.get(i, j) * lambda[i]).sum::<f64>();
         }
-        if self.n_v > 0 {
-            let (n_v, data) = (self.n_v, self.b_mat.as_slice());
-            for &j in &self.b_nz_cols {
+        if n_v > 0 {
+            let data = b_f.as_slice();
+            for &j in b_f_cols {
                 self.r[j] += data[j * n_v..(j + 1) * n_v].iter().zip(mu).map(|(a, b)| a * b).sum::<f64>();
             }
         }
@@ -411,7 +486,12 @@ impl<L: LinearSolver> GenAlpha<L> {
     pub fn initialize<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &mut State) -> Result<(), Error> {
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
         self.last_step = None; // a new start: nothing to extrapolate from
-        self.update_jacobians(sys, s.t, &s.q);
+        if self.weighted {
+            // At the start the weighted state is the state itself.
+            self.t_alpha = s.t;
+            self.q_alpha.copy_from_slice(&s.q);
+        }
+        self.update_jacobians(sys, s.t, &s.q, true);
         self.matrix.fill_zero();
         sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));
         self.place_constraint_blocks();
@@ -569,8 +649,12 @@ impl<L: LinearSolver> GenAlpha<L> {
         let t1 = s.t + h;
 
         // Predictor: v̇_{n+1} = v̇_n, or extrapolated from v̇_{n−1} when the last step was
-        // contiguous and of the same size.
+        // contiguous and of the same size (in the Chung–Hulbert form, the same for v̇_α).
         self.q_n.copy_from_slice(&s.q);
+        let (t_n, weighted) = (s.t, self.weighted);
+        if weighted {
+            self.v_n.copy_from_slice(&s.v);
+        }
         let extrapolate =
             np.predictor == Predictor::ExtrapolatedAcceleration && self.last_step == Some((s.t, h.to_bits()));
         if np.predictor == Predictor::ExtrapolatedAcceleration {
@@ -582,7 +666,12 @@ impl<L: LinearSolver> GenAlpha<L> {
             let v_dot_n = s.v_dot[i];
             let a1 = if extrapolate {
                 s.v_dot[i] = 2.0 * v_dot_n - self.v_dot_previous[i];
-                ((1.0 - c.alpha_f) * s.v_dot[i] + c.alpha_f * v_dot_n - c.alpha_m * a_n) / (1.0 - c.alpha_m)
+                if weighted {
+                    // v̇_α = (1 − α_m) a_{n+1} + α_m a_n.
+                    (s.v_dot[i] - c.alpha_m * a_n) / (1.0 - c.alpha_m)
+                } else {
+                    ((1.0 - c.alpha_f) * s.v_dot[i] + c.alpha_f * v_dot_n - c.alpha_m * a_n) / (1.0 - c.alpha_m)
+                }
             } else {
                 (v_dot_n - c.alpha_m * a_n) / (1.0 - c.alpha_m)
             };
@@ -598,6 +687,11 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.predictor_delta.copy_from_slice(&self.delta);
         }
 
+        // The weights of the dynamic rows: ∂v̇/∂x of the Newton unknown x (the scaling of the
+        // dynamic rows is its inverse, and the multipliers move by it times their unknowns).
+        // In the Chung–Hulbert form every weighted quantity moves by (1 − α_f) times its
+        // end-of-step value, so the scaled matrix is the same.
+        let c_vdot = if weighted { (1.0 - c.alpha_f) * c.beta_prime } else { c.beta_prime };
         let mut stats = StepStats { n_substeps: 1, ..StepStats::default() };
         let mut prev_inc = f64::INFINITY;
         let mut fresh = false; // factorisation made at this iterate's matrix
@@ -684,17 +778,22 @@ impl<L: LinearSolver> GenAlpha<L> {
                 || (iter == 1 && self.refresh_steps_left > 0)
                 || (iter > 1 && contraction > np.max_contraction && !fresh)
                 || (iter > 4 && !fresh && iterations_to_converge(inc_norm, contraction) > MAX_MORE_ITERATIONS);
-            // Dynamic residual at the current iterate, with the iteration matrix when it is
-            // refactorised here (one pass over the elements).
-            self.update_jacobians(sys, t1, &s.q);
+            // Dynamic residual at the current iterate (or its weighted state), with the iteration
+            // matrix when it is refactorised here (one pass over the elements).
+            if weighted {
+                self.set_weighted_state(sys, t_n, s);
+            }
+            self.update_jacobians(sys, t1, &s.q, need);
             if need {
                 self.assemble_with_residual(sys, t1, s, true);
+            } else if weighted {
+                sys.residual_inplace(self.t_alpha, &self.q_alpha, &self.v_alpha, &s.v_dot, &mut self.r);
             } else {
                 sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
             }
             self.stats.n_residual_evals += 1;
             self.add_constraint_forces(&s.lambda, &s.mu);
-            let res_norm = inf_norm(&self.r) / c.beta_prime;
+            let res_norm = inf_norm(&self.r) / c_vdot;
             stats.residual_norm = res_norm;
             if !res_norm.is_finite() {
                 return Err(Error::NonFinite { t: t1, iter });
@@ -716,9 +815,9 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.previous_delta.copy_from_slice(&self.delta);
             }
             step_back = false;
-            let inv_beta_prime = 1.0 / c.beta_prime;
+            let inv_c_vdot = 1.0 / c_vdot;
             for (b, r) in self.rhs[..n].iter_mut().zip(&self.r) {
-                *b = -r * inv_beta_prime;
+                *b = -r * inv_c_vdot;
             }
             for i in 0..n_h {
                 self.rhs[n + i] = -self.phi[i];
@@ -751,7 +850,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 *d += dx * inv_h;
                 *hd = h * *d;
                 *v += c.gamma_prime * dx;
-                *v_dot += c.beta_prime * dx;
+                *v_dot += c_vdot * dx;
                 *a += dx * inv_beta_h2;
             }
             inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
@@ -771,10 +870,10 @@ impl<L: LinearSolver> GenAlpha<L> {
                 });
             }
             for i in 0..n_h {
-                s.lambda[i] += c.beta_prime * self.rhs[n + i];
+                s.lambda[i] += c_vdot * self.rhs[n + i];
             }
             for i in 0..n_v {
-                s.mu[i] += c.beta_prime * self.rhs[n + n_h + i];
+                s.mu[i] += c_vdot * self.rhs[n + n_h + i];
             }
             sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
         }
@@ -788,6 +887,21 @@ impl<L: LinearSolver> GenAlpha<L> {
         })
     }
 
+    /// The Chung–Hulbert form's weighted state of the iterate `s` of a step from `t_n`:
+    /// `q_α = q_n ∘ exp((1 − α_f) h Δq_n)`, `v_α = (1 − α_f) v + α_f v_n`, `t_α`.
+    fn set_weighted_state<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t_n: f64, s: &State) {
+        let c = self.c;
+        let w = 1.0 - c.alpha_f;
+        for (((ha, d), va), (v, v0)) in
+            self.hdelta_alpha.iter_mut().zip(&self.delta).zip(self.v_alpha.iter_mut()).zip(s.v.iter().zip(&self.v_n))
+        {
+            *ha = w * c.h * d;
+            *va = w * v + c.alpha_f * v0;
+        }
+        sys.retract_inplace(&self.q_n, &self.hdelta_alpha, &mut self.q_alpha);
+        self.t_alpha = t_n + w * c.h;
+    }
+
     /// Assemble the scaled iteration matrix at the current iterate, and evaluate the residual
     /// there into `self.r` (without constraint forces): into the solver's own storage when
     /// `direct` is allowed and the solver offers one ([`LinearSolver::assembly_target`]), else into
@@ -796,22 +910,34 @@ impl<L: LinearSolver> GenAlpha<L> {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
         let (c_m, c_c, c_k) = (1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime);
+        // Where the forces are evaluated: the end of the step or the weighted state.
+        let (t_f, q_f, v_f) =
+            if self.weighted { (self.t_alpha, &self.q_alpha[..], &self.v_alpha[..]) } else { (t1, &s.q[..], &s.v[..]) };
+        let (phi_f, phi_f_cols, b_f, b_f_cols) = if self.weighted {
+            (&self.phi_q_alpha, &self.phi_q_alpha_cols, &self.b_alpha, &self.b_alpha_nz_cols)
+        } else {
+            (&self.phi_q, &self.phi_q_cols, &self.b_mat, &self.b_nz_cols)
+        };
         if direct && let Some(target) = self.solver.assembly_target() {
             target.clear();
             {
                 let mut k = MatView::direct(&mut *target, 0, 0, n, n);
-                sys.residual_and_iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
-                sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, c_k, &mut k);
+                sys.residual_and_iteration_matrix_inplace(t_f, q_f, v_f, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
+                sys.constraint_force_tangent_inplace(t_f, q_f, &s.lambda, &s.mu, c_k, &mut k);
             }
             if n_v > 0 {
                 let mut j = MatView::direct(&mut *target, n + n_h, 0, n_v, n);
                 sys.psi_q_inplace(t1, &s.q, &s.v, &mut j.scaled(1.0 / c.gamma_prime));
             }
+            // Constraint rows at the end of the step, multiplier columns from the force Jacobians.
             for &j in &self.phi_q_cols {
                 for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
-                    let x = self.phi_q.get(i, j);
-                    target.add(n + i, j, x);
-                    target.add(j, n + i, x);
+                    target.add(n + i, j, self.phi_q.get(i, j));
+                }
+            }
+            for &j in phi_f_cols {
+                for i in (0..n_h).filter(|&i| phi_f.get(i, j) != 0.0) {
+                    target.add(j, n + i, phi_f.get(i, j));
                 }
             }
             if n_v > 0 {
@@ -819,6 +945,11 @@ impl<L: LinearSolver> GenAlpha<L> {
                     let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
                     for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
                         target.add(n + n_h + i, j, x);
+                    }
+                }
+                for &j in b_f_cols {
+                    let col = &b_f.as_slice()[j * n_v..(j + 1) * n_v];
+                    for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
                         target.add(j, n + n_h + i, x);
                     }
                 }
@@ -828,10 +959,12 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
         self.assembled_direct = false;
         self.clear_added_blocks();
+        let (t_f, q_f, v_f) =
+            if self.weighted { (self.t_alpha, &self.q_alpha[..], &self.v_alpha[..]) } else { (t1, &s.q[..], &s.v[..]) };
         {
             let mut k = self.matrix.block(0, 0, n, n);
-            sys.residual_and_iteration_matrix_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
-            sys.constraint_force_tangent_inplace(t1, &s.q, &s.lambda, &s.mu, c_k, &mut k);
+            sys.residual_and_iteration_matrix_inplace(t_f, q_f, v_f, &s.v_dot, &mut self.r, c_m, c_c, c_k, &mut k);
+            sys.constraint_force_tangent_inplace(t_f, q_f, &s.lambda, &s.mu, c_k, &mut k);
         }
         if n_v > 0 {
             let mut j = self.matrix.block(n + n_h, 0, n_v, n);

@@ -28,6 +28,14 @@
 //! Newton starts from a predictor: constant or linearly extrapolated acceleration
 //! (`NewtonParams::predictor`).
 //!
+//! [`Form::ChungHulbert`] keeps the Newmark relations and the end-of-step constraints but
+//! evaluates the forces (and the constraint forces' Jacobians) at the weighted state
+//! `q_α = q_n ∘ exp((1 − α_f) h Δq_n)`, `v_α = (1 − α_f) v_{n+1} + α_f v_n`,
+//! `v̇_α = (1 − α_m) a_{n+1} + α_m a_n`: Chung & Hulbert's original form, the implicit midpoint
+//! rule at `rho_inf = 1`. Every weighted quantity moves by `1 − α_f` times its end-of-step
+//! increment, so the scaled iteration matrix is the same; only the rows of B (end of step) and
+//! the columns of Bᵀ (weighted state) differ.
+//!
 //! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
 #![warn(missing_docs)]
 
@@ -46,7 +54,7 @@ pub use error::Error;
 pub use integrator::{GenAlpha, State};
 pub use linear_solver::{Assembled, DenseLu, LinearSolver};
 pub use matrix::{AssemblyTarget, DenseMatrix, MatView};
-pub use params::{Coefficients, IntegratorParams, NewtonParams, Predictor};
+pub use params::{Coefficients, Form, IntegratorParams, NewtonParams, Predictor};
 pub use stats::{IterationRecord, Stats, StepStats};
 pub use system::ConstrainedSystem;
 

@@ -218,6 +218,28 @@ pub struct NewtonSettings {
     pub predictor: Option<PredictorSetting>,
 }
 
+/// Where the generalized-α step enforces the equations of motion (the constraints are
+/// enforced at the end of the step in both).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FormSetting {
+    /// At the end of the step (Arnold & Brüls 2007); the trapezoidal rule at rho_inf = 1.
+    ArnoldBruls,
+    /// At the α-weighted state inside the step (Chung & Hulbert 1993); the implicit midpoint
+    /// rule at rho_inf = 1, whose gyroscopic terms do no discrete work.
+    ChungHulbert,
+}
+
+impl FormSetting {
+    /// The genalpha form.
+    pub fn to_form(self) -> genalpha::Form {
+        match self {
+            FormSetting::ArnoldBruls => genalpha::Form::ArnoldBruls,
+            FormSetting::ChungHulbert => genalpha::Form::ChungHulbert,
+        }
+    }
+}
+
 /// Newton's starting point in each step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -349,6 +371,9 @@ pub struct AncfSettings {
     /// DAE (default) or ODE path.
     #[serde(default)]
     pub path: AncfPath,
+    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`.
+    #[serde(default)]
+    pub form: Option<FormSetting>,
     /// Newton settings.
     #[serde(default)]
     pub newton: NewtonSettings,
@@ -368,6 +393,11 @@ pub struct GebfSettings {
     /// Position-level projection of the joints after each step. Default off.
     #[serde(default)]
     pub stabilization: bool,
+    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
+    /// `chung_hulbert` keeps the floating frames' gyroscopic forces from doing discrete work
+    /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies.
+    #[serde(default)]
+    pub form: Option<FormSetting>,
     /// Newton settings.
     #[serde(default)]
     pub newton: NewtonSettings,

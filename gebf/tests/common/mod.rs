@@ -74,11 +74,16 @@ pub fn run_paper_case(c: f64, beta_deg: f64, rho_inf: f64, stabilization: bool) 
 
 /// A paper case (5 elements per body, 2 s) at time step `dt`.
 pub fn run_paper_case_dt(c: f64, beta_deg: f64, rho_inf: f64, stabilization: bool, dt: f64) -> Run {
+    run_paper_case_with(c, beta_deg, stabilization, IntegratorParams::new(rho_inf, dt))
+}
+
+/// A paper case (5 elements per body, 2 s) with the given integrator parameters.
+pub fn run_paper_case_with(c: f64, beta_deg: f64, stabilization: bool, params: IntegratorParams) -> Run {
     let (b, j, g) = samples::double_pendulum(c, beta_deg, 5);
     let mut m = Model::new(&b, &j, g, Options { stabilization, ..Options::default() }).unwrap();
     let mut r =
         Run { tip: Vec::new(), fold: Vec::new(), energy: Vec::new(), residual: Vec::new(), stats: Default::default() };
-    let (_, stats) = simulate::run(&mut m, IntegratorParams::new(rho_inf, dt), 2.0, |m, s, _| {
+    let (_, stats) = simulate::run(&mut m, params, 2.0, |m, s, _| {
         r.tip.push((s.t, m.tip_position(&s.q)));
         r.fold.push(m.fold_angle(&s.q, 1).unwrap());
         r.energy.push(m.energies(&s.q, &s.v));
