@@ -588,7 +588,11 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
         let c = self.c;
         let k = c.h * c.h * (c.beta - 1.0 / 6.0).abs();
-        let est = (0..self.n).fold(0.0_f64, |m, i| m.max(self.weights[i] * (s.a[i] - self.backup.a[i]).abs()));
+        // In the Chung–Hulbert form `a` carries the undamped spurious root at rho_inf = 1
+        // (it alternates about the acceleration); the weighted v̇_α is smooth and changes by the
+        // same h·(jerk) to leading order.
+        let (x, x0) = if self.weighted { (&s.v_dot, &self.backup.v_dot) } else { (&s.a, &self.backup.a) };
+        let est = (0..self.n).fold(0.0_f64, |m, i| m.max(self.weights[i] * (x[i] - x0[i]).abs()));
         k * est > tol
     }
 
