@@ -231,6 +231,14 @@ pub enum FormSetting {
 }
 
 impl FormSetting {
+    /// The name in case files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FormSetting::ArnoldBruls => "arnold_bruls",
+            FormSetting::ChungHulbert => "chung_hulbert",
+        }
+    }
+
     /// The genalpha form.
     pub fn to_form(self) -> genalpha::Form {
         match self {

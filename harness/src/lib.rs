@@ -3,7 +3,9 @@
 //! Reads case files ([`case`]), builds the scene for ANCF and for GEBF ([`scene`]), integrates
 //! each with the shared generalized-α integrator ([`run`]), compares them with each other and with
 //! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
-//! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]).
+//! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
+//! ladders ([`converge`]), the stress matrix ([`stress`]), energy by integrator form
+//! ([`energy`]), speed ([`bench`]).
 #![warn(missing_docs)]
 
 pub mod aero;
@@ -12,6 +14,7 @@ pub mod case;
 pub mod converge;
 pub mod csv;
 pub mod driver;
+pub mod energy;
 pub mod gate;
 pub mod metrics;
 pub mod plot;

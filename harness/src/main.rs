@@ -10,7 +10,7 @@ use harness::case::{CaseFile, Formulation, Override, json_schema};
 use harness::csv::{to_csv, write_file};
 use harness::driver::{discover, expand_all, run_all, write_reports};
 use harness::report::write_case;
-use harness::{bench, converge, gate, stress};
+use harness::{bench, converge, energy, gate, stress};
 
 #[derive(Parser)]
 #[command(
@@ -95,6 +95,19 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
+    /// Energy at rho_inf = 1 of the c = 1 pendulums, each formulation in both generalized-α forms
+    /// (Arnold–Brüls, Chung–Hulbert); writes `<out>/energy/` (energy.md, energy.csv, energy.svg).
+    Energy {
+        /// Folder of case files.
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Output folder (writes `<out>/energy/`).
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
     /// Time each formulation on each case (median thread CPU time of repeated serial runs, ANCF on
     /// both paths) with the work per step; writes `<out>/bench/` (bench.md, bench.json, bench.svg).
     Bench {
@@ -132,6 +145,32 @@ fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, out: &std::path::P
     bench::write(&out.join("bench"), &rows, |c| pendulums.contains(&c))?;
     println!("bench: {} configurations x {repeats} runs in {:.1} s", rows.len(), t.elapsed().as_secs_f64());
     Ok(rows)
+}
+
+/// Run the energy study on the c = 1 pendulums among `runs`, write `<out>/energy/` and print the
+/// drifts.
+fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<()> {
+    let t = std::time::Instant::now();
+    let study = energy::run(&energy::select(runs));
+    energy::write(&out.join("energy"), &study)?;
+    for r in &study {
+        let m = &r.metrics;
+        println!(
+            "energy {} {} {}: {}",
+            r.case,
+            r.formulation,
+            energy::form_name(r.form),
+            m.error.as_ref().map_or_else(
+                || format!(
+                    "drift {:.2e} of the peak kinetic energy, {:.2} Newton/step",
+                    m.energy_drift, m.newton_per_step
+                ),
+                |e| format!("FAILED: {e}")
+            )
+        );
+    }
+    println!("energy study: {} runs in {:.1} s", study.len(), t.elapsed().as_secs_f64());
+    Ok(())
 }
 
 /// The extra hard runs of the stress study: a 20 s pendulum and the wing at AoA 15°.
@@ -227,6 +266,7 @@ fn real_main() -> Result<ExitCode> {
                     }
                     println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
                 }
+                run_energy(&runs, &out)?;
                 let pendulums: Vec<_> = runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
                 run_bench(&pendulums, 7, &out)?;
             }
@@ -346,6 +386,14 @@ fn real_main() -> Result<ExitCode> {
             }
             println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
             Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Energy { cases, out, set } => {
+            let (runs, errors) = expand_all(&discover(&cases)?, &set);
+            for e in &errors {
+                eprintln!("error: {e}");
+            }
+            run_energy(&runs, &out)?;
+            Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
         }
         Cmd::Bench { files, cases, repeats, out, set } => {
             let explicit = !files.is_empty();

@@ -464,6 +464,9 @@ pub fn studies_html(out: &Path) -> String {
             );
         }
     }
+    if out.join("energy/energy.svg").exists() {
+        s.push_str("<h2 id=\"energy\">Energy at ρ<sub>∞</sub> = 1: the integrator's two forms</h2>\n<p>No aerodynamics and no numerical dissipation: the exact energy is constant, so |E − E(0)| / max T is the scheme's error. Each formulation in the default Arnold–Brüls form (forces at the end of the step: the trapezoidal rule) and in the Chung–Hulbert form (forces at the α-weighted state: the implicit midpoint rule), every step recorded: <a href=\"energy/energy.md\">energy.md</a>, <a href=\"energy/energy.csv\">energy.csv</a>.</p>\n<figure><img src=\"energy/energy.svg\" alt=\"energy\"><figcaption>Energy error against time</figcaption></figure>\n");
+    }
     if out.join("bench/bench.svg").exists() {
         s.push_str("<h2 id=\"bench\">Speed</h2>\n<p>Median thread CPU time of repeated serial runs at each case's own settings (ANCF on both solve paths), with the Newton work per step: <a href=\"bench/bench.md\">bench.md</a>, <a href=\"bench/bench.json\">bench.json</a>. Lines: the issues' targets for the paper's pendulums.</p>\n<figure><img src=\"bench/bench.svg\" alt=\"speed\"><figcaption>CPU time per run</figcaption></figure>\n");
     }
