@@ -1,4 +1,4 @@
-//! The generalized-α stepper (Arnold–Brüls form with scaled constraint rows).
+//! The generalized-α stepper (Arnold–Brüls or Chung–Hulbert form, with scaled constraint rows).
 
 use crate::{
     Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, Form, IntegratorParams, IterationRecord,
@@ -371,27 +371,32 @@ impl<L: LinearSolver> GenAlpha<L> {
 
     /// Φ_q and B at the end of the step `(t, q)` and, in the Chung–Hulbert form, at the weighted
     /// state (`self.t_alpha`, `self.q_alpha`, which the caller has set). In that form the
-    /// end-of-step B only enters the matrix's constraint rows, so it is evaluated only when
-    /// `assembling` (the constraint residual Ψ is the model's own function).
+    /// end-of-step Φ_q and B only enter the matrix's constraint rows, so they are evaluated only
+    /// when `assembling` (the constraint residuals Φ and Ψ are the model's own functions).
     fn update_jacobians<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t: f64, q: &[f64], assembling: bool) {
+        let rows = assembling || !self.weighted;
         if self.n_h > 0 && !(self.phi_q_ready && sys.phi_q_is_constant()) {
             // Forget the previous Φ_q in the assembled matrix: its non-zero columns may move.
             let (n, n_h) = (self.n, self.n_h);
-            for &j in &self.phi_q_cols {
-                (0..n_h).for_each(|i| *self.matrix.get_mut(n + i, j) = 0.0);
+            if rows {
+                for &j in &self.phi_q_cols {
+                    (0..n_h).for_each(|i| *self.matrix.get_mut(n + i, j) = 0.0);
+                }
             }
             let force_cols = if self.weighted { &self.phi_q_alpha_cols } else { &self.phi_q_cols };
             for &j in force_cols {
                 (0..n_h).for_each(|i| *self.matrix.get_mut(j, n + i) = 0.0);
             }
-            eval_phi_q(sys, t, q, &mut self.phi_q, &mut self.phi_q_cols);
+            if rows {
+                eval_phi_q(sys, t, q, &mut self.phi_q, &mut self.phi_q_cols);
+            }
             if self.weighted {
                 eval_phi_q(sys, self.t_alpha, &self.q_alpha, &mut self.phi_q_alpha, &mut self.phi_q_alpha_cols);
             }
             self.phi_q_ready = true;
         }
         if self.n_v > 0 {
-            if assembling || !self.weighted {
+            if rows {
                 eval_b(sys, t, q, &mut self.b_mat, &mut self.b_nz_cols);
             }
             if self.weighted {
@@ -579,8 +584,9 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// Local error control (off when `newton.local_error_tol` is 0): the position update
     /// `q_{n+1} = q_n + h v_n + h²[(½ − β) a_n + β a_{n+1}]` differs from the Taylor series by
     /// `h²(β − 1/6)(a_{n+1} − a_n) + O(h⁴)` (Zienkiewicz & Xie's estimator for Newmark-type
-    /// schemes), measured in the increment's weighted max norm against the tolerance. `self.backup`
-    /// holds the state at the start of the step.
+    /// schemes), measured in the increment's weighted max norm against the tolerance (in the
+    /// Chung–Hulbert form with `v̇_α` for `a`, see below). `self.backup` holds the state at the
+    /// start of the step.
     fn local_error_too_large(&self, s: &State) -> bool {
         let tol = self.params.newton.local_error_tol;
         if tol <= 0.0 {
@@ -979,8 +985,9 @@ impl<L: LinearSolver> GenAlpha<L> {
 
     /// Factorise the matrix of the last [`assemble_with_residual`](Self::assemble_with_residual).
     /// When the solver's own storage asks for the dense path, the same matrix is assembled
-    /// densely (the residual is recomputed, with the same values) and factorised (a solver whose
-    /// storage met an entry outside its structure stops offering it).
+    /// densely (the residual is recomputed with the same values, and the constraint forces added
+    /// to it again) and factorised (a solver whose storage met an entry outside its structure
+    /// stops offering it).
     fn factorize_iteration_matrix<S: ConstrainedSystem + ?Sized>(
         &mut self,
         sys: &S,
@@ -991,7 +998,14 @@ impl<L: LinearSolver> GenAlpha<L> {
             match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: t1, pivot })? {
                 Assembled::Factorized => return Ok(()),
                 Assembled::UseDense => {
+                    // The storage met an entry outside the declared structure (or could not
+                    // factorise): from now on the dense matrix is cleared whole, not only inside
+                    // the structure, so that such entries do not pile up from one assembly to
+                    // the next. The residual is recomputed on the way: add the constraint forces
+                    // again.
+                    self.k_rows.clear();
                     self.assemble_with_residual(sys, t1, s, false);
+                    self.add_constraint_forces(&s.lambda, &s.mu);
                 }
             }
         }

@@ -33,8 +33,9 @@
 //! `q_α = q_n ∘ exp((1 − α_f) h Δq_n)`, `v_α = (1 − α_f) v_{n+1} + α_f v_n`,
 //! `v̇_α = (1 − α_m) a_{n+1} + α_m a_n`: Chung & Hulbert's original form, the implicit midpoint
 //! rule at `rho_inf = 1`. Every weighted quantity moves by `1 − α_f` times its end-of-step
-//! increment, so the scaled iteration matrix is the same; only the rows of B (end of step) and
-//! the columns of Bᵀ (weighted state) differ.
+//! increment, so the scaled iteration matrix is the same; only the constraint rows (Φ_q and B
+//! at the end of the step) and the multiplier columns (Φ_qᵀ and Bᵀ at the weighted state)
+//! differ.
 //!
 //! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
 #![warn(missing_docs)]

@@ -40,7 +40,7 @@ pub struct NewtonParams {
     pub broyden: bool,
     /// Local error control: a converged step whose error estimate
     /// `h²|β − 1/6|·max_i w_i |a_{n+1,i} − a_{n,i}|` (coordinate units, `w` the increment
-    /// weights) exceeds this is redone as two half steps, within `max_step_halvings`; counted
+    /// weights; in the Chung–Hulbert form with the change of `v̇_α` instead of `a`) exceeds this is redone as two half steps, within `max_step_halvings`; counted
     /// like a Newton-failure halving. Default 0: off (every step has the nominal size unless
     /// Newton fails).
     pub local_error_tol: f64,
@@ -51,11 +51,12 @@ pub struct NewtonParams {
 /// The predictor: the first Newton iterate of a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Predictor {
-    /// `v̇_{n+1} = v̇_n`, with `v_{n+1}`, `q_{n+1}` and `a_{n+1}` from the Newmark relations.
+    /// `v̇_{n+1} = v̇_n` (in the Chung–Hulbert form `v̇_α` of the last step), with `v_{n+1}`,
+    /// `q_{n+1}` and `a_{n+1}` from the Newmark relations.
     #[default]
     ConstantAcceleration,
-    /// `v̇_{n+1} = 2 v̇_n − v̇_{n−1}`: the acceleration extrapolated linearly from the last two
-    /// steps (when the last step had the same size and ended where this one starts; otherwise
+    /// `v̇_{n+1} = 2 v̇_n − v̇_{n−1}` (in the Chung–Hulbert form, of `v̇_α`): the acceleration
+    /// extrapolated linearly from the last two steps (when the last step had the same size and ended where this one starts; otherwise
     /// as [`ConstantAcceleration`](Self::ConstantAcceleration)). One order more accurate in h,
     /// which pays where the residual is strongly nonlinear in the velocities: GEBF's gyroscopic
     /// terms of fast-spinning floating frames. (A model whose `post_step` changes how the rates

@@ -379,7 +379,8 @@ pub struct AncfSettings {
     /// DAE (default) or ODE path.
     #[serde(default)]
     pub path: AncfPath,
-    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`.
+    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
+    /// `chung_hulbert` is not available with aerodynamics.
     #[serde(default)]
     pub form: Option<FormSetting>,
     /// Newton settings.
@@ -403,7 +404,8 @@ pub struct GebfSettings {
     pub stabilization: bool,
     /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
     /// `chung_hulbert` keeps the floating frames' gyroscopic forces from doing discrete work
-    /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies.
+    /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies. Not available
+    /// with aerodynamics (the coupled step holds the loads of the step's end).
     #[serde(default)]
     pub form: Option<FormSetting>,
     /// Newton settings.
@@ -813,6 +815,16 @@ impl Case {
             }
         }
         if let Some(a) = &self.aero {
+            // The coupled step holds the aerodynamic loads of t_{n+1} over the step; evaluated at
+            // the weighted instant t_{n+1-α_f}, they would make the coupling first order.
+            for (f, form) in [("ancf", self.ancf.form), ("gebf", self.gebf.form)] {
+                if form == Some(FormSetting::ChungHulbert) {
+                    return Err(format!(
+                        "{f}.form: chung_hulbert is not available with aerodynamics (the loads are those of \
+                         the step's end)"
+                    ));
+                }
+            }
             pos("aero.rho", a.rho)?;
             pos("aero.chord", a.chord)?;
             if !finite3(&a.v_inf) || norm3(&a.v_inf) == 0.0 {
@@ -925,6 +937,12 @@ mod tests {
             let e = c.validate().unwrap_err();
             assert!(e.contains(needle), "{path}: {e}");
         }
+        // The Chung–Hulbert form with aerodynamics.
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/wing_aoa5.json");
+        let mut v: Value = serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        set_path(&mut v, "gebf.form", json!("chung_hulbert")).unwrap();
+        let e = parse_case(&v).unwrap().validate().unwrap_err();
+        assert!(e.contains("gebf.form"), "{e}");
         // Non-finite numbers cannot even be written in JSON; a string where a number belongs:
         let mut v = raw();
         set_path(&mut v, "bodies.0.section.mass", json!("NaN")).unwrap();
