@@ -467,6 +467,7 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// `r += Φ_qᵀ λ + Bᵀ μ` (the force Jacobians).
+    #[inline]
     fn add_constraint_forces(&mut self, lambda: &[f64], mu: &[f64]) {
         let (n_h, n_v) = (self.n_h, self.n_v);
         let (phi_f, phi_f_cols, b_f, b_f_cols) = if self.weighted {
@@ -939,15 +940,22 @@ impl<L: LinearSolver> GenAlpha<L> {
                 let mut j = MatView::direct(&mut *target, n + n_h, 0, n_v, n);
                 sys.psi_q_inplace(t1, &s.q, &s.v, &mut j.scaled(1.0 / c.gamma_prime));
             }
-            // Constraint rows at the end of the step, multiplier columns from the force Jacobians.
+            // Constraint rows at the end of the step, multiplier columns from the force Jacobians
+            // (the same matrix in the Arnold–Brüls form: one pass).
             for &j in &self.phi_q_cols {
                 for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
-                    target.add(n + i, j, self.phi_q.get(i, j));
+                    let x = self.phi_q.get(i, j);
+                    target.add(n + i, j, x);
+                    if !self.weighted {
+                        target.add(j, n + i, x);
+                    }
                 }
             }
-            for &j in phi_f_cols {
-                for i in (0..n_h).filter(|&i| phi_f.get(i, j) != 0.0) {
-                    target.add(j, n + i, phi_f.get(i, j));
+            if self.weighted {
+                for &j in phi_f_cols {
+                    for i in (0..n_h).filter(|&i| phi_f.get(i, j) != 0.0) {
+                        target.add(j, n + i, phi_f.get(i, j));
+                    }
                 }
             }
             if n_v > 0 {
@@ -955,12 +963,17 @@ impl<L: LinearSolver> GenAlpha<L> {
                     let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
                     for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
                         target.add(n + n_h + i, j, x);
+                        if !self.weighted {
+                            target.add(j, n + n_h + i, x);
+                        }
                     }
                 }
-                for &j in b_f_cols {
-                    let col = &b_f.as_slice()[j * n_v..(j + 1) * n_v];
-                    for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
-                        target.add(j, n + n_h + i, x);
+                if self.weighted {
+                    for &j in b_f_cols {
+                        let col = &b_f.as_slice()[j * n_v..(j + 1) * n_v];
+                        for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+                            target.add(j, n + n_h + i, x);
+                        }
                     }
                 }
             }
