@@ -87,10 +87,6 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     have_factorization: bool,
     /// The last assembly went to the solver's storage.
     assembled_direct: bool,
-    /// Per column `j < n` of the K block, the row ranges (below `n`) the model may write, from
-    /// the declared [`BandedBorder`](crate::BandedBorder); empty when no structure is declared
-    /// (then the whole block is cleared).
-    k_rows: Vec<Vec<(usize, usize)>>,
     /// Steps left during which the factorisation is refreshed at each step's predictor, because
     /// a factorisation reused from an earlier step recently failed to contract.
     refresh_steps_left: usize,
@@ -157,33 +153,6 @@ fn iterations_to_converge(inc_norm: f64, theta: f64) -> f64 {
         return 0.0;
     }
     inc_norm.max(1.0).ln() / -theta.min(0.999).ln()
-}
-
-/// Per column of the `n × n` block, the row ranges inside the declared structure: the band of
-/// the column's diagonal block and every border row; a border column is whole.
-fn k_block_rows(st: &crate::BandedBorder, n: usize) -> Vec<Vec<(usize, usize)>> {
-    let mut in_block = vec![None; n];
-    for &(first, len, w) in &st.blocks {
-        in_block[first..first + len].fill(Some((first, len, w)));
-    }
-    // Border rows as contiguous runs.
-    let mut border: Vec<(usize, usize)> = Vec::new();
-    for i in (0..n).filter(|&i| in_block[i].is_none()) {
-        match border.last_mut() {
-            Some(r) if r.1 == i => r.1 = i + 1,
-            _ => border.push((i, i + 1)),
-        }
-    }
-    (0..n)
-        .map(|j| match in_block[j] {
-            None => vec![(0, n)],
-            Some((first, len, w)) => {
-                let mut r = border.clone();
-                r.push((j.saturating_sub(w).max(first), (j + w + 1).min(first + len)));
-                r
-            }
-        })
-        .collect()
 }
 
 fn copy_state(from: &State, to: &mut State) {
@@ -289,7 +258,6 @@ impl<L: LinearSolver> GenAlpha<L> {
         if let Some(st) = &structure {
             solver.set_structure(st);
         }
-        let k_rows = structure.filter(|st| st.is_valid(n)).map(|st| k_block_rows(&st, n)).unwrap_or_default();
         let weighted = params.form == Form::ChungHulbert;
         let (n_hw, n_vw, n_w, n_qw) = if weighted { (n_h, n_v, n, n_q) } else { (0, 0, 0, 0) };
         Ok(Self {
@@ -318,7 +286,6 @@ impl<L: LinearSolver> GenAlpha<L> {
             v_n: vec![0.0; n_w],
             have_factorization: false,
             assembled_direct: false,
-            k_rows,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
             r: vec![0.0; n],
@@ -453,15 +420,12 @@ impl<L: LinearSolver> GenAlpha<L> {
         let (n, n_h) = (self.n, self.n_h);
         let n_all = self.matrix.n_rows();
         let data = self.matrix.as_mut_slice();
-        for (j, col) in data.chunks_exact_mut(n_all).take(n).enumerate() {
-            match self.k_rows.get(j) {
-                Some(ranges) => {
-                    ranges.iter().for_each(|&(a, b)| col[a..b].fill(0.0));
-                    // Entries outside the declared structure are never written, so stay zero.
-                    debug_assert!(col[..n].iter().all(|&x| x == 0.0), "K column {j} written outside its structure");
-                }
-                None => col[..n].fill(0.0),
-            }
+        // Whole columns, also outside a declared structure: a model that writes outside it
+        // (which the solvers detect and then drop the structure) must not leave entries to pile
+        // up from one dense assembly to the next. Dense assemblies are rare when the solver
+        // offers its own storage (the first matrix, and hand-overs).
+        for col in data.chunks_exact_mut(n_all).take(n) {
+            col[..n].fill(0.0);
             col[n + n_h..].fill(0.0);
         }
     }
@@ -1012,11 +976,8 @@ impl<L: LinearSolver> GenAlpha<L> {
                 Assembled::Factorized => return Ok(()),
                 Assembled::UseDense => {
                     // The storage met an entry outside the declared structure (or could not
-                    // factorise): from now on the dense matrix is cleared whole, not only inside
-                    // the structure, so that such entries do not pile up from one assembly to
-                    // the next. The residual is recomputed on the way: add the constraint forces
-                    // again.
-                    self.k_rows.clear();
+                    // factorise). The residual is recomputed on the way: add the constraint
+                    // forces again.
                     self.assemble_with_residual(sys, t1, s, false);
                     self.add_constraint_forces(&s.lambda, &s.mu);
                 }

@@ -636,6 +636,8 @@ struct CoupledPendulum {
     k_c: f64,
     t_on: f64,
     structured: bool,
+    /// A mass coupling `m_c (ẍ z̈)`-type term, present from the start (outside the structure).
+    m_c: f64,
 }
 
 impl ConstrainedSystem for CoupledPendulum {
@@ -650,6 +652,8 @@ impl ConstrainedSystem for CoupledPendulum {
     }
     fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
         self.p.residual_inplace(t, q, v, v_dot, r);
+        r[0] += self.m_c * v_dot[1];
+        r[1] += self.m_c * v_dot[0];
         if t > self.t_on {
             r[0] += self.k_c * q[1];
             r[1] += self.k_c * q[0];
@@ -667,6 +671,10 @@ impl ConstrainedSystem for CoupledPendulum {
         k: &mut MatView<'_>,
     ) {
         self.p.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
+        if self.m_c != 0.0 {
+            k.add(0, 1, c_m * self.m_c);
+            k.add(1, 0, c_m * self.m_c);
+        }
         if t > self.t_on {
             k.add(0, 1, c_k * self.k_c);
             k.add(1, 0, c_k * self.k_c);
@@ -711,6 +719,7 @@ fn dense_hand_over_keeps_the_constraint_forces() {
                 k_c: 50.0,
                 t_on: 0.1,
                 structured,
+                m_c: 0.0,
             };
             let mut p = IntegratorParams::new(0.8, 1e-2);
             p.form = form;
@@ -860,6 +869,41 @@ fn full_newton_converges_quadratically_in_both_forms() {
                 assert!(st.max_newton_iters <= 3, "{st:?}");
                 assert!(worst < 1e-8, "{form:?}: equations of motion hold to {worst:.2e} m g");
             }
+        }
+    }
+}
+
+/// A model that writes outside its declared structure from the first matrix on: the dense LU
+/// drops the structure at once and never offers its own storage, so every matrix is assembled
+/// densely. Those entries must be cleared before each assembly, not added up (they once were:
+/// Newton diverged at t = 0.08 s). Same iterations and states as without a declared structure.
+#[test]
+fn entries_outside_a_declared_structure_do_not_pile_up() {
+    for form in [Form::ArnoldBruls, Form::ChungHulbert] {
+        let run = |structured: bool| {
+            let mut sys = CoupledPendulum {
+                p: Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: false },
+                k_c: 0.0,
+                t_on: f64::INFINITY,
+                structured,
+                m_c: 0.3,
+            };
+            let mut p = IntegratorParams::new(0.8, 1e-2);
+            p.form = form;
+            p.newton.reuse_factorization = false;
+            let mut ga = GenAlpha::new(p, &sys).unwrap();
+            let mut s = State::at_rest(&sys, 0.0, vec![1.0, 0.0]);
+            ga.initialize(&sys, &mut s).unwrap();
+            for _ in 0..100 {
+                ga.step(&mut sys, &mut s).unwrap();
+            }
+            (s, *ga.stats())
+        };
+        let (a, sa) = run(false);
+        let (b, sb) = run(true);
+        assert_eq!(sa.n_newton_iters, sb.n_newton_iters, "{form:?}");
+        for (x, y) in a.q.iter().chain(&a.lambda).zip(b.q.iter().chain(&b.lambda)) {
+            assert!((x - y).abs() < 1e-9 * (1.0 + x.abs()), "{form:?}: {x} vs {y}");
         }
     }
 }

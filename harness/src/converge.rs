@@ -305,6 +305,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         x_label: "log10 wall time [s]".into(),
         y_label: "max tip error [m]".into(),
         log_y: true,
+        legend_lower_right: false,
         series: series(&|g| g.wall_s.max(1e-6), &[Ladder::Diagonal, Ladder::Time, Ladder::Space]),
     };
     panels_svg(&dir.join("work_precision.svg"), &[wp], 1, (900, 480))?;
@@ -313,6 +314,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         x_label: "log10 dt [s]".into(),
         y_label: "max tip error [m]".into(),
         log_y: true,
+        legend_lower_right: false,
         series: series(&|g| g.dt, &[Ladder::Time]),
     };
     let s = Panel {
@@ -320,6 +322,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         x_label: "log10 elements (first body) [-]".into(),
         y_label: "max tip error [m]".into(),
         log_y: true,
+        legend_lower_right: false,
         series: series(&|g| g.elements.for_body(0) as f64, &[Ladder::Space]),
     };
     panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (600, 420))

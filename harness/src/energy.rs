@@ -23,6 +23,7 @@ use crate::case::{Case, FormSetting, Formulation, RunSpec};
 use crate::csv::write_file;
 use crate::metrics::FormulationMetrics;
 use crate::plot::{Panel, Series, colors, panels_svg};
+use crate::run::RunOutput;
 use crate::scene::run_formulation;
 
 /// Smallest relative energy error plotted (the start of every run is below it).
@@ -58,7 +59,12 @@ pub fn form_name(form: FormSetting) -> &'static str {
 /// The study's cases among `runs`: the pendulums (no aerodynamics) at c = 1.
 pub fn select(runs: &[RunSpec]) -> Vec<RunSpec> {
     runs.iter()
-        .filter(|r| r.ancf.aero.is_none() && r.ancf.stiffness_scale == 1.0 && r.gebf.stiffness_scale == 1.0)
+        .filter(|r| {
+            r.ancf.aero.is_none()
+                && r.gebf.aero.is_none()
+                && r.ancf.stiffness_scale == 1.0
+                && r.gebf.stiffness_scale == 1.0
+        })
         .cloned()
         .collect()
 }
@@ -90,7 +96,11 @@ pub fn run(specs: &[RunSpec]) -> Vec<EnergyRun> {
         .collect();
     jobs.par_iter()
         .map(|&(i, f, form)| {
-            let out = run_formulation(&study_case(specs[i].case(f), f, form), f);
+            let case = study_case(specs[i].case(f), f, form);
+            let out = match case.validate() {
+                Ok(()) => run_formulation(&case, f),
+                Err(e) => RunOutput::failed(f, format!("{}: {e}", specs[i].name)),
+            };
             let metrics = FormulationMetrics::of(&out);
             let e0 = out.rows.first().map_or(0.0, |r| r.total);
             let peak = if metrics.peak_kinetic > 0.0 { metrics.peak_kinetic } else { 1.0 };
@@ -126,7 +136,7 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
         );
         let drift = match &m.error {
             None => format!("{:.2e}", m.energy_drift),
-            Some(_) => format!("failed at {:.3} s", m.t_reached),
+            Some(_) => format!("failed after {:.3} s", m.t_reached),
         };
         let _ = writeln!(
             md,
@@ -155,6 +165,7 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
             x_label: "t [s]".into(),
             y_label: "|E − E(0)| / max T (≥ 1e-8)".into(),
             log_y: true,
+            legend_lower_right: true,
             series: runs
                 .iter()
                 .filter(|r| r.case == *c)

@@ -148,10 +148,15 @@ fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, out: &std::path::P
 }
 
 /// Run the energy study on the c = 1 pendulums among `runs`, write `<out>/energy/` and print the
-/// drifts.
-fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<()> {
+/// drifts; returns whether every run reached its end (true when there is nothing to study).
+fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<bool> {
     let t = std::time::Instant::now();
-    let study = energy::run(&energy::select(runs));
+    let specs = energy::select(runs);
+    if specs.is_empty() {
+        println!("energy study: no c = 1 pendulum (no aerodynamics) among the cases; nothing written");
+        return Ok(true);
+    }
+    let study = energy::run(&specs);
     energy::write(&out.join("energy"), &study)?;
     for r in &study {
         let m = &r.metrics;
@@ -170,7 +175,7 @@ fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<
         );
     }
     println!("energy study: {} runs in {:.1} s", study.len(), t.elapsed().as_secs_f64());
-    Ok(())
+    Ok(study.iter().all(|r| r.metrics.error.is_none()))
 }
 
 /// The extra hard runs of the stress study: a 20 s pendulum and the wing at AoA 15°.
@@ -392,8 +397,14 @@ fn real_main() -> Result<ExitCode> {
             for e in &errors {
                 eprintln!("error: {e}");
             }
-            run_energy(&runs, &out)?;
-            Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+            let ok = run_energy(&runs, &out)?;
+            Ok(if !errors.is_empty() {
+                ExitCode::from(2)
+            } else if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            })
         }
         Cmd::Bench { files, cases, repeats, out, set } => {
             let explicit = !files.is_empty();

@@ -29,6 +29,8 @@ pub struct Panel {
     pub y_label: String,
     /// Logarithmic y axis (non-positive values are clipped to the smallest positive one).
     pub log_y: bool,
+    /// Legend in the lower right corner instead of the upper right (for curves that end high).
+    pub legend_lower_right: bool,
     /// Curves.
     pub series: Vec<Series>,
 }
@@ -64,6 +66,10 @@ fn pad(lo: f64, hi: f64) -> (f64, f64) {
     }
 }
 
+fn legend_position(p: &Panel) -> SeriesLabelPosition {
+    if p.legend_lower_right { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperRight }
+}
+
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), String>
 where
     DB::ErrorType: 'static,
@@ -96,7 +102,7 @@ where
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(label_style)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend_position(p))
             .draw()
             .map_err(|e| e.to_string())?;
     } else {
@@ -120,7 +126,7 @@ where
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(label_style)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend_position(p))
             .draw()
             .map_err(|e| e.to_string())?;
     }
@@ -159,6 +165,7 @@ mod tests {
             x_label: "t [s]".into(),
             y_label: "Z [m]".into(),
             log_y,
+            legend_lower_right: log_y,
             series: vec![Series {
                 label: "ANCF".into(),
                 color: colors::ANCF,

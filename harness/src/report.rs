@@ -197,6 +197,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 x_label: "t [s]".into(),
                 y_label: format!("tip {} [m]", axis[k]),
                 log_y: false,
+                legend_lower_right: false,
                 series,
             }
         })
@@ -224,6 +225,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         x_label: "t [s]".into(),
         y_label: "tip distance [m]".into(),
         log_y: true,
+        legend_lower_right: false,
         series: diff,
     };
     panels_svg(&dir.join("tip_difference.svg"), &[diff_panel], 1, (900, 380))?;
@@ -266,6 +268,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 x_label: "t [s]".into(),
                 y_label: "energy [J]".into(),
                 log_y: false,
+                legend_lower_right: false,
                 series: comp,
             },
             Panel {
@@ -273,6 +276,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 x_label: "t [s]".into(),
                 y_label: "(E − E0 − W_aero) / max T [-]".into(),
                 log_y: false,
+                legend_lower_right: false,
                 series: drift,
             },
         ],
@@ -306,6 +310,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
             x_label: "t [s]".into(),
             y_label: "residual [m, rad]".into(),
             log_y: true,
+            legend_lower_right: false,
             series: cres,
         }],
         1,
@@ -328,6 +333,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 x_label: "t [s]".into(),
                 y_label: "lift [N]".into(),
                 log_y: false,
+                legend_lower_right: false,
                 series: lift,
             }],
             1,
@@ -341,6 +347,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
             x_label: "t [s]".into(),
             y_label: "fold angle [deg]".into(),
             log_y: false,
+            legend_lower_right: false,
             series: fold,
         }],
         1,
