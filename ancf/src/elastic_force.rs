@@ -309,7 +309,7 @@ impl Element {
     /// exactly symmetric.
     ///
     /// The strains are taken a [`StrainGroup`] (equal block sets) at a time, see
-    /// [`add_group_tangent`]; the geometric terms `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8
+    /// `add_group_tangent`; the geometric terms `C (s − s⁰) a ⊗ I₃` are gathered on the 8×8
     /// block level and added last.
     ///
     /// [`StrainGroup`]: crate::strain::StrainGroup

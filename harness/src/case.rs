@@ -581,7 +581,7 @@ impl CaseFile {
         self.path.parent().map(Path::to_path_buf).unwrap_or_default()
     }
 
-    /// Expand the sweep and apply overrides; returns one [`Run`] per sweep point.
+    /// Expand the sweep and apply overrides; returns one [`RunSpec`] per sweep point.
     pub fn expand(&self, overrides: &[Override]) -> Result<Vec<RunSpec>, Error> {
         let file = self.path.display().to_string();
         let err = |msg: String| Error::Case { file: file.clone(), msg };

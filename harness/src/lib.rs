@@ -5,7 +5,7 @@
 //! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
 //! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
 //! ladders ([`converge`]), the stress matrix ([`stress`]), energy by integrator form
-//! ([`energy`]), speed ([`bench`]).
+//! ([`energy`]), speed ([`bench`](mod@bench)).
 #![warn(missing_docs)]
 
 pub mod aero;
