@@ -5,7 +5,8 @@
 //! rho_inf = 1 (no numerical dissipation) the drift `max_t |E(t) − E(0)|` over the peak kinetic
 //! energy is the scheme's own error. Every stiff-enough pendulum case (c = 1) is run with both
 //! formulations in both generalized-α forms, recording every step (the β = 45° error is a
-//! transient of ~20 steps while the tip whips through the fold):
+//! transient of ~20 steps while the tip whips through the fold), at the case's time step and at
+//! half of it (the drift's observed order):
 //!
 //! * Arnold–Brüls (the default; the trapezoidal rule at rho_inf = 1): the frames' gyroscopic
 //!   and Coriolis forces do O(h²) work in GEBF's floating frames;
@@ -43,6 +44,8 @@ pub struct EnergyRun {
     pub form: FormSetting,
     /// Metrics (drift, Newton work, wall time, failure).
     pub metrics: FormulationMetrics,
+    /// The same run at half the time step (the drift's observed order in dt).
+    pub half_step: FormulationMetrics,
     /// `(t, (E(t) − E(0)) / peak kinetic energy)` at every step.
     #[serde(skip)]
     pub history: Vec<(f64, f64)>,
@@ -69,18 +72,20 @@ pub fn select(runs: &[RunSpec]) -> Vec<RunSpec> {
         .collect()
 }
 
-/// The case of formulation `f` at rho_inf = 1 in `form`, recording every step, without gate
-/// or references.
-fn study_case(base: &Case, f: Formulation, form: FormSetting) -> Case {
+/// The case of formulation `f` at rho_inf = 1 in `form` with the time step divided by
+/// `refine`, recording every step, without gate or references.
+fn study_case(base: &Case, f: Formulation, form: FormSetting, refine: f64) -> Case {
     let mut k = base.clone();
     match f {
         Formulation::Ancf => {
             k.ancf.rho_inf = 1.0;
             k.ancf.form = Some(form);
+            k.ancf.dt /= refine;
         }
         Formulation::Gebf => {
             k.gebf.rho_inf = 1.0;
             k.gebf.form = Some(form);
+            k.gebf.dt /= refine;
         }
     }
     k.output_dt = None;
@@ -89,41 +94,79 @@ fn study_case(base: &Case, f: Formulation, form: FormSetting) -> Case {
     k
 }
 
-/// Run the study on `specs` (rayon over runs).
+/// Run the study on `specs` (rayon over runs): each case, formulation and form at the case's
+/// time step and at half of it.
 pub fn run(specs: &[RunSpec]) -> Vec<EnergyRun> {
-    let jobs: Vec<(usize, Formulation, FormSetting)> = (0..specs.len())
-        .flat_map(|i| Formulation::ALL.into_iter().flat_map(move |f| FORMS.into_iter().map(move |m| (i, f, m))))
+    let jobs: Vec<(usize, Formulation, FormSetting, f64)> = (0..specs.len())
+        .flat_map(|i| {
+            Formulation::ALL.into_iter().flat_map(move |f| {
+                FORMS.into_iter().flat_map(move |m| [1.0, 2.0].into_iter().map(move |r| (i, f, m, r)))
+            })
+        })
         .collect();
-    jobs.par_iter()
-        .map(|&(i, f, form)| {
-            let case = study_case(specs[i].case(f), f, form);
-            let out = match case.validate() {
+    let outs: Vec<RunOutput> = jobs
+        .par_iter()
+        .map(|&(i, f, form, refine)| {
+            let case = study_case(specs[i].case(f), f, form, refine);
+            match case.validate() {
                 Ok(()) => run_formulation(&case, f),
                 Err(e) => RunOutput::failed(f, format!("{}: {e}", specs[i].name)),
-            };
-            let metrics = FormulationMetrics::of(&out);
-            let e0 = out.rows.first().map_or(0.0, |r| r.total);
+            }
+        })
+        .collect();
+    jobs.chunks(2)
+        .zip(outs.chunks(2))
+        .map(|(j, o)| {
+            let (i, f, form, _) = j[0];
+            let metrics = FormulationMetrics::of(&o[0]);
+            let e0 = o[0].rows.first().map_or(0.0, |r| r.total);
             let peak = if metrics.peak_kinetic > 0.0 { metrics.peak_kinetic } else { 1.0 };
-            let history = out.rows.iter().map(|r| (r.t, (r.total - e0) / peak)).collect();
-            EnergyRun { case: specs[i].name.clone(), formulation: f, form, metrics, history }
+            let history = o[0].rows.iter().map(|r| (r.t, (r.total - e0) / peak)).collect();
+            EnergyRun {
+                case: specs[i].name.clone(),
+                formulation: f,
+                form,
+                metrics,
+                half_step: FormulationMetrics::of(&o[1]),
+                history,
+            }
         })
         .collect()
+}
+
+impl EnergyRun {
+    /// Observed order of the drift in dt, `log2(drift(dt) / drift(dt/2))` (None when a run
+    /// failed or a drift is zero).
+    pub fn order(&self) -> Option<f64> {
+        let (a, b) = (&self.metrics, &self.half_step);
+        (a.error.is_none() && b.error.is_none() && a.energy_drift > 0.0 && b.energy_drift > 0.0)
+            .then(|| (a.energy_drift / b.energy_drift).log2())
+    }
 }
 
 /// Write `energy.csv`, `energy.md` and `energy.svg` (|E − E(0)| / peak kinetic energy against
 /// time, one panel per case) into `dir`.
 pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
-    let mut csv =
-        String::from("case,formulation,form,ok,t_reached,energy_drift,newton_per_step,factorizations,wall_s\n");
-    let mut md = String::from(
-        "# Energy at rho_inf = 1\n\nmax |E(t) − E(0)| / peak kinetic energy over the run, every step recorded.\n\n\
-         | case | formulation | form | energy drift | Newton / step | wall [ms] |\n|---|---|---|---|---|---|\n",
+    let mut csv = String::from(
+        "case,formulation,form,ok,t_reached,energy_drift,newton_per_step,factorizations,wall_s,\
+         energy_drift_half_dt,order\n",
     );
+    let mut md = String::from(
+        "# Energy at rho_inf = 1\n\nmax |E(t) − E(0)| / peak kinetic energy over the run, every step recorded, at the \
+         case's time step and at half of it (order = log2 of their ratio).\n\n\
+         | case | formulation | form | energy drift | at dt / 2 | order | Newton / step | wall [ms] |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    let drift = |m: &FormulationMetrics| match &m.error {
+        None => format!("{:.2e}", m.energy_drift),
+        Some(_) => format!("failed after {:.3} s", m.t_reached),
+    };
     for r in runs {
-        let m = &r.metrics;
+        let (m, h) = (&r.metrics, &r.half_step);
+        let order = r.order();
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:e},{:.4},{},{:.6}",
+            "{},{},{},{},{},{:e},{:.4},{},{:.6},{:e},{}",
             r.case,
             r.formulation,
             r.form.as_str(),
@@ -132,18 +175,19 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
             m.energy_drift,
             m.newton_per_step,
             m.n_factorizations,
-            m.wall_s
+            m.wall_s,
+            h.energy_drift,
+            order.map_or(String::new(), |o| format!("{o:.3}"))
         );
-        let drift = match &m.error {
-            None => format!("{:.2e}", m.energy_drift),
-            Some(_) => format!("failed after {:.3} s", m.t_reached),
-        };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {drift} | {:.2} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |",
             r.case,
             r.formulation,
             form_name(r.form),
+            drift(m),
+            drift(h),
+            order.map_or("–".into(), |o| format!("{o:.2}")),
             m.newton_per_step,
             1e3 * m.wall_s
         );
@@ -195,9 +239,9 @@ mod tests {
         assert_eq!(specs.len(), 1);
         for f in Formulation::ALL {
             for form in FORMS {
-                let k = study_case(specs[0].case(f), f, form);
-                assert_eq!(crate::scene::settings(&k, f).params.form, form.to_form());
-                assert_eq!(crate::scene::settings(&k, f).params.rho_inf, 1.0);
+                let k = study_case(specs[0].case(f), f, form, 2.0);
+                let p = crate::scene::settings(&k, f).params;
+                assert_eq!((p.form, p.rho_inf, p.dt), (form.to_form(), 1.0, 0.001));
             }
         }
         let runs = run(&specs);
@@ -205,6 +249,7 @@ mod tests {
         for r in &runs {
             assert!(r.metrics.error.is_none(), "{:?}", r.metrics.error);
             assert_eq!(r.history.len(), 51, "every step of 0.002 s");
+            assert_eq!(r.half_step.n_steps, 100, "half steps");
             assert!(r.metrics.energy_drift < 1e-3, "{} {:?}: {}", r.formulation, r.form, r.metrics.energy_drift);
         }
         let dir = std::env::temp_dir().join(format!("harness-energy-{}", std::process::id()));

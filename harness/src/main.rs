@@ -96,7 +96,8 @@ enum Cmd {
         set: Vec<Override>,
     },
     /// Energy at rho_inf = 1 of the c = 1 pendulums, each formulation in both generalized-α forms
-    /// (Arnold–Brüls, Chung–Hulbert); writes `<out>/energy/` (energy.md, energy.csv, energy.svg).
+    /// (Arnold–Brüls, Chung–Hulbert), at dt and dt/2; writes `<out>/energy/` (energy.md, energy.csv,
+    /// energy.svg).
     Energy {
         /// Folder of case files.
         #[arg(long, default_value = "cases")]
