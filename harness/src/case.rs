@@ -220,10 +220,11 @@ pub struct NewtonSettings {
 
 /// Where the generalized-α step enforces the equations of motion (the constraints are
 /// enforced at the end of the step in both).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum FormSetting {
     /// At the end of the step (Arnold & Brüls 2007); the trapezoidal rule at rho_inf = 1.
+    #[default]
     ArnoldBruls,
     /// At the α-weighted state inside the step (Chung & Hulbert 1993); the implicit midpoint
     /// rule at rho_inf = 1, whose gyroscopic terms do no discrete work.
@@ -236,6 +237,14 @@ impl FormSetting {
         match self {
             FormSetting::ArnoldBruls => "arnold_bruls",
             FormSetting::ChungHulbert => "chung_hulbert",
+        }
+    }
+
+    /// The name in tables and legends.
+    pub fn label(self) -> &'static str {
+        match self {
+            FormSetting::ArnoldBruls => "Arnold–Brüls",
+            FormSetting::ChungHulbert => "Chung–Hulbert",
         }
     }
 
@@ -382,7 +391,7 @@ pub struct AncfSettings {
     /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
     /// `chung_hulbert` is not available with aerodynamics.
     #[serde(default)]
-    pub form: Option<FormSetting>,
+    pub form: FormSetting,
     /// Newton settings.
     #[serde(default)]
     pub newton: NewtonSettings,
@@ -407,7 +416,7 @@ pub struct GebfSettings {
     /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies. Not available
     /// with aerodynamics (the coupled step holds the loads of the step's end).
     #[serde(default)]
-    pub form: Option<FormSetting>,
+    pub form: FormSetting,
     /// Newton settings.
     #[serde(default)]
     pub newton: NewtonSettings,
@@ -818,7 +827,7 @@ impl Case {
             // The coupled step holds the aerodynamic loads of t_{n+1} over the step; evaluated at
             // the weighted instant t_{n+1-α_f}, they would make the coupling first order.
             for (f, form) in [("ancf", self.ancf.form), ("gebf", self.gebf.form)] {
-                if form == Some(FormSetting::ChungHulbert) {
+                if form == FormSetting::ChungHulbert {
                     return Err(format!(
                         "{f}.form: chung_hulbert is not available with aerodynamics (the loads are those of \
                          the step's end)"

@@ -51,14 +51,6 @@ pub struct EnergyRun {
     pub history: Vec<(f64, f64)>,
 }
 
-/// Short name of a form for tables and legends.
-pub fn form_name(form: FormSetting) -> &'static str {
-    match form {
-        FormSetting::ArnoldBruls => "Arnold–Brüls",
-        FormSetting::ChungHulbert => "Chung–Hulbert",
-    }
-}
-
 /// The study's cases among `runs`: the pendulums (no aerodynamics) at c = 1.
 pub fn select(runs: &[RunSpec]) -> Vec<RunSpec> {
     runs.iter()
@@ -79,12 +71,12 @@ fn study_case(base: &Case, f: Formulation, form: FormSetting, refine: f64) -> Ca
     match f {
         Formulation::Ancf => {
             k.ancf.rho_inf = 1.0;
-            k.ancf.form = Some(form);
+            k.ancf.form = form;
             k.ancf.dt /= refine;
         }
         Formulation::Gebf => {
             k.gebf.rho_inf = 1.0;
-            k.gebf.form = Some(form);
+            k.gebf.form = form;
             k.gebf.dt /= refine;
         }
     }
@@ -184,7 +176,7 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
             "| {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |",
             r.case,
             r.formulation,
-            form_name(r.form),
+            r.form.label(),
             drift(m),
             drift(h),
             order.map_or("–".into(), |o| format!("{o:.2}")),
@@ -214,7 +206,7 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
                 .iter()
                 .filter(|r| r.case == *c)
                 .map(|r| Series {
-                    label: format!("{} {}", r.formulation.as_str().to_uppercase(), form_name(r.form)),
+                    label: format!("{} {}", r.formulation.as_str().to_uppercase(), r.form.label()),
                     color: color(r.formulation, r.form),
                     points: r.history.iter().map(|&(t, e)| (t, e.abs().max(ENERGY_FLOOR))).collect(),
                 })

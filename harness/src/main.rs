@@ -165,7 +165,7 @@ fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<
             "energy {} {} {}: {}",
             r.case,
             r.formulation,
-            energy::form_name(r.form),
+            r.form.label(),
             m.error.as_ref().map_or_else(
                 || format!(
                     "drift {:.2e} of the peak kinetic energy, {:.2} Newton/step",

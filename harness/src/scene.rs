@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::Error;
 use crate::aero::{AeroStructure, SectionLoad, simulate_aero, station_map};
-use crate::case::{AncfPath, Case, FormSetting, Formulation, Joint};
+use crate::case::{AncfPath, Case, Formulation, Joint};
 use crate::run::{Energies, RunOutput, RunSettings, Structure, simulate};
 
 fn unit(v: [f64; 3]) -> Vector3<f64> {
@@ -270,19 +270,6 @@ impl AeroStructure for Sensed<gebf::Model> {
     }
 }
 
-/// The generalized-α form a formulation uses when its case sets none: Arnold–Brüls for both.
-/// GEBF's energy at rho_inf = 1 is better in the Chung–Hulbert form (the implicit midpoint
-/// rule: the β = 45° pendulum's energy error is 1.6e-4 of the peak kinetic energy instead of
-/// 1.35e-3), which costs 2 % more work on the c = 1 pendulums and 8–13 % on the soft ones
-/// (more Newton iterations where the tip twists, and B at two states); a case opts in with
-/// `gebf.form`. Not even at rho_inf = 1, where it needs fewer Newton iterations on the paper
-/// cases: over the stress matrix's 72 GEBF cells at rho_inf = 1 (c × β × dt) it reaches the end
-/// at fixed steps in 46 against 51 (it fails on soft tips at 2–5 × dt, where step control then
-/// recovers them), although its energy error is 2–100 times smaller in most cells.
-pub fn default_form(_f: Formulation) -> genalpha::Form {
-    genalpha::Form::ArnoldBruls
-}
-
 /// The integrator parameters, end time and output interval of formulation `f` of a case.
 pub fn settings(case: &Case, f: Formulation) -> RunSettings {
     use genalpha::Predictor::{ConstantAcceleration, ExtrapolatedAcceleration};
@@ -297,7 +284,16 @@ pub fn settings(case: &Case, f: Formulation) -> RunSettings {
     };
     let mut params = genalpha::IntegratorParams::new(rho, dt);
     params.newton = newton.to_params(predictor);
-    params.form = form.map_or(default_form(f), FormSetting::to_form);
+    // Both formulations default to the Arnold–Brüls form. GEBF's energy at rho_inf = 1 is better
+    // in the Chung–Hulbert form (the implicit midpoint rule: the β = 45° pendulum's energy error
+    // is 1.6e-4 of the peak kinetic energy instead of 1.35e-3), which costs 2 % more work on the
+    // c = 1 pendulums and 8–13 % on the soft ones (more Newton iterations where the tip twists,
+    // and B at two states), so a case opts in with `gebf.form`. Not even at rho_inf = 1, where
+    // it needs fewer Newton iterations on the paper cases: over the stress matrix's 72 GEBF
+    // cells at rho_inf = 1 (c × β × dt) it reaches the end at fixed steps in 46 against 51 (it
+    // fails on soft tips at 2–5 × dt, where step control then recovers them), although its
+    // energy error is 2–100 times smaller in most cells.
+    params.form = form.to_form();
     RunSettings { params, t_end: case.t_end, output_dt: case.output_dt }
 }
 
