@@ -1,4 +1,4 @@
-//! Run one double-pendulum case (DESIGN §6) and compare the tip with a reference CSV.
+//! Run one double-pendulum case (docs/cases.md §1) and compare the tip with a reference CSV.
 //!
 //! Usage: `pendulum_check c beta_deg n_el dt rho_inf [hybrid|kirchhoff|mixed] [dae|ode] [reference.csv]`
 //!

@@ -1,4 +1,4 @@
-//! The flared-hinge wing of DESIGN §6 (Table 3–4) under gravity alone: clamped inner body
+//! The flared-hinge wing of docs/cases.md §2 (Table 3–4) under gravity alone: clamped inner body
 //! (12 m, 12 elements) and outer body (4 m, 4 elements) on a 10° flared hinge; prints the
 //! wingtip height and fold angle. A structural smoke test of the aeroelastic case.
 use ancf::{BodySpec, JointSpec, Model, Options, Section};

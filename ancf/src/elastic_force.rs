@@ -1,4 +1,4 @@
-//! Elastic energy, force and analytic tangent of the element (THEORY §A.3).
+//! Elastic energy, force and analytic tangent of the element (docs/ancf.md §3.6).
 //!
 //! With the sampled strains `s_k = ½ eᵀ A_k e` (see [`strain`](crate::strain)) and their
 //! stiffness-weighted quadrature weights `C_k`:

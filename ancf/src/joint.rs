@@ -1,4 +1,4 @@
-//! Joints as linear equations in the nodal coordinates (paper eq. 5, THEORY §A.5).
+//! Joints as linear equations in the nodal coordinates (paper eq. 5, docs/ancf.md §5).
 //!
 //! * Ground hinge about the fixed unit axis `n`: `r = r₀` and `Σ_b α_b r_b = n` at the body's
 //!   start node, with `α = F₀ᵀ n` the axis in the body's reference section frame and

@@ -1,7 +1,7 @@
 //! # ancf — absolute nodal coordinate beams with linear joints
 //!
 //! Two-node beam elements with the nodal coordinates `e_k = [r, r_x, r_y, r_z]` (12 per node,
-//! 24 per element; THEORY §A), a constant mass matrix, an elastic force from beam strains written
+//! 24 per element; docs/ancf.md), a constant mass matrix, an elastic force from beam strains written
 //! as quadratic forms of the coordinates (exact analytic tangent), and joints that are *linear*
 //! in the coordinates (ground hinge, flared hinge of paper eq. 5, clamp). Equations of motion:
 //!
@@ -13,7 +13,7 @@
 //! $$ B^T M B\, \ddot z + B^T\big(f_{el}(B z + q_p) - Q\big) = 0 . $$
 //!
 //! [`Model`] implements [`genalpha::ConstrainedSystem`] in either form ([`Options::path`]).
-//! Elastic energy (THEORY §A.3), with reference values subtracted:
+//! Elastic energy (docs/ancf.md §3), with reference values subtracted:
 //!
 //! $$ U = \tfrac12\int_0^L \big[EA\,\varepsilon^2 + GA_y\gamma_y^2 + GA_z\gamma_z^2 + GJ K_1^2
 //!      + EI_{yy} K_2^2 + EI_{zz} K_3^2\big] dx + \text{section penalties}. $$
@@ -37,7 +37,7 @@
 //! [`Model::set_point_loads`]; statics with [`Model::solve_statics`], linear modes with
 //! [`Model::linear_modes`]. Reference scenes are in [`samples`].
 //!
-//! Units SI; global frame as in DESIGN §3.
+//! Units SI; global frame as in docs/conventions.md §1.
 #![warn(missing_docs)]
 
 pub mod elastic_force;

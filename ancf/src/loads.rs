@@ -1,4 +1,4 @@
-//! External loads: gravity and point loads (THEORY §A.4).
+//! External loads: gravity and point loads (docs/ancf.md §4).
 //!
 //! * Gravity: the constant generalized force `Q_g = Σ_e ∫ m S_cᵀ g dx`.
 //! * A point force `F` at the material point (s, y, z) of a body (arclength s along the

@@ -1,4 +1,4 @@
-//! The constant consistent element mass matrix (THEORY §A.2).
+//! The constant consistent element mass matrix (docs/ancf.md §2).
 //!
 //! $$ M_e = \int_0^l \big[m\,S_c^T S_c + D_{yy} S_y^T S_y + D_{zz} S_z^T S_z\big]\,dx
 //!        = \bar m \otimes I_3 $$

@@ -4,7 +4,7 @@
 //!
 //! A pose moves body `b` rigidly from its reference configuration (start `X₀`, section frame
 //! `F₀`): the material point `X` goes to `r = t + R (X − X₀)` and moves with
-//! `ṙ = v + ω × (r − t)`. For the nodes of the two-node element (THEORY §A.1) this is
+//! `ṙ = v + ω × (r − t)`. For the nodes of the two-node element (docs/ancf.md §1) this is
 //!
 //! $$ r_k = t + R F_0 e_x s_k,\quad [r_x, r_y, r_z]_k = R F_0,\qquad
 //!    \dot r_k = v + \omega \times (r_k - t),\quad \dot r_{b,k} = \omega \times r_{b,k} .$$

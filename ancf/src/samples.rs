@@ -21,7 +21,7 @@ pub fn pendulum_section(c: f64) -> Section {
     }
 }
 
-/// The paper's flared double pendulum (DESIGN §6): two 0.5 m bodies along +X, ground hinge
+/// The paper's flared double pendulum (docs/cases.md §1): two 0.5 m bodies along +X, ground hinge
 /// about +Y at the origin, flared hinge (β in degrees) at X = 0.5, gravity 9.8 m/s² along −Z.
 /// Returns (bodies, joints, gravity).
 pub fn double_pendulum(c: f64, beta_deg: f64, n_elements: usize) -> (Vec<BodySpec>, Vec<JointSpec>, Vector3<f64>) {

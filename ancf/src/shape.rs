@@ -1,4 +1,4 @@
-//! Shape functions of the two-node element (THEORY §A.1) and the interpolated fields.
+//! Shape functions of the two-node element (docs/ancf.md §1) and the interpolated fields.
 //!
 //! Element coordinates are eight nodal 3-vectors ("blocks"), in this order:
 //! `[r¹, r¹_x, r¹_y, r¹_z, r², r²_x, r²_y, r²_z]` (24 numbers). With ξ = x/l the position of the

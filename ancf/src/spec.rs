@@ -31,7 +31,7 @@ pub struct Section {
 }
 
 impl Section {
-    /// Slope inertias of the ANCF mass matrix (THEORY §A.2):
+    /// Slope inertias of the ANCF mass matrix (docs/ancf.md §2):
     /// `D_yy = (J_xx − J_yy + J_zz)/2`, `D_zz = (J_xx + J_yy − J_zz)/2`, kg·m. Exact when
     /// `J_xx = J_yy + J_zz`; otherwise the torsional inertia `J_xx = D_yy + D_zz` is kept.
     pub fn slope_inertias(&self) -> (f64, f64) {
@@ -206,7 +206,7 @@ pub enum SolvePath {
     Ode,
 }
 
-/// Bending-curvature measure of the element (THEORY §A.3; details in [`strain`](crate::strain)).
+/// Bending-curvature measure of the element (docs/ancf.md §3.2; details in [`strain`](crate::strain)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Curvature {

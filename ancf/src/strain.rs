@@ -1,4 +1,4 @@
-//! Strain measures of the element and where they are sampled (THEORY §A.3).
+//! Strain measures of the element and where they are sampled (docs/ancf.md §3).
 //!
 //! Every strain is a quadratic form of the element coordinates: a sum of dot products of
 //! interpolated *fields* (axis tangent `r_x`, `r_xx`, section slopes `r_y`, `r_z`, their
@@ -381,7 +381,7 @@ impl Builder {
     }
 }
 
-/// The strain plan of an element of length `l` (THEORY §A.3, see the module documentation).
+/// The strain plan of an element of length `l` (docs/ancf.md §3, see the module documentation).
 pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> StrainPlan {
     use Field::*;
     use StrainKind::*;

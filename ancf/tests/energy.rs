@@ -1,4 +1,4 @@
-//! Conservation (DESIGN §7.6): no aerodynamics, scleronomic joints, so T + U + V is conserved by
+//! Conservation (docs/cases.md §6, rung 6): no aerodynamics, scleronomic joints, so T + U + V is conserved by
 //! the exact solution. With rho_inf = 1 the generalized-α scheme has no numerical damping and the
 //! energy error of the c = 1 runs at the paper's settings stays within 1e-3 of the peak kinetic
 //! energy; with rho_inf = 0.8 the (small) numerical dissipation is reported.

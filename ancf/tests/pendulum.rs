@@ -1,4 +1,4 @@
-//! The paper's flared double pendulum (DESIGN §6) against the external references in
+//! The paper's flared double pendulum (docs/cases.md §1) against the external references in
 //! `cases/reference/` (Exudyn geometrically exact beam, converged; see its README).
 mod common;
 

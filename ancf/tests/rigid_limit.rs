@@ -1,4 +1,4 @@
-//! Rigid limit (DESIGN §7.7): with c = 1000 the flexible model approaches the rigid two-body
+//! Rigid limit (docs/cases.md §6, rung 7): with c = 1000 the flexible model approaches the rigid two-body
 //! solution `cases/reference/exudyn/rigid_beta*_ode.csv` (2-DOF Lagrangian model, DOP853 at
 //! tolerance 1e-12). Bound: 1 cm over 2 s at the paper's settings; measured 0.75 mm (β = 0),
 //! 1.8 mm (β = 45°), 0.15 mm (β = 90°).

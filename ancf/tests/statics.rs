@@ -1,4 +1,4 @@
-//! Static benchmarks with exact answers (THEORY §E.1–E.2) and the locking checks.
+//! Static benchmarks with exact answers (docs/cases.md §3.1–3.2) and the locking checks.
 use ancf::statics::StaticsParams;
 use ancf::{Curvature, Model, Options, PointLoad, Section, samples};
 use nalgebra::Vector3;
@@ -54,7 +54,7 @@ fn tip_moment_rolls_into_a_full_circle() {
     }
 }
 
-/// Tip-load elastica (Mattiasson 1981, THEORY §E.2): u/L, w/L and tip rotation within 0.5 %
+/// Tip-load elastica (Mattiasson 1981, docs/cases.md §3.2): u/L, w/L and tip rotation within 0.5 %
 /// with 16 elements. Measured worst: 6.0e-4 (w/L at PL²/EI = 10).
 #[test]
 fn tip_load_elastica_table() {

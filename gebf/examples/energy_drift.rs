@@ -1,6 +1,6 @@
 //! Energy drift of the c = 1 paper double pendulum against the time step and the number of
 //! elements: max over 2 s of |E(t) − E(0)| divided by the run's peak kinetic energy
-//! (DESIGN.md §5), with the largest joint violation of the run.
+//! (docs/outputs.md §3), with the largest joint violation of the run.
 //!
 //! `cargo run --release -p gebf --example energy_drift -- [c] [rho_inf] [stabilization 0/1]`
 use gebf::{Model, Options, samples, simulate};

@@ -41,7 +41,7 @@ fn two_bodies(section: Section, n_el: usize, beta: f64) -> (Vec<BodySpec>, Vec<J
     (bodies, joints)
 }
 
-/// The paper's flared double pendulum (DESIGN.md §6): two 0.5 m bodies along +X, ground hinge
+/// The paper's flared double pendulum (docs/cases.md §1): two 0.5 m bodies along +X, ground hinge
 /// about +Y at the origin, flared hinge at X = 0.5 with flare angle `beta_deg`, `n_el`
 /// three-node elements per body, gravity 9.8 m/s² along −Z. Joint 1 is the flared hinge.
 pub fn double_pendulum(c: f64, beta_deg: f64, n_el: usize) -> (Vec<BodySpec>, Vec<JointSpec>, Vector3<f64>) {
@@ -49,7 +49,7 @@ pub fn double_pendulum(c: f64, beta_deg: f64, n_el: usize) -> (Vec<BodySpec>, Ve
     (b, j, Vector3::new(0.0, 0.0, -9.8))
 }
 
-/// SHARPy's own regression `tests/coupled/multibody/double_slanted_pendulum` (THEORY §B.7):
+/// SHARPy's own regression `tests/coupled/multibody/double_slanted_pendulum` (docs/cases.md §5):
 /// aluminium 0.02 m square bars (m = 1.08 kg/m, J_xx = 7.2e-5, J_yy = J_zz = 3.6e-5 kg·m,
 /// EA = 2.8e7, GA = 1.037e7, GJ = 691.4, EI = 933.3), 11 nodes (5 three-node elements) per
 /// body, flare 45°, g = 9.81 m/s² along −Z. SHARPy's tip at t = 0.3 s (Newmark γ = ½,

@@ -209,7 +209,7 @@ mod tests {
 
     /// CRV interpolation is not objective for a *deformed* element (Crisfield & Jelenić 1999):
     /// superposing a rigid rotation changes the energy slightly. Pin the size of the effect for
-    /// a moderately bent element (a known weakness, THEORY §B.6 #5).
+    /// a moderately bent element (a known weakness, docs/gebf.md §11).
     #[test]
     fn superposed_rotation_on_a_bent_element_changes_energy_only_slightly() {
         let le = 0.3;

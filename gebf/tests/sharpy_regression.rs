@@ -1,4 +1,4 @@
-//! SHARPy's own flared double-pendulum regression (THEORY §B.7; SHARPy
+//! SHARPy's own flared double-pendulum regression (docs/cases.md §5; SHARPy
 //! `tests/coupled/multibody/double_slanted_pendulum`, doi 10.2514/6.2024-1441): aluminium bars,
 //! 5 three-node elements per body, flare 45°, g = 9.81, Newmark γ = ½, β = ¼ (= generalized-α
 //! with rho_inf = 1), dt = 0.01. SHARPy's tip at t = 0.3 s is (0.80955, 0.10248, −0.48184);

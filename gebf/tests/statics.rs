@@ -1,4 +1,4 @@
-//! Statics with exact answers (THEORY §E.1–E.2), solved by the crate's Newton/load stepping.
+//! Statics with exact answers (docs/cases.md §3.1–3.2), solved by the crate's Newton/load stepping.
 
 use gebf::{Model, NodalLoad, Options, Section, StaticOptions, samples};
 use nalgebra::Vector3;
@@ -70,7 +70,7 @@ fn tip_moment_arc_matches_reissner_solution() {
     assert!((c[(1, 0)].atan2(c[(0, 0)]) - th).abs() < 1e-4);
 }
 
-/// Tip-load elastica (Mattiasson 1981, recomputed by shooting; THEORY §E.2): dead load P along
+/// Tip-load elastica (Mattiasson 1981, recomputed by shooting; docs/cases.md §3.2): dead load P along
 /// −z at the tip. Acceptance: u/L, w/L and the tip rotation within 0.5 %.
 #[test]
 fn tip_load_elastica_table() {

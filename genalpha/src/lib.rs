@@ -16,7 +16,7 @@
 //!
 //! `q ∘ exp(·)` is the model's [`ConstrainedSystem::retract_inplace`]: plain addition for
 //! vector coordinates (ANCF), an exponential-map update for quaternion frames (GEBF).
-//! Newton iterates on the tangent increment with the scaled iteration matrix of THEORY §C.3
+//! Newton iterates on the tangent increment with the scaled iteration matrix of docs/integrator.md §5.2
 //! (dynamic rows × 1/β′, velocity rows × 1/γ′, multipliers λ/β′, μ/β′). The factorisation is
 //! reused across iterations and steps while Newton contracts, refreshed at the predictor for a
 //! while after a reused one failed; an update made with a reused factorisation that diverged is

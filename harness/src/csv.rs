@@ -1,4 +1,4 @@
-//! Time-history CSV files: the run output format of DESIGN.md §4 and reading external references.
+//! Time-history CSV files: the run output format of docs/outputs.md §2 and reading external references.
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Metrics of DESIGN.md §5: tip difference between formulations and against references, energy
+//! Metrics of docs/outputs.md §3: tip difference between formulations and against references, energy
 //! drift, constraint residual, speed.
 
 use serde::Serialize;

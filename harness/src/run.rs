@@ -1,4 +1,4 @@
-//! Integrating one formulation of one case and recording the sensors of DESIGN.md §3.
+//! Integrating one formulation of one case and recording the sensors of docs/conventions.md §5.
 
 use std::time::Instant;
 

@@ -549,7 +549,7 @@ proptest! {
 proptest! {
     #![proptest_config(config())]
 
-    /// The paper's flared-hinge wing (DESIGN §6: inner body 12 m clamped at the root, outer
+    /// The paper's flared-hinge wing (docs/cases.md §2: inner body 12 m clamped at the root, outer
     /// body 4 m, the wing section, any flare angle) with the wingtip folded by θ at the rate θ̇:
     /// both formulations satisfy the clamp and the hinge and agree with the closed form.
     #[test]

@@ -82,7 +82,7 @@ pub struct FlaredWing {
     pub flare: f64,
     /// Angle of attack: nose-up pitch of the whole wing about +X, rad.
     pub aoa: f64,
-    /// Blend the slant over this many columns on each side of the hinge (UVLM.md §4.5): column at
+    /// Blend the slant over this many columns on each side of the hinge (docs/uvlm.md §7): column at
     /// distance d gets slant β·(1 − d/(blend + 1)). 0 = only the hinge column is slanted; needed
     /// when tanβ·c/2 approaches the panel width (fine spanwise meshes).
     pub blend_columns: usize,
@@ -121,7 +121,7 @@ impl FlaredWing {
         pitch * Vector3::new(self.flare.sin(), self.flare.cos(), 0.0)
     }
 
-    /// Stations with the outer body folded by `fold` (rad, DESIGN.md §3: right-hand rule about
+    /// Stations with the outer body folded by `fold` (rad, docs/conventions.md §4: right-hand rule about
     /// −a, positive lifts the tip towards +z).
     pub fn stations(&self, fold: f64) -> Vec<SpanStation> {
         let pitch = Rotation3::from_axis_angle(&Vector3::x_axis(), self.aoa);

@@ -6,7 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 /// One span station: a section frame with chord data. Grid column `j` of a lattice is generated
 /// from station `j`.
 ///
-/// Section frame convention (DESIGN.md §3): the columns of `frame` are the section axes
+/// Section frame convention (docs/conventions.md §2): the columns of `frame` are the section axes
 /// `x_s` (along the span, the direction of increasing column index), `y_s` (in the chord plane,
 /// pointing to the leading edge) and `z_s = x_s × y_s` (the lifting-surface normal).
 /// The grid column is the line through `origin` along `sin(slant)·x_s + cos(slant)·y_s`; its

@@ -44,7 +44,7 @@ fn lift_proportional_to_sin_alpha() {
 /// Elliptic planform (straight quarter-chord line), 80 spanwise strips per side (cosine towards
 /// the tip), 8 cosine chordwise, α = 5°, near-field Joukowski drag: span efficiency
 /// e = CL²/(π·AR·CDi) within 1 ± 0.02; CLα within 0.5 % of Ptera Software's steady ring VLM on the
-/// same kind of mesh (UVLM.md §2.2: 3.756, 4.803, 5.493 for AR 4, 8, 16).
+/// same kind of mesh (docs/uvlm.md §10.2: 3.756, 4.803, 5.493 for AR 4, 8, 16).
 #[test]
 fn elliptic_wing_span_efficiency() {
     for (ar, ptera) in [(4.0, 3.756), (8.0, 4.803), (16.0, 5.493)] {

@@ -1,5 +1,5 @@
 //! Harmonic pitch about the quarter chord of a 2D-like wing against Theodorsen's theory
-//! (`cases/reference/uvlm/theodorsen.csv`, UVLM.md §2.4). Exercises the moving lattice, the node
+//! (`cases/reference/uvlm/theodorsen.csv`, docs/uvlm.md §10.4). Exercises the moving lattice, the node
 //! velocities in the boundary condition and the ρ·A·n·dΓ/dt load term.
 
 mod common;

@@ -67,7 +67,7 @@ fn prefilled_steady_wake_is_fixed_point() {
     }
 }
 
-/// Wake truncation bias (UVLM.md §2.6, `uvlm_bias_core_truncation.csv`): a 40-row CFL-1 wake of
+/// Wake truncation bias (docs/uvlm.md §10.6, `uvlm_bias_core_truncation.csv`): a 40-row CFL-1 wake of
 /// a 4-chordwise AR-16 wing, closed by the last spanwise segment, lowers CLα by ≈ 1.3 %
 /// (horseshoe estimate −1.32 %); closing it with semi-infinite legs removes the bias.
 #[test]
