@@ -49,7 +49,7 @@ impl Section {
         Self { mass, rho_ixx, rho_iyy, rho_izz, ea, ga_y, ga_z, gj, ei_yy, ei_zz, cg_offset: [0.0; 2] }
     }
 
-    /// Slope inertias of ANCF's constant mass matrix (docs/ancf.md):
+    /// Slope inertias of ANCF's constant mass matrix (docs/ancf.md §2):
     /// `D_yy = (J_xx − J_yy + J_zz)/2`, `D_zz = (J_xx + J_yy − J_zz)/2`, kg·m, with the `J` about
     /// the centre of mass. Exact when `J_xx = J_yy + J_zz`; otherwise the torsional inertia
     /// `J_xx = D_yy + D_zz` is kept. Clamped at zero (validation rejects non-positive values).
