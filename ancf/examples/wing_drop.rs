@@ -17,6 +17,7 @@ fn main() {
         gj: 1e4,
         ei_yy: 2e4,
         ei_zz: 5e6,
+        cg_offset: [0.0; 2],
     };
     let body = |name: &str, x0: f64, length: f64, n_elements: usize| BodySpec {
         name: name.into(),
@@ -25,6 +26,7 @@ fn main() {
         frame: Matrix3::identity(),
         section,
         n_elements,
+        point_masses: Vec::new(),
     };
     let bodies = [body("inner", 0.0, 12.0, 12), body("outer", 12.0, 4.0, 4)];
     let joints =

@@ -397,6 +397,7 @@ mod tests {
             gj: 6.91,
             ei_yy: 9.33,
             ei_zz: 12.0,
+            cg_offset: [0.0; 2],
         }
     }
 

@@ -6,6 +6,15 @@
 /// `bodies[1].length: -0.5 is not positive`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
+    /// The scene is not valid (checked once for both formulations).
+    #[error(transparent)]
+    Scene(#[from] scene::Error),
+    /// A scene feature this formulation does not model.
+    #[error("{field}: not supported by the ANCF formulation")]
+    Unsupported {
+        /// Field path.
+        field: String,
+    },
     /// A number that must be finite is NaN or infinite.
     #[error("{field}: {value} is not a finite number")]
     NonFinite {

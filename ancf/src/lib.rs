@@ -65,5 +65,5 @@ pub use modal::{Mode, ModeKind};
 pub use model::{Energies, Model};
 pub use rigid::RigidPose;
 pub use skyline::SkylineLu;
-pub use spec::{BodySpec, Curvature, JointSpec, Options, Section, SolvePath};
+pub use spec::{BodySpec, Curvature, ForceElement, JointSpec, Options, PointMass, Scene, Section, SolvePath};
 pub use strain::StrainKind;

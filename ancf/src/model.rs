@@ -8,8 +8,7 @@ use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
 use crate::reduction::Reduction;
 use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
-use crate::spec::finite;
-use crate::{BodySpec, Error, JointSpec, Options, SolvePath};
+use crate::{BodySpec, Error, JointSpec, Options, Scene, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::RefCell;
@@ -107,26 +106,23 @@ pub struct Model {
 
 impl Model {
     /// Validate the scene and build the model (constant mass, element kernels, constraint
-    /// equations, elimination basis). Errors name the offending field.
+    /// equations, elimination basis). Errors name the offending field. A scene without force
+    /// elements; see [`from_scene`](Self::from_scene).
     pub fn new(
         bodies: &[BodySpec],
         joints: &[JointSpec],
         gravity: Vector3<f64>,
         options: Options,
     ) -> Result<Model, Error> {
-        if bodies.is_empty() {
-            return Err(Error::NoBodies);
-        }
-        for (i, b) in bodies.iter().enumerate() {
-            b.validate(i)?;
-        }
-        for (j, s) in joints.iter().enumerate() {
-            s.validate(j, bodies)?;
-        }
-        for (k, g) in gravity.iter().enumerate() {
-            finite(&format!("gravity[{k}]"), *g)?;
-        }
+        Self::from_scene(&Scene::new(bodies.to_vec(), joints.to_vec(), gravity), options)
+    }
+
+    /// Validate the scene and build the model. Errors name the offending field.
+    pub fn from_scene(scene: &Scene, options: Options) -> Result<Model, Error> {
+        scene.validate()?;
         options.validate()?;
+        let (bodies, joints, gravity) = (&scene.bodies, &scene.joints, scene.gravity);
+        unsupported(scene)?;
 
         let mut offset = 0;
         let bodies: Vec<Body> = bodies
@@ -826,4 +822,21 @@ impl ConstrainedSystem for Model {
             SolvePath::Ode => self.weights[self.reduction.full_of(i)],
         }
     }
+}
+
+/// Scene features this formulation does not model yet: an error naming the field, never a
+/// silent omission.
+fn unsupported(scene: &Scene) -> Result<(), Error> {
+    for (i, b) in scene.bodies.iter().enumerate() {
+        if b.section.cg_offset != [0.0; 2] {
+            return Err(Error::Unsupported { field: format!("bodies[{i}].section.cg_offset") });
+        }
+        if !b.point_masses.is_empty() {
+            return Err(Error::Unsupported { field: format!("bodies[{i}].point_masses") });
+        }
+    }
+    if let Some(f) = scene.forces.first() {
+        return Err(Error::Unsupported { field: format!("joints[{}].spring", f.joint()) });
+    }
+    Ok(())
 }

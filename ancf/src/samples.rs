@@ -18,6 +18,7 @@ pub fn pendulum_section(c: f64) -> Section {
         gj: c * 6.91,
         ei_yy: c * 9.33,
         ei_zz: c * 9.33,
+        cg_offset: [0.0; 2],
     }
 }
 
@@ -32,6 +33,7 @@ pub fn double_pendulum(c: f64, beta_deg: f64, n_elements: usize) -> (Vec<BodySpe
         frame: Matrix3::identity(),
         section: pendulum_section(c),
         n_elements,
+        point_masses: Vec::new(),
     };
     (
         vec![body("body1", 0.0), body("body2", 0.5)],
@@ -53,6 +55,7 @@ pub fn cantilever(section: Section, length: f64, n_elements: usize) -> (Vec<Body
             frame: Matrix3::identity(),
             section,
             n_elements,
+            point_masses: Vec::new(),
         }],
         vec![JointSpec::Clamp { body: 0 }],
     )

@@ -489,6 +489,7 @@ mod tests {
             gj: 50.0,
             ei_yy: 80.0,
             ei_zz: 120.0,
+            cg_offset: [0.0; 2],
         }
     }
 

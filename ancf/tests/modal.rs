@@ -19,6 +19,7 @@ fn section() -> Section {
         gj: 300.0,
         ei_yy: 800.0,
         ei_zz: 2000.0,
+        cg_offset: [0.0; 2],
     }
 }
 

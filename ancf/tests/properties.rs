@@ -98,6 +98,7 @@ fn scene(
         frame,
         section: samples::pendulum_section(c),
         n_elements,
+        point_masses: Vec::new(),
     };
     let bodies = vec![body("p", start, lengths.0, fp, n_el.0), body("c", hinge0, lengths.1, fc, n_el.1)];
     let mut joints = Vec::new();

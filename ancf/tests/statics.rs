@@ -18,6 +18,7 @@ fn slender(ga: f64) -> Section {
         gj: 1.0,
         ei_yy: 1.0,
         ei_zz: 1.0,
+        cg_offset: [0.0; 2],
     }
 }
 

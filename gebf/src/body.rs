@@ -13,57 +13,9 @@
 
 use crate::crv::{M3, V3};
 use crate::quaternion::Quaternion;
-use crate::{Error, Section};
-use nalgebra::{Matrix3, Vector3};
+use crate::Section;
 
-/// A straight beam body in its reference configuration.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BodySpec {
-    /// Name (for reports).
-    pub name: String,
-    /// Start point, m, global.
-    pub start: Vector3<f64>,
-    /// Length, m.
-    pub length: f64,
-    /// Columns = section frame x (beam axis), y, z in global coordinates (orthonormal, right-handed).
-    pub frame: Matrix3<f64>,
-    /// Section data.
-    pub section: Section,
-    /// Number of three-node elements.
-    pub n_elements: usize,
-}
-
-impl BodySpec {
-    /// Check every field; errors name the field as `bodies[i].<field>`.
-    pub fn validate(&self, i: usize) -> Result<(), Error> {
-        let path = format!("bodies[{i}]");
-        for (k, v) in self.start.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(Error::NotFinite { field: format!("{path}.start[{k}]"), value: *v });
-            }
-        }
-        if !self.length.is_finite() {
-            return Err(Error::NotFinite { field: format!("{path}.length"), value: self.length });
-        }
-        if self.length <= 0.0 {
-            return Err(Error::NotPositive { field: format!("{path}.length"), value: self.length });
-        }
-        for (k, v) in self.frame.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(Error::NotFinite { field: format!("{path}.frame[{}][{}]", k % 3, k / 3), value: *v });
-            }
-        }
-        let dev = (self.frame.transpose() * self.frame - M3::identity()).amax();
-        let det = self.frame.determinant();
-        if dev > 1e-9 || det <= 0.0 {
-            return Err(Error::NotOrthonormal { field: format!("{path}.frame"), deviation: dev, det });
-        }
-        if self.n_elements == 0 {
-            return Err(Error::ZeroCount { field: format!("{path}.n_elements") });
-        }
-        self.section.validate(&format!("{path}.section"))
-    }
-}
+pub use scene::BodySpec;
 
 /// Internal description of one body: geometry, section and where its unknowns live.
 #[derive(Debug, Clone)]

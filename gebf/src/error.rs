@@ -3,6 +3,15 @@
 /// Errors of model construction, queries and the static solver.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
+    /// The scene is not valid (checked once for both formulations).
+    #[error(transparent)]
+    Scene(#[from] scene::Error),
+    /// A scene feature this formulation does not model.
+    #[error("{field}: not supported by the GEBF formulation")]
+    Unsupported {
+        /// Field path.
+        field: String,
+    },
     /// A number that must be finite is not.
     #[error("{field}: {value} is not finite")]
     NotFinite {

@@ -7,44 +7,8 @@ use crate::flared_hinge::FlaredHinge;
 use crate::ground_hinge::GroundHinge;
 use crate::quaternion::Quaternion;
 use genalpha::MatView;
-use nalgebra::Vector3;
 
-/// Joints, bodies referred to by index into the body list.
-#[derive(Debug, Clone, PartialEq)]
-pub enum JointSpec {
-    /// Body's start point pinned; rotation only about a fixed global axis.
-    GroundHinge {
-        /// The body.
-        body: usize,
-        /// Hinge axis, global (any non-zero length).
-        axis: Vector3<f64>,
-    },
-    /// End of `parent` to start of `child`; axis a = sin β x + cos β y in the section frame of
-    /// the parent's end (β in rad, [−π/2, π/2]).
-    FlaredHinge {
-        /// Parent body (its last node carries the hinge).
-        parent: usize,
-        /// Child body (its frame origin is the hinge point).
-        child: usize,
-        /// Flare angle β, rad.
-        beta: f64,
-    },
-    /// Body's start section fully clamped to ground.
-    Clamp {
-        /// The body.
-        body: usize,
-    },
-    /// A flared hinge locked at its reference fold: the child frame is welded to the parent's
-    /// end section (a sixth, angular row along the axis). The fold angle is still measured.
-    LockedHinge {
-        /// Parent body (its last node carries the joint).
-        parent: usize,
-        /// Child body (its frame origin is the joint point).
-        child: usize,
-        /// Flare angle β of the locked hinge, rad.
-        beta: f64,
-    },
-}
+pub use scene::JointSpec;
 
 /// Internal joint.
 #[derive(Debug, Clone)]

@@ -88,6 +88,7 @@ mod stiffness;
 pub use body::BodySpec;
 pub use error::Error;
 pub use joint::JointSpec;
+pub use scene::{ForceElement, PointMass, Scene};
 pub use loads::NodalLoad;
 pub use modal::Modes;
 pub use model::{Energies, Model};

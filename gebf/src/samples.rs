@@ -18,6 +18,7 @@ pub fn paper_section(c: f64) -> Section {
         gj: c * 6.91,
         ei_yy: c * 9.33,
         ei_zz: c * 9.33,
+        cg_offset: [0.0; 2],
     }
 }
 
@@ -32,6 +33,7 @@ fn two_bodies(section: Section, n_el: usize, beta: f64) -> (Vec<BodySpec>, Vec<J
         frame: Matrix3::identity(),
         section,
         n_elements: n_el,
+        point_masses: Vec::new(),
     };
     let bodies = vec![body("body1", 0.0), body("body2", 0.5)];
     let joints = vec![
@@ -66,6 +68,7 @@ pub fn sharpy_slanted_pendulum() -> (Vec<BodySpec>, Vec<JointSpec>, Vector3<f64>
         gj: 6.914e2,
         ei_yy: 9.333e2,
         ei_zz: 9.333e2,
+        cg_offset: [0.0; 2],
     };
     let (b, j) = two_bodies(section, 5, 45f64.to_radians());
     (b, j, Vector3::new(0.0, 0.0, -9.81))
@@ -83,6 +86,7 @@ pub fn cantilever(section: Section, length: f64, n_el: usize) -> (Vec<BodySpec>,
         frame: Matrix3::identity(),
         section,
         n_elements: n_el,
+        point_masses: Vec::new(),
     };
     (vec![body], vec![JointSpec::Clamp { body: 0 }])
 }

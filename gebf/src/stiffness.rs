@@ -16,6 +16,7 @@
 //! `C^{AB}`, `T`, `D` at fixed `N`, `M` (which needs the Hessian of `Mᵀ T(psi) psi'`).
 
 use crate::Section;
+use crate::section::SectionDiagonals;
 use crate::crv::{M3, Tangent, V3, diag_mul, skew_mul};
 use crate::element::{ElementState, Mat24, Vec24, add3, add33, gauss_rule, interp, shape};
 
@@ -168,6 +169,7 @@ mod tests {
             gj: 7.0,
             ei_yy: 9.0,
             ei_zz: 11.0,
+            cg_offset: [0.0; 2],
         }
     }
 

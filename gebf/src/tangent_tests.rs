@@ -32,6 +32,7 @@ fn unit_section() -> Section {
         gj: 1.5,
         ei_yy: 2.0,
         ei_zz: 2.5,
+        cg_offset: [0.0; 2],
     }
 }
 
@@ -215,6 +216,7 @@ fn random_model(rng: &mut Lcg, beta: f64, locked: bool) -> (Model, Vec<f64>, Vec
         frame,
         section: sec,
         n_elements: n,
+        point_masses: Vec::new(),
     };
     let bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
     let joints = vec![
@@ -391,6 +393,7 @@ fn model_tangents_with_rescaled_crvs() {
         frame: rotation_matrix(&V3::new(0.2, 0.1, -0.3)),
         section: sec,
         n_elements: 2,
+        point_masses: Vec::new(),
     };
     let mut model = Model::new(&[body], &[], V3::new(0.3, -0.4, -9.8), Options::default()).unwrap();
     model.set_nodal_load(0, 4, NodalLoad { force: rng.v3(1.0), moment: rng.v3(1.0) }).unwrap();

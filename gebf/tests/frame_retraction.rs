@@ -19,6 +19,7 @@ fn final_error(dt: f64) -> f64 {
         frame: Matrix3::identity(),
         section: samples::paper_section(1.0),
         n_elements: 2,
+        point_masses: Vec::new(),
     };
     let mut m = Model::new(&[body], &[], Vector3::zeros(), Options::default()).unwrap();
     let mut s = m.initial_state();

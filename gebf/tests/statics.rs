@@ -17,6 +17,7 @@ fn section() -> Section {
         gj: 1.0,
         ei_yy: 1.0,
         ei_zz: 1.0,
+        cg_offset: [0.0; 2],
     }
 }
 

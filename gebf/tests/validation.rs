@@ -18,11 +18,11 @@ fn invalid_models_name_the_field() {
 
     let mut bb = b.clone();
     bb[0].n_elements = 0;
-    assert_eq!(msg(new(&bb, &j)), "bodies[0].n_elements: must be at least 1");
+    assert_eq!(msg(new(&bb, &j)), "bodies[0].n_elements: a body needs at least one element (got 0)");
 
     let mut bb = b.clone();
     bb[0].start.y = f64::NAN;
-    assert_eq!(msg(new(&bb, &j)), "bodies[0].start[1]: NaN is not finite");
+    assert_eq!(msg(new(&bb, &j)), "bodies[0].start[1]: NaN is not a finite number");
 
     let mut bb = b.clone();
     bb[0].frame = Matrix3::new(1.0, 0.1, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
@@ -37,7 +37,7 @@ fn invalid_models_name_the_field() {
     assert_eq!(msg(new(&bb, &j)), "bodies[1].section.gj: 0 is not positive");
 
     let jj = vec![JointSpec::GroundHinge { body: 3, axis: Vector3::y() }, j[1].clone()];
-    assert_eq!(msg(new(&b, &jj)), "joints[0].body: no body 3 (the model has 2)");
+    assert_eq!(msg(new(&b, &jj)), "joints[0].body: no body 3 (the scene has 2 bodies)");
 
     let jj = vec![JointSpec::GroundHinge { body: 0, axis: Vector3::zeros() }, j[1].clone()];
     assert_eq!(msg(new(&b, &jj)), "joints[0].axis: the axis has zero length");
@@ -53,7 +53,7 @@ fn invalid_models_name_the_field() {
 
     let mut gg = g;
     gg.z = f64::INFINITY;
-    assert_eq!(msg(Model::new(&b, &j, gg, Options::default())), "gravity[2]: inf is not finite");
+    assert_eq!(msg(Model::new(&b, &j, gg, Options::default())), "gravity[2]: inf is not a finite number");
 
     let bad = Options { n_gauss_stiffness: 4, ..Options::default() };
     assert_eq!(msg(Model::new(&b, &j, g, bad)), "options.n_gauss_stiffness: 4 is not in [1, 3]");

@@ -105,9 +105,43 @@ pub struct Body {
     pub y_axis: [f64; 3],
     /// Section properties per unit length.
     pub section: Section,
+    /// Point masses fixed to the body's sections (default none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub point_masses: Vec<PointMass>,
 }
 
-/// Cross-section data per unit length (SI). Centre of mass and shear centre on the beam axis.
+/// A rigid point mass fixed to a body's section.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PointMass {
+    /// Arclength of the section it is fixed to, from the body's start, m.
+    pub at: f64,
+    /// Its centre relative to the section's axis point, `[x, y, z]` in the section frame, m
+    /// (default `[0, 0, 0]`).
+    #[serde(default)]
+    pub offset: [f64; 3],
+    /// Mass, kg.
+    pub mass: f64,
+    /// Principal inertias about its own centre along the section axes `[I_xx, I_yy, I_zz]`,
+    /// kg·m² (default `[0, 0, 0]`).
+    #[serde(default)]
+    pub inertia: [f64; 3],
+}
+
+/// A rotational spring and damper about a hinge's axis: the moment `−k (θ − θ₀) − c θ̇`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Spring {
+    /// Stiffness k, N·m/rad (default 0).
+    pub stiffness: f64,
+    /// Damping c, N·m·s/rad (default 0).
+    pub damping: f64,
+    /// Rest angle θ₀, degrees, from the reference configuration (default 0).
+    pub rest_deg: f64,
+}
+
+/// Cross-section data per unit length (SI). The shear centre lies on the beam axis; the centre of
+/// mass may be offset by `cg_offset`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Section {
@@ -131,6 +165,14 @@ pub struct Section {
     pub ei_yy: f64,
     /// Bending stiffness EI_zz, N·m².
     pub ei_zz: f64,
+    /// Centre of mass in the section plane, `[y, z]` in the section frame, m (default `[0, 0]`).
+    /// The rotary inertias are about it.
+    #[serde(default, skip_serializing_if = "is_zero2")]
+    pub cg_offset: [f64; 2],
+}
+
+fn is_zero2(v: &[f64; 2]) -> bool {
+    *v == [0.0; 2]
 }
 
 /// A joint.
@@ -146,6 +188,9 @@ pub enum Joint {
         body: String,
         /// Hinge axis, global (normalised).
         axis: [f64; 3],
+        /// Rotational spring and damper about the axis (default none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        spring: Option<Spring>,
     },
     /// Flared hinge from the end of `parent` to the start of `child`, axis
     /// a = sin β·x + cos β·y in the parent's end section frame.
@@ -163,6 +208,10 @@ pub enum Joint {
         /// used for the rigid-wing check. Default false.
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         locked: bool,
+        /// Rotational spring and damper about the hinge axis, on the fold angle (default none;
+        /// not with `locked`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        spring: Option<Spring>,
     },
     /// The body's start section clamped to ground.
     Clamp {
@@ -713,6 +762,91 @@ impl Case {
         self.bodies.iter().map(|b| b.length).sum()
     }
 
+    /// The scene of formulation `f`: bodies (stiffnesses scaled by `stiffness_scale`, element
+    /// counts of `f`), joints, hinge springs as force elements, gravity. Body names that do not
+    /// resolve become an index past the last body, which [`scene::Scene::validate`] rejects.
+    pub fn scene(&self, f: Formulation) -> scene::Scene {
+        let n_el = match f {
+            Formulation::Ancf => &self.ancf.elements_per_body,
+            Formulation::Gebf => &self.gebf.elements_per_body,
+        };
+        let unit = |v: [f64; 3]| nalgebra::Vector3::from(v).normalize();
+        let bodies = self
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let (x, y) = (unit(b.x_axis), unit(b.y_axis));
+                let s = &b.section;
+                let section = scene::Section {
+                    cg_offset: s.cg_offset,
+                    ..scene::Section::centred(
+                        s.mass, s.rho_ixx, s.rho_iyy, s.rho_izz, s.ea, s.ga_y, s.ga_z, s.gj, s.ei_yy, s.ei_zz,
+                    )
+                };
+                scene::BodySpec {
+                    name: b.name.clone(),
+                    start: b.start.into(),
+                    length: b.length,
+                    frame: nalgebra::Matrix3::from_columns(&[x, y, x.cross(&y)]),
+                    section: section.with_stiffness_scale(self.stiffness_scale),
+                    n_elements: n_el.for_body(i),
+                    point_masses: b
+                        .point_masses
+                        .iter()
+                        .map(|p| scene::PointMass {
+                            at: p.at,
+                            offset: p.offset.into(),
+                            mass: p.mass,
+                            inertia: p.inertia.into(),
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        let idx = |n: &str| self.body_index(n).unwrap_or(usize::MAX);
+        let joints = self
+            .joints
+            .iter()
+            .map(|j| match j {
+                Joint::GroundHinge { body, axis, .. } => {
+                    // Normalised here as the case promises (a zero axis stays zero for the
+                    // scene's validation to name).
+                    let a = nalgebra::Vector3::from(*axis);
+                    let axis = if a.norm() > 0.0 { a.normalize() } else { a };
+                    scene::JointSpec::GroundHinge { body: idx(body), axis }
+                }
+                Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
+                    let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
+                    if *locked {
+                        scene::JointSpec::LockedHinge { parent, child, beta }
+                    } else {
+                        scene::JointSpec::FlaredHinge { parent, child, beta }
+                    }
+                }
+                Joint::Clamp { body, .. } => scene::JointSpec::Clamp { body: idx(body) },
+            })
+            .collect();
+        let forces = self
+            .joints
+            .iter()
+            .enumerate()
+            .filter_map(|(joint, j)| match j {
+                Joint::GroundHinge { spring, .. } | Joint::FlaredHinge { spring, .. } => spring.map(|s| {
+                    scene::ForceElement::HingeSpring {
+                        joint,
+                        stiffness: s.stiffness,
+                        damping: s.damping,
+                        rest: s.rest_deg.to_radians(),
+                    }
+                }),
+                Joint::Clamp { .. } => None,
+            })
+            .collect();
+        let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);
+        scene::Scene { bodies, joints, forces, gravity }
+    }
+
     /// Check every value; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
         let pos = |f: &str, v: f64| -> Result<(), String> {
@@ -735,10 +869,6 @@ impl Case {
             if self.bodies[..i].iter().any(|o| o.name == b.name) {
                 return Err(f(&format!("name: `{}` is used twice", b.name)));
             }
-            if !finite3(&b.start) {
-                return Err(f("start: non-finite coordinate"));
-            }
-            pos(&f("length"), b.length)?;
             if !finite3(&b.x_axis) || norm3(&b.x_axis) < 1e-12 {
                 return Err(f("x_axis: not a finite non-zero vector"));
             }
@@ -750,36 +880,23 @@ impl Case {
             if dot.abs() > 1e-9 {
                 return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
             }
-            let s = &b.section;
-            pos(&f("section.mass"), s.mass)?;
-            for (n, v) in [("rho_ixx", s.rho_ixx), ("rho_iyy", s.rho_iyy), ("rho_izz", s.rho_izz)] {
-                nonneg(&f(&format!("section.{n}")), v)?;
-            }
-            for (n, v) in
-                [("ea", s.ea), ("ga_y", s.ga_y), ("ga_z", s.ga_z), ("gj", s.gj), ("ei_yy", s.ei_yy), ("ei_zz", s.ei_zz)]
-            {
-                pos(&f(&format!("section.{n}")), v)?;
-            }
         }
         let body = |field: String, name: &str| -> Result<(), String> {
             if self.body_index(name).is_some() { Ok(()) } else { Err(format!("{field}: no body named `{name}`")) }
         };
         for (i, j) in self.joints.iter().enumerate() {
             match j {
-                Joint::GroundHinge { body: b, axis, .. } => {
+                Joint::GroundHinge { body: b, .. } => {
                     body(format!("joints[{i}].body"), b)?;
-                    if !finite3(axis) || norm3(axis) < 1e-12 {
-                        return Err(format!("joints[{i}].axis: not a finite non-zero vector"));
-                    }
                 }
-                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
+                Joint::FlaredHinge { parent, child, flare_deg, locked, spring, .. } => {
                     body(format!("joints[{i}].parent"), parent)?;
                     body(format!("joints[{i}].child"), child)?;
-                    if parent == child {
-                        return Err(format!("joints[{i}].child: same body as the parent"));
-                    }
                     if !(flare_deg.is_finite() && (-90.0..=90.0).contains(flare_deg)) {
                         return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
+                    }
+                    if *locked && spring.is_some() {
+                        return Err(format!("joints[{i}].spring: a locked hinge cannot carry a spring"));
                     }
                 }
                 Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
@@ -792,12 +909,13 @@ impl Case {
                 None => return Err(format!("fold_joint: no joint named `{n}`")),
             }
         }
-        if let Some(g) = &self.gravity
-            && !finite3(g)
-        {
-            return Err("gravity: non-finite component".into());
-        }
         pos("stiffness_scale", self.stiffness_scale)?;
+        for (f, n) in [("ancf", &self.ancf.elements_per_body), ("gebf", &self.gebf.elements_per_body)] {
+            n.check(&format!("{f}.elements_per_body"), self.bodies.len())?;
+        }
+        // Everything else about the structure, as both formulations will check it (in degrees
+        // where the case speaks degrees).
+        self.scene(Formulation::Ancf).validate().map_err(|e| e.to_string())?;
         pos("t_end", self.t_end)?;
         if let Some(t) = self.converge_t_end {
             pos("converge_t_end", t)?;
@@ -805,11 +923,7 @@ impl Case {
         if let Some(o) = self.output_dt {
             pos("output_dt", o)?;
         }
-        for (f, n, dt, rho) in [
-            ("ancf", &self.ancf.elements_per_body, self.ancf.dt, self.ancf.rho_inf),
-            ("gebf", &self.gebf.elements_per_body, self.gebf.dt, self.gebf.rho_inf),
-        ] {
-            n.check(&format!("{f}.elements_per_body"), self.bodies.len())?;
+        for (f, dt, rho) in [("ancf", self.ancf.dt, self.ancf.rho_inf), ("gebf", self.gebf.dt, self.gebf.rho_inf)] {
             pos(&format!("{f}.dt"), dt)?;
             if !(0.0..=1.0).contains(&rho) {
                 return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));

@@ -5,72 +5,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::Error;
 use crate::aero::{AeroStructure, SectionLoad, simulate_aero, station_map};
-use crate::case::{AncfPath, Case, Formulation, Joint};
+use crate::case::{AncfPath, Case, Formulation};
 use crate::run::{Energies, RunOutput, RunSettings, Structure, simulate};
-
-fn unit(v: [f64; 3]) -> Vector3<f64> {
-    Vector3::from(v).normalize()
-}
-
-/// Section frame of a body: columns x (beam axis), y, z = x × y.
-fn frame(x: [f64; 3], y: [f64; 3]) -> Matrix3<f64> {
-    let x = unit(x);
-    let y = unit(y);
-    Matrix3::from_columns(&[x, y, x.cross(&y)])
-}
-
-/// Bodies and joints in a formulation crate's own spec types (both crates share the shape).
-macro_rules! specs {
-    ($krate:ident, $case:expr, $n_el:expr) => {{
-        let case: &Case = $case;
-        let c = case.stiffness_scale;
-        let bodies: Vec<$krate::BodySpec> = case
-            .bodies
-            .iter()
-            .enumerate()
-            .map(|(i, b)| $krate::BodySpec {
-                name: b.name.clone(),
-                start: Vector3::from(b.start),
-                length: b.length,
-                frame: frame(b.x_axis, b.y_axis),
-                section: $krate::Section {
-                    mass: b.section.mass,
-                    rho_ixx: b.section.rho_ixx,
-                    rho_iyy: b.section.rho_iyy,
-                    rho_izz: b.section.rho_izz,
-                    ea: c * b.section.ea,
-                    ga_y: c * b.section.ga_y,
-                    ga_z: c * b.section.ga_z,
-                    gj: c * b.section.gj,
-                    ei_yy: c * b.section.ei_yy,
-                    ei_zz: c * b.section.ei_zz,
-                },
-                n_elements: $n_el.for_body(i),
-            })
-            .collect();
-        let idx = |n: &str| case.body_index(n).unwrap_or(usize::MAX);
-        let joints: Vec<$krate::JointSpec> = case
-            .joints
-            .iter()
-            .map(|j| match j {
-                Joint::GroundHinge { body, axis, .. } => {
-                    $krate::JointSpec::GroundHinge { body: idx(body), axis: unit(*axis) }
-                }
-                Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
-                    let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
-                    if *locked {
-                        $krate::JointSpec::LockedHinge { parent, child, beta }
-                    } else {
-                        $krate::JointSpec::FlaredHinge { parent, child, beta }
-                    }
-                }
-                Joint::Clamp { body, .. } => $krate::JointSpec::Clamp { body: idx(body) },
-            })
-            .collect();
-        let gravity = case.gravity.map(Vector3::from).unwrap_or_else(Vector3::zeros);
-        (bodies, joints, gravity)
-    }};
-}
 
 /// A model with its fold-sensor joint.
 pub struct Sensed<M> {
@@ -299,20 +235,18 @@ pub fn settings(case: &Case, f: Formulation) -> RunSettings {
 
 /// Build the ANCF model of a case (DAE or ODE path as the case says).
 pub fn build_ancf(case: &Case) -> Result<ancf::Model, Error> {
-    let (bodies, joints, gravity) = specs!(ancf, case, case.ancf.elements_per_body);
     let path = match case.ancf.path {
         AncfPath::Dae => ancf::SolvePath::Dae,
         AncfPath::Ode => ancf::SolvePath::Ode,
     };
-    ancf::Model::new(&bodies, &joints, gravity, ancf::Options { path, ..Default::default() })
+    ancf::Model::from_scene(&case.scene(Formulation::Ancf), ancf::Options { path, ..Default::default() })
         .map_err(|e| Error::Model { formulation: Formulation::Ancf, msg: e.to_string() })
 }
 
 /// Build the GEBF model of a case.
 pub fn build_gebf(case: &Case) -> Result<gebf::Model, Error> {
-    let (bodies, joints, gravity) = specs!(gebf, case, case.gebf.elements_per_body);
     let options = gebf::Options { stabilization: case.gebf.stabilization, ..Default::default() };
-    gebf::Model::new(&bodies, &joints, gravity, options)
+    gebf::Model::from_scene(&case.scene(Formulation::Gebf), options)
         .map_err(|e| Error::Model { formulation: Formulation::Gebf, msg: e.to_string() })
 }
 

@@ -126,6 +126,7 @@ impl Scene {
                 frame: b.frame,
                 section: self.section.ancf(),
                 n_elements: b.n_ancf,
+                point_masses: Vec::new(),
             })
             .collect();
         let mut joints = Vec::new();
@@ -151,6 +152,7 @@ impl Scene {
                 frame: b.frame,
                 section: self.section.gebf(),
                 n_elements: b.n_gebf,
+                point_masses: Vec::new(),
             })
             .collect();
         let mut joints = Vec::new();
