@@ -255,6 +255,11 @@ pub fn simulate_aero<S: AeroStructure>(
         Ok(u) => u,
         Err(e) => return fail(out, format!("aerodynamic lattice: {e}")),
     };
+    // The flow is the free stream alone (no disturbance); the UVLM's clock, at which a
+    // disturbance would be evaluated, starts at the structure's and advances with each commit.
+    if let Err(e) = uv.set_time(s.t) {
+        return fail(out, format!("aerodynamic clock: {e}"));
+    }
     let span_dir = [1.0, 0.0, 0.0];
     let mut loads: Vec<SectionLoad> = map
         .iter()
@@ -298,6 +303,7 @@ pub fn simulate_aero<S: AeroStructure>(
                 t.force = Vector3::from(fbuf[j]);
                 t.moment = Vector3::from(mbuf[j]);
             }
+            // Lift ⊥ the free stream aero.v_inf (a direction: a disturbance would not turn it).
             Ok(uvlm::lift_drag_of(l.total_force(), aero.v_inf, span_dir).0)
         };
         // 2. Wake and aerodynamic solve at the predicted lattice.
@@ -343,6 +349,7 @@ pub fn simulate_aero<S: AeroStructure>(
         if let Err(e) = uv.commit_step() {
             return fail(out, format!("step {k}: aerodynamics: {e}"));
         }
+        debug_assert!((uv.time() - s.t).abs() <= 1e-9 * s.t.abs().max(1.0), "the UVLM's clock follows the structure's");
         // 5. Work of the aerodynamic loads over the step (trapezoidal in the station velocities).
         stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
         work += 0.5 * dt * (power(&loads, &vel_n) + power(&loads, &vel));

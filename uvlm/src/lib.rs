@@ -9,14 +9,17 @@
 //! shifted a quarter panel downstream along the grid lines, collocation points sit at the ring
 //! centroids. The non-penetration condition at every collocation point `c` with normal `n`,
 //!
-//! $$ \big(V_\infty + u_{ind}(c) - \dot x_c\big)\cdot n = 0, $$
+//! $$ \big(V_{ext}(c, t) + u_{ind}(c) - \dot x_c\big)\cdot n = 0, \qquad
+//!    V_{ext}(x, t) = V_\infty + u_{dist}(x, t), $$
 //!
-//! gives the linear system `A Γ = −(V∞ − ẋ_c + u_wake)·n` for the ring circulations, with
+//! gives the linear system `A Γ = −(V_ext − ẋ_c + u_wake)·n` for the ring circulations (the
+//! external flow [`Flow`] is the free stream plus an optional disturbance field such as a gust,
+//! evaluated at each point and at the solver's time; see [`flow`]), with
 //! the Biot–Savart law of straight segments ([`biot_savart`]) evaluated once per shared edge with
 //! its net circulation. The Kutta condition is explicit (as SHARPy): every step the trailing-edge
 //! circulation is shed into a new wake row; steady solves close the rings by semi-infinite legs
 //! along the free stream.
-//! The wake ([`Wake`]) is a ring buffer of rows shed every step, convected with the free stream
+//! The wake ([`Wake`]) is a ring buffer of rows shed every step, convected with the external flow
 //! (prescribed) or the local velocity (free), truncated after `n_wake_rows` rows, optionally
 //! closed by semi-infinite legs. Loads ([`Loads`]) are Joukowski forces per segment plus
 //! ρ·A·n·dΓ/dt per ring (eq. 16 of Otsuka, Cheng & Palacios 2024), as nodal forces on the ring
@@ -60,7 +63,10 @@
 //!   (strongly coupled) steps, [`Uvlm::advance_wake`]`(dt)` once, then [`Uvlm::solve_step`] as
 //!   often as needed, then [`Uvlm::commit_step`] — [`Uvlm::prefill_wake`],
 //!   accessors [`Uvlm::gamma`], [`Uvlm::gamma_dot`], [`Uvlm::wake`], [`Uvlm::loads`],
-//!   [`Uvlm::stats`], [`Uvlm::velocity_at`].
+//!   [`Uvlm::stats`], [`Uvlm::velocity_at`]; the clock [`Uvlm::time`] / [`Uvlm::set_time`].
+//! * External flow ([`flow`]): [`FlowField`] (`velocity(x, t)`, batch `add_velocity_inplace`),
+//!   [`Uniform`], [`Flow`] (free stream + optional disturbance); attach a gust with
+//!   [`Uvlm::set_disturbance`].
 //! * Loads: [`Loads::nodal`] (per ring node, N), [`Loads::strip`] (per panel column),
 //!   [`Loads::total_force`], [`Loads::moment_about`], [`Loads::lift_drag`],
 //!   [`Loads::column_loads_inplace`] (force + moment about each station origin).
@@ -83,6 +89,7 @@ mod aic;
 pub mod biot_savart;
 mod dense_lu;
 mod error;
+pub mod flow;
 pub mod images;
 mod induce;
 pub mod lattice;
@@ -96,6 +103,7 @@ mod wake;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
 pub use error::{Result, UvlmError};
+pub use flow::{Flow, FlowField, Uniform};
 pub use images::ImagePlane;
 pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};

@@ -3,9 +3,10 @@
 //! Steady part — Joukowski per lattice segment (Simpson, Palacios & Murua 2013), at the segment
 //! midpoint with the local relative velocity:
 //!
-//! $$ f_s = \rho\,\Gamma_s\,\big(V_\infty + u_{ind}(x_s) - \dot x_s\big)\times(x_B - x_A),$$
+//! $$ f_s = \rho\,\Gamma_s\,\big(V_{ext}(x_s, t) + u_{ind}(x_s) - \dot x_s\big)\times(x_B - x_A),$$
 //!
-//! `Γ_s` the segment's net circulation, split ½–½ to its end nodes. The trailing-edge segment
+//! `V_ext = V∞ + u_dist` the external flow at the midpoint (see [`crate::flow`]), `Γ_s` the
+//! segment's net circulation, split ½–½ to its end nodes. The trailing-edge segment
 //! (net strength Γ_w0 − Γ_TE, the circulation shed during the step) is skipped by default, as in
 //! SHARPy, or included, as in Ptera Software (`te_segment_force`). Unsteady part (eq. 16 of
 //! Otsuka, Cheng & Palacios 2024; Katz & Plotkin §13.12):
@@ -55,7 +56,8 @@ impl Loads {
     }
 
     /// Lift and drag, N: drag along the free stream, lift along `v̂ × ŝ` where `ŝ` is
-    /// `span_dir` made perpendicular to the free stream.
+    /// `span_dir` made perpendicular to the free stream. Pass the free stream `V∞` (a direction;
+    /// a disturbance does not turn the lift/drag axes).
     pub fn lift_drag(&self, v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f64) {
         let f = self.total_force();
         let (l, d) = lift_drag_of(f, v_inf, span_dir);
@@ -100,17 +102,19 @@ pub fn lift_drag_of(f: [f64; 3], v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f
     (lift, drag)
 }
 
-/// Fill `loads` from the solved bound system. `u_mid[s]` is the induced velocity at the midpoint
-/// of lattice segment `s`; `gamma_dot` the ring circulation rates (None: steady).
+/// Fill `loads` from the solved bound system. `v_mid[s]` and `u_mid[s]` are the external flow and
+/// the induced velocity at the midpoint of lattice segment `s`; `gamma_dot` the ring circulation
+/// rates (None: steady).
 pub(crate) fn compute_loads(
     loads: &mut Loads,
     lat: &Lattice,
     bs: &BoundSystem,
+    v_mid: &[[f64; 3]],
     u_mid: &[[f64; 3]],
     gamma_dot: Option<&[f64]>,
     params: &UvlmParams,
 ) {
-    let (rho, v_inf, te_segment_force) = (params.rho, params.v_inf, params.te_segment_force);
+    let (rho, te_segment_force) = (params.rho, params.te_segment_force);
     let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
     let nc = n + 1;
     let nodes = lat.ring_nodes();
@@ -133,7 +137,7 @@ pub(crate) fn compute_loads(
         let dl = [nodes[b][0] - nodes[a][0], nodes[b][1] - nodes[a][1], nodes[b][2] - nodes[a][2]];
         let mut v = [0.0; 3];
         for q in 0..3 {
-            v[q] = v_inf[q] + u_mid[s][q] - 0.5 * (vel[a][q] + vel[b][q]);
+            v[q] = v_mid[s][q] + u_mid[s][q] - 0.5 * (vel[a][q] + vel[b][q]);
         }
         let f = [
             rho * g * (v[1] * dl[2] - v[2] * dl[1]),

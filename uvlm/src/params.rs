@@ -9,10 +9,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum WakeConvection {
-    /// Convected with the free stream (SHARPy `convection_scheme = 2`, Ptera `prescribed_wake`).
+    /// Convected with the external flow, free stream + disturbance (SHARPy `convection_scheme = 2`,
+    /// Ptera `prescribed_wake`).
     #[default]
     Prescribed,
-    /// Convected with the local velocity (free stream + induced), forward Euler.
+    /// Convected with the local velocity (external flow + induced), forward Euler.
     Free,
 }
 
@@ -37,7 +38,9 @@ pub const PARALLEL_MIN_PAIRS: usize = 100_000;
 pub struct UvlmParams {
     /// Air density ρ, kg/m³.
     pub rho: f64,
-    /// Free-stream (wind) velocity in the global frame, m/s.
+    /// Free-stream (wind) velocity in the global frame, m/s. The undisturbed part of the external
+    /// flow ([`crate::Flow`]; a disturbance is attached with [`crate::Uvlm::set_disturbance`]) and
+    /// the direction of steady trailing legs and wake closure.
     pub v_inf: [f64; 3],
     /// Maximum number of wake ring rows kept (truncation), ≥ 1. Default 40.
     #[serde(default = "default_wake_rows")]

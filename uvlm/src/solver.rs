@@ -4,6 +4,7 @@ use crate::aic::{BoundSystem, TrailingEdge, build_known_wake};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
+use crate::flow::{Flow, FlowField};
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
@@ -22,18 +23,25 @@ enum Mode {
 
 /// A UVLM solver owning its lattice, wake, circulations, work buffers and loads.
 ///
-/// Per unsteady step ([`Uvlm::step`]), with the lattice already moved to the new time:
-/// 1. convect the wake (free stream, or free stream + induced velocity for a free wake);
+/// The solver keeps the time `t` of its committed solution ([`Uvlm::time`], 0 at construction,
+/// see [`Uvlm::set_time`]); the external flow `V_ext(x, t) = V∞ + u_dist(x, t)` ([`Flow`]) is
+/// evaluated at the points and times below. Per unsteady step `t → t + dt` ([`Uvlm::step`]), with
+/// the lattice already moved to the new time:
+/// 1. convect the wake with `V_ext(x, t)` (plus the induced velocity for a free wake), forward
+///    Euler over `dt`;
 /// 2. shed a row (explicit Kutta condition): the previous trailing-edge ring row, convected,
 ///    becomes the downstream edge of the newest wake ring, which carries the trailing-edge
 ///    circulation of the previous step (the oldest row is dropped when the buffer is full);
 /// 3. assemble and factorise the AIC of the bound rings unless the lattice is unchanged;
-/// 4. right-hand side `−(V∞ − ẋ_c + u_wake(c))·n`, solve for Γ;
-/// 5. loads: Joukowski per segment + ρ·A·n·dΓ/dt (backward differences, first order on the first
-///    step, second order after).
+/// 4. right-hand side `−(V_ext(c, t + dt) − ẋ_c + u_wake(c))·n`, solve for Γ;
+/// 5. loads: Joukowski per segment with `V_ext` at its midpoint at `t + dt`, + ρ·A·n·dΓ/dt
+///    (backward differences, first order on the first step, second order after);
+/// 6. on commit, `t ← t + dt`.
 #[derive(Debug)]
 pub struct Uvlm {
     params: UvlmParams,
+    flow: Flow,
+    time: f64,
     lattice: Lattice,
     wake: Wake,
     gamma: Vec<f64>,
@@ -57,6 +65,9 @@ pub struct Uvlm {
     u_col: Vec<[f64; 3]>,
     u_mid: Vec<[f64; 3]>,
     u_wake: Vec<[f64; 3]>,
+    v_col: Vec<[f64; 3]>,
+    v_mid: Vec<[f64; 3]>,
+    v_wake: Vec<[f64; 3]>,
     row_buf: Vec<[f64; 3]>,
     gamma_row: Vec<f64>,
     blk: NodeBlock,
@@ -76,6 +87,8 @@ impl Uvlm {
         let wake = Wake::new(n, params.n_wake_rows);
         let prev_te = (0..=n).map(|j| lattice.ring_nodes()[lattice.node_index(m, j)]).collect();
         Ok(Self {
+            flow: Flow::new(params.v_inf),
+            time: 0.0,
             wake,
             gamma: vec![0.0; nr],
             gamma_prev: vec![0.0; nr],
@@ -98,6 +111,9 @@ impl Uvlm {
             u_col: vec![[0.0; 3]; nr],
             u_mid: Vec::new(),
             u_wake: Vec::new(),
+            v_col: vec![[0.0; 3]; nr],
+            v_mid: Vec::new(),
+            v_wake: Vec::new(),
             row_buf: vec![[0.0; 3]; n + 1],
             gamma_row: vec![0.0; n],
             blk: NodeBlock::default(),
@@ -138,11 +154,52 @@ impl Uvlm {
     pub fn stats(&self) -> &Stats {
         &self.stats
     }
+    /// The external flow (free stream `params().v_inf` and disturbance).
+    pub fn flow(&self) -> &Flow {
+        &self.flow
+    }
 
-    /// Total velocity `V∞ + u_ind` at a point, m/s: bound rings and wake of the last solve
-    /// (images included). The bound part is zero before the first solve.
+    /// Attach a disturbance field (gust, turbulence) to the free stream, or remove it (`None`).
+    /// It applies from the next evaluation on: the next wake convection and solve. See
+    /// [`crate::flow`] for where it is evaluated and how to write one.
+    pub fn set_disturbance(&mut self, disturbance: Option<Box<dyn FlowField>>) {
+        self.flow.set_disturbance(disturbance);
+    }
+
+    /// Time of the committed solution, s: 0 at construction (or as set by [`Uvlm::set_time`]),
+    /// advanced by `dt` on every [`Uvlm::commit_step`] ([`Uvlm::step`]). A steady solve is at
+    /// this time; a pending step ([`Uvlm::advance_wake`] … [`Uvlm::solve_step`]) solves at
+    /// `time() + dt`.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Set the time of the current solution, s (e.g. the structure's initial time). Only between
+    /// steps; the disturbance is evaluated from this clock.
+    pub fn set_time(&mut self, t: f64) -> Result<()> {
+        if !t.is_finite() {
+            return Err(UvlmError::InvalidParameter { field: "t", value: t });
+        }
+        if self.pending_dt.is_some() {
+            return Err(UvlmError::StepOrder { call: "set_time", expected: "commit_step" });
+        }
+        self.time = t;
+        Ok(())
+    }
+
+    /// Time of the last solve, s: `time() + dt` while a solved step is pending, else `time()`.
+    fn solution_time(&self) -> f64 {
+        match self.pending_dt {
+            Some(dt) if self.solved_pending => self.time + dt,
+            _ => self.time,
+        }
+    }
+
+    /// Total velocity `V_ext + u_ind` at a point, m/s: external flow at the time of the last
+    /// solve, bound rings and wake of the last solve (images included). The bound part is zero
+    /// before the first solve.
     pub fn velocity_at(&self, p: [f64; 3]) -> [f64; 3] {
-        let mut v = self.params.v_inf;
+        let mut v = self.flow.velocity(p, self.solution_time());
         let mut add = |u: [f64; 3]| {
             for q in 0..3 {
                 v[q] += u[q];
@@ -167,9 +224,11 @@ impl Uvlm {
         self.lattice.set_grid(positions, velocities)
     }
 
-    /// Unit free-stream direction (error if the free stream is zero).
+    /// Unit free-stream direction (error if the free stream is zero). A direction, not a
+    /// velocity: the steady trailing legs and the wake-closure legs follow the free stream `V∞`
+    /// whatever the disturbance.
     fn stream_dir(&self) -> Result<[f64; 3]> {
-        let v = self.params.v_inf;
+        let v = self.flow.free_stream();
         let vn = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         if vn > 0.0 {
             Ok([v[0] / vn, v[1] / vn, v[2] / vn])
@@ -211,8 +270,8 @@ impl Uvlm {
         Ok(())
     }
 
-    /// Solve for Γ with the current AIC: rhs = −(V∞ − ẋ_c + u_known(c))·n.
-    fn solve_gamma(&mut self, with_known_wake: bool) -> Result<()> {
+    /// Solve for Γ with the current AIC at time `t`: rhs = −(V_ext(c, t) − ẋ_c + u_known(c))·n.
+    fn solve_gamma(&mut self, with_known_wake: bool, t: f64) -> Result<()> {
         self.load_collocation();
         let nr = self.lattice.n_rings();
         if with_known_wake {
@@ -226,10 +285,11 @@ impl Uvlm {
         } else {
             self.u_col.fill([0.0; 3]);
         }
-        let v = self.params.v_inf;
+        self.flow.velocity_inplace(&self.col, t, &mut self.v_col);
         let cv = self.lattice.collocation_velocities();
         let nrm = self.lattice.normals();
         for r in 0..nr {
+            let v = self.v_col[r];
             let mut s = 0.0;
             for q in 0..3 {
                 s += (v[q] - cv[r][q] + self.u_col[r][q]) * nrm[r][q];
@@ -246,8 +306,9 @@ impl Uvlm {
         Ok(())
     }
 
-    /// Induced velocity at the lattice segment midpoints (bound + known wake) and the loads.
-    fn update_loads(&mut self, with_known_wake: bool, unsteady: bool) {
+    /// Induced velocity and external flow (at time `t`) at the lattice segment midpoints (bound
+    /// + known wake) and the loads.
+    fn update_loads(&mut self, with_known_wake: bool, unsteady: bool, t: f64) {
         self.mid.clear();
         // Trailing-edge segments carry no force unless asked for: skip their midpoints.
         let n_mid = if self.params.te_segment_force {
@@ -279,11 +340,14 @@ impl Uvlm {
             )
         };
         self.stats.n_pair_evaluations += pairs;
+        self.v_mid.resize(self.mid.len(), [0.0; 3]);
+        self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
         let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
-        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.u_mid, gd, &self.params);
+        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.v_mid, &self.u_mid, gd, &self.params);
     }
 
-    /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM).
+    /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM), in the
+    /// external flow at [`Uvlm::time`] (the legs follow `V∞`, not the disturbance).
     /// Does not touch the wake or the unsteady history.
     pub fn solve_steady(&mut self) -> Result<&Loads> {
         if self.pending_dt.is_some() {
@@ -291,9 +355,9 @@ impl Uvlm {
         }
         let t0 = Instant::now();
         self.prepare_aic(Mode::Steady)?;
-        self.solve_gamma(false)?;
+        self.solve_gamma(false, self.time)?;
         self.gamma_dot.fill(0.0);
-        self.update_loads(false, false);
+        self.update_loads(false, false, self.time);
         self.stats.n_steady_solves += 1;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(&self.loads)
@@ -302,7 +366,8 @@ impl Uvlm {
     /// Replace the wake by the steady wake of the current Γ for time step `dt`: `n_wake_rows`
     /// straight rows convected with the free stream, every row carrying Γ_TE, and make the
     /// current Γ the unsteady history (dΓ/dt = 0). Call after [`Uvlm::solve_steady`] to start
-    /// an unsteady run from a converged state instead of impulsively.
+    /// an unsteady run from a converged state instead of impulsively. The rows follow the free
+    /// stream `V∞` (the steady wake's geometry, a direction), not the disturbance.
     pub fn prefill_wake(&mut self, dt: f64) -> Result<()> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(UvlmError::InvalidParameter { field: "dt", value: dt });
@@ -311,7 +376,7 @@ impl Uvlm {
             return Err(UvlmError::StepOrder { call: "prefill_wake", expected: "commit_step" });
         }
         let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
-        let v = self.params.v_inf;
+        let v = self.flow.free_stream();
         for j in 0..=n {
             self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
         }
@@ -335,22 +400,8 @@ impl Uvlm {
         Ok(())
     }
 
-    /// Convect the wake and the previous trailing-edge row over `dt`.
-    fn convect(&mut self, dt: f64) {
-        let v = self.params.v_inf;
-        let free = self.params.wake_convection == WakeConvection::Free
-            && self.has_solution
-            && self.bound_mode == Some(Mode::Unsteady);
-        if !free {
-            let d = [v[0] * dt, v[1] * dt, v[2] * dt];
-            self.wake.translate(d);
-            for p in &mut self.prev_te {
-                for q in 0..3 {
-                    p[q] += d[q];
-                }
-            }
-            return;
-        }
+    /// Wake nodes (row by row) then the previous trailing-edge row into `wpts`.
+    fn load_wake_points(&mut self) {
         let n = self.lattice.n_spanwise();
         self.wpts.clear();
         for r in 0..self.wake.n_rows() {
@@ -361,24 +412,54 @@ impl Uvlm {
         for p in &self.prev_te {
             self.wpts.push(*p);
         }
+    }
+
+    /// Convect the wake and the previous trailing-edge row over `dt` with the velocity at the
+    /// start of the step (time [`Uvlm::time`]): the external flow, plus the induced velocity for a
+    /// free wake.
+    fn convect(&mut self, dt: f64) {
+        let t = self.time;
+        let free = self.params.wake_convection == WakeConvection::Free
+            && self.has_solution
+            && self.bound_mode == Some(Mode::Unsteady);
+        if !free && self.flow.is_uniform() {
+            // The same displacement V∞·dt for every node.
+            let v = self.flow.free_stream();
+            let d = [v[0] * dt, v[1] * dt, v[2] * dt];
+            self.wake.translate(d);
+            for p in &mut self.prev_te {
+                for q in 0..3 {
+                    p[q] += d[q];
+                }
+            }
+            return;
+        }
+        let n = self.lattice.n_spanwise();
+        self.load_wake_points();
+        self.v_wake.resize(self.wpts.len(), [0.0; 3]);
+        self.flow.velocity_inplace(&self.wpts, t, &mut self.v_wake);
         self.u_wake.resize(self.wpts.len(), [0.0; 3]);
-        self.stats.n_pair_evaluations += induced_velocity_inplace(
-            &[&self.bound.fil, &self.known],
-            &self.wpts,
-            &mut self.u_wake,
-            self.params.parallel,
-            &mut self.blk,
-        );
+        if free {
+            self.stats.n_pair_evaluations += induced_velocity_inplace(
+                &[&self.bound.fil, &self.known],
+                &self.wpts,
+                &mut self.u_wake,
+                self.params.parallel,
+                &mut self.blk,
+            );
+        } else {
+            self.u_wake.fill([0.0; 3]);
+        }
         let mut k = 0;
         for r in 0..self.wake.n_rows() {
             for j in 0..=n {
-                let u = self.u_wake[k];
+                let (v, u) = (self.v_wake[k], self.u_wake[k]);
                 self.wake.displace(r, j, [(v[0] + u[0]) * dt, (v[1] + u[1]) * dt, (v[2] + u[2]) * dt]);
                 k += 1;
             }
         }
         for p in &mut self.prev_te {
-            let u = self.u_wake[k];
+            let (v, u) = (self.v_wake[k], self.u_wake[k]);
             for q in 0..3 {
                 p[q] += (v[q] + u[q]) * dt;
             }
@@ -444,7 +525,8 @@ impl Uvlm {
             &self.params.bound_core,
             &self.params.images,
         );
-        self.solve_gamma(true)?;
+        let t = self.time + dt;
+        self.solve_gamma(true, t)?;
         for r in 0..self.gamma.len() {
             self.gamma_dot[r] = if self.n_history >= 2 {
                 (3.0 * self.gamma[r] - 4.0 * self.gamma_prev[r] + self.gamma_prev2[r]) / (2.0 * dt)
@@ -452,7 +534,7 @@ impl Uvlm {
                 (self.gamma[r] - self.gamma_prev[r]) / dt
             };
         }
-        self.update_loads(true, true);
+        self.update_loads(true, true, t);
         self.solved_pending = true;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(&self.loads)
@@ -471,7 +553,9 @@ impl Uvlm {
         for j in 0..=n {
             self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
         }
-        self.pending_dt = None;
+        if let Some(dt) = self.pending_dt.take() {
+            self.time += dt;
+        }
         self.solved_pending = false;
         self.stats.n_steps += 1;
         Ok(())

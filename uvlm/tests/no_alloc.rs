@@ -1,6 +1,7 @@
 //! The time loop does not allocate: once the wake buffer is full and every work buffer has
 //! reached its size, `update_stations` + `step` perform no heap allocation (counting allocator,
-//! single thread; prescribed and free wake, with a symmetry plane).
+//! single thread; prescribed and free wake, with a symmetry plane, without and with a disturbance
+//! field).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -34,7 +35,12 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn step_does_not_allocate() {
-    for convection in [WakeConvection::Prescribed, WakeConvection::Free] {
+    for (convection, disturbed) in [
+        (WakeConvection::Prescribed, false),
+        (WakeConvection::Free, false),
+        (WakeConvection::Prescribed, true),
+        (WakeConvection::Free, true),
+    ] {
         let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
         let stations: Vec<Vec<SpanStation>> = (0..8).map(|k| wing.stations(0.02 * k as f64)).collect();
         let vel = vec![StationVelocity::default(); stations[0].len()];
@@ -46,6 +52,10 @@ fn step_does_not_allocate() {
         p.wake_core = CoreModel::Scully { fraction: 0.1 };
         p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
         let mut u = Uvlm::new(lat, p).unwrap();
+        if disturbed {
+            // A travelling vertical gust: evaluated at every point, every step.
+            u.set_disturbance(Some(Box::new(|x: [f64; 3], t: f64| [0.0, 0.0, (x[1] + 25.0 * t).sin()])));
+        }
         for k in 0..8 {
             u.update_stations(&stations[k % 8], Some(&vel)).unwrap();
             u.step(0.01).unwrap();
@@ -56,6 +66,11 @@ fn step_does_not_allocate() {
             u.step(0.01).unwrap();
         }
         let after = ALLOCATIONS.load(Ordering::Relaxed);
-        assert_eq!(after - before, 0, "{convection:?}: {} allocations in 8 steps", after - before);
+        assert_eq!(
+            after - before,
+            0,
+            "{convection:?}, disturbed {disturbed}: {} allocations in 8 steps",
+            after - before
+        );
     }
 }
