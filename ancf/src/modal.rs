@@ -1,8 +1,8 @@
 //! Linear modes of the constrained model about a configuration: the generalized eigenproblem
 //!
-//! $$ B^T K_t B\, \phi = \omega^2\, B^T M B\, \phi $$
+//! $$ N^T K_t N\, \phi = \omega^2\, N^T M N\, \phi,\qquad \Phi_q N = 0 $$
 //!
-//! on the independent coordinates (joints eliminated exactly), each mode classified by the
+//! on the free motions (joints eliminated exactly), each mode classified by the
 //! strain kind that stores most of its linearised strain energy, so that the cross-section
 //! penalty modes can be told apart from beam modes.
 
@@ -10,9 +10,9 @@ use crate::Error;
 use crate::elastic_force::ElementVector;
 use crate::model::Model;
 use crate::shape::{ELEMENT_DOF, NODE_DOF};
+use crate::statics::FullCoordinates;
 use crate::strain::{N_STRAINS, StrainKind};
-use genalpha::DenseMatrix;
-use nalgebra::DMatrix;
+use genalpha::analysis;
 
 /// Classification of a mode by where its strain energy sits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,32 +48,17 @@ impl Model {
     /// Linear modes about the full configuration `q_full` (usually
     /// [`reference_coordinates`](Model::reference_coordinates)), sorted by frequency. External
     /// loads are ignored; the tangent includes the stress stiffening of `q_full`.
+    ///
+    /// The eigenproblem is the integrator crate's generic one
+    /// ([`genalpha::analysis::linearise`], then
+    /// [`natural_modes`](genalpha::analysis::Linearisation::natural_modes)) on the full
+    /// coordinates, with the joints eliminated by an orthonormal basis of `ker Φ_q` (the same
+    /// subspace as the [`reduction`](crate::reduction)'s `B`); the classification is ANCF's.
     pub fn linear_modes(&self, q_full: &[f64]) -> Result<Vec<Mode>, Error> {
-        let n = self.n_full_coords();
-        let red = &self.reduction;
-        let nz = red.n_reduced();
-        let mut b = DMatrix::<f64>::zeros(n, nz);
-        for i in 0..n {
-            for &(z, c) in red.row(i) {
-                b[(i, z)] = c;
-            }
-        }
-        let full = |c_m: f64, c_k: f64| {
-            let mut d = DenseMatrix::zeros(n, n);
-            self.assemble_full_inplace(q_full, c_m, c_k, &mut d.view());
-            DMatrix::from_column_slice(n, n, d.as_slice())
-        };
-        let k = b.transpose() * full(0.0, 1.0) * &b;
-        let m = b.transpose() * full(1.0, 0.0) * &b;
-        let k = 0.5 * (&k + k.transpose());
-        let chol = m.cholesky().ok_or(Error::SingularMatrix { pivot: 0 })?;
-        let l = chol.l();
-        let l_inv = l.clone().try_inverse().ok_or(Error::SingularMatrix { pivot: 0 })?;
-        let a = &l_inv * k * l_inv.transpose();
-        let a = 0.5 * (&a + a.transpose());
-        let eig = a.symmetric_eigen();
-        let mut order: Vec<usize> = (0..nz).collect();
-        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+        let lambda = vec![0.0; self.n_constraint_rows()];
+        let natural = analysis::linearise(&FullCoordinates(self), 0.0, q_full, &lambda, &[])
+            .and_then(|lin| lin.natural_modes())
+            .map_err(|_| Error::SingularMatrix { pivot: 0 })?;
         type Gradients = Vec<(StrainKind, f64, ElementVector)>;
         let grads: Vec<(usize, Gradients)> = self
             .bodies
@@ -85,13 +70,12 @@ impl Model {
                 })
             })
             .collect();
-        let modes = order
-            .into_iter()
-            .map(|i| {
-                let lam = eig.eigenvalues[i];
-                let y = eig.eigenvectors.column(i);
-                let phi_z = l_inv.transpose() * y;
-                let shape: Vec<f64> = (&b * phi_z).iter().copied().collect();
+        let modes = natural
+            .omega_squared
+            .iter()
+            .zip(natural.shapes.column_iter())
+            .map(|(&lam, column)| {
+                let shape: Vec<f64> = column.iter().copied().collect();
                 let mut energy = [0.0; N_STRAINS];
                 for (first, list) in &grads {
                     let e = &shape[*first..*first + ELEMENT_DOF];

@@ -4,11 +4,14 @@
 //!    \begin{bmatrix} \Delta q \\ \Delta\lambda \end{bmatrix}
 //!  = -\begin{bmatrix} f_{el}(q) - \lambda_L Q(q) + \Phi_q^T\lambda \\ \Phi(q) \end{bmatrix} $$
 //!
-//! with the load factor `λ_L` ramped linearly over the load steps.
+//! with the load factor `λ_L` ramped linearly over the load steps. The Newton iteration is the
+//! integrator crate's generic one ([`genalpha::analysis::StaticSolver`]) on `FullCoordinates`,
+//! the model in its DAE form whatever [`SolvePath`](crate::SolvePath) it integrates with.
 
 use crate::Error;
 use crate::model::Model;
-use genalpha::{DenseLu, DenseMatrix, LinearSolver};
+use genalpha::analysis::{self, StaticSolver};
+use genalpha::{ConstrainedSystem, MatView};
 
 /// Static solver settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,80 +41,81 @@ pub struct StaticSolution {
     pub n_iterations: usize,
 }
 
+/// The model on its full nodal coordinates with every joint row as a holonomic constraint (the
+/// [`SolvePath::Dae`](crate::SolvePath::Dae) form, whatever path the model was built with): what
+/// the static solver and the modal analysis work on. No damping: `c_c` is ignored.
+pub(crate) struct FullCoordinates<'a>(pub(crate) &'a Model);
+
+impl ConstrainedSystem for FullCoordinates<'_> {
+    fn n_coords(&self) -> usize {
+        self.0.n_full_coords()
+    }
+    fn n_dof(&self) -> usize {
+        self.0.n_full_coords()
+    }
+    fn n_holonomic(&self) -> usize {
+        self.0.n_constraint_rows()
+    }
+    fn residual_inplace(&self, _t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.0.full_residual(q, v_dot, r);
+    }
+    fn iteration_matrix_inplace(
+        &self,
+        _t: f64,
+        q: &[f64],
+        _v: &[f64],
+        _v_dot: &[f64],
+        c_m: f64,
+        _c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        self.0.assemble_full_inplace(q, c_m, c_k, k);
+    }
+    fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {
+        for (p, row) in phi.iter_mut().zip(self.0.rows()) {
+            *p = row.value(q);
+        }
+    }
+    fn phi_q_inplace(&self, _t: f64, _q: &[f64], j: &mut MatView<'_>) {
+        for (i, row) in self.0.rows().iter().enumerate() {
+            for &(col, c) in &row.entries {
+                j.add(i, col, c);
+            }
+        }
+    }
+    fn phi_q_is_constant(&self) -> bool {
+        true
+    }
+    fn increment_weight(&self, i: usize) -> f64 {
+        self.0.full_weight(i)
+    }
+}
+
 impl Model {
     /// Solve for static equilibrium under gravity and the point loads, starting from the
     /// reference configuration. Works on the full coordinates whatever [`SolvePath`](crate::SolvePath) the model
     /// was built with; the load factor is left at 1.
     pub fn solve_statics(&mut self, params: StaticsParams) -> Result<StaticSolution, Error> {
-        let n = self.n_full_coords();
-        let m = self.n_constraint_rows();
-        let mut q = self.reference_coordinates().to_vec();
-        let mut lambda = vec![0.0; m];
-        let mut mat = DenseMatrix::zeros(n + m, n + m);
-        let mut lu = DenseLu::default();
-        lu.set_dimension(n + m);
-        let zeros = vec![0.0; n];
-        let mut r = vec![0.0; n];
-        let mut rhs = vec![0.0; n + m];
-        let weights: Vec<f64> = (0..n).map(|i| self.full_weight(i)).collect();
-        let mut n_iterations = 0;
+        let generic = analysis::StaticParams { max_iter: params.max_iter, tol: params.tol, rel_residual_tol: 0.0 };
+        let mut solver = StaticSolver::new(&FullCoordinates(self), generic);
+        let mut x = analysis::StaticSolution::guess(&FullCoordinates(self), self.reference_coordinates());
         let n_steps = params.n_load_steps.max(1);
-        for step in 1..=n_steps {
-            let lf = step as f64 / n_steps as f64;
-            self.set_load_factor(lf);
-            let mut converged = false;
-            let mut res_norm = f64::INFINITY;
-            for iter in 1..=params.max_iter {
-                self.full_residual(&q, &zeros, &mut r);
-                for (row, l) in self.rows().iter().zip(&lambda) {
-                    for &(j, c) in &row.entries {
-                        r[j] += c * l;
-                    }
-                }
-                res_norm = r.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-                mat.fill_zero();
-                self.assemble_full_inplace(&q, 0.0, 1.0, &mut mat.block(0, 0, n, n));
-                // constraint rows scaled to the stiffness so that the pivots stay balanced
-                let scale = (0..n).map(|i| mat.get(i, i).abs()).fold(0.0, f64::max).max(1.0);
-                for (i, row) in self.rows().iter().enumerate() {
-                    for &(j, c) in &row.entries {
-                        *mat.get_mut(n + i, j) += scale * c;
-                        *mat.get_mut(j, n + i) += scale * c;
-                    }
-                    rhs[n + i] = -scale * row.value(&q);
-                }
-                for i in 0..n {
-                    rhs[i] = -r[i];
-                }
-                lu.factorize(&mat).map_err(|pivot| Error::SingularMatrix { pivot })?;
-                lu.solve_in_place(&mut rhs);
-                if !rhs.iter().all(|x| x.is_finite()) {
-                    break;
-                }
-                let mut inc: f64 = 0.0;
-                for i in 0..n {
-                    q[i] += rhs[i];
-                    inc = inc.max((rhs[i] * weights[i]).abs());
-                }
-                for i in 0..m {
-                    lambda[i] += scale * rhs[n + i];
-                }
-                n_iterations += 1;
-                if inc < params.tol {
-                    converged = true;
-                    break;
-                }
-                if iter == params.max_iter {
-                    break;
-                }
-            }
-            if !converged {
+        for load_factor in analysis::load_steps(n_steps) {
+            self.set_load_factor(load_factor);
+            if let Err(e) = solver.solve(&FullCoordinates(self), 0.0, &mut x) {
                 self.set_load_factor(1.0);
-                return Err(Error::StaticsDiverged { load_factor: lf, iter: params.max_iter, residual_norm: res_norm });
+                return Err(match e {
+                    genalpha::Error::SingularMatrix { pivot, .. } => Error::SingularMatrix { pivot },
+                    genalpha::Error::NonFinite { iter, .. } => {
+                        Error::StaticsDiverged { load_factor, iter, residual_norm: x.residual_norm }
+                    }
+                    _ => Error::StaticsDiverged { load_factor, iter: params.max_iter, residual_norm: x.residual_norm },
+                });
             }
         }
         self.set_load_factor(1.0);
-        Ok(StaticSolution { q, lambda, n_iterations })
+        Ok(StaticSolution { q: x.q, lambda: x.lambda, n_iterations: x.n_iterations })
     }
 }
 

@@ -8,10 +8,13 @@
 //!    \begin{bmatrix} \delta q \\ \delta\mu \end{bmatrix} =
 //!    -\begin{bmatrix} r + B^T \mu \\ 0 \end{bmatrix} $$
 //!
-//! and updates `q ← q ∘ exp(δq)`. The load factor goes from `1/n_load_steps` to 1.
+//! and updates `q ← q ∘ exp(δq)`. The load factor goes from `1/n_load_steps` to 1. The Newton
+//! iteration is the integrator crate's generic one ([`genalpha::analysis::StaticSolver`]), with
+//! the nodal CRVs rescaled past π after every update.
 
 use crate::{Error, Model};
-use genalpha::{ConstrainedSystem, DenseLu, DenseMatrix, LinearSolver};
+use genalpha::ConstrainedSystem;
+use genalpha::analysis::{self, StaticSolver};
 
 /// Settings of the static solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,87 +66,23 @@ impl Model {
     }
 
     fn solve_static_inner(&mut self, q0: &[f64], opts: &StaticOptions) -> Result<StaticSolution, Error> {
-        let n = self.n_dof();
-        let nc = self.n_velocity_constraints();
-        let zeros = vec![0.0; n];
-        let weights: Vec<f64> = (0..n).map(|i| self.increment_weight(i)).collect();
-        let mut q = q0.to_vec();
-        let mut q_new = q.clone();
-        let mut mu = vec![0.0; nc];
-        let mut r = vec![0.0; n];
-        let mut rhs = vec![0.0; n + nc];
-        let mut a = DenseMatrix::zeros(n + nc, n + nc);
-        let mut b = DenseMatrix::zeros(nc, n);
-        let mut lu = DenseLu::default();
-        lu.set_dimension(n + nc);
-        let mut total = 0;
-        for step in 1..=opts.n_load_steps {
-            self.load_scale = step as f64 / opts.n_load_steps as f64;
-            let mut converged = false;
-            let mut inc = f64::INFINITY;
-            let mut res = f64::INFINITY;
-            let mut res0 = f64::NAN;
-            for _ in 0..opts.max_iter {
-                total += 1;
-                self.residual_inplace(0.0, &q, &zeros, &zeros, &mut r);
-                b.fill_zero();
-                self.psi_v_inplace(0.0, &q, &mut b.view());
-                b.add_mul_transpose_vec_inplace(&mu, &mut r);
-                res = r.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                if res0.is_nan() {
-                    res0 = res;
-                } else if res <= opts.rel_residual_tol * res0 {
-                    converged = true;
-                    break;
+        let params =
+            analysis::StaticParams { max_iter: opts.max_iter, tol: opts.tol, rel_residual_tol: opts.rel_residual_tol };
+        let mut solver = StaticSolver::new(&*self, params);
+        let mut x = analysis::StaticSolution::guess(&*self, q0);
+        for load_factor in analysis::load_steps(opts.n_load_steps) {
+            self.load_scale = load_factor;
+            let model = &*self;
+            // stored CRVs past π are rescaled after every update, as after every time step
+            solver.solve_normalised(model, 0.0, &mut x, |q| model.rescale_rotations(q, None)).map_err(|_| {
+                Error::StaticDiverged {
+                    load_factor,
+                    iter: x.n_iterations,
+                    residual_norm: x.residual_norm,
+                    increment_norm: x.increment_norm,
                 }
-                a.fill_zero();
-                {
-                    let mut k = a.block(0, 0, n, n);
-                    self.iteration_matrix_inplace(0.0, &q, &zeros, &zeros, 0.0, 0.0, 1.0, &mut k);
-                    self.constraint_force_tangent_inplace(0.0, &q, &[], &mu, 1.0, &mut k);
-                }
-                for i in 0..nc {
-                    for j in 0..n {
-                        let x = b.get(i, j);
-                        *a.get_mut(n + i, j) = x;
-                        *a.get_mut(j, n + i) = x;
-                    }
-                }
-                lu.factorize(&a).map_err(|_| Error::StaticDiverged {
-                    load_factor: self.load_scale,
-                    iter: total,
-                    residual_norm: res,
-                    increment_norm: inc,
-                })?;
-                for i in 0..n {
-                    rhs[i] = -r[i];
-                }
-                rhs[n..].iter_mut().for_each(|x| *x = 0.0);
-                lu.solve_in_place(&mut rhs);
-                if !rhs.iter().all(|x| x.is_finite()) {
-                    break;
-                }
-                inc = rhs[..n].iter().zip(&weights).fold(0.0_f64, |m, (x, w)| m.max((x * w).abs()));
-                self.retract_inplace(&q, &rhs[..n], &mut q_new);
-                std::mem::swap(&mut q, &mut q_new);
-                self.rescale_rotations(&mut q, None);
-                for (m, d) in mu.iter_mut().zip(&rhs[n..]) {
-                    *m += d;
-                }
-                if inc <= opts.tol {
-                    converged = true;
-                    break;
-                }
-            }
-            if !converged {
-                return Err(Error::StaticDiverged {
-                    load_factor: self.load_scale,
-                    iter: total,
-                    residual_norm: res,
-                    increment_norm: inc,
-                });
-            }
+            })?;
         }
-        Ok(StaticSolution { q, mu, n_iterations: total })
+        Ok(StaticSolution { q: x.q, mu: x.mu, n_iterations: x.n_iterations })
     }
 }

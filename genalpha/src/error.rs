@@ -1,6 +1,7 @@
 //! Typed errors of the integrator.
 
-/// Errors of the generalized-α integrator. Every variant carries the time it happened at.
+/// Errors of the generalized-α integrator and of the [`analysis`](crate::analysis) module. A
+/// variant raised by a time step or a static solve carries the time it happened at.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
     /// Newton did not converge within `max_iter` iterations.
@@ -46,5 +47,43 @@ pub enum Error {
         field: &'static str,
         /// What is wrong with it.
         reason: String,
+    },
+    /// The static Newton iteration did not converge.
+    #[error(
+        "static equilibrium not found at t = {t:.6} s after {iter} Newton iterations \
+         (residual {residual_norm:.3e}, weighted increment {increment_norm:.3e})"
+    )]
+    StaticNotConverged {
+        /// Time the forces were evaluated at, s.
+        t: f64,
+        /// Iterations done.
+        iter: usize,
+        /// Infinity norm of the last equilibrium residual `r + Φ_qᵀλ + Bᵀμ`.
+        residual_norm: f64,
+        /// Weighted infinity norm of the last increment.
+        increment_norm: f64,
+    },
+    /// A step of a static continuation failed.
+    #[error("continuation step {step} (parameter {parameter}) failed: {source}")]
+    ContinuationFailed {
+        /// Index of the failed step in the path.
+        step: usize,
+        /// The parameter value of that step.
+        parameter: f64,
+        /// What went wrong in its solve.
+        source: Box<Error>,
+    },
+    /// The mass matrix restricted to the free motions is not positive definite (a free motion
+    /// without inertia).
+    #[error("the mass matrix on the {n_free} free motions is not positive definite")]
+    MassNotPositiveDefinite {
+        /// Number of free motions (null-space dimension).
+        n_free: usize,
+    },
+    /// A dense SVD or eigenvalue iteration did not converge (or produced non-finite values).
+    #[error("a dense decomposition of dimension {n} did not converge")]
+    DecompositionNotConverged {
+        /// Dimension of the decomposed matrix.
+        n: usize,
     },
 }

@@ -37,9 +37,12 @@
 //! at the end of the step) and the multiplier columns (Φ_qᵀ and Bᵀ at the weighted state)
 //! differ.
 //!
-//! The crate knows no beams: a structural model implements [`ConstrainedSystem`].
+//! The crate knows no beams: a structural model implements [`ConstrainedSystem`]. The same trait
+//! serves the [`analysis`] module: static equilibrium with continuation, linearisation about it,
+//! natural and damped modes, written once for every model.
 #![warn(missing_docs)]
 
+pub mod analysis;
 mod banded;
 mod error;
 mod integrator;
