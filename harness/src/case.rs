@@ -832,14 +832,14 @@ impl Case {
             .iter()
             .enumerate()
             .filter_map(|(joint, j)| match j {
-                Joint::GroundHinge { spring, .. } | Joint::FlaredHinge { spring, .. } => spring.map(|s| {
-                    scene::ForceElement::HingeSpring {
+                Joint::GroundHinge { spring, .. } | Joint::FlaredHinge { spring, .. } => {
+                    spring.map(|s| scene::ForceElement::HingeSpring {
                         joint,
                         stiffness: s.stiffness,
                         damping: s.damping,
                         rest: s.rest_deg.to_radians(),
-                    }
-                }),
+                    })
+                }
                 Joint::Clamp { .. } => None,
             })
             .collect();
@@ -968,6 +968,17 @@ impl Case {
             }
             pos("aero.coupling.tolerance", a.coupling.tolerance)?;
             crate::aero::station_map(self, a)?;
+            // The lattice's own limit on a hinge column's slant, found here rather than at run time.
+            for (i, j) in self.joints.iter().enumerate() {
+                if let Joint::FlaredHinge { flare_deg, .. } = j
+                    && flare_deg.abs() >= uvlm::lattice::MAX_HINGE_FLARE_DEG
+                {
+                    return Err(format!(
+                        "joints[{i}].flare_deg: {flare_deg} is not below the lattice's limit of ±{}° (aero)",
+                        uvlm::lattice::MAX_HINGE_FLARE_DEG
+                    ));
+                }
+            }
         }
         if let Some(g) = &self.gate {
             pos("gate.energy_drift", g.energy_drift)?;

@@ -201,6 +201,17 @@ fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String,
     Ok(v)
 }
 
+/// 2 when any input was bad (whatever else happened), else 1 when a run or a gate failed.
+fn exit_code<E>(input_errors: &[E], ok: bool) -> ExitCode {
+    if !input_errors.is_empty() {
+        ExitCode::from(2)
+    } else if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
 fn main() -> ExitCode {
     match real_main() {
         Ok(code) => code,
@@ -287,7 +298,7 @@ fn real_main() -> Result<ExitCode> {
                 failed,
                 out.join("index.html").display()
             );
-            Ok(if failed == 0 && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+            Ok(exit_code(&errors, failed == 0))
         }
         Cmd::Run { case, formulation, out, set } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
@@ -435,7 +446,7 @@ fn real_main() -> Result<ExitCode> {
                 }
             }
             println!("gate: {} of {} cases pass", results.len() - failing.len(), results.len());
-            Ok(if failing.is_empty() && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+            Ok(exit_code(&errors, failing.is_empty()))
         }
     }
 }

@@ -16,9 +16,8 @@ fn tmp_case(name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
     let src = root().join("cases/double_pendulum_c1_beta45.json");
     let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(src).unwrap()).unwrap();
     edit(&mut v);
-    let dir = std::env::temp_dir().join(format!("harness-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
+    let p = std::env::temp_dir().join(format!("harness-cli-{}", std::process::id())).join(name);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
     std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
     p
 }
@@ -144,4 +143,120 @@ fn bench_writes_a_row_per_solver() {
     assert!(rows[0]["cpu_median_ms"].as_f64().unwrap() > 0.0);
     assert!(out.join("bench/bench.svg").exists());
     std::fs::remove_dir_all(out).ok();
+}
+
+/// Every field of springs, point masses and the section's centre-of-mass offset, set to a value
+/// no model accepts, is rejected with exit 2 and the field named, by `run`, `list` and `gate`.
+#[test]
+fn new_scene_fields_are_validated_by_every_command() {
+    use serde_json::json;
+    let point_mass = json!({"at": 0.5, "offset": [0.0, 0.01, 0.0], "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]});
+    let spring = json!({"stiffness": 1.0, "damping": 0.1, "rest_deg": 0.0});
+    type Edit = fn(&mut serde_json::Value, &serde_json::Value, &serde_json::Value);
+    let cases: [(&str, Edit, &str); 10] = [
+        (
+            "spring_k",
+            |v, _, s| {
+                v["joints"][1]["spring"] = s.clone();
+                v["joints"][1]["spring"]["stiffness"] = json!(-1.0);
+            },
+            "joints[1].spring.stiffness",
+        ),
+        (
+            "spring_c",
+            |v, _, s| {
+                v["joints"][0]["spring"] = s.clone();
+                v["joints"][0]["spring"]["damping"] = json!(-0.5);
+            },
+            "joints[0].spring.damping",
+        ),
+        (
+            "spring_rest",
+            |v, _, s| {
+                v["joints"][1]["spring"] = s.clone();
+                v["joints"][1]["spring"]["rest_deg"] = json!("ninety");
+            },
+            // serde reports type errors inside a tagged joint at the joint (`joints[1]`), with the
+            // offending type and value
+            "joints[1]: invalid type: string \"ninety\", expected f64",
+        ),
+        (
+            "spring_locked",
+            |v, _, s| {
+                v["joints"][1]["spring"] = s.clone();
+                v["joints"][1]["locked"] = json!(true);
+            },
+            "joints[1].spring",
+        ),
+        (
+            "pm_at",
+            |v, p, _| {
+                v["bodies"][1]["point_masses"] = json!([p]);
+                v["bodies"][1]["point_masses"][0]["at"] = json!(0.7);
+            },
+            "bodies[1].point_masses[0].at",
+        ),
+        (
+            "pm_mass",
+            |v, p, _| {
+                v["bodies"][0]["point_masses"] = json!([p]);
+                v["bodies"][0]["point_masses"][0]["mass"] = json!(-0.1);
+            },
+            "bodies[0].point_masses[0].mass",
+        ),
+        (
+            "pm_inertia",
+            |v, p, _| {
+                v["bodies"][0]["point_masses"] = json!([p]);
+                v["bodies"][0]["point_masses"][0]["inertia"] = json!([1e-5, -1e-5, 1e-5]);
+            },
+            "bodies[0].point_masses[0].inertia[1]",
+        ),
+        (
+            "pm_offset",
+            |v, p, _| {
+                v["bodies"][0]["point_masses"] = json!([p]);
+                v["bodies"][0]["point_masses"][0]["offset"] = json!([0.0, 0.1]);
+            },
+            "bodies[0].point_masses[0].offset",
+        ),
+        (
+            "pm_unknown",
+            |v, p, _| {
+                v["bodies"][0]["point_masses"] = json!([p]);
+                v["bodies"][0]["point_masses"][0]["body"] = json!("tip");
+            },
+            "point_masses[0]",
+        ),
+        (
+            "cg",
+            |v, _, _| v["bodies"][1]["section"]["cg_offset"] = json!([0.0, -0.01, 0.3]),
+            "bodies[1].section.cg_offset",
+        ),
+    ];
+    for (name, edit, field) in cases {
+        let p = tmp_case(&format!("{name}/case.json"), |v| edit(v, &point_mass, &spring));
+        let path = p.to_str().unwrap();
+        let folder = p.parent().unwrap().to_str().unwrap();
+        for args in [vec!["run", path], vec!["list", "--cases", folder], vec!["gate", path]] {
+            let o = harness(&args);
+            assert_eq!(o.status.code(), Some(2), "{name}: {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+            assert_clean_error(&o, field);
+        }
+    }
+}
+
+/// A flare angle the lattice cannot take is an input error of the case, not a run-time failure.
+#[test]
+fn a_flare_beyond_the_lattice_limit_is_rejected_before_the_run() {
+    let src = root().join("cases/wing_aoa5.json");
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(src).unwrap()).unwrap();
+    let i = v["joints"].as_array().unwrap().iter().position(|j| j["type"] == "flared_hinge").unwrap();
+    v["joints"][i]["flare_deg"] = serde_json::json!(85.0);
+    let dir = std::env::temp_dir().join(format!("harness-cli-{}/wing_flare85", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("case.json"), serde_json::to_string(&v).unwrap()).unwrap();
+    let o = harness(&["list", "--cases", dir.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_clean_error(&o, &format!("joints[{i}].flare_deg"));
 }

@@ -161,13 +161,13 @@ impl Scene {
             }
             attached[b] = Some(j);
         }
-        for b in 0..nb {
+        for (b, joint) in attached.iter().enumerate() {
             let (mut cur, mut n) = (b, 0);
             while let Some(p) = parent[cur] {
                 n += 1;
                 cur = p;
                 if n > nb {
-                    return Err(Error::JointLoop { joint: attached[b].unwrap_or(0) });
+                    return Err(Error::JointLoop { joint: joint.unwrap_or(0) });
                 }
             }
         }

@@ -40,6 +40,10 @@ impl ChordwiseSpacing {
     }
 }
 
+/// Largest flare angle of a hinge column, degrees (exclusive): beyond it the slanted column's
+/// panels degenerate (their spanwise edges approach the chordwise lines).
+pub const MAX_HINGE_FLARE_DEG: f64 = 80.0;
+
 /// A flared hinge placed on an interior grid column.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -144,7 +148,7 @@ impl Lattice {
             if h.column == 0 || h.column >= n {
                 return Err(UvlmError::HingeNotInterior { column: h.column, n_columns_minus_one: n });
             }
-            if !(h.flare.is_finite() && h.flare.abs() < 80f64.to_radians()) {
+            if !(h.flare.is_finite() && h.flare.abs() < MAX_HINGE_FLARE_DEG.to_radians()) {
                 return Err(UvlmError::InvalidParameter { field: "hinge.flare", value: h.flare });
             }
         }
