@@ -118,6 +118,13 @@ pub enum Error {
         /// The joint.
         joint: usize,
     },
+    /// A query that needs a free hinge (a ground hinge or a free flared hinge) was given
+    /// another joint.
+    #[error("joints[{joint}] is not a ground hinge or a free flared hinge")]
+    NotAFreeHinge {
+        /// The joint.
+        joint: usize,
+    },
     /// A node index out of range.
     #[error("body {body} has no node {node} (it has {n_nodes})")]
     NoSuchNode {

@@ -8,16 +8,18 @@ use crate::element::{ElementState, Mat24, V_OFF, Vec24};
 use crate::flared_hinge::FlaredHinge;
 use crate::gravity::{add_gravity, potential};
 use crate::ground_hinge::GroundHinge;
+use crate::hinge_spring::{HingeSpring, principal_angle, unwrap};
 use crate::inertia::{MatrixCoefficients, add_inertia};
 use crate::joint::Joint;
 use crate::loads::{NodalLoad, add_load, add_load_tangent};
 use crate::quaternion::Quaternion;
 use crate::stiffness::add_elastic;
-use crate::{BodySpec, Error, JointSpec, Options, Scene};
+use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::Vector3;
 
-/// Energies in J. potential = −∫ m g·(r − r_ref) ds (zero in the reference configuration).
+/// Energies in J. potential = −∫ m g·(r − r_ref) ds − Σ m_p g·(r_p − r_p,ref) (zero in the
+/// reference configuration).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Energies {
     /// Kinetic energy, J.
@@ -26,12 +28,14 @@ pub struct Energies {
     pub elastic: f64,
     /// Gravitational potential energy, J.
     pub potential: f64,
+    /// Energy of the hinge springs `Σ ½ k (θ − θ₀)²`, J.
+    pub spring: f64,
 }
 
 impl Energies {
-    /// kinetic + elastic + potential, J.
+    /// kinetic + elastic + potential + spring, J.
     pub fn total(&self) -> f64 {
-        self.kinetic + self.elastic + self.potential
+        self.kinetic + self.elastic + self.potential + self.spring
     }
 }
 
@@ -54,6 +58,11 @@ pub struct Model {
     n_loaded: usize,
     /// Factor on gravity and nodal loads (load stepping in statics).
     pub(crate) load_scale: f64,
+    /// Hinge springs and dampers.
+    springs: Vec<HingeSpring>,
+    /// Per joint: the hinge angle θ of the last accepted step (free hinges; 0 otherwise), rad,
+    /// against which the principal angle is unwrapped (docs/gebf.md §13).
+    hinge_last: Vec<f64>,
 }
 
 /// The element's local unknowns as two contiguous global ranges: (first local index, first
@@ -116,7 +125,8 @@ impl Model {
             .map(|spec| match *spec {
                 JointSpec::GroundHinge { body, ref axis } => Joint::Ground(GroundHinge::new(body, axis, &bs[body])),
                 JointSpec::Clamp { body } => Joint::Clamp(Clamp { body }),
-                JointSpec::FlaredHinge { parent: p, child: c, beta } | JointSpec::LockedHinge { parent: p, child: c, beta } => {
+                JointSpec::FlaredHinge { parent: p, child: c, beta }
+                | JointSpec::LockedHinge { parent: p, child: c, beta } => {
                     parent[c] = Some(p);
                     let locked = matches!(spec, JointSpec::LockedHinge { .. });
                     Joint::Flared(FlaredHinge::new(p, c, beta, locked, &bs[p], &bs[c]))
@@ -124,9 +134,7 @@ impl Model {
             })
             .collect();
         // Depth of every body along its parents.
-        let depth: Vec<usize> = (0..nb)
-            .map(|b| std::iter::successors(parent[b], |&p| parent[p]).count())
-            .collect();
+        let depth: Vec<usize> = (0..nb).map(|b| std::iter::successors(parent[b], |&p| parent[p]).count()).collect();
         let joint_body: Vec<usize> = joints
             .iter()
             .map(|s| match s {
@@ -143,6 +151,16 @@ impl Model {
             rows += j.n_rows();
         }
         let loads = bs.iter().map(|b| vec![NodalLoad::default(); b.n_nodes()]).collect();
+        let springs = scene
+            .forces
+            .iter()
+            .map(|f| match *f {
+                ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
+                    HingeSpring { joint, stiffness, damping, rest }
+                }
+            })
+            .collect();
+        let hinge_last = vec![0.0; js.len()];
         Ok(Model {
             bodies: bs,
             joints: js,
@@ -156,6 +174,8 @@ impl Model {
             loads,
             n_loaded: 0,
             load_scale: 1.0,
+            springs,
+            hinge_last,
         })
     }
 
@@ -323,6 +343,42 @@ impl Model {
         }
     }
 
+    /// The hinge angle θ (rad) used by a hinge spring on joint `joint` (a ground hinge or a free
+    /// flared hinge, with or without a spring): for a flared hinge the fold angle
+    /// ([`fold_angle`](Self::fold_angle)), for a ground hinge the body's rotation about the hinge
+    /// axis (right-handed), both zero in the reference configuration. Unlike `fold_angle` it is
+    /// unwrapped against the angle of the last accepted step (docs/gebf.md §13), so it is
+    /// continuous through ±180° and counts turns.
+    pub fn hinge_angle(&self, q: &[f64], joint: usize) -> Result<f64, Error> {
+        let j = self.joints.get(joint).ok_or(Error::NoSuchJoint { joint, n_joints: self.joints.len() })?;
+        let principal = principal_angle(j, &self.bodies, q).ok_or(Error::NotAFreeHinge { joint })?;
+        Ok(unwrap(principal, self.hinge_last[joint]))
+    }
+
+    /// Set the angles the hinge angles are unwrapped against to the principal angles at `q`
+    /// (in (−π, π]). The model does this itself after every accepted step; call it before
+    /// integrating from a state that is not the continuation of the last step (a model reused
+    /// for a new run). [`simulate::run`](crate::simulate::run) calls it at its start.
+    pub fn reset_hinge_angles(&mut self, q: &[f64]) {
+        for (j, last) in self.joints.iter().zip(self.hinge_last.iter_mut()) {
+            *last = principal_angle(j, &self.bodies, q).unwrap_or(0.0);
+        }
+    }
+
+    /// Power dissipated by the hinge dampers, `Σ c θ̇² ≥ 0`, W. Its time integral is the
+    /// work the dampers remove: `E(t) + ∫ Σ c θ̇² dt` is conserved without external loads.
+    pub fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
+        self.springs
+            .iter()
+            .filter(|s| s.damping != 0.0)
+            .filter_map(|s| {
+                let j = &self.joints[s.joint];
+                HingeSpring::angle_and_rate(j, &self.bodies, self.hinge_last[s.joint], q, v)
+                    .map(|(_, rate)| s.damping * rate * rate)
+            })
+            .sum()
+    }
+
     /// Indices (into the joint list) of the flared hinges.
     pub fn flared_hinges(&self) -> Vec<usize> {
         self.joints.iter().enumerate().filter(|(_, j)| matches!(j, Joint::Flared(_))).map(|(i, _)| i).collect()
@@ -340,6 +396,12 @@ impl Model {
                 e.kinetic += add_inertia(&st, b.le, &b.section, &mut res, None);
                 e.elastic += add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
                 e.potential += potential(&st, b, el, &self.gravity, &r_a, &c_ga);
+            }
+        }
+        for s in &self.springs {
+            let j = &self.joints[s.joint];
+            if let Some((theta, _)) = HingeSpring::angle_and_rate(j, &self.bodies, self.hinge_last[s.joint], q, v) {
+                e.spring += s.energy(theta);
             }
         }
         e
@@ -462,6 +524,11 @@ impl Model {
                     }
                 }
             }
+        }
+        for s in &self.springs {
+            let matrix = matrix.as_mut().map(|(c, k)| (c.c_c, c.c_k, &mut **k));
+            let j = &self.joints[s.joint];
+            s.add(j, &self.bodies, self.hinge_last[s.joint], q, v, r.as_deref_mut(), matrix);
         }
     }
 
@@ -613,6 +680,13 @@ impl ConstrainedSystem for Model {
                 self.joints[j].project(&self.bodies, q, [&mut *v, &mut *v_dot, &mut *a]);
             }
         }
+        // The accepted angles, for the unwrapping in the next step (the rescaling and the
+        // projection above keep every rotation, so they do not move the angle).
+        for (j, last) in self.joints.iter().zip(self.hinge_last.iter_mut()) {
+            if let Some(p) = principal_angle(j, &self.bodies, q) {
+                *last = unwrap(p, *last);
+            }
+        }
     }
 
     /// Each body's nodal unknowns form a band block (an element couples 3 consecutive nodes:
@@ -649,9 +723,6 @@ fn unsupported(scene: &Scene) -> Result<(), Error> {
         if !b.point_masses.is_empty() {
             return Err(Error::Unsupported { field: format!("bodies[{i}].point_masses") });
         }
-    }
-    if let Some(f) = scene.forces.first() {
-        return Err(Error::Unsupported { field: format!("joints[{}].spring", f.joint()) });
     }
     Ok(())
 }

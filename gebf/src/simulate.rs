@@ -16,6 +16,7 @@ pub fn run(
 ) -> Result<(State, Stats), Error> {
     let mut ga = GenAlpha::new(params, model)?;
     let mut s = model.initial_state();
+    model.reset_hinge_angles(&s.q);
     ga.initialize(model, &mut s)?;
     observe(model, &s, &StepStats::default());
     let n_steps = (t_end / params.dt).round() as usize;

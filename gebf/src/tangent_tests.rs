@@ -12,7 +12,7 @@ use crate::element::{ElementState, Mat24, Vec24};
 use crate::gravity::add_gravity;
 use crate::inertia::{MatrixCoefficients, add_inertia};
 use crate::stiffness::add_elastic;
-use crate::{BodySpec, JointSpec, Model, NodalLoad, Options, Section};
+use crate::{BodySpec, ForceElement, JointSpec, Model, NodalLoad, Options, Scene, Section};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use proptest::prelude::*;
 
@@ -201,7 +201,13 @@ fn mass_matrix_is_symmetric_positive_definite() {
 
 /// A two-body flared pendulum with a third free body hanging off the second: covers the ground
 /// hinge, two flared hinges and nodal loads at a random state.
-fn random_model(rng: &mut Lcg, beta: f64, locked: bool) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+/// Optionally with a hinge spring and damper on every free hinge.
+fn random_model_with(
+    rng: &mut Lcg,
+    beta: f64,
+    locked: bool,
+    springs: bool,
+) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let sec = unit_section();
     let f1 = rotation_matrix(&V3::new(0.1, -0.2, 0.3));
     let f2 = rotation_matrix(&V3::new(-0.3, 0.2, 0.4));
@@ -228,7 +234,16 @@ fn random_model(rng: &mut Lcg, beta: f64, locked: bool) -> (Model, Vec<f64>, Vec
             JointSpec::FlaredHinge { parent: 1, child: 2, beta: -0.3 }
         },
     ];
-    let mut model = Model::new(&bodies, &joints, V3::new(0.5, -1.0, -9.8), Options::default()).unwrap();
+    let mut scene = Scene::new(bodies, joints, V3::new(0.5, -1.0, -9.8));
+    if springs {
+        let free = if locked { 2 } else { 3 };
+        for (joint, stiffness, damping, rest) in
+            [(0, 3.0, 0.7, 0.2), (1, 2.0, 1.3, -0.4), (2, 1.5, 0.4, 2.9)].into_iter().take(free)
+        {
+            scene.forces.push(ForceElement::HingeSpring { joint, stiffness, damping, rest });
+        }
+    }
+    let mut model = Model::from_scene(&scene, Options::default()).unwrap();
     model.set_nodal_load(1, 4, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
     model.set_nodal_load(2, 0, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
     model.set_nodal_load(0, 3, NodalLoad { force: rng.v3(2.0), moment: rng.v3(2.0) }).unwrap();
@@ -315,8 +330,12 @@ fn check_iteration_matrix(model: &Model, q: &[f64], v: &[f64], a: &[f64], label:
 }
 
 fn check_model(seed: u64, beta: f64, locked: bool) {
+    check_model_with(seed, beta, locked, false);
+}
+
+fn check_model_with(seed: u64, beta: f64, locked: bool, springs: bool) {
     let mut rng = Lcg(seed);
-    let (model, q, v, a, mu) = random_model(&mut rng, beta, locked);
+    let (model, q, v, a, mu) = random_model_with(&mut rng, beta, locked, springs);
     let n = model.n_dof();
     let nc = model.n_velocity_constraints();
     check_iteration_matrix(&model, &q, &v, &a, &format!("model iteration matrix (seed {seed})"));
@@ -359,6 +378,53 @@ fn check_model(seed: u64, beta: f64, locked: bool) {
 #[test]
 fn model_tangents_match_finite_differences() {
     check_model(3, 0.7, false);
+}
+
+/// Hinge springs and dampers on the ground hinge and both flared hinges: the residual's
+/// position and velocity tangents (c_k, c_c parts of the iteration matrix) against finite
+/// differences along the retraction.
+#[test]
+fn model_tangents_with_hinge_springs() {
+    check_model_with(3, 0.7, false, true);
+    check_model_with(8, std::f64::consts::FRAC_PI_2, false, true);
+    check_model_with(5, 0.4, true, true);
+}
+
+/// The springs' own forces and tangents, isolated: the difference of the models with and
+/// without springs at the same state (so no other term hides an error), against finite
+/// differences along the retraction; the velocity tangent is checked the same way.
+#[test]
+fn hinge_spring_tangents_alone() {
+    for (seed, beta) in [(3, 0.7), (9, -1.2), (12, std::f64::consts::FRAC_PI_2)] {
+        let (with, q, v, a, _) = random_model_with(&mut Lcg(seed), beta, false, true);
+        let (without, ..) = random_model_with(&mut Lcg(seed), beta, false, false);
+        let n = with.n_dof();
+        let spring = |q: &[f64], v: &[f64], r: &mut [f64]| {
+            let mut r0 = vec![0.0; n];
+            with.residual_inplace(0.0, q, v, &a, r);
+            without.residual_inplace(0.0, q, v, &a, &mut r0);
+            r.iter_mut().zip(&r0).for_each(|(x, y)| *x -= y);
+        };
+        for (which, c_c, c_k) in [(1, 1.0, 0.0), (2, 0.0, 1.0)] {
+            let (mut k1, mut k0) = (DenseMatrix::zeros(n, n), DenseMatrix::zeros(n, n));
+            with.iteration_matrix_inplace(0.0, &q, &v, &a, 0.0, c_c, c_k, &mut k1.view());
+            without.iteration_matrix_inplace(0.0, &q, &v, &a, 0.0, c_c, c_k, &mut k0.view());
+            let mut an = DenseMatrix::zeros(n, n);
+            for j in 0..n {
+                for i in 0..n {
+                    *an.get_mut(i, j) = k1.get(i, j) - k0.get(i, j);
+                }
+            }
+            let fd = if which == 1 {
+                fd_x(n, &v, n, |x, r| spring(&q, x, r))
+            } else {
+                fd_q(&with, &q, n, |x, r| spring(x, &v, r))
+            };
+            let e = dense_rel_err(&an, &fd);
+            println!("spring alone (seed {seed}, part {which}): rel err {e:.2e}");
+            assert!(e < TOL, "spring alone (seed {seed}, part {which}): rel err {e:.2e}");
+        }
+    }
 }
 
 /// The locked hinge's sixth (axial) angular row in every tangent.
@@ -437,9 +503,9 @@ fn model_tangents_with_rescaled_crvs() {
 /// large rotations (elements mapped across π take the separate residual path).
 #[test]
 fn fused_residual_and_matrix_equal_the_separate_calls() {
-    for (seed, scale) in [(5, 1.0), (6, 15.0)] {
+    for (seed, scale, springs) in [(5, 1.0, false), (6, 15.0, false), (7, 1.0, true)] {
         let mut rng = Lcg(seed);
-        let (model, q0, v, a, _) = random_model(&mut rng, 0.4, false);
+        let (model, q0, v, a, _) = random_model_with(&mut rng, 0.4, false, springs);
         let n = model.n_dof();
         let dq: Vec<f64> = (0..n).map(|_| rng.next() * scale).collect();
         let mut q = q0.clone();
