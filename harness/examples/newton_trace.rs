@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use genalpha::{GenAlpha, IterationRecord, LinearSolver};
 use harness::case::{CaseFile, Formulation, Override};
 use harness::run::Structure;
-use harness::scene::{Sensed, build_ancf, build_gebf, settings};
+use harness::scene::{build_ancf, build_gebf, settings};
 
 fn trace<S: Structure>(sys: &mut S, params: genalpha::IntegratorParams, t_end: f64) -> Result<Vec<IterationRecord>>
 where
@@ -51,12 +51,11 @@ fn main() -> Result<()> {
     if case.aero.is_some() {
         bail!("{}: cases with aerodynamics are not traced", spec.name);
     }
-    let fold_joint = case.fold_joint_index();
     let run = settings(case, if gebf { Formulation::Gebf } else { Formulation::Ancf });
     let records = if gebf {
-        trace(&mut Sensed { model: build_gebf(case)?, fold_joint }, run.params, run.t_end)?
+        trace(&mut build_gebf(case)?, run.params, run.t_end)?
     } else {
-        trace(&mut Sensed { model: build_ancf(case)?, fold_joint }, run.params, run.t_end)?
+        trace(&mut build_ancf(case)?, run.params, run.t_end)?
     };
     println!("t,h,iter,factorized,residual_norm,phi_norm,psi_norm,increment_norm,worst_unknown");
     for r in &records {

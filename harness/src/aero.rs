@@ -217,8 +217,9 @@ pub fn simulate_aero<S: AeroStructure>(
     settings: &crate::run::RunSettings,
     aero: &AeroSettings,
     map: &[StationMap],
+    observer: &mut dyn crate::run::Observer,
 ) -> crate::run::RunOutput {
-    use crate::run::{RunOutput, row};
+    use crate::run::{RunOutput, SnapshotFeed, row};
     use genalpha::State;
     let start = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
@@ -270,10 +271,15 @@ pub fn simulate_aero<S: AeroStructure>(
     let (mut fbuf, mut mbuf) = (vec![[0.0; 3]; map.len()], vec![[0.0; 3]; map.len()]);
     let mut work = 0.0;
     let mut lift;
-    let mut r0 = row(model, &s, 0);
+    let fold = settings.fold_joint;
+    let mut feed = SnapshotFeed::new(observer);
+    let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
     r0.lift = 0.0;
     out.rows.push(r0);
+    if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
+        return fail(out, format!("output at t = {}: {e}", s.t));
+    }
     let mut qp = vec![0.0; s.q.len()];
     let mut vel_n = Vec::with_capacity(map.len());
     let mut dq = vec![0.0; s.v.len()];
@@ -354,10 +360,13 @@ pub fn simulate_aero<S: AeroStructure>(
         stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
         work += 0.5 * dt * (power(&loads, &vel_n) + power(&loads, &vel));
         if k % every == 0 || k == n_steps {
-            let mut r = row(model, &s, st.n_newton_iters);
+            let mut r = row(model, fold, &s, st.n_newton_iters);
             r.aero_work = work;
             r.lift = lift;
             out.rows.push(r);
+            if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
+                return fail(out, format!("step {k}: output: {e}"));
+            }
         }
     }
     out.stats = *ga.stats();

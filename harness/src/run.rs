@@ -3,6 +3,7 @@
 use std::time::Instant;
 
 use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, LinearSolver, State, Stats};
+use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
 use crate::case::Formulation;
@@ -19,7 +20,9 @@ pub struct Energies {
 }
 
 /// What the harness needs from a structural model beyond the integrator's trait: its initial
-/// state and the sensors. Implemented in [`crate::scene`] for both formulations.
+/// state, the sensors and its geometry. Implemented in [`crate::scene`] directly on both
+/// formulations' models (the integrator sees the model itself, with every optional method of
+/// its trait).
 pub trait Structure: ConstrainedSystem {
     /// The linear solver the formulation integrates best with.
     type Solver: LinearSolver;
@@ -29,12 +32,114 @@ pub trait Structure: ConstrainedSystem {
     fn initial_state(&self) -> State;
     /// Tip position (centroid of the last body's free end), m.
     fn tip(&self, q: &[f64]) -> [f64; 3];
-    /// Fold angle of the sensor joint, rad (NaN without one).
-    fn fold(&self, q: &[f64]) -> f64;
+    /// Fold angle of flared hinge `joint`, rad (NaN when it is not one).
+    fn fold(&self, q: &[f64], joint: usize) -> f64;
     /// Energies.
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
     /// Position-level joint violation (gap in m and axis misalignment in rad, Euclidean norm).
     fn constraint_residual(&self, q: &[f64]) -> f64;
+    /// Number of bodies.
+    fn n_bodies(&self) -> usize;
+    /// Positions and section frames of body `body`'s nodes, written into `out` (cleared first).
+    fn body_geometry(&self, q: &[f64], body: usize, out: &mut BeamGeometry);
+}
+
+/// One body's nodes in the current configuration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BeamGeometry {
+    /// Arclength of each node in the reference configuration, m.
+    pub arc: Vec<f64>,
+    /// Node positions, global, m.
+    pub positions: Vec<Vector3<f64>>,
+    /// Section frames at the nodes: columns x (beam axis), y, z, global.
+    pub frames: Vec<Matrix3<f64>>,
+}
+
+impl BeamGeometry {
+    /// Forget the nodes, keep the storage.
+    pub fn clear(&mut self) {
+        self.arc.clear();
+        self.positions.clear();
+        self.frames.clear();
+    }
+
+    /// Append a node.
+    pub fn push(&mut self, arc: f64, position: Vector3<f64>, frame: Matrix3<f64>) {
+        self.arc.push(arc);
+        self.positions.push(position);
+        self.frames.push(frame);
+    }
+}
+
+/// What a run hands its [`Observer`] at every output step: the time, every body's nodes with their
+/// section frames, and the aerodynamic state (lattice, bound circulation, wake) when the case has
+/// one. Borrowed: an observer copies what it keeps.
+pub struct Snapshot<'a> {
+    /// Output row index (0 at the initial state).
+    pub index: usize,
+    /// Time, s.
+    pub t: f64,
+    /// One entry per body.
+    pub beams: &'a [BeamGeometry],
+    /// The UVLM after the step (lattice, `gamma()`, `wake()`, `loads()`), if any.
+    pub aero: Option<&'a uvlm::Uvlm>,
+}
+
+/// Receives each output step's geometry (3-D output, animation, probes): the output seam. The time
+/// loops call it; a new output format implements it and touches no loop.
+pub trait Observer {
+    /// Whether the run should assemble snapshots at all (false: no geometry is computed).
+    fn wants_snapshots(&self) -> bool {
+        true
+    }
+    /// One output step. An error stops the run with the message.
+    fn observe(&mut self, snapshot: &Snapshot<'_>) -> Result<(), String>;
+}
+
+/// The observer of a run that records only its rows.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn wants_snapshots(&self) -> bool {
+        false
+    }
+    fn observe(&mut self, _: &Snapshot<'_>) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// Builds snapshots with reused storage and hands them to an observer.
+pub(crate) struct SnapshotFeed<'o> {
+    observer: &'o mut dyn Observer,
+    beams: Vec<BeamGeometry>,
+    index: usize,
+}
+
+impl<'o> SnapshotFeed<'o> {
+    pub(crate) fn new(observer: &'o mut dyn Observer) -> Self {
+        Self { observer, beams: Vec::new(), index: 0 }
+    }
+
+    /// Hand the state `q` at `t` (and the UVLM, if any) to the observer.
+    pub(crate) fn feed<S: Structure + ?Sized>(
+        &mut self,
+        model: &S,
+        t: f64,
+        q: &[f64],
+        aero: Option<&uvlm::Uvlm>,
+    ) -> Result<(), String> {
+        let index = self.index;
+        self.index += 1;
+        if !self.observer.wants_snapshots() {
+            return Ok(());
+        }
+        self.beams.resize_with(model.n_bodies(), BeamGeometry::default);
+        for (b, g) in self.beams.iter_mut().enumerate() {
+            model.body_geometry(q, b, g);
+        }
+        self.observer.observe(&Snapshot { index, t, beams: &self.beams, aero })
+    }
 }
 
 /// One output row (the CSV columns).
@@ -73,6 +178,8 @@ pub struct RunSettings {
     pub t_end: f64,
     /// Output interval, s (None: every step).
     pub output_dt: Option<f64>,
+    /// The flared hinge whose fold angle is the `fold` column (None: NaN).
+    pub fold_joint: Option<usize>,
 }
 
 /// Outcome of one run: what was computed, even when it failed part-way.
@@ -110,12 +217,12 @@ impl RunOutput {
 }
 
 /// The sensors of `model` at state `s` (aerodynamic columns NaN).
-pub fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize) -> Row {
+pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &State, newton_iterations: usize) -> Row {
     let e = model.energies(&s.q, &s.v);
     Row {
         t: s.t,
         tip: model.tip(&s.q),
-        fold: model.fold(&s.q),
+        fold: fold_joint.map_or(f64::NAN, |j| model.fold(&s.q, j)),
         kinetic: e.kinetic,
         elastic: e.elastic,
         potential: e.potential,
@@ -127,9 +234,14 @@ pub fn row<S: Structure + ?Sized>(model: &S, s: &State, newton_iterations: usize
     }
 }
 
-/// Integrate `model` from its reference state to `t_end`, recording rows.
-/// A Newton failure ends the run with `error` set and the rows computed so far.
-pub fn simulate<S: Structure>(formulation: Formulation, model: &mut S, settings: &RunSettings) -> RunOutput {
+/// Integrate `model` from its reference state to `t_end`, recording rows and handing each output
+/// step to `observer`. A Newton failure ends the run with `error` set and the rows computed so far.
+pub fn simulate<S: Structure>(
+    formulation: Formulation,
+    model: &mut S,
+    settings: &RunSettings,
+    observer: &mut dyn Observer,
+) -> RunOutput {
     let start = Instant::now();
     let mut out = RunOutput {
         formulation,
@@ -156,12 +268,22 @@ pub fn simulate<S: Structure>(formulation: Formulation, model: &mut S, settings:
         out.error = Some(format!("initial accelerations: {e}"));
         return out;
     }
-    out.rows.push(row(model, &s, 0));
+    let fold = settings.fold_joint;
+    let mut feed = SnapshotFeed::new(observer);
+    out.rows.push(row(model, fold, &s, 0));
+    if let Err(e) = feed.feed(model, s.t, &s.q, None) {
+        out.error = Some(format!("output at t = {}: {e}", s.t));
+        return out;
+    }
     for k in 1..=n_steps {
         match ga.step(model, &mut s) {
             Ok(st) => {
                 if k % every == 0 || k == n_steps {
-                    out.rows.push(row(model, &s, st.n_newton_iters));
+                    out.rows.push(row(model, fold, &s, st.n_newton_iters));
+                    if let Err(e) = feed.feed(model, s.t, &s.q, None) {
+                        out.error = Some(format!("step {k}: output: {e}"));
+                        break;
+                    }
                 }
             }
             Err(e) => {

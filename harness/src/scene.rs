@@ -6,96 +6,14 @@ use nalgebra::{Matrix3, Vector3};
 use crate::Error;
 use crate::aero::{AeroStructure, SectionLoad, simulate_aero, station_map};
 use crate::case::{AncfPath, Case, Formulation};
-use crate::run::{Energies, RunOutput, RunSettings, Structure, simulate};
+use crate::run::{BeamGeometry, Energies, NoObserver, Observer, RunOutput, RunSettings, Structure, simulate};
 
-/// A model with its fold-sensor joint.
-pub struct Sensed<M> {
-    /// The model.
-    pub model: M,
-    /// Joint index of the fold sensor.
-    pub fold_joint: Option<usize>,
-}
-
-macro_rules! forward_system {
-    ($t:ty) => {
-        impl genalpha::ConstrainedSystem for Sensed<$t> {
-            fn n_coords(&self) -> usize {
-                self.model.n_coords()
-            }
-            fn n_dof(&self) -> usize {
-                self.model.n_dof()
-            }
-            fn n_holonomic(&self) -> usize {
-                self.model.n_holonomic()
-            }
-            fn n_velocity_constraints(&self) -> usize {
-                self.model.n_velocity_constraints()
-            }
-            fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
-                self.model.retract_inplace(q, dq, q_out)
-            }
-            fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
-                self.model.residual_inplace(t, q, v, v_dot, r)
-            }
-            fn iteration_matrix_inplace(
-                &self,
-                t: f64,
-                q: &[f64],
-                v: &[f64],
-                v_dot: &[f64],
-                c_m: f64,
-                c_c: f64,
-                c_k: f64,
-                k: &mut genalpha::MatView<'_>,
-            ) {
-                self.model.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k)
-            }
-            fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
-                self.model.phi_inplace(t, q, phi)
-            }
-            fn phi_q_inplace(&self, t: f64, q: &[f64], j: &mut genalpha::MatView<'_>) {
-                self.model.phi_q_inplace(t, q, j)
-            }
-            fn phi_q_is_constant(&self) -> bool {
-                self.model.phi_q_is_constant()
-            }
-            fn phi_qq_vv_inplace(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-                self.model.phi_qq_vv_inplace(t, q, v, out)
-            }
-            fn psi_inplace(&self, t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
-                self.model.psi_inplace(t, q, v, psi)
-            }
-            fn psi_v_inplace(&self, t: f64, q: &[f64], j: &mut genalpha::MatView<'_>) {
-                self.model.psi_v_inplace(t, q, j)
-            }
-            fn psi_q_inplace(&self, t: f64, q: &[f64], v: &[f64], j: &mut genalpha::MatView<'_>) {
-                self.model.psi_q_inplace(t, q, v, j)
-            }
-            fn constraint_force_tangent_inplace(
-                &self,
-                t: f64,
-                q: &[f64],
-                lambda: &[f64],
-                mu: &[f64],
-                c_k: f64,
-                k: &mut genalpha::MatView<'_>,
-            ) {
-                self.model.constraint_force_tangent_inplace(t, q, lambda, mu, c_k, k)
-            }
-            fn post_step(&mut self, t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
-                self.model.post_step(t, q, v, v_dot, a)
-            }
-            fn increment_weight(&self, i: usize) -> f64 {
-                self.model.increment_weight(i)
-            }
-        }
-    };
-}
-
+/// `Structure` for a formulation's model: the integrator it runs with and its sensors. The
+/// model itself goes to the integrator, so every optional method of `ConstrainedSystem` it
+/// overrides (GEBF's fused residual-and-matrix pass, its declared matrix structure) is used.
 macro_rules! structure {
-    ($t:ty, $solver:ty, $make:expr) => {
-        forward_system!($t);
-        impl Structure for Sensed<$t> {
+    ($t:ty, $solver:ty, $make:expr, $geometry:expr) => {
+        impl Structure for $t {
             type Solver = $solver;
             fn integrator(
                 &self,
@@ -103,23 +21,31 @@ macro_rules! structure {
             ) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> {
                 let make: fn(&$t, genalpha::IntegratorParams) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> =
                     $make;
-                make(&self.model, params)
+                make(self, params)
             }
             fn initial_state(&self) -> genalpha::State {
-                self.model.initial_state()
+                <$t>::initial_state(self)
             }
             fn tip(&self, q: &[f64]) -> [f64; 3] {
-                self.model.tip_position(q).into()
+                self.tip_position(q).into()
             }
-            fn fold(&self, q: &[f64]) -> f64 {
-                self.fold_joint.and_then(|j| self.model.fold_angle(q, j).ok()).unwrap_or(f64::NAN)
+            fn fold(&self, q: &[f64], joint: usize) -> f64 {
+                self.fold_angle(q, joint).unwrap_or(f64::NAN)
             }
             fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
-                let e = self.model.energies(q, v);
+                let e = <$t>::energies(self, q, v);
                 Energies { kinetic: e.kinetic, elastic: e.elastic, potential: e.potential }
             }
             fn constraint_residual(&self, q: &[f64]) -> f64 {
-                self.model.constraint_residual(q)
+                <$t>::constraint_residual(self, q)
+            }
+            fn n_bodies(&self) -> usize {
+                <$t>::n_bodies(self)
+            }
+            fn body_geometry(&self, q: &[f64], body: usize, out: &mut BeamGeometry) {
+                out.clear();
+                let geometry: fn(&$t, &[f64], usize, &mut BeamGeometry) = $geometry;
+                geometry(self, q, body, out)
             }
         }
     };
@@ -127,13 +53,31 @@ macro_rules! structure {
 
 // ANCF brings its skyline LU (banded, symmetric-structure); GEBF declares a block-banded
 // structure that genalpha's default solver exploits.
-structure!(ancf::Model, ancf::SkylineLu, |m, p| m.integrator(p));
-structure!(gebf::Model, genalpha::DenseLu, |m, p| genalpha::GenAlpha::new(p, m));
+structure!(ancf::Model, ancf::SkylineLu, |m, p| m.integrator(p), |m, q, body, out| {
+    // The nodes of ANCF's two-node elements, equally spaced.
+    let Some(spec) = m.body_spec(body) else { return };
+    for k in 0..=spec.n_elements {
+        let s = spec.length * k as f64 / spec.n_elements as f64;
+        if let Ok((p, r)) = m.section_frame(q, body, s) {
+            out.push(s, p, r);
+        }
+    }
+});
+structure!(gebf::Model, genalpha::DenseLu, |m, p| genalpha::GenAlpha::new(p, m), |m, q, body, out| {
+    // Every node of the three-node elements, middle nodes included.
+    for k in 0..m.n_nodes(body) {
+        if let (Ok(s), Ok(p), Ok(r)) =
+            (m.node_arc_length(body, k), m.node_position(q, body, k), m.node_frame(q, body, k))
+        {
+            out.push(s, p, r);
+        }
+    }
+});
 
-impl AeroStructure for Sensed<ancf::Model> {
+impl AeroStructure for ancf::Model {
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
         // The station list is validated against the case, so (body, s) is always in range.
-        self.model.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))
+        self.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))
     }
     fn set_section_loads(&mut self, loads: &[SectionLoad]) {
         let pl: Vec<ancf::PointLoad> = loads
@@ -141,7 +85,7 @@ impl AeroStructure for Sensed<ancf::Model> {
             .map(|l| ancf::PointLoad { body: l.body, s: l.s, y: 0.0, z: 0.0, force: l.force, moment: l.moment })
             .collect();
         // Stations come from the validated case: in range by construction.
-        let _ = self.model.set_point_loads(&pl);
+        let _ = self.set_point_loads(&pl);
     }
 }
 
@@ -165,7 +109,6 @@ fn gebf_element(model: &gebf::Model, body: usize, s: f64) -> Option<([usize; 3],
     None
 }
 
-/// Rotation vector of a rotation matrix (|θ| < π).
 /// Rotation vector of a rotation matrix. Through the quaternion (Shepperd's method), accurate at
 /// every angle: an `acos` of the trace returns NaN when rounding pushes it past 3 for the tiny
 /// relative rotations of a stiff wing.
@@ -173,11 +116,11 @@ fn log_so3(r: &Matrix3<f64>) -> Vector3<f64> {
     gebf::crv::from_rotation_matrix(r)
 }
 
-impl AeroStructure for Sensed<gebf::Model> {
+impl AeroStructure for gebf::Model {
     /// Quadratic interpolation of the element's nodal positions, and of the nodal rotations
     /// relative to the middle node (objective).
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
-        let m = &self.model;
+        let m = self;
         let Some((nodes, w)) = gebf_element(m, body, s) else {
             return (Vector3::from_element(f64::NAN), Matrix3::identity());
         };
@@ -191,16 +134,15 @@ impl AeroStructure for Sensed<gebf::Model> {
     }
     /// Consistent nodal loads: the quadratic weights distribute each station's force and moment.
     fn set_section_loads(&mut self, loads: &[SectionLoad]) {
-        self.model.clear_nodal_loads();
+        self.clear_nodal_loads();
         for l in loads {
-            let Some((nodes, w)) = gebf_element(&self.model, l.body, l.s) else { continue };
+            let Some((nodes, w)) = gebf_element(self, l.body, l.s) else { continue };
             for (k, wk) in nodes.iter().zip(w) {
                 let old = self
-                    .model
                     .nodal_load(l.body, *k)
                     .unwrap_or(gebf::NodalLoad { force: Vector3::zeros(), moment: Vector3::zeros() });
                 let new = gebf::NodalLoad { force: old.force + wk * l.force, moment: old.moment + wk * l.moment };
-                let _ = self.model.set_nodal_load(l.body, *k, new);
+                let _ = self.set_nodal_load(l.body, *k, new);
             }
         }
     }
@@ -230,7 +172,7 @@ pub fn settings(case: &Case, f: Formulation) -> RunSettings {
     // fails on soft tips at 2–5 × dt, where step control then recovers them), although its
     // energy error is 2–100 times smaller in most cells.
     params.form = form.to_form();
-    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt }
+    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt, fold_joint: case.fold_joint_index() }
 }
 
 /// Build the ANCF model of a case (DAE or ODE path as the case says).
@@ -253,22 +195,26 @@ pub fn build_gebf(case: &Case) -> Result<gebf::Model, Error> {
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot
 /// be built gives a failed [`RunOutput`] with the reason.
 pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
+    run_formulation_observed(case, f, &mut NoObserver)
+}
+
+/// As [`run_formulation`], handing every output step's geometry to `observer`.
+pub fn run_formulation_observed(case: &Case, f: Formulation, observer: &mut dyn Observer) -> RunOutput {
     let s = settings(case, f);
-    let fold_joint = case.fold_joint_index();
     let built = match (&case.aero, f) {
-        (None, Formulation::Ancf) => build_ancf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
-        (None, Formulation::Gebf) => build_gebf(case).map(|model| simulate(f, &mut Sensed { model, fold_joint }, &s)),
-        (Some(aero), _) => {
-            match station_map(case, aero) {
-                Err(msg) => Err(Error::Model { formulation: f, msg }),
-                Ok(map) => match f {
-                    Formulation::Ancf => build_ancf(case)
-                        .map(|model| simulate_aero(f, &mut Sensed { model, fold_joint }, &s, aero, &map)),
-                    Formulation::Gebf => build_gebf(case)
-                        .map(|model| simulate_aero(f, &mut Sensed { model, fold_joint }, &s, aero, &map)),
-                },
-            }
-        }
+        (None, Formulation::Ancf) => build_ancf(case).map(|mut model| simulate(f, &mut model, &s, observer)),
+        (None, Formulation::Gebf) => build_gebf(case).map(|mut model| simulate(f, &mut model, &s, observer)),
+        (Some(aero), _) => match station_map(case, aero) {
+            Err(msg) => Err(Error::Model { formulation: f, msg }),
+            Ok(map) => match f {
+                Formulation::Ancf => {
+                    build_ancf(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
+                }
+                Formulation::Gebf => {
+                    build_gebf(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
+                }
+            },
+        },
     };
     built.unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
 }
