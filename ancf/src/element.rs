@@ -5,7 +5,7 @@
 //! [`elastic_force`](crate::elastic_force).
 
 use crate::elastic_force::ElementMatrix;
-use crate::mass::{element_mass, nonzeros};
+use crate::mass::{cg_offset_mass, element_mass, nonzeros};
 use crate::shape::N_BLOCKS;
 use crate::strain::{StrainPlan, strain_plan};
 use crate::{Curvature, Section};
@@ -25,6 +25,8 @@ pub struct Element {
     pub plan: StrainPlan,
     /// Mass per unit length, kg/m (for gravity and point loads).
     pub mass_per_length: f64,
+    /// Centre of mass of the section `[y_c, z_c]`, section frame, m.
+    pub cg_offset: [f64; 2],
 }
 
 impl Element {
@@ -33,7 +35,15 @@ impl Element {
     /// (see [`strain`](crate::strain)).
     pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> Self {
         let (d_yy, d_zz) = section.slope_inertias();
-        let mass = element_mass(section.mass, d_yy, d_zz, l);
+        let mut mass = element_mass(section.mass, d_yy, d_zz, l);
+        if section.cg_offset != [0.0; 2] {
+            let extra = cg_offset_mass(section.mass, section.cg_offset, l);
+            for (row, extra_row) in mass.iter_mut().zip(&extra) {
+                for (m, x) in row.iter_mut().zip(extra_row) {
+                    *m += x;
+                }
+            }
+        }
         let mut mass_matrix = ElementMatrix::zeros();
         for (a, row) in mass.iter().enumerate() {
             for (b, m) in row.iter().enumerate() {
@@ -49,6 +59,7 @@ impl Element {
             mass,
             plan: strain_plan(l, section, curvature, penalty_factor, kappa),
             mass_per_length: section.mass,
+            cg_offset: section.cg_offset,
         }
     }
 
@@ -63,7 +74,8 @@ impl Element {
         }
     }
 
-    /// Generalized gravity force of one element, `∫ m S_cᵀ g dx` (24 numbers).
+    /// Generalized gravity force of one element, `∫ m S(x, y_c, z_c)ᵀ g dx` (24 numbers): the
+    /// weight acts at the section's centre of mass.
     pub fn gravity_force(&self, g: [f64; 3]) -> [f64; 24] {
         let (m, l) = (self.mass_per_length, self.l);
         // ∫ h dx = (l/2, l²/12, l/2, −l²/12)
@@ -72,6 +84,15 @@ impl Element {
         for (b, x) in w {
             for i in 0..3 {
                 f[3 * b + i] = m * x * g[i];
+            }
+        }
+        if self.cg_offset != [0.0; 2] {
+            // ∫ (1 − ξ) dx = ∫ ξ dx = l/2 on the slopes r_y (blocks 2, 6) and r_z (3, 7)
+            let [yc, zc] = self.cg_offset;
+            for (b, c) in [(2, yc), (6, yc), (3, zc), (7, zc)] {
+                for i in 0..3 {
+                    f[3 * b + i] = m * c * 0.5 * l * g[i];
+                }
             }
         }
         f

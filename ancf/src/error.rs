@@ -125,6 +125,13 @@ pub enum Error {
         /// Number of joints.
         n_joints: usize,
     },
+    /// A sensor that needs a ground hinge or a free flared hinge was asked about another joint
+    /// type.
+    #[error("joint {joint}: not a ground hinge or free flared hinge")]
+    NotAFreeHinge {
+        /// Index asked for.
+        joint: usize,
+    },
     /// A sensor that needs a flared hinge was asked about another joint type.
     #[error("joint {joint}: not a flared hinge")]
     NotAFlaredHinge {

@@ -45,15 +45,20 @@ pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 /// Fold angle θ of `r = R_parentᵀ R_child R_ref⁻¹` about `−a` (`a` in the parent section frame):
 /// `θ = atan2(n2·(r n1), n1·(r n1))` with `n1 ⟂ a` fixed and `n2 = (−a) × n1`.
 pub fn fold_angle(r: &Matrix3<f64>, a: &Vector3<f64>) -> f64 {
-    let am = -a.normalize();
-    // n1: the unit vector of the least aligned coordinate axis, made orthogonal to a.
-    let k = am.iamin();
-    let mut n1 = Vector3::zeros();
-    n1[k] = 1.0;
-    let n1 = (n1 - am * am.dot(&n1)).normalize();
-    let n2 = am.cross(&n1);
+    let (n1, n2) = rotation_basis(&-a.normalize());
     let rn1 = r * n1;
     n2.dot(&rn1).atan2(n1.dot(&rn1))
+}
+
+/// The fixed unit vectors that measure a rotation about the unit axis `axis`: `n1 ⟂ axis` (the
+/// least aligned coordinate axis, made orthogonal to `axis`) and `n2 = axis × n1`. A rotation
+/// `R` by θ about `axis` has `θ = atan2(n2·(R n1), n1·(R n1))`.
+pub fn rotation_basis(axis: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let k = axis.iamin();
+    let mut n1 = Vector3::zeros();
+    n1[k] = 1.0;
+    let n1 = (n1 - axis * axis.dot(&n1)).normalize();
+    (n1, axis.cross(&n1))
 }
 
 #[cfg(test)]

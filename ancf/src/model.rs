@@ -4,11 +4,14 @@
 use crate::elastic_force::{ElementMatrix, mirror_upper_inplace};
 use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
+use crate::hinge_spring::{Hessian, HingeSpring, Kinematics};
 use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
+use crate::mass::nonzeros;
+use crate::point_mass::{PointInertia, point_mass_matrix, point_mass_weights};
 use crate::reduction::Reduction;
 use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
-use crate::{BodySpec, Error, JointSpec, Options, Scene, SolvePath};
+use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::RefCell;
@@ -31,21 +34,24 @@ impl Body {
     }
 }
 
-/// Energies in J. `potential = −∫ m g·(r − r_ref) ds` (zero in the reference configuration).
+/// Energies in J. `potential = −∫ m g·(r − r_ref) ds − Σ m_p g·(r_p − r_p,ref)` (zero in the
+/// reference configuration).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Energies {
-    /// Kinetic energy ½ q̇ᵀ M q̇, J.
+    /// Kinetic energy ½ q̇ᵀ M q̇ (point masses included), J.
     pub kinetic: f64,
     /// Elastic energy including the cross-section penalty terms, J.
     pub elastic: f64,
     /// Gravitational potential energy relative to the reference configuration, J.
     pub potential: f64,
+    /// Energy of the hinge springs `Σ ½ k (θ − θ₀)²`, J.
+    pub spring: f64,
 }
 
 impl Energies {
-    /// T + U + V, J.
+    /// T + U + V + spring energy, J.
     pub fn total(&self) -> f64 {
-        self.kinetic + self.elastic + self.potential
+        self.kinetic + self.elastic + self.potential + self.spring
     }
 }
 
@@ -54,6 +60,8 @@ struct Workspace {
     q: Vec<f64>,
     v: Vec<f64>,
     r: Vec<f64>,
+    /// Full velocities (ODE path, for the hinge dampers).
+    rate: Vec<f64>,
 }
 
 /// An element with dependent coordinates on the ODE path: its matrix `k_e` enters the reduced
@@ -78,7 +86,7 @@ struct ReducedElement {
 #[derive(Debug)]
 pub struct Model {
     pub(crate) bodies: Vec<Body>,
-    joints: Vec<Joint>,
+    pub(crate) joints: Vec<Joint>,
     rows: Vec<ConstraintRow>,
     pub(crate) reduction: Reduction,
     options: Options,
@@ -99,9 +107,15 @@ pub struct Model {
     reduced_block: RefCell<Vec<f64>>,
     work: RefCell<Workspace>,
     sensor: RefCell<(Vec<f64>, Vec<f64>)>,
-    /// Whether the iteration matrix is symmetric (no follower moments), shared with the
-    /// [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
+    /// Whether the iteration matrix is symmetric (no follower moments, no hinge dampers),
+    /// shared with the [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
     symmetric: Arc<AtomicBool>,
+    /// Hinge springs and dampers (docs/ancf.md §11).
+    springs: Vec<HingeSpring>,
+    /// Whether a spring has damping: its tangent `c θ_q (θ_qq v)ᵀ` is not symmetric.
+    damped: bool,
+    /// Point masses (docs/ancf.md §12.2), each on its element.
+    point_inertia: Vec<PointInertia>,
 }
 
 impl Model {
@@ -122,7 +136,6 @@ impl Model {
         scene.validate()?;
         options.validate()?;
         let (bodies, joints, gravity) = (&scene.bodies, &scene.joints, scene.gravity);
-        unsupported(scene)?;
 
         let mut offset = 0;
         let bodies: Vec<Body> = bodies
@@ -180,6 +193,38 @@ impl Model {
             }
         }
 
+        // Point masses: their mass on their element, their weight at their centre.
+        let mut point_inertia = Vec::new();
+        let mut elements_before = 0;
+        for b in &bodies {
+            for p in &b.spec.point_masses {
+                let st = locate(b, p.at);
+                let w = point_mass_weights(p, st.xi, st.l);
+                for (k, wk) in w.iter().enumerate() {
+                    for i in 0..3 {
+                        gravity_force[st.first + 3 * k + i] += p.mass * wk * g[i];
+                    }
+                }
+                point_inertia.push(PointInertia {
+                    e_index: elements_before + (st.first - b.offset) / NODE_DOF,
+                    first: st.first,
+                    mass_nz: nonzeros(&point_mass_matrix(p, st.xi, st.l)),
+                });
+            }
+            elements_before += b.n_elements();
+        }
+
+        let springs: Vec<HingeSpring> = scene
+            .forces
+            .iter()
+            .map(|f| match *f {
+                ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
+                    HingeSpring::new(joint, &joint_list[joint], &bodies, stiffness, damping, rest)
+                }
+            })
+            .collect();
+        let damped = springs.iter().any(|s| s.damping != 0.0);
+
         let mut element_z = Vec::new();
         let mut element_reduced = Vec::new();
         for b in &bodies {
@@ -224,9 +269,17 @@ impl Model {
             element_z,
             element_reduced,
             reduced_block: RefCell::new(vec![0.0; max_reduced * max_reduced]),
-            work: RefCell::new(Workspace { q: vec![0.0; n_full], v: vec![0.0; n_full], r: vec![0.0; n_full] }),
+            work: RefCell::new(Workspace {
+                q: vec![0.0; n_full],
+                v: vec![0.0; n_full],
+                r: vec![0.0; n_full],
+                rate: vec![0.0; if damped { n_full } else { 0 }],
+            }),
             sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
-            symmetric: Arc::new(AtomicBool::new(true)),
+            symmetric: Arc::new(AtomicBool::new(!damped)),
+            springs,
+            damped,
+            point_inertia,
         })
     }
 
@@ -303,6 +356,19 @@ impl Model {
                 }
             }
         }
+        for spring in &self.springs {
+            let (idx, n) = spring.coordinates();
+            set.clear();
+            for &a in &idx[..n] {
+                match self.options.path {
+                    SolvePath::Dae => set.push(a),
+                    SolvePath::Ode => set.extend(self.reduction.row(a).iter().map(|&(z, _)| z)),
+                }
+            }
+            for &i in &set {
+                adj[i].extend_from_slice(&set);
+            }
+        }
         if self.options.path == SolvePath::Dae {
             for (r, row) in self.rows.iter().enumerate() {
                 for &(col, _) in &row.entries {
@@ -320,7 +386,7 @@ impl Model {
 
     /// A [`SkylineLu`](crate::SkylineLu) that knows the structure of this model's iteration
     /// matrix (in the integrator's layout: coordinates, then multipliers) and, while no follower
-    /// moment is loaded, that its values are symmetric (see
+    /// moment is loaded and no hinge has a damper, that its values are symmetric (see
     /// [`SkylineLu::with_symmetry_hint`](crate::SkylineLu::with_symmetry_hint)).
     pub fn linear_solver(&self) -> crate::SkylineLu {
         crate::SkylineLu::with_structure(self.n_dof(), self.adjacency()).with_symmetry_hint(Arc::clone(&self.symmetric))
@@ -421,9 +487,81 @@ impl Model {
                 e.elastic += b.element.elastic_energy(&qf[range]);
             }
         }
+        for p in &self.point_inertia {
+            let range = p.first..p.first + ELEMENT_DOF;
+            mv.iter_mut().for_each(|x| *x = 0.0);
+            p.add_mass_times(1.0, &vf[range.clone()], &mut mv);
+            e.kinetic += 0.5 * mv.iter().zip(&vf[range]).map(|(a, b)| a * b).sum::<f64>();
+        }
+        e.spring = self.springs.iter().map(|s| s.energy(qf)).sum();
         e.potential =
             -self.gravity_force.iter().zip(qf.iter().zip(&self.q_ref)).map(|(g, (q, q0))| g * (q - q0)).sum::<f64>();
         e
+    }
+
+    /// Power dissipated by the hinge dampers `Σ c θ̇²`, W (≥ 0), at coordinates `q` and
+    /// velocities `v` of the model's form. Its time integral is the work the dampers took out
+    /// of `T + U + V + spring energy`.
+    pub fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
+        if !self.damped {
+            return 0.0;
+        }
+        let mut s = self.sensor.borrow_mut();
+        let (qf, vf) = &mut *s;
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, &mut vf[..self.n_full]);
+        self.springs
+            .iter()
+            .filter(|sp| sp.damping != 0.0)
+            .map(|sp| {
+                let rate = HingeSpring::rate(&sp.kinematics(qf, false), vf);
+                sp.damping * rate * rate
+            })
+            .sum()
+    }
+
+    /// Hinge angle θ (rad) of joint `joint`, a ground hinge or a free flared hinge, as the hinge
+    /// springs measure it (docs/ancf.md §11): for a flared hinge the fold angle (about `−a`, as
+    /// [`fold_angle`](Self::fold_angle), equal to it for orthonormal section slopes), for a
+    /// ground hinge the rotation of the body's start section about the fixed axis (right-hand
+    /// rule), both zero in the reference configuration. On a joint with a spring the angle is
+    /// unwrapped against the last accepted step (it keeps counting past ±π); on other joints
+    /// it is in [−π, π).
+    pub fn hinge_angle(&self, q: &[f64], joint: usize) -> Result<f64, Error> {
+        let jt = self.joints.get(joint).ok_or(Error::NoSuchJoint { joint, n_joints: self.joints.len() })?;
+        if !matches!(jt, Joint::Ground { .. } | Joint::Flared { lock: None, .. }) {
+            return Err(Error::NotAFreeHinge { joint });
+        }
+        Ok(self.with_full(q, |q| match self.springs.iter().find(|s| s.joint == joint) {
+            Some(s) => s.angle(q),
+            None => HingeSpring::new(joint, jt, &self.bodies, 0.0, 0.0, 0.0).angle(q),
+        }))
+    }
+
+    /// Restart the hinge springs' angle unwrapping at `q` (the model's form): each spring's
+    /// angle becomes its principal value in [−π, π). Call it before integrating from a state
+    /// that is not the continuation of the model's last step (a model reused for a new run, or
+    /// a start away from the reference configuration); after every accepted step
+    /// [`post_step`](ConstrainedSystem::post_step) unwraps against the previous angle instead.
+    pub fn reset_hinge_angles(&mut self, q: &[f64]) {
+        if self.springs.is_empty() {
+            return;
+        }
+        self.springs.iter_mut().for_each(HingeSpring::forget);
+        self.accept_hinge_angles(q);
+    }
+
+    /// The angles at `q` (the model's form) become the springs' unwrapping reference.
+    fn accept_hinge_angles(&mut self, q: &[f64]) {
+        let Model { springs, work, reduction, options, .. } = self;
+        match options.path {
+            SolvePath::Dae => springs.iter_mut().for_each(|s| s.accept(q)),
+            SolvePath::Ode => {
+                let qf = &mut work.get_mut().q;
+                reduction.expand_inplace(q, qf);
+                springs.iter_mut().for_each(|s| s.accept(qf));
+            }
+        }
     }
 
     /// Position-level joint violation: the Euclidean norm over all joints of (position gap in m,
@@ -530,8 +668,8 @@ impl Model {
                 self.moments.push((st, p.moment));
             }
         }
-        // a follower moment's tangent is not symmetric
-        self.symmetric.store(self.moments.is_empty(), Ordering::Relaxed);
+        // a follower moment's tangent is not symmetric, nor is a damper's
+        self.symmetric.store(self.moments.is_empty() && !self.damped, Ordering::Relaxed);
         Ok(())
     }
 
@@ -562,8 +700,15 @@ impl Model {
         &self.rows
     }
 
-    /// `r = M v̇ + f_el(q) − λ_load (Q_g + Q_F + Q_M(q))` on full coordinates.
+    /// `r = M v̇ + f_el(q) − λ_load (Q_g + Q_F + Q_M(q))` on full coordinates, with the hinge
+    /// springs at rest (`θ̇ = 0`: no damping force).
     pub(crate) fn full_residual(&self, q: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.full_residual_at(q, None, v_dot, r);
+    }
+
+    /// `r = M v̇ + f_el(q) + Σ (k(θ−θ₀) + cθ̇) θ_q − λ_load (Q_g + Q_F + Q_M(q))` on full
+    /// coordinates; `v` (full velocities) is read only by the dampers (`None`: θ̇ = 0).
+    fn full_residual_at(&self, q: &[f64], v: Option<&[f64]>, v_dot: &[f64], r: &mut [f64]) {
         let lf = self.load_factor;
         for ((ri, g), p) in r.iter_mut().zip(&self.gravity_force).zip(&self.point_force) {
             *ri = -lf * (g + p);
@@ -585,10 +730,27 @@ impl Model {
                 add_moment_force(*st, &(-lf * m), q, r);
             }
         }
+        for p in &self.point_inertia {
+            let range = p.first..p.first + ELEMENT_DOF;
+            p.add_mass_times(1.0, &v_dot[range.clone()], &mut r[range]);
+        }
+        for spring in &self.springs {
+            let kin = spring.kinematics(q, false);
+            let rate = match v {
+                Some(v) if spring.damping != 0.0 => HingeSpring::rate(&kin, v),
+                _ => 0.0,
+            };
+            let m = spring.moment(&kin, rate);
+            for a in 0..kin.n {
+                r[kin.idx[a]] += m * kin.grad[a];
+            }
+        }
     }
 
-    /// `k += c_m M + c_k ∂r/∂q` at full coordinates `q`, written through the chosen form.
-    fn add_iteration_matrix(&self, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
+    /// `k += c_m M + c_c ∂r/∂v + c_k ∂r/∂q` at full coordinates `q` and velocities `v` (`None`:
+    /// zero; only the dampers read them), written through the chosen form.
+    #[allow(clippy::too_many_arguments)] // the state and the three generalized-α weights
+    fn add_iteration_matrix(&self, q: &[f64], v: Option<&[f64]>, c_m: f64, c_c: f64, c_k: f64, k: &mut MatView<'_>) {
         let mut ke = ElementMatrix::zeros();
         let mut e_index = 0;
         for b in &self.bodies {
@@ -612,6 +774,40 @@ impl Model {
             let lf = self.load_factor;
             for (st, m) in &self.moments {
                 moment_tangent(*st, m, q, c_k * lf, |i, j, blk| self.scatter_block(i, j, blk, k));
+            }
+        }
+        for p in &self.point_inertia {
+            ke.as_mut_slice().fill(0.0);
+            for &(a, bb, m) in p.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
+                for i in 0..3 {
+                    ke[(3 * a + i, 3 * bb + i)] = c_m * m;
+                }
+            }
+            self.scatter_element(p.first, p.e_index, &mut ke, k);
+        }
+        for spring in &self.springs {
+            let kin = spring.kinematics(q, true);
+            let t = spring.tangent(&kin, v, c_c, c_k);
+            self.scatter_spring(&kin, &t, k);
+        }
+    }
+
+    /// Add a spring's local matrix (coordinates `kin.idx`, not necessarily symmetric) through
+    /// the chosen form.
+    fn scatter_spring(&self, kin: &Kinematics, t: &Hessian, k: &mut MatView<'_>) {
+        for b in 0..kin.n {
+            for a in 0..kin.n {
+                let x = t[(a, b)];
+                match self.options.path {
+                    SolvePath::Dae => k.add(kin.idx[a], kin.idx[b], x),
+                    SolvePath::Ode => {
+                        for &(za, ca) in self.reduction.row(kin.idx[a]) {
+                            for &(zb, cb) in self.reduction.row(kin.idx[b]) {
+                                k.add(za, zb, ca * cb * x);
+                            }
+                        }
+                    }
+                }
             }
         }
     }
@@ -666,6 +862,7 @@ impl Model {
 
     /// Assemble `c_m M + c_k K_t` on full coordinates into a dense column-major matrix
     /// (DAE layout regardless of the path; used by the static solver and the modal analysis).
+    /// The hinge springs enter with their stiffness at rest (`θ̇ = 0`, no damping).
     pub(crate) fn assemble_full_inplace(&self, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
         let mut ke = ElementMatrix::zeros();
         for b in &self.bodies {
@@ -684,6 +881,24 @@ impl Model {
         let lf = self.load_factor;
         for (st, m) in &self.moments {
             moment_tangent(*st, m, q, c_k * lf, |i, j, blk| k.add_block(i, j, blk));
+        }
+        for p in &self.point_inertia {
+            ke.as_mut_slice().fill(0.0);
+            for &(a, bb, m) in &p.mass_nz {
+                for i in 0..3 {
+                    ke[(3 * a + i, 3 * bb + i)] += c_m * m;
+                }
+            }
+            k.add_block(p.first, p.first, &ke);
+        }
+        for spring in &self.springs {
+            let kin = spring.kinematics(q, true);
+            let t = spring.tangent(&kin, None, 0.0, c_k);
+            for b in 0..kin.n {
+                for a in 0..kin.n {
+                    k.add(kin.idx[a], kin.idx[b], t[(a, b)]);
+                }
+            }
         }
     }
 
@@ -743,15 +958,21 @@ impl ConstrainedSystem for Model {
         }
     }
 
-    fn residual_inplace(&self, _t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+    fn residual_inplace(&self, _t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
         match self.options.path {
-            SolvePath::Dae => self.full_residual(q, v_dot, r),
+            SolvePath::Dae => self.full_residual_at(q, Some(v), v_dot, r),
             SolvePath::Ode => {
                 let mut w = self.work.borrow_mut();
-                let Workspace { q: qf, v: af, r: rf } = &mut *w;
+                let Workspace { q: qf, v: af, r: rf, rate } = &mut *w;
                 self.reduction.expand_inplace(q, qf);
                 self.reduction.expand_rate_inplace(v_dot, af);
-                self.full_residual(qf, af, rf);
+                let vf = if self.damped {
+                    self.reduction.expand_rate_inplace(v, rate);
+                    Some(&rate[..])
+                } else {
+                    None
+                };
+                self.full_residual_at(qf, vf, af, rf);
                 self.reduction.project_inplace(rf, r);
             }
         }
@@ -761,19 +982,26 @@ impl ConstrainedSystem for Model {
         &self,
         _t: f64,
         q: &[f64],
-        _v: &[f64],
+        v: &[f64],
         _v_dot: &[f64],
         c_m: f64,
-        _c_c: f64,
+        c_c: f64,
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
         match self.options.path {
-            SolvePath::Dae => self.add_iteration_matrix(q, c_m, c_k, k),
+            SolvePath::Dae => self.add_iteration_matrix(q, Some(v), c_m, c_c, c_k, k),
             SolvePath::Ode => {
                 let mut w = self.work.borrow_mut();
-                self.reduction.expand_inplace(q, &mut w.q);
-                self.add_iteration_matrix(&w.q, c_m, c_k, k);
+                let Workspace { q: qf, rate, .. } = &mut *w;
+                self.reduction.expand_inplace(q, qf);
+                let vf = if self.damped {
+                    self.reduction.expand_rate_inplace(v, rate);
+                    Some(&rate[..])
+                } else {
+                    None
+                };
+                self.add_iteration_matrix(qf, vf, c_m, c_c, c_k, k);
             }
         }
     }
@@ -800,12 +1028,23 @@ impl ConstrainedSystem for Model {
         true
     }
 
+    /// The springs' unwrapping reference: the angles of the accepted step (docs/ancf.md §11).
+    fn post_step(&mut self, _t: f64, q: &mut [f64], _v: &mut [f64], _v_dot: &mut [f64], _a: &mut [f64]) {
+        if !self.springs.is_empty() {
+            self.accept_hinge_angles(q);
+        }
+    }
+
     /// DAE: one band block per body (node-ordered coordinates, half-bandwidth 23), the joint
-    /// rows on the border. ODE: one band block over all independent coordinates with the
-    /// half-bandwidth of the eliminated couplings.
+    /// rows on the border; bodies coupled by a flared hinge's spring share a block (the spring
+    /// couples the parent's last node to the child's first). ODE: one band block over all
+    /// independent coordinates with the half-bandwidth of the eliminated couplings.
     fn matrix_structure(&self) -> Option<genalpha::BandedBorder> {
         let blocks = match self.options.path {
-            SolvePath::Dae => self.bodies.iter().map(|b| (b.offset, NODE_DOF * b.n_nodes, ELEMENT_DOF - 1)).collect(),
+            SolvePath::Dae => {
+                let bodies = self.bodies.iter().map(|b| (b.offset, NODE_DOF * b.n_nodes, ELEMENT_DOF - 1)).collect();
+                if self.springs.iter().any(HingeSpring::couples_bodies) { self.merged_blocks(bodies) } else { bodies }
+            }
             SolvePath::Ode => {
                 let adj = self.adjacency();
                 let w =
@@ -824,19 +1063,30 @@ impl ConstrainedSystem for Model {
     }
 }
 
-/// Scene features this formulation does not model yet: an error naming the field, never a
-/// silent omission.
-fn unsupported(scene: &Scene) -> Result<(), Error> {
-    for (i, b) in scene.bodies.iter().enumerate() {
-        if b.section.cg_offset != [0.0; 2] {
-            return Err(Error::Unsupported { field: format!("bodies[{i}].section.cg_offset") });
+impl Model {
+    /// The DAE band blocks `(first, len, half-bandwidth)` with the bodies a flared hinge's spring
+    /// couples merged into one block (with everything between them), whose half-bandwidth covers
+    /// the spring's couplings.
+    fn merged_blocks(&self, bodies: Vec<(usize, usize, usize)>) -> Vec<(usize, usize, usize)> {
+        let mut spans: Vec<(usize, usize, usize)> = bodies.iter().map(|&(f, n, w)| (f, f + n, w)).collect();
+        for s in self.springs.iter().filter(|s| s.couples_bodies()) {
+            let (idx, n) = s.coordinates();
+            let (lo, hi) = (idx[..n].iter().min().copied(), idx[..n].iter().max().copied());
+            if let (Some(lo), Some(hi)) = (lo, hi) {
+                spans.push((lo, hi + 1, hi - lo));
+            }
         }
-        if !b.point_masses.is_empty() {
-            return Err(Error::Unsupported { field: format!("bodies[{i}].point_masses") });
+        spans.sort_unstable();
+        let mut merged: Vec<(usize, usize, usize)> = Vec::new();
+        for (start, end, w) in spans {
+            match merged.last_mut() {
+                Some(last) if start < last.1 => {
+                    last.1 = last.1.max(end);
+                    last.2 = last.2.max(w);
+                }
+                _ => merged.push((start, end, w)),
+            }
         }
+        merged.into_iter().map(|(start, end, w)| (start, end - start, w)).collect()
     }
-    if let Some(f) = scene.forces.first() {
-        return Err(Error::Unsupported { field: format!("joints[{}].spring", f.joint()) });
-    }
-    Ok(())
 }
