@@ -1090,3 +1090,10 @@ impl Model {
         merged.into_iter().map(|(start, end, w)| (start, end - start, w)).collect()
     }
 }
+
+impl Model {
+    /// Number of force elements (hinge springs and dampers) in the model.
+    pub fn n_force_elements(&self) -> usize {
+        self.springs.len()
+    }
+}

@@ -726,3 +726,10 @@ fn unsupported(scene: &Scene) -> Result<(), Error> {
     }
     Ok(())
 }
+
+impl Model {
+    /// Number of force elements (hinge springs and dampers) in the model.
+    pub fn n_force_elements(&self) -> usize {
+        self.springs.len()
+    }
+}

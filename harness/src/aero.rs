@@ -219,7 +219,7 @@ pub fn simulate_aero<S: AeroStructure>(
     map: &[StationMap],
     observer: &mut dyn crate::run::Observer,
 ) -> crate::run::RunOutput {
-    use crate::run::{RunOutput, SnapshotFeed, row};
+    use crate::run::{Dissipation, RunOutput, SnapshotFeed, row};
     use genalpha::State;
     let start = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
@@ -273,6 +273,7 @@ pub fn simulate_aero<S: AeroStructure>(
     let mut lift;
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
+    let mut dissipation = Dissipation::new(model, &s);
     let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
     r0.lift = 0.0;
@@ -359,8 +360,9 @@ pub fn simulate_aero<S: AeroStructure>(
         // 5. Work of the aerodynamic loads over the step (trapezoidal in the station velocities).
         stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
         work += 0.5 * dt * (power(&loads, &vel_n) + power(&loads, &vel));
+        dissipation.step(model, &s);
         if k % every == 0 || k == n_steps {
-            let mut r = row(model, fold, &s, st.n_newton_iters);
+            let mut r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
             r.aero_work = work;
             r.lift = lift;
             out.rows.push(r);

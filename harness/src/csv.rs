@@ -14,48 +14,38 @@ pub const HEADER: &str =
 pub const HEADER_AERO: &str =
     "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,newton_iterations,lift";
 
-/// Render rows as CSV text (aerodynamic columns when the run has them).
+/// Render rows as CSV text: the aerodynamic columns when the run has them, and `spring` (hinge
+/// spring potential) and `dissipated` (work of the dampers since t = 0) after `potential` when
+/// the model has force elements.
 pub fn to_csv(rows: &[Row]) -> String {
     let aero = rows.iter().any(|r| r.aero_work.is_finite());
-    let mut s = String::with_capacity(rows.len() * 200);
-    s.push_str(if aero { HEADER_AERO } else { HEADER });
+    let springs = rows.iter().any(|r| r.spring.is_finite());
+    let mut s = String::with_capacity(rows.len() * 220);
+    let header = if aero { HEADER_AERO } else { HEADER };
+    if springs {
+        s.push_str(&header.replace(",potential,", ",potential,spring,dissipated,"));
+    } else {
+        s.push_str(header);
+    }
     s.push('\n');
     for r in rows {
-        if aero {
-            let _ = writeln!(
-                s,
-                "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e},{},{:.6e}",
-                r.t,
-                r.tip[0],
-                r.tip[1],
-                r.tip[2],
-                r.fold,
-                r.kinetic,
-                r.elastic,
-                r.potential,
-                r.total,
-                r.aero_work,
-                r.constraint_residual,
-                r.newton_iterations,
-                r.lift
-            );
-            continue;
-        }
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e},{}",
-            r.t,
-            r.tip[0],
-            r.tip[1],
-            r.tip[2],
-            r.fold,
-            r.kinetic,
-            r.elastic,
-            r.potential,
-            r.total,
-            r.constraint_residual,
-            r.newton_iterations
+            "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},",
+            r.t, r.tip[0], r.tip[1], r.tip[2], r.fold, r.kinetic, r.elastic, r.potential,
         );
+        if springs {
+            let _ = write!(s, "{:.9e},{:.9e},", r.spring, r.dissipated);
+        }
+        let _ = write!(s, "{:.9e},", r.total);
+        if aero {
+            let _ = write!(s, "{:.9e},", r.aero_work);
+        }
+        let _ = write!(s, "{:.3e},{}", r.constraint_residual, r.newton_iterations);
+        if aero {
+            let _ = write!(s, ",{:.6e}", r.lift);
+        }
+        s.push('\n');
     }
     s
 }

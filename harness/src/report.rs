@@ -254,10 +254,19 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         let e0 = run.rows.first().map_or(0.0, |x| x.total);
         let peak = r.metrics.get(&run.formulation).map_or(1.0, |m| m.peak_kinetic).max(f64::MIN_POSITIVE);
         let w = |x: &crate::run::Row| if x.aero_work.is_finite() { x.aero_work } else { 0.0 };
+        let d = |x: &crate::run::Row| if x.dissipated.is_finite() { x.dissipated } else { 0.0 };
+        let label =
+            match (run.rows.iter().any(|x| x.aero_work.is_finite()), run.rows.iter().any(|x| x.dissipated.is_finite()))
+            {
+                (true, true) => "(E + W_damp − E0 − W_aero)/max T",
+                (true, false) => "(E − E0 − W_aero)/max T",
+                (false, true) => "(E + W_damp − E0)/max T",
+                (false, false) => "(E − E0)/max T",
+            };
         drift.push(Series {
-            label: format!("{l} (E − E0 − W_aero)/max T"),
+            label: format!("{l} {label}"),
             color: run_color(run.formulation),
-            points: run.rows.iter().map(|x| (x.t, (x.total - e0 - w(x)) / peak)).collect(),
+            points: run.rows.iter().map(|x| (x.t, (x.total + d(x) - e0 - w(x)) / peak)).collect(),
         });
     }
     panels_svg(

@@ -17,6 +17,8 @@ pub struct Energies {
     pub elastic: f64,
     /// Gravitational potential V (zero in the reference configuration).
     pub potential: f64,
+    /// Potential of the hinge springs ½k(θ − θ₀)².
+    pub spring: f64,
 }
 
 /// What the harness needs from a structural model beyond the integrator's trait: its initial
@@ -36,6 +38,10 @@ pub trait Structure: ConstrainedSystem {
     fn fold(&self, q: &[f64], joint: usize) -> f64;
     /// Energies.
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
+    /// Power dissipated by the force elements' dampers, W (≥ 0).
+    fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64;
+    /// Whether the model has force elements (the spring and dissipated-work columns).
+    fn has_force_elements(&self) -> bool;
     /// Position-level joint violation (gap in m and axis misalignment in rad, Euclidean norm).
     fn constraint_residual(&self, q: &[f64]) -> f64;
     /// Number of bodies.
@@ -157,7 +163,11 @@ pub struct Row {
     pub elastic: f64,
     /// Gravitational potential, J.
     pub potential: f64,
-    /// Total energy, J.
+    /// Hinge spring potential, J (NaN without force elements).
+    pub spring: f64,
+    /// Work dissipated by the dampers since t = 0, J (NaN without force elements).
+    pub dissipated: f64,
+    /// Total energy T + U + V (+ spring potential), J.
     pub total: f64,
     /// Position-level constraint residual.
     pub constraint_residual: f64,
@@ -219,6 +229,7 @@ impl RunOutput {
 /// The sensors of `model` at state `s` (aerodynamic columns NaN).
 pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &State, newton_iterations: usize) -> Row {
     let e = model.energies(&s.q, &s.v);
+    let springs = model.has_force_elements();
     Row {
         t: s.t,
         tip: model.tip(&s.q),
@@ -226,11 +237,51 @@ pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &Stat
         kinetic: e.kinetic,
         elastic: e.elastic,
         potential: e.potential,
-        total: e.kinetic + e.elastic + e.potential,
+        spring: if springs { e.spring } else { f64::NAN },
+        dissipated: if springs { 0.0 } else { f64::NAN },
+        total: if springs {
+            e.kinetic + e.elastic + e.potential + e.spring
+        } else {
+            e.kinetic + e.elastic + e.potential
+        },
         constraint_residual: model.constraint_residual(&s.q),
         newton_iterations,
         aero_work: f64::NAN,
         lift: f64::NAN,
+    }
+}
+
+/// Work dissipated by the dampers: the trapezoidal rule on the dissipation power over every
+/// accepted step (the rule the generalized-α energy balance follows at rho_inf = 1).
+pub(crate) struct Dissipation {
+    on: bool,
+    t: f64,
+    power: f64,
+    work: f64,
+}
+
+impl Dissipation {
+    pub(crate) fn new<S: Structure + ?Sized>(model: &S, s: &State) -> Self {
+        let on = model.has_force_elements();
+        Self { on, t: s.t, power: if on { model.dissipation_power(&s.q, &s.v) } else { 0.0 }, work: 0.0 }
+    }
+
+    /// Account for the step that ended at state `s`.
+    pub(crate) fn step<S: Structure + ?Sized>(&mut self, model: &S, s: &State) {
+        if self.on {
+            let p = model.dissipation_power(&s.q, &s.v);
+            self.work += 0.5 * (s.t - self.t) * (self.power + p);
+            self.power = p;
+        }
+        self.t = s.t;
+    }
+
+    /// The row with the work dissipated so far.
+    pub(crate) fn record(&self, mut r: Row) -> Row {
+        if self.on {
+            r.dissipated = self.work;
+        }
+        r
     }
 }
 
@@ -270,6 +321,7 @@ pub fn simulate<S: Structure>(
     }
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
+    let mut dissipation = Dissipation::new(model, &s);
     out.rows.push(row(model, fold, &s, 0));
     if let Err(e) = feed.feed(model, s.t, &s.q, None) {
         out.error = Some(format!("output at t = {}: {e}", s.t));
@@ -278,8 +330,9 @@ pub fn simulate<S: Structure>(
     for k in 1..=n_steps {
         match ga.step(model, &mut s) {
             Ok(st) => {
+                dissipation.step(model, &s);
                 if k % every == 0 || k == n_steps {
-                    out.rows.push(row(model, fold, &s, st.n_newton_iters));
+                    out.rows.push(dissipation.record(row(model, fold, &s, st.n_newton_iters)));
                     if let Err(e) = feed.feed(model, s.t, &s.q, None) {
                         out.error = Some(format!("step {k}: output: {e}"));
                         break;

@@ -34,7 +34,13 @@ macro_rules! structure {
             }
             fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
                 let e = <$t>::energies(self, q, v);
-                Energies { kinetic: e.kinetic, elastic: e.elastic, potential: e.potential }
+                Energies { kinetic: e.kinetic, elastic: e.elastic, potential: e.potential, spring: e.spring }
+            }
+            fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
+                <$t>::dissipation_power(self, q, v)
+            }
+            fn has_force_elements(&self) -> bool {
+                <$t>::n_force_elements(self) > 0
             }
             fn constraint_residual(&self, q: &[f64]) -> f64 {
                 <$t>::constraint_residual(self, q)
