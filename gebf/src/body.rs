@@ -11,9 +11,10 @@
 //! * tangent (`v`, `v_dot`, residual rows): nodes 1..=N `(R_dot, psi_dot)`, then `v_A` (3) and
 //!   `omega_A` (3), both in A components.
 
+use crate::Section;
 use crate::crv::{M3, V3};
 use crate::quaternion::Quaternion;
-use crate::Section;
+use crate::rigid_slice::Slice;
 
 pub use scene::BodySpec;
 
@@ -34,15 +35,28 @@ pub(crate) struct Body {
     pub dof0: usize,
     /// First storage index of the body.
     pub coord0: usize,
+    /// The section's centre of mass relative to the axis, `(0, y_c, z_c)` in section
+    /// components, m (zero: the axis kernel of `inertia.rs`).
+    pub cg: V3,
+    /// The point masses of each element, at their parametric positions.
+    pub point_masses: Vec<Vec<Slice>>,
 }
 
 impl Body {
     pub fn new(spec: &BodySpec, dof0: usize, coord0: usize) -> Self {
         // Orthonormalise the frame (it passed a 1e-9 check) so that the quaternion is exact.
         let quat0 = Quaternion::from_rotation_matrix(&spec.frame);
+        let le = spec.length / spec.n_elements as f64;
+        let mut point_masses = vec![Vec::new(); spec.n_elements];
+        for p in &spec.point_masses {
+            // The element holding arclength `at` (the last one for the body's end).
+            let e = ((p.at / le).floor().max(0.0) as usize).min(spec.n_elements - 1);
+            let xi = (2.0 * (p.at - e as f64 * le) / le - 1.0).clamp(-1.0, 1.0);
+            point_masses[e].push(Slice { xi, mass: p.mass, inertia: p.inertia, offset: p.offset });
+        }
         Self {
             n_elements: spec.n_elements,
-            le: spec.length / spec.n_elements as f64,
+            le,
             length: spec.length,
             section: spec.section,
             start: spec.start,
@@ -50,6 +64,8 @@ impl Body {
             quat0,
             dof0,
             coord0,
+            cg: V3::new(0.0, spec.section.cg_offset[0], spec.section.cg_offset[1]),
+            point_masses,
         }
     }
     /// Number of nodes, including the clamped node 0.

@@ -80,6 +80,7 @@ mod model;
 mod options;
 pub mod quaternion;
 mod rigid;
+mod rigid_slice;
 pub mod samples;
 mod section;
 pub mod simulate;

@@ -6,13 +6,13 @@ use crate::clamp::Clamp;
 use crate::crv::{M3, V3, rotation_matrix};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24};
 use crate::flared_hinge::FlaredHinge;
-use crate::gravity::{add_gravity, potential};
 use crate::ground_hinge::GroundHinge;
 use crate::hinge_spring::{HingeSpring, principal_angle, unwrap};
-use crate::inertia::{MatrixCoefficients, add_inertia};
+use crate::inertia::MatrixCoefficients;
 use crate::joint::Joint;
 use crate::loads::{NodalLoad, add_load, add_load_tangent};
 use crate::quaternion::Quaternion;
+use crate::rigid_slice::{add_element_gravity, add_element_inertia, element_potential};
 use crate::stiffness::add_elastic;
 use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene};
 use genalpha::{ConstrainedSystem, MatView, State};
@@ -107,7 +107,6 @@ impl Model {
     pub fn from_scene(scene: &Scene, options: Options) -> Result<Model, Error> {
         scene.validate()?;
         options.validate()?;
-        unsupported(scene)?;
         let (bodies, joints, gravity) = (&scene.bodies[..], &scene.joints[..], scene.gravity);
         let (mut dof, mut coord) = (0, 0);
         let mut bs = Vec::with_capacity(bodies.len());
@@ -393,9 +392,9 @@ impl Model {
             let c_ga = chi.to_rotation_matrix();
             for el in 0..b.n_elements {
                 let st = ElementState::gather(b, el, q, Some(v), None);
-                e.kinetic += add_inertia(&st, b.le, &b.section, &mut res, None);
+                e.kinetic += add_element_inertia(&st, b, el, &mut res, None);
                 e.elastic += add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
-                e.potential += potential(&st, b, el, &self.gravity, &r_a, &c_ga);
+                e.potential += element_potential(&st, b, el, &self.gravity, &r_a, &c_ga);
             }
         }
         for s in &self.springs {
@@ -439,16 +438,16 @@ impl Model {
 
     /// Element matrix when a node's CRV was mapped to another branch: the mass, gyroscopic and
     /// stiffness parts are needed separately for the chain rule.
-    fn mapped_element_matrix(&self, b: &Body, st: &ElementState, g_a: &V3, c: MatrixCoefficients) -> Mat24 {
+    fn mapped_element_matrix(&self, b: &Body, e: usize, st: &ElementState, g_a: &V3, c: MatrixCoefficients) -> Mat24 {
         let (mut m, mut g, mut k) = (Mat24::zeros(), Mat24::zeros(), Mat24::zeros());
         let mut res = Vec24::zeros();
         let mut scratch = Vec24::zeros();
         let unit = |c_m, c_c, c_k| MatrixCoefficients { c_m, c_c, c_k };
-        add_inertia(st, b.le, &b.section, &mut res, Some((&mut m, unit(1.0, 0.0, 0.0))));
-        add_inertia(st, b.le, &b.section, &mut scratch, Some((&mut g, unit(0.0, 1.0, 0.0))));
-        add_inertia(st, b.le, &b.section, &mut scratch, Some((&mut k, unit(0.0, 0.0, 1.0))));
+        add_element_inertia(st, b, e, &mut res, Some((&mut m, unit(1.0, 0.0, 0.0))));
+        add_element_inertia(st, b, e, &mut scratch, Some((&mut g, unit(0.0, 1.0, 0.0))));
+        add_element_inertia(st, b, e, &mut scratch, Some((&mut k, unit(0.0, 0.0, 1.0))));
         add_elastic(st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut k, 1.0)));
-        add_gravity(st, b.le, b.section.mass, g_a, &mut res, Some((&mut k, 1.0)));
+        add_element_gravity(st, b, e, g_a, &mut res, Some((&mut k, 1.0)));
         st.map_matrix(&res, &m, &g, &k, c)
     }
 
@@ -480,23 +479,23 @@ impl Model {
                 let plain_residual = match &matrix {
                     None => true,
                     Some((coeffs, _)) if mapped => {
-                        mat = self.mapped_element_matrix(b, &st, &g_a, *coeffs);
+                        mat = self.mapped_element_matrix(b, e, &st, &g_a, *coeffs);
                         r.is_some()
                     }
                     Some((coeffs, _)) => {
                         mat.as_mut_slice().fill(0.0);
-                        add_inertia(&st, b.le, &b.section, &mut res, Some((&mut mat, *coeffs)));
+                        add_element_inertia(&st, b, e, &mut res, Some((&mut mat, *coeffs)));
                         // c_k = 0 leaves the stiffness out of the matrix, not out of the residual
                         let k_part = (coeffs.c_k != 0.0).then_some(coeffs.c_k);
                         add_elastic(&st, b.le, &b.section, ng, &mut res, k_part.map(|c| (&mut mat, c)));
-                        add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, k_part.map(|c| (&mut mat, c)));
+                        add_element_gravity(&st, b, e, &g_a, &mut res, k_part.map(|c| (&mut mat, c)));
                         false
                     }
                 };
                 if plain_residual {
-                    add_inertia(&st, b.le, &b.section, &mut res, None);
+                    add_element_inertia(&st, b, e, &mut res, None);
                     add_elastic(&st, b.le, &b.section, ng, &mut res, None);
-                    add_gravity(&st, b.le, b.section.mass, &g_a, &mut res, None);
+                    add_element_gravity(&st, b, e, &g_a, &mut res, None);
                 }
                 if let Some(r) = r.as_deref_mut() {
                     st.map_residual(&mut res);
@@ -711,20 +710,6 @@ impl ConstrainedSystem for Model {
         }
         1.0
     }
-}
-
-/// Scene features this formulation does not model yet: an error naming the field, never a
-/// silent omission.
-fn unsupported(scene: &Scene) -> Result<(), Error> {
-    for (i, b) in scene.bodies.iter().enumerate() {
-        if b.section.cg_offset != [0.0; 2] {
-            return Err(Error::Unsupported { field: format!("bodies[{i}].section.cg_offset") });
-        }
-        if !b.point_masses.is_empty() {
-            return Err(Error::Unsupported { field: format!("bodies[{i}].point_masses") });
-        }
-    }
-    Ok(())
 }
 
 impl Model {

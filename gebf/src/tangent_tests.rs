@@ -11,8 +11,9 @@ use crate::crv::{M3, V3, rotation_matrix};
 use crate::element::{ElementState, Mat24, Vec24};
 use crate::gravity::add_gravity;
 use crate::inertia::{MatrixCoefficients, add_inertia};
+use crate::rigid_slice::{Slice, add_slice_gravity, add_slice_inertia};
 use crate::stiffness::add_elastic;
-use crate::{BodySpec, ForceElement, JointSpec, Model, NodalLoad, Options, Scene, Section};
+use crate::{BodySpec, ForceElement, JointSpec, Model, NodalLoad, Options, PointMass, Scene, Section};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use proptest::prelude::*;
 
@@ -163,6 +164,75 @@ fn check_element(seed: u64, rot: f64) {
     assert!(e < TOL, "gravity tangent (seed {seed}) rel err {e:.2e}");
 }
 
+/// A rigid slice with an offset centre (a point mass, or a section with its centre of mass off
+/// the axis): inertia tangents (each coefficient) and gravity tangents, with and without the
+/// axis part, against finite differences.
+fn check_slice(seed: u64, rot: f64) {
+    let mut rng = Lcg(seed);
+    let le = 0.8;
+    let st = random_state(&mut rng, le, rot);
+    let g_a = rng.v3(2.0);
+    let slice = Slice { xi: rng.next(), mass: 1.7, inertia: V3::new(0.3, 0.2, 0.25), offset: rng.v3(0.4) };
+    let wt = 0.37;
+    let inertia = |s: &ElementState, _g: &V3| {
+        let mut r = Vec24::zeros();
+        add_slice_inertia(s, le, wt, &slice, &mut r, None);
+        r
+    };
+    for (slot, c) in [(Slot::A, [1.0, 0.0, 0.0]), (Slot::V, [0.0, 1.0, 0.0]), (Slot::Q, [0.0, 0.0, 1.0])] {
+        let mut an = Mat24::zeros();
+        let mut r = Vec24::zeros();
+        let coeffs = MatrixCoefficients { c_m: c[0], c_c: c[1], c_k: c[2] };
+        add_slice_inertia(&st, le, wt, &slice, &mut r, Some((&mut an, coeffs)));
+        let e = rel_err(&an, &fd_matrix(inertia, &st, &g_a, slot));
+        println!("seed {seed}: slice inertia slot {:?} rel err {e:.2e}", c);
+        assert!(e < TOL, "slice inertia tangent (seed {seed}, {c:?}) rel err {e:.2e}");
+    }
+    for axis_part in [true, false] {
+        let gravity = |s: &ElementState, g: &V3| {
+            let mut r = Vec24::zeros();
+            add_slice_gravity(s, le, wt, &slice, g, axis_part, &mut r, None);
+            r
+        };
+        let mut an = Mat24::zeros();
+        let mut r = Vec24::zeros();
+        add_slice_gravity(&st, le, wt, &slice, &g_a, axis_part, &mut r, Some((&mut an, 1.0)));
+        let e = rel_err(&an, &fd_matrix(gravity, &st, &g_a, Slot::Q));
+        println!("seed {seed}: slice gravity (axis part {axis_part}) rel err {e:.2e}");
+        assert!(e < TOL, "slice gravity tangent (seed {seed}, axis part {axis_part}) rel err {e:.2e}");
+    }
+}
+
+#[test]
+fn slice_tangents_match_finite_differences() {
+    for seed in 31..36 {
+        check_slice(seed, 0.6);
+    }
+    check_slice(41, 1e-7);
+    check_slice(43, 1.5);
+}
+
+/// With a zero offset the slice kernel at the three Gauss points is the axis kernel (same
+/// forces, matrices and kinetic energy to round-off).
+#[test]
+fn slice_kernel_without_offset_is_the_axis_kernel() {
+    let mut rng = Lcg(57);
+    let (le, sec) = (0.8, unit_section());
+    let st = random_state(&mut rng, le, 0.7);
+    let c = MatrixCoefficients { c_m: 0.9, c_c: 0.4, c_k: 0.3 };
+    let (mut r1, mut r2, mut m1, mut m2) = (Vec24::zeros(), Vec24::zeros(), Mat24::zeros(), Mat24::zeros());
+    let t1 = add_inertia(&st, le, &sec, &mut r1, Some((&mut m1, c)));
+    let mut t2 = 0.0;
+    for &(xi, w) in crate::element::gauss_rule(3) {
+        let s =
+            Slice { xi, mass: sec.mass, inertia: V3::new(sec.rho_ixx, sec.rho_iyy, sec.rho_izz), offset: V3::zeros() };
+        t2 += add_slice_inertia(&st, le, 0.5 * le * w, &s, &mut r2, Some((&mut m2, c)));
+    }
+    assert!((t1 - t2).abs() < 1e-13 * t1.abs());
+    assert!((r1 - r2).amax() < 1e-13 * r1.amax());
+    assert!(rel_err(&m1, &m2) < 1e-13);
+}
+
 #[test]
 fn element_tangents_match_finite_differences() {
     for seed in 1..6 {
@@ -208,6 +278,18 @@ fn random_model_with(
     locked: bool,
     springs: bool,
 ) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    random_model_full(rng, beta, locked, springs, false)
+}
+
+/// [`random_model_with`], optionally with point masses (at a node, inside an element, at both
+/// body ends) and a centre-of-mass offset on two of the bodies' sections.
+fn random_model_full(
+    rng: &mut Lcg,
+    beta: f64,
+    locked: bool,
+    springs: bool,
+    masses: bool,
+) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let sec = unit_section();
     let f1 = rotation_matrix(&V3::new(0.1, -0.2, 0.3));
     let f2 = rotation_matrix(&V3::new(-0.3, 0.2, 0.4));
@@ -224,7 +306,15 @@ fn random_model_with(
         n_elements: n,
         point_masses: Vec::new(),
     };
-    let bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
+    let mut bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
+    if masses {
+        let pm = |at: f64, offset: V3, mass: f64| PointMass { at, offset, mass, inertia: V3::new(0.05, 0.03, 0.04) };
+        bodies[0].point_masses = vec![pm(0.3, V3::new(0.1, -0.2, 0.15), 0.8), pm(1.1, V3::new(0.0, 0.3, -0.1), 0.5)];
+        bodies[1].section.cg_offset = [0.07, -0.05];
+        bodies[1].point_masses = vec![pm(0.45, V3::new(-0.05, 0.1, 0.2), 1.2)];
+        bodies[2].section.cg_offset = [-0.1, 0.04];
+        bodies[2].point_masses = vec![pm(0.0, V3::new(0.05, 0.1, 0.0), 0.6), pm(0.5, V3::zeros(), 0.4)];
+    }
     let joints = vec![
         JointSpec::GroundHinge { body: 0, axis: V3::new(0.2, 1.0, 0.1) },
         JointSpec::FlaredHinge { parent: 0, child: 1, beta },
@@ -334,8 +424,12 @@ fn check_model(seed: u64, beta: f64, locked: bool) {
 }
 
 fn check_model_with(seed: u64, beta: f64, locked: bool, springs: bool) {
+    check_model_full(seed, beta, locked, springs, false);
+}
+
+fn check_model_full(seed: u64, beta: f64, locked: bool, springs: bool, masses: bool) {
     let mut rng = Lcg(seed);
-    let (model, q, v, a, mu) = random_model_with(&mut rng, beta, locked, springs);
+    let (model, q, v, a, mu) = random_model_full(&mut rng, beta, locked, springs, masses);
     let n = model.n_dof();
     let nc = model.n_velocity_constraints();
     check_iteration_matrix(&model, &q, &v, &a, &format!("model iteration matrix (seed {seed})"));
@@ -427,6 +521,14 @@ fn hinge_spring_tangents_alone() {
     }
 }
 
+/// Point masses (at node 0, at a middle node, inside elements, at a body's end) and offset
+/// section centres of mass, with gravity, nodal loads and springs: every model tangent.
+#[test]
+fn model_tangents_with_point_masses_and_offsets() {
+    check_model_full(4, 0.6, false, true, true);
+    check_model_full(13, -0.9, true, false, true);
+}
+
 /// The locked hinge's sixth (axial) angular row in every tangent.
 #[test]
 fn model_tangents_with_a_locked_hinge() {
@@ -450,8 +552,26 @@ proptest! {
 /// CRVs rescaled to |psi| ≤ π): the residual and every tangent must still be exact.
 #[test]
 fn model_tangents_with_rescaled_crvs() {
+    rescaled_crvs(false);
+}
+
+/// The same with an offset section centre of mass and point masses (the slices take the mapped
+/// element state and the chain rule of the mapped matrix like the axis kernel).
+#[test]
+fn model_tangents_with_rescaled_crvs_and_point_masses() {
+    rescaled_crvs(true);
+}
+
+fn rescaled_crvs(masses: bool) {
     let mut rng = Lcg(77);
-    let sec = unit_section();
+    let mut sec = unit_section();
+    let mut point_masses = Vec::new();
+    if masses {
+        sec.cg_offset = [0.08, -0.06];
+        let inertia = V3::new(0.05, 0.03, 0.04);
+        point_masses.push(PointMass { at: 1.2, offset: V3::new(0.02, 0.2, -0.1), mass: 0.7, inertia });
+        point_masses.push(PointMass { at: 0.5, offset: V3::new(0.0, -0.1, 0.1), mass: 0.3, inertia });
+    }
     let body = BodySpec {
         name: "twisted".into(),
         start: V3::new(0.1, 0.0, -0.2),
@@ -459,7 +579,7 @@ fn model_tangents_with_rescaled_crvs() {
         frame: rotation_matrix(&V3::new(0.2, 0.1, -0.3)),
         section: sec,
         n_elements: 2,
-        point_masses: Vec::new(),
+        point_masses,
     };
     let mut model = Model::new(&[body], &[], V3::new(0.3, -0.4, -9.8), Options::default()).unwrap();
     model.set_nodal_load(0, 4, NodalLoad { force: rng.v3(1.0), moment: rng.v3(1.0) }).unwrap();
@@ -503,9 +623,11 @@ fn model_tangents_with_rescaled_crvs() {
 /// large rotations (elements mapped across π take the separate residual path).
 #[test]
 fn fused_residual_and_matrix_equal_the_separate_calls() {
-    for (seed, scale, springs) in [(5, 1.0, false), (6, 15.0, false), (7, 1.0, true)] {
+    for (seed, scale, springs, masses) in
+        [(5, 1.0, false, false), (6, 15.0, false, false), (7, 1.0, true, true), (8, 15.0, true, true)]
+    {
         let mut rng = Lcg(seed);
-        let (model, q0, v, a, _) = random_model_with(&mut rng, 0.4, false, springs);
+        let (model, q0, v, a, _) = random_model_full(&mut rng, 0.4, false, springs, masses);
         let n = model.n_dof();
         let dq: Vec<f64> = (0..n).map(|_| rng.next() * scale).collect();
         let mut q = q0.clone();
