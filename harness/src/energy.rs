@@ -113,7 +113,9 @@ pub fn run(specs: &[RunSpec]) -> Vec<EnergyRun> {
             let metrics = FormulationMetrics::of(&o[0]);
             let e0 = o[0].rows.first().map_or(0.0, |r| r.total);
             let peak = if metrics.peak_kinetic > 0.0 { metrics.peak_kinetic } else { 1.0 };
-            let history = o[0].rows.iter().map(|r| (r.t, (r.total - e0) / peak)).collect();
+            // E + W_dissipated is what is conserved when the case has dampers.
+            let d = |r: &crate::run::Row| if r.dissipated.is_finite() { r.dissipated } else { 0.0 };
+            let history = o[0].rows.iter().map(|r| (r.t, (r.total + d(r) - e0) / peak)).collect();
             EnergyRun {
                 case: specs[i].name.clone(),
                 formulation: f,
