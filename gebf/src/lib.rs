@@ -14,7 +14,8 @@
 //!    U = \tfrac12\int \gamma^T S_\gamma \gamma + \kappa^T S_\kappa \kappa \, ds .$$
 //!
 //! **Inertia** (3-point integration): with `W = v_A + R_dot + omega_A × R` and
-//! `Omega = T(psi) psi_dot + C^{BA} omega_A`, `T_kin = ½ ∫ m|W|² + Omegaᵀ J Omega ds`; the
+//! `Omega = T(psi) psi_dot + C^{BA} omega_A`, `T_kin = ½ ∫ m|W|² + Omegaᵀ J Omega ds` (plus the
+//! rigid slices of point masses and of offset centres of mass, docs/gebf.md §14); the
 //! equations of motion are
 //!
 //! $$ M(q)\dot v + g_{gyr}(q, v) + g_{el}(q) - f_{grav}(q) - f_{ext}(q) + B(q)^T \mu = 0,
@@ -42,6 +43,12 @@
 //!   and a moment in global components at a node (held fixed during a step); the geometry comes
 //!   from [`Model::node_position`], [`Model::node_frame`], [`Model::node_velocity`],
 //!   [`Model::node_angular_velocity`] and [`Model::node_arc_length`].
+//! * Force elements and mass distribution from the [`Scene`] ([`Model::from_scene`]): hinge
+//!   springs and dampers on ground and free flared hinges ([`ForceElement::HingeSpring`];
+//!   [`Model::hinge_angle`], [`Model::dissipation_power`], [`Energies::spring`],
+//!   [`Model::reset_hinge_angles`]; docs/gebf.md §13), point masses ([`PointMass`]) and the
+//!   section's centre-of-mass offset (`Section::cg_offset`), exact in the inertial forces,
+//!   gravity and the potential (docs/gebf.md §14).
 //! * Extras: [`Model::solve_static`] (Newton with load stepping), [`Model::linear_modes`],
 //!   [`samples`] (the paper's cases, SHARPy's regression, cantilevers), [`simulate`] (a plain
 //!   time loop).
