@@ -1,6 +1,6 @@
 //! The model's per-step primitives do not allocate (STYLE rule 4): residual, iteration matrix,
 //! constraints, sensors and load updates, on both solve paths, counted with a global allocator.
-use ancf::{Model, Options, PointLoad, SolvePath, samples};
+use ancf::{ForceElement, Model, Options, PointLoad, PointMass, Scene, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use nalgebra::Vector3;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -53,6 +53,49 @@ fn per_step_primitives_do_not_allocate() {
             let _ = model.constraint_residual(&s.q);
             let _ = model.section_frame(&s.q, 1, 0.25).unwrap();
             let _ = model.material_velocity(&s.v, 1, 0.25, 0.1, 0.0).unwrap();
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert_eq!(after - before, 0, "{path:?}: {} allocations", after - before);
+    }
+    spring_and_point_mass_primitives_do_not_allocate();
+}
+
+/// The same with hinge springs and dampers on both hinges, point masses and an offset section:
+/// the spring terms, the dampers' velocity expansion (ODE path), the hinge-angle bookkeeping of
+/// `post_step` and the new sensors allocate nothing either. (Called from the test above: the
+/// counter is global, and a second test running in parallel would count its allocations.)
+fn spring_and_point_mass_primitives_do_not_allocate() {
+    for path in [SolvePath::Dae, SolvePath::Ode] {
+        let (mut b, j, g) = samples::double_pendulum(1.0, 45.0, 4);
+        b[1].section.cg_offset = [0.01, 0.02];
+        b[1].point_masses.push(PointMass {
+            at: 0.1,
+            offset: Vector3::new(0.01, 0.02, 0.0),
+            mass: 0.2,
+            inertia: Vector3::new(2e-4, 1e-4, 1e-4),
+        });
+        let forces = vec![
+            ForceElement::HingeSpring { joint: 0, stiffness: 1.0, damping: 0.1, rest: 0.0 },
+            ForceElement::HingeSpring { joint: 1, stiffness: 2.0, damping: 0.0, rest: 0.2 },
+        ];
+        let scene = Scene { forces, ..Scene::new(b, j, g) };
+        let mut model = Model::from_scene(&scene, Options { path, ..Default::default() }).unwrap();
+        let mut s = model.initial_state();
+        s.v.iter_mut().enumerate().for_each(|(i, x)| *x = 0.01 * (i % 7) as f64);
+        let n = model.n_dof();
+        let mut r = vec![0.0; n];
+        let mut k = DenseMatrix::zeros(n, n);
+        let (mut q, mut v, mut vd, mut a) = (s.q.clone(), s.v.clone(), s.v_dot.clone(), s.a.clone());
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..3 {
+            model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
+            model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.5, 1e-6, &mut k.view());
+            let _ = model.energies(&s.q, &s.v);
+            let _ = model.dissipation_power(&s.q, &s.v);
+            let _ = model.hinge_angle(&s.q, 1).unwrap();
+            q.copy_from_slice(&s.q);
+            model.post_step(0.0, &mut q, &mut v, &mut vd, &mut a);
+            model.reset_hinge_angles(&q);
         }
         let after = ALLOCATIONS.load(Ordering::Relaxed);
         assert_eq!(after - before, 0, "{path:?}: {} allocations", after - before);
