@@ -29,11 +29,19 @@
 //! a shear/section-strain *gradient* stabilisation (zero for uniform shear and section strain)
 //! keeps that compliance small and mesh-independent.
 //!
-//! **Use**: build a [`Model`] from [`BodySpec`]s and [`JointSpec`]s, take
+//! **Force elements and lumped masses** (docs/ancf.md §11–12): a hinge spring and damper
+//! ([`ForceElement::HingeSpring`]) on a ground or free flared hinge adds
+//! `(k(θ − θ₀) + c θ̇) θ_q` to the residual, with θ a smooth, unwrapped function of the section
+//! slopes and analytic tangents; point masses ([`PointMass`]) and a section centre of mass off
+//! the axis ([`Section::cg_offset`]) add constant terms to `M` and to the gravity force, since
+//! every material point is linear in the coordinates.
+//!
+//! **Use**: build a [`Model`] from [`BodySpec`]s and [`JointSpec`]s (or a [`Scene`] with force
+//! elements, [`Model::from_scene`]), take
 //! [`Model::initial_state`], integrate with [`Model::integrator`] (generalized-α with the
 //! [`SkylineLu`] solver) or `genalpha::GenAlpha::new` (the model declares its band structure),
-//! read [`Model::tip_position`], [`Model::fold_angle`], [`Model::energies`],
-//! [`Model::constraint_residual`]; apply aerodynamic or other loads with
+//! read [`Model::tip_position`], [`Model::fold_angle`], [`Model::hinge_angle`],
+//! [`Model::energies`], [`Model::dissipation_power`], [`Model::constraint_residual`]; apply aerodynamic or other loads with
 //! [`Model::set_point_loads`]; statics with [`Model::solve_statics`], linear modes with
 //! [`Model::linear_modes`]. Reference scenes are in [`samples`].
 //!

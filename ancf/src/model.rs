@@ -76,10 +76,11 @@ struct ReducedElement {
 /// The ANCF multibody model. Implements [`genalpha::ConstrainedSystem`] in the form chosen by
 /// [`Options::path`]:
 ///
-/// * [`SolvePath::Dae`]: `q` = all nodal coordinates, `M q̈ + f_el(q) − Q + Φ_qᵀ λ = 0`,
-///   `Φ(q) = Φ_q q − c = 0` with the constant `Φ_q`.
+/// * [`SolvePath::Dae`]: `q` = all nodal coordinates, `M q̈ + f_el(q) + f_s(q, q̇) − Q + Φ_qᵀ λ = 0`,
+///   `Φ(q) = Φ_q q − c = 0` with the constant `Φ_q`; `f_s = Σ (k(θ−θ₀) + c θ̇) θ_q` of the
+///   hinge springs and dampers, `M` constant with the point masses and centre-of-mass offsets.
 /// * [`SolvePath::Ode`]: `q` = the independent coordinates `z`, `q_full = B z + q_p`,
-///   `BᵀMB z̈ + Bᵀ(f_el − Q) = 0`.
+///   `BᵀMB z̈ + Bᵀ(f_el + f_s − Q) = 0`.
 ///
 /// Every method taking `q` (or `v`) expects the vector of the chosen form, as the integrator
 /// holds it.
