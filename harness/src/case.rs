@@ -929,6 +929,14 @@ impl Case {
                 return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
             }
         }
+        // The integrator's own checks (Newton tolerances, iteration counts), named by case path.
+        for f in Formulation::ALL {
+            if let Err(genalpha::Error::InvalidParameter { field, reason }) =
+                crate::scene::settings(self, f).params.validate()
+            {
+                return Err(format!("{f}.{field}: {reason}"));
+            }
+        }
         for (k, r) in self.references.iter().enumerate() {
             if !r.time_shift.is_finite() {
                 return Err(format!("references[{k}].time_shift: not finite"));

@@ -260,3 +260,12 @@ fn a_flare_beyond_the_lattice_limit_is_rejected_before_the_run() {
     assert_eq!(o.status.code(), Some(2));
     assert_clean_error(&o, &format!("joints[{i}].flare_deg"));
 }
+
+/// An integrator setting the time loop would refuse is an input error found by `list` too.
+#[test]
+fn a_zero_newton_tolerance_is_an_input_error_for_list() {
+    let p = tmp_case("rtol0/case.json", |v| v["gebf"]["newton"] = serde_json::json!({"rtol": 0.0}));
+    let o = harness(&["list", "--cases", p.parent().unwrap().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_clean_error(&o, "gebf.newton.rtol: 0 is not a positive number");
+}
