@@ -298,7 +298,11 @@ fn real_main() -> Result<ExitCode> {
                 failed,
                 out.join("index.html").display()
             );
-            Ok(exit_code(&errors, failed == 0))
+            let gate_failed = results.iter().filter(|r| r.status() == "FAIL").count();
+            if gate_failed > 0 {
+                eprintln!("gate: {gate_failed} case(s) fail their tolerances (see the table)");
+            }
+            Ok(exit_code(&errors, failed == 0 && gate_failed == 0))
         }
         Cmd::Run { case, formulation, out, set } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
@@ -428,7 +432,7 @@ fn real_main() -> Result<ExitCode> {
             let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
             let rows = run_bench(&runs, repeats, &out)?;
             let failed = rows.iter().filter(|r| r.error.is_some()).count();
-            Ok(if failed == 0 && errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+            Ok(exit_code(&errors, failed == 0))
         }
         Cmd::Gate { files, cases, set } => {
             let files = if files.is_empty() { discover(&cases)? } else { files };
