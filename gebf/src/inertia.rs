@@ -16,9 +16,9 @@
 //! Integrated with 3 Gauss points (exact for the translational mass of the quadratic element).
 
 use crate::Section;
-use crate::section::SectionDiagonals;
 use crate::crv::{M3, Tangent, V3, col_mul, diag_mul, skew, skew_mul};
 use crate::element::{ElementState, Mat24, V_OFF, Vec24, W_OFF, add3, add33, gauss_rule, interp, shape};
+use crate::section::SectionDiagonals;
 
 /// Coefficients of the iteration matrix: `c_m ∂/∂v_dot + c_c ∂/∂v + c_k ∂/∂q`.
 #[derive(Debug, Clone, Copy, PartialEq)]

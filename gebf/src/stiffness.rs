@@ -16,9 +16,9 @@
 //! `C^{AB}`, `T`, `D` at fixed `N`, `M` (which needs the Hessian of `Mᵀ T(psi) psi'`).
 
 use crate::Section;
-use crate::section::SectionDiagonals;
 use crate::crv::{M3, Tangent, V3, diag_mul, skew_mul};
 use crate::element::{ElementState, Mat24, Vec24, add3, add33, gauss_rule, interp, shape};
+use crate::section::SectionDiagonals;
 
 /// Add the elastic forces of one element to `res` (and `c_k ×` their tangent to `mat`);
 /// returns the element's elastic energy, J.

@@ -2,7 +2,7 @@
 //! (`cases/reference/uvlm/theodorsen.csv`, docs/uvlm.md §10.4). Exercises the moving lattice, the node
 //! velocities in the boundary condition and the ρ·A·n·dΓ/dt load term.
 
-mod common;
+use crate::common;
 
 use common::reference_csv;
 use nalgebra::{Rotation3, Vector3};

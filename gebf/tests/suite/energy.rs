@@ -48,7 +48,7 @@
 //! 7.9e-3 at rho_inf = 1, with 8.4 Newton iterations per step; 6.4e-3 at 0.8), the midpoint
 //! rule's known weakness in nonlinear elastodynamics (Simo & Tarnow 1992).
 
-mod common;
+use crate::common;
 use common::*;
 use genalpha::{Form, IntegratorParams};
 

@@ -1,7 +1,7 @@
 //! All five paper cases at the paper's settings reach 2 s; β = 0 stays planar; β = 90° keeps
 //! the fold below 1° (the hinge axis is the beam axis, and the section is symmetric).
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -1,7 +1,7 @@
 //! Unsteady checks: Wagner function, steady state as a fixed point of the unsteady step, wake
 //! truncation bias, work counters, free wake.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;

@@ -6,7 +6,7 @@
 //!
 //! Both generalized-α forms (the default Arnold–Brüls and the Chung–Hulbert evaluation).
 
-mod common;
+use crate::common;
 use common::*;
 use genalpha::{Form, IntegratorParams};
 

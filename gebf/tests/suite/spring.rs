@@ -165,10 +165,10 @@ fn ground_hinge_spring_oscillates_at_sqrt_k_over_j() {
 
 /// The paper's c = 1, β = 45° pendulum with a damper c = 0.05 N·m·s/rad on its flared hinge:
 /// `E(t) + W_d(t)`, `W_d = ∫ c θ̇² dt` by the trapezoidal rule on `dissipation_power` per step,
-/// stays at E(0) to the integrator's energy error, measured as in tests/energy.rs relative to
+/// stays at E(0) to the integrator's energy error, measured as in tests/suite/energy.rs relative to
 /// the peak kinetic energy (ρ∞ = 1, dt = 0.002, 2 s). Without the damper the same runs drift
-/// by 1.6e-4 (Chung–Hulbert) and 1.35e-3 (Arnold–Brüls) of the peak (tests/energy.rs); the
-/// bounds below are those of tests/energy.rs (1e-3, and 1.5e-3 for the Arnold–Brüls form at
+/// by 1.6e-4 (Chung–Hulbert) and 1.35e-3 (Arnold–Brüls) of the peak (tests/suite/energy.rs); the
+/// bounds below are those of tests/suite/energy.rs (1e-3, and 1.5e-3 for the Arnold–Brüls form at
 /// β = 45°). The damper removes a few per cent of the energy (`W_d` printed), so a missing or
 /// wrongly signed dissipation term would show as an error of that size.
 #[test]

@@ -1,7 +1,7 @@
 //! Joint drift: the velocity-level joints let the hinge gap grow (reported every step by
 //! `Model::constraint_residual`); with the optional position projection it stays below 1e-8.
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

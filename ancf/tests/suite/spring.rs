@@ -191,7 +191,7 @@ fn small_oscillation_frequency_is_sqrt_k_over_j() {
 /// The paper's pendulum (c = 1, β = 45°, 5 elements, dt = 2 ms, rho_inf = 1, ODE path) with a
 /// damper c = 0.05 N·m·s/rad on the flared hinge: `E(t) + W(t)` stays at E(0), with W the
 /// dissipated work ∫ c θ̇² dt by the trapezoidal rule on the power per step. Tolerance: the
-/// undamped run's energy bound, 1e-3 of the peak kinetic energy (ancf/tests/energy.rs);
+/// undamped run's energy bound, 1e-3 of the peak kinetic energy (ancf/tests/suite/energy.rs);
 /// measured: 4.4e-5, against W(2 s) = 0.147 of the peak kinetic energy (the damper takes out
 /// over three thousand times the balance error; without W, E drifts by 0.147). W grows
 /// monotonically; the power is never negative.

@@ -2,7 +2,7 @@
 //! gives the rotated and shifted motion, on both solve paths; and a scene whose child body has
 //! a different (but equivalent) section frame orientation is handled by the general flared-hinge
 //! axis `α_C = F_Cᵀ F_P (sin β, cos β, 0)`.
-mod common;
+use crate::common;
 
 use ancf::{JointSpec, Model, Options, SolvePath, samples};
 use nalgebra::{Rotation3, Vector3};

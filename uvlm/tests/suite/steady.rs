@@ -1,7 +1,7 @@
 //! Steady ring-VLM checks: lift slope of rectangular wings, sin α proportionality, elliptic-wing
 //! span efficiency, symmetry plane vs full wing, ground effect.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;

@@ -243,9 +243,9 @@ fn cantilever_with_tip_mass_first_bending_frequency() {
 /// The paper's c = 1, β = 45° pendulum with a 0.2 kg tip mass 5 cm off the second body's axis
 /// (with inertia), a 0.1 kg mass inside the first body, and the second body's section centre of
 /// mass 1 cm off its axis: the total energy (the gravitational potential including the offsets)
-/// is conserved to the integrator's energy error, measured as in tests/energy.rs (Chung–Hulbert
+/// is conserved to the integrator's energy error, measured as in tests/suite/energy.rs (Chung–Hulbert
 /// form, ρ∞ = 1, dt = 0.002, 2 s; relative to the peak kinetic energy). Bound: 1e-3, the
-/// criterion of tests/energy.rs.
+/// criterion of tests/suite/energy.rs.
 #[test]
 fn pendulum_with_offset_masses_conserves_energy() {
     let (mut b, j, g) = samples::double_pendulum(1.0, 45.0, 5);

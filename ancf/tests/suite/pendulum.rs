@@ -1,6 +1,6 @@
 //! The paper's flared double pendulum (docs/cases.md §1) against the external references in
 //! `cases/reference/` (Exudyn geometrically exact beam, converged; see its README).
-mod common;
+use crate::common;
 
 use ancf::{Options, SolvePath};
 use common::*;

@@ -2,7 +2,7 @@
 //! the exact solution. With rho_inf = 1 the generalized-α scheme has no numerical damping and the
 //! energy error of the c = 1 runs at the paper's settings stays within 1e-3 of the peak kinetic
 //! energy; with rho_inf = 0.8 the (small) numerical dissipation is reported.
-mod common;
+use crate::common;
 
 use ancf::{Options, SolvePath};
 use common::*;

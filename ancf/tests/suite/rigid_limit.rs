@@ -2,7 +2,7 @@
 //! solution `cases/reference/exudyn/rigid_beta*_ode.csv` (2-DOF Lagrangian model, DOP853 at
 //! tolerance 1e-12). Bound: 1 cm over 2 s at the paper's settings; measured 0.75 mm (β = 0),
 //! 1.8 mm (β = 45°), 0.15 mm (β = 90°).
-mod common;
+use crate::common;
 
 use ancf::{Options, SolvePath};
 use common::*;

@@ -24,7 +24,7 @@ const BEFORE: [f64; 10] = [
     1.508864061124952e3,
 ];
 
-/// L = 2 m, 8 elements, the section of `tests/modal.rs`.
+/// L = 2 m, 8 elements, the section of `tests/suite/modal.rs`.
 fn cantilever(path: SolvePath) -> Model {
     let mut sec = samples::pendulum_section(1.0);
     (sec.mass, sec.rho_ixx, sec.rho_iyy, sec.rho_izz) = (2.0, 4e-5, 1e-5, 3e-5);

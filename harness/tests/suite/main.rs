@@ -1,0 +1,8 @@
+//! The harness crate's integration tests, one module per file, built as one test binary (one
+//! link instead of one per file).
+
+mod aero;
+mod cli;
+mod gate;
+mod observer;
+mod properties;

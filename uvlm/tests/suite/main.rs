@@ -1,0 +1,10 @@
+//! The uvlm crate's integration tests, one module per file, built as one test binary (one
+//! link instead of one per file); the allocation tests stay separate binaries because they install a counting global allocator.
+
+mod common;
+mod flow;
+mod hinge;
+mod properties;
+mod steady;
+mod theodorsen;
+mod unsteady;
