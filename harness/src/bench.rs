@@ -23,7 +23,7 @@ use crate::csv::write_file;
 use crate::plot::colors;
 use crate::scene::run_formulation;
 
-/// Speed targets of the paper's double pendulums (issues #2 and #3), ms per 2 s run; the paper's
+/// Speed targets of the paper's double pendulums (docs/cases.md), ms per 2 s run; the paper's
 /// MATLAB code took ~20 s and SHARPy ~40 s CPU.
 pub const TARGET_MS: [(Formulation, f64); 2] = [(Formulation::Ancf, 50.0), (Formulation::Gebf, 100.0)];
 

@@ -1,6 +1,6 @@
 //! The integrator crate's generic linearisation and modes (`genalpha::analysis`) on an ANCF
 //! cantilever, against the frequencies of `Model::linear_modes` as they were before that function
-//! delegated to the generic code (ANCF reduction basis `B`, commit 42633e0), and against each
+//! delegated to the generic code (ANCF reduction basis `B`), and against each
 //! other through the model's two integrator forms: the DAE form (joints as holonomic rows,
 //! eliminated by an SVD null space) and the ODE form (joints eliminated by the reduction, no
 //! constraint rows).
@@ -10,7 +10,7 @@ use genalpha::analysis::linearise;
 use nalgebra::Vector3;
 
 /// The first ten circular frequencies (rad/s) of the 8-element cantilever below from
-/// `Model::linear_modes` at commit 42633e0 (its own eigenproblem on the reduction basis).
+/// `Model::linear_modes` before it delegated to the generic code (its own eigenproblem on the reduction basis).
 const BEFORE: [f64; 10] = [
     1.757951961942833e1,
     2.77942333913123e1,

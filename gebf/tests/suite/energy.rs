@@ -11,7 +11,7 @@
 //! part of the trapezoidal loss analysed below (the same −1.03e-3 + −2.6e-4 as without it).
 //! rho_inf = 0.8 dissipates a little; the drift is reported, not hidden.
 //!
-//! Diagnosis of the β = 45° drift (issue #3): the energy error is a transient of ~20 steps
+//! Diagnosis of the β = 45° drift: the energy error is a transient of ~20 steps
 //! while the tip whips through the fold at ~27 rad/s (t ≈ 1.42 s), not a growth: E − E(0) goes
 //! from −1e-4 (t = 1.402 s) to −1.35e-3 (1.418 s) and back to −2e-5 (1.428 s) of the peak
 //! kinetic energy. It is the same for 5 and 10 elements per body and for 2- or 3-point
@@ -23,8 +23,8 @@
 //! criterion; an energy-conserving scheme would be needed to meet it at dt = 0.002.
 //!
 //! The discrete energy balance split by force group (exact for the trapezoidal rule: each
-//! group's energy change minus the trapezoidal work of its tangent-space forces; the audit code
-//! is on the `energy-audit` branch, commit e236b0d, not on main) puts
+//! group's energy change minus the trapezoidal work of its tangent-space forces)
+//! puts
 //! the −1.345e-3 at t = 1.418 s on: body 2's translational inertia −1.032e-3 (kinetic energy
 //! change against the trapezoidal work of its inertial forces in its floating frame), the flared
 //! hinge's constraint forces −2.57e-4 (angular rows −2.80e-4, linear rows +2.3e-5: B depends on

@@ -1,6 +1,6 @@
 //! The integrator crate's generic linearisation and modes (`genalpha::analysis`) on a GEBF
 //! cantilever, against the frequencies of `Model::linear_modes` as they were before that function
-//! delegated to the generic code (null space from the eigenvectors of BᵀB, commit 42633e0), and
+//! delegated to the generic code (null space from the eigenvectors of BᵀB), and
 //! the damped (first-order, Schur) eigenvalues against the undamped ones.
 use gebf::{Model, Options, samples};
 use genalpha::ConstrainedSystem;
@@ -8,7 +8,7 @@ use genalpha::analysis::linearise;
 use nalgebra::Vector3;
 
 /// The first twelve circular frequencies (rad/s) of the 8-element, 5 m cantilever with the
-/// paper's section (c = 1) from `Model::linear_modes` at commit 42633e0. The bending pairs are
+/// paper's section (c = 1) from `Model::linear_modes` before it delegated to the generic code. The bending pairs are
 /// degenerate (EI_yy = EI_zz); they split by up to 2e-7, old and new, within the eigensolver's
 /// precision (see the test).
 const BEFORE: [f64; 12] = [
