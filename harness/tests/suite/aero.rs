@@ -1,4 +1,4 @@
-//! Aeroelastic coupling checks on the paper's wing : symmetry at rest, convergence as the
+//! Aeroelastic coupling checks on the paper's wing: symmetry at rest, convergence as the
 //! coupling tightens, and the rigid limit against the UVLM's own steady solution.
 
 use std::path::PathBuf;
@@ -50,7 +50,7 @@ fn strong_coupling_converges_as_it_tightens() {
     }
 }
 
-/// Rigid limit : the paper's two-body wing with stiffness ×1e4 and the flared hinge
+/// Rigid limit: the paper's two-body wing with stiffness ×1e4 and the flared hinge
 /// locked, no gravity, wake closed by semi-infinite legs: after the start-up transient the
 /// coupled lift equals the UVLM's steady solution of the same (slanted-hinge) lattice within 0.5 %.
 #[test]
