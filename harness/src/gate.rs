@@ -56,7 +56,22 @@ pub fn evaluate(r: &CaseResult) -> Option<GateOutcome> {
             out.failures.push(format!("{} run failed: {e}", run.formulation));
         }
     }
+    // The time every formulation reached: a window past it was never simulated, and its
+    // statistics over the rows that exist would pass vacuously.
+    let reached = if r.runs.is_empty() {
+        0.0
+    } else {
+        r.runs.iter().map(|run| run.rows.last().map_or(f64::NEG_INFINITY, |row| row.t)).fold(f64::INFINITY, f64::min)
+    };
     for w in &gate.windows {
+        if w.t_end > reached + 1e-9 * w.t_end.abs().max(1.0) || reached.is_nan() {
+            out.failures.push(format!(
+                "gate window [{}, {}] s not covered: the run reached t = {} s",
+                w.t_start,
+                w.t_end,
+                if reached.is_finite() { reached } else { 0.0 }
+            ));
+        }
         let s = window_stats(&r.pair_diff, w.t_start, w.t_end);
         out.checks.push(check(format!("tip_max[{},{}]", w.t_start, w.t_end), s.max, w.tip_max_m));
         out.checks.push(check(format!("tip_rms[{},{}]", w.t_start, w.t_end), s.rms, w.tip_rms_m));

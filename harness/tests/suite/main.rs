@@ -4,5 +4,6 @@
 mod aero;
 mod cli;
 mod gate;
+mod honest;
 mod observer;
 mod properties;
