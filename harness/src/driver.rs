@@ -9,7 +9,8 @@ use crate::Error;
 use crate::case::{CaseFile, Formulation, Override, RunSpec};
 use crate::csv::write_file;
 use crate::report::{CaseResult, index_html, studies_html, summary_markdown, write_case};
-use crate::scene::run_formulation;
+use crate::run::{NoObserver, Observer};
+use crate::scene::run_formulation_observed;
 
 /// All `*.json` case files in a folder, sorted by name (`*.schema.json` excluded).
 pub fn discover(dir: &Path) -> Result<Vec<PathBuf>, Error> {
@@ -38,6 +39,17 @@ pub fn expand_all(files: &[PathBuf], overrides: &[Override]) -> (Vec<RunSpec>, V
 /// Run the given formulations of every run in parallel (rayon), with a progress bar when
 /// `progress` is set; results in input order.
 pub fn run_all(runs: &[RunSpec], formulations: &[Formulation], progress: bool) -> Vec<CaseResult> {
+    run_all_observed(runs, formulations, progress, &|_, _| Box::new(NoObserver))
+}
+
+/// As [`run_all`], each run handing its output steps to the observer `observer(run, formulation)`
+/// makes (e.g. a [`crate::vtk::VtkWriter`]); the observer is dropped when its run ends.
+pub fn run_all_observed(
+    runs: &[RunSpec],
+    formulations: &[Formulation],
+    progress: bool,
+    observer: &(dyn Fn(&RunSpec, Formulation) -> Box<dyn Observer> + Sync),
+) -> Vec<CaseResult> {
     let jobs: Vec<(usize, Formulation)> =
         (0..runs.len()).flat_map(|i| formulations.iter().map(move |&f| (i, f))).collect();
     let bar = if progress {
@@ -52,7 +64,8 @@ pub fn run_all(runs: &[RunSpec], formulations: &[Formulation], progress: bool) -
     let outputs: Vec<_> = jobs
         .par_iter()
         .map(|&(i, f)| {
-            let out = run_formulation(runs[i].case(f), f);
+            let mut obs = observer(&runs[i], f);
+            let out = run_formulation_observed(runs[i].case(f), f, &mut *obs);
             bar.set_message(format!("{} {f}", runs[i].name));
             bar.inc(1);
             (i, out)

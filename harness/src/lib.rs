@@ -22,6 +22,7 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod stress;
+pub mod vtk;
 
 /// Errors of the harness library (the binary adds context with anyhow).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -60,6 +60,14 @@ enum Cmd {
         /// Override a case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        /// Also write ParaView files (beams, vortex lattice, wake; .vtp plus a .pvd time series per
+        /// family) to `<out>/<case>/vtk/<formulation>/`.
+        #[arg(long)]
+        vtk: bool,
+        /// With --vtk, write every N-th output step (default: about 100 frames per run,
+        /// max(1, output rows / 100)).
+        #[arg(long, value_name = "N", requires = "vtk")]
+        vtk_stride: Option<usize>,
     },
     /// Run the gated cases and check their tolerances; exit 1 when any case fails.
     Gate {
@@ -304,14 +312,21 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(exit_code(&errors, failed == 0 && gate_failed == 0))
         }
-        Cmd::Run { case, formulation, out, set } => {
+        Cmd::Run { case, formulation, out, set, vtk, vtk_stride } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
             let fs: Vec<Formulation> = match formulation {
                 Which::Ancf => vec![Formulation::Ancf],
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
-            let results = run_all(&runs, &fs, true);
+            let results = if vtk {
+                harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| {
+                    let stride = vtk_stride.unwrap_or_else(|| harness::vtk::default_stride(spec.case(f), f));
+                    Box::new(harness::vtk::VtkWriter::for_run(&out, &spec.name, f, stride))
+                })
+            } else {
+                run_all(&runs, &fs, true)
+            };
             let mut failed = false;
             for r in &results {
                 let dir = out.join(&r.name);

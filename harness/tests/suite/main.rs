@@ -7,3 +7,4 @@ mod gate;
 mod honest;
 mod observer;
 mod properties;
+mod vtk;
