@@ -131,11 +131,13 @@ fn vtk_pendulum_beams_match_the_csv_tip() {
 fn vtk_wing_writes_lattice_and_wake() {
     let out = std::env::temp_dir().join(format!("harness-vtk-wing-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    run("cases/wing_aoa5.json", "0.03", &out, &["--formulation", "gebf", "--vtk-stride", "1"]);
+    run("cases/wing_aoa5.json", "0.03", &out, &["--formulation", "gebf"]);
     let dir = out.join("wing_aoa5").join("vtk").join("gebf");
     let beams = check_family(&dir, "beams");
     let lattice = check_family(&dir, "lattice");
     let wake = check_family(&dir, "wake");
+    // The default stride: max(1, 4 output rows / 100) = 1, every row.
+    assert_eq!(beams.len(), 4);
     assert_eq!(beams.len(), lattice.len());
     assert_eq!(beams.len(), wake.len());
     let mut polys = Vec::new();
