@@ -735,6 +735,20 @@ impl RunSpec {
     }
 }
 
+/// The number of steps of `dt` in `t` when `t` is a whole multiple of it (within a relative
+/// 1e-9) and at least one step.
+pub fn whole_steps(t: f64, dt: f64) -> Option<usize> {
+    let r = t / dt;
+    let n = r.round();
+    (r.is_finite() && n >= 1.0 && (r - n).abs() <= 1e-9 * r).then_some(n as usize)
+}
+
+/// The step nearest `dt` that divides `t` into a whole number (at least one) of steps: studies
+/// that scale a case's step use it so that their runs still end at `t`.
+pub fn commensurate_dt(t: f64, dt: f64) -> f64 {
+    t / (t / dt).round().max(1.0)
+}
+
 fn finite3(v: &[f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -925,6 +939,18 @@ impl Case {
         }
         for (f, dt, rho) in [("ancf", self.ancf.dt, self.ancf.rho_inf), ("gebf", self.gebf.dt, self.gebf.rho_inf)] {
             pos(&format!("{f}.dt"), dt)?;
+            // The time loops take whole steps: a t_end (or output interval) between two steps
+            // would end (or sample) the run somewhere else than the case says.
+            if self.t_end < dt * (1.0 - 1e-9) {
+                return Err(format!("{f}.dt: t_end = {} is shorter than one step of {dt} s", self.t_end));
+            }
+            for (name, t) in [("t_end", Some(self.t_end)), ("output_dt", self.output_dt)] {
+                if let Some(t) = t
+                    && whole_steps(t, dt).is_none()
+                {
+                    return Err(format!("{f}.dt: {name} = {t} is not a whole number of steps of {dt} s"));
+                }
+            }
             if !(0.0..=1.0).contains(&rho) {
                 return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
             }

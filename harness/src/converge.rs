@@ -112,6 +112,12 @@ fn rung_spec(spec: &RunSpec, f: Formulation, elements: Elements, dt: f64) -> cra
     if let Some(t) = c.converge_t_end {
         c.t_end = t.min(c.t_end);
     }
+    // Every rung ends at t_end: a step that does not divide it is rounded to one that does.
+    let dt = crate::case::commensurate_dt(c.t_end, dt);
+    match f {
+        Formulation::Ancf => c.ancf.dt = dt,
+        Formulation::Gebf => c.gebf.dt = dt,
+    }
     // The wake sheds one row per step: keep its physical length (rows × V·dt) as dt changes, so
     // that every rung discretises the same wake.
     if let Some(aero) = c.aero.as_mut() {

@@ -88,8 +88,9 @@ fn cell_case(base: &Case, c: f64, beta: f64, dt_factor: f64, rho: f64) -> Case {
             *flare_deg = beta;
         }
     }
-    k.ancf.dt *= dt_factor;
-    k.gebf.dt *= dt_factor;
+    // Rounded to a whole number of steps in t_end, so that every cell ends at t_end.
+    k.ancf.dt = crate::case::commensurate_dt(k.t_end, k.ancf.dt * dt_factor);
+    k.gebf.dt = crate::case::commensurate_dt(k.t_end, k.gebf.dt * dt_factor);
     k.ancf.rho_inf = rho;
     k.gebf.rho_inf = rho;
     k.gate = None;
