@@ -47,3 +47,33 @@ fn t_end_and_output_dt_must_be_whole_numbers_of_steps() {
     let o = harness(&["list"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+fn tmp_text(name: &str, edit: impl FnOnce(String) -> String) -> PathBuf {
+    let src = root().join("cases/double_pendulum_c1_beta45.json");
+    let text = edit(std::fs::read_to_string(src).unwrap());
+    let d = std::env::temp_dir().join(format!("harness-honest-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let p = d.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn duplicate_json_keys_are_errors_naming_key_and_path() {
+    let cases: [(&str, &str, &str, &str); 2] = [
+        ("dup_top.json", "\"t_end\": 2.0,", "\"t_end\": -1, \"t_end\": 0.01,", "duplicate key \"t_end\""),
+        (
+            "dup_body.json",
+            "\"length\": 0.5,",
+            "\"length\": 0.5, \"length\": 0.7,",
+            "bodies[0]: duplicate key \"length\"",
+        ),
+    ];
+    for (name, from, to, needle) in cases {
+        let p = tmp_text(name, |t| t.replacen(from, to, 1));
+        let o = harness(&["run", p.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+    }
+}
