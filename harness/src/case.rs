@@ -693,6 +693,9 @@ impl CaseFile {
                 let mut case = parse_case(&r).map_err(&err)?;
                 case.name.push_str(&suffix);
                 case.validate().map_err(&err)?;
+                for (k, r) in case.references.iter().enumerate() {
+                    check_reference(&self.dir(), &r.file).map_err(|e| err(format!("references[{k}].file: {e}")))?;
+                }
                 per.push(case);
             }
             let gebf = per.pop().expect("two formulations");
@@ -701,6 +704,30 @@ impl CaseFile {
         }
         Ok(runs)
     }
+}
+
+/// Largest reference file read, bytes.
+pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
+
+/// Check that reference `file` (relative to the case folder `dir`) is a readable regular file
+/// of at most [`MAX_REFERENCE_BYTES`] inside `dir`, holding a curve; the message names the file.
+pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
+    let path = dir.join(file);
+    let shown = path.display();
+    let canon = |p: &Path| p.canonicalize().map_err(|e| format!("{}: {e}", p.display()));
+    let base = canon(if dir.as_os_str().is_empty() { Path::new(".") } else { dir })?;
+    let full = canon(&path)?;
+    if !full.starts_with(&base) {
+        return Err(format!("{shown}: not under the case file's folder {}", base.display()));
+    }
+    let meta = std::fs::metadata(&full).map_err(|e| format!("{shown}: {e}"))?;
+    if !meta.is_file() {
+        return Err(format!("{shown}: not a regular file"));
+    }
+    if meta.len() > MAX_REFERENCE_BYTES {
+        return Err(format!("{shown}: {} bytes, more than the limit of {MAX_REFERENCE_BYTES}", meta.len()));
+    }
+    crate::csv::read_curve(&full).map(|_| ()).map_err(|e| e.to_string())
 }
 
 /// Parse JSON text into a [`Value`], refusing a key repeated within one object anywhere in the

@@ -77,3 +77,28 @@ fn duplicate_json_keys_are_errors_naming_key_and_path() {
         assert!(err.contains(needle), "{name}: {err}");
     }
 }
+
+#[test]
+fn unreadable_reference_is_an_input_error_before_any_run() {
+    let inside = root().join("cases/reference/exudyn/rigid_beta45_ode.csv");
+    let outside = inside.canonicalize().unwrap();
+    let cases: [(&str, String, &str); 4] = [
+        ("ref_missing.json", "nope.csv".into(), "nope.csv"),
+        ("ref_dir.json", ".".into(), "not a regular file"),
+        ("ref_outside.json", outside.display().to_string(), "not under the case file's folder"),
+        ("ref_dev.json", "/dev/null".into(), "/dev/null"),
+    ];
+    for (name, file, needle) in cases {
+        let p = tmp_text(name, |t| {
+            let mut v: serde_json::Value = serde_json::from_str(&t).unwrap();
+            v["references"][0]["file"] = serde_json::json!(file);
+            serde_json::to_string(&v).unwrap()
+        });
+        let out = std::env::temp_dir().join(format!("harness-honest-out-{}-{name}", std::process::id()));
+        let o = harness(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("references[0].file") && err.contains(needle), "{name}: {err}");
+        assert!(!out.exists(), "{name}: a run wrote {}", out.display());
+    }
+}
