@@ -99,7 +99,8 @@ impl Observer for VtkWriter {
 pub fn default_stride(case: &Case, f: Formulation) -> usize {
     let s = settings(case, f);
     let dt = s.params.dt;
-    let n_steps = (s.t_end / dt - 1e-9).ceil().max(0.0) as usize;
+    // As the time loops count their steps.
+    let n_steps = (s.t_end / dt).round().max(1.0) as usize;
     let every = s.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
     let rows = n_steps / every + 1;
     (rows / 100).max(1)
