@@ -680,6 +680,8 @@ impl CaseFile {
                 let key = path.rsplit('.').next().unwrap_or(path);
                 let val = match v {
                     Value::String(s) => s.clone(),
+                    // `[0,1,0]` → `0,1,0`: brackets are not among a name's characters.
+                    Value::Array(a) => a.iter().map(Value::to_string).collect::<Vec<_>>().join(","),
                     other => other.to_string(),
                 };
                 suffix.push_str(&format!("__{key}={val}"));
@@ -973,8 +975,14 @@ impl Case {
         let nonneg = |f: &str, v: f64| -> Result<(), String> {
             if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{f}: {v} is not a non-negative number")) }
         };
-        if self.name.is_empty() || self.name.contains(['/', '\\']) {
-            return Err(format!("name: `{}` is empty or contains a path separator", self.name));
+        // The name is a folder under the output directory (and a sweep adds `__key=value`).
+        let n = &self.name;
+        let safe = |c: char| c.is_ascii_alphanumeric() || "._-+=,".contains(c);
+        if n.is_empty() || n.len() > 120 || n == "." || n == ".." || !n.chars().all(safe) {
+            return Err(format!(
+                "name: `{n}` is not a safe file name (1 to 120 bytes of ASCII letters, digits and `._-+=,`; \
+                 not `.` or `..`)"
+            ));
         }
         if self.bodies.is_empty() {
             return Err("bodies: at least one body is needed".into());
@@ -1183,7 +1191,7 @@ mod tests {
     fn sweep_expands_with_formulation_overrides() {
         let mut v = raw();
         v["sweep"] = json!([{"path": "stiffness_scale", "values": [1, 0.1]}, {"path": "joints.1.flare_deg", "values": [0, 45, 90]}]);
-        let cf = CaseFile { path: PathBuf::from("cases/x.json"), raw: v };
+        let cf = CaseFile { path: Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/x.json"), raw: v };
         let ov: Override = "gebf:t_end=1".parse().unwrap();
         let runs = cf.expand(&[ov]).unwrap();
         assert_eq!(runs.len(), 6);

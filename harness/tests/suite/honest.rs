@@ -102,3 +102,33 @@ fn unreadable_reference_is_an_input_error_before_any_run() {
         assert!(!out.exists(), "{name}: a run wrote {}", out.display());
     }
 }
+
+#[test]
+fn case_names_are_safe_file_names() {
+    let long = "a".repeat(121);
+    for bad in ["", ".", "..", "a/b", "a b", "../x", "é", long.as_str()] {
+        let p = tmp_text("bad_name.json", |t| {
+            let mut v: serde_json::Value = serde_json::from_str(&t).unwrap();
+            v["name"] = serde_json::json!(bad);
+            serde_json::to_string(&v).unwrap()
+        });
+        let o = harness(&["run", p.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {err}");
+        assert!(err.contains("name: `"), "{bad:?}: {err}");
+    }
+    // What a sweep appends is allowed, arrays and negative or exponent numbers included.
+    let p = tmp_text("sweep_name.json", |t| {
+        let mut v: serde_json::Value = serde_json::from_str(&t).unwrap();
+        v["references"] = serde_json::json!([]);
+        v["sweep"] = serde_json::json!([
+            {"path": "stiffness_scale", "values": [1e-5, 0.5]},
+            {"path": "bodies.0.x_axis", "values": [[1, 0, 0]]},
+            {"path": "ancf.path", "values": ["ode"]},
+        ]);
+        serde_json::to_string(&v).unwrap()
+    });
+    let out = std::env::temp_dir().join(format!("harness-honest-out-{}-sweep", std::process::id()));
+    let o = harness(&["run", p.to_str().unwrap(), "--set", "t_end=0.002", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
