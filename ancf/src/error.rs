@@ -9,12 +9,6 @@ pub enum Error {
     /// The scene is not valid (checked once for both formulations).
     #[error(transparent)]
     Scene(#[from] scene::Error),
-    /// A scene feature this formulation does not model.
-    #[error("{field}: not supported by the ANCF formulation")]
-    Unsupported {
-        /// Field path.
-        field: String,
-    },
     /// A number that must be finite is NaN or infinite.
     #[error("{field}: {value} is not a finite number")]
     NonFinite {
@@ -39,15 +33,6 @@ pub enum Error {
         /// The offending value.
         value: f64,
     },
-    /// A body needs at least one element.
-    #[error("{field}: a body needs at least one element (got 0)")]
-    ZeroElements {
-        /// Field path, e.g. `bodies[2].n_elements`.
-        field: String,
-    },
-    /// A model needs at least one body.
-    #[error("bodies: the model has no body")]
-    NoBodies,
     /// A joint refers to a body that does not exist.
     #[error("{field}: no body {body} (the model has {n_bodies} bodies)")]
     NoSuchBody {
@@ -58,14 +43,6 @@ pub enum Error {
         /// Number of bodies in the model.
         n_bodies: usize,
     },
-    /// A flared hinge connects a body to itself.
-    #[error("{field}: body {body} cannot be hinged to itself")]
-    SelfJoint {
-        /// Field path.
-        field: String,
-        /// The body index.
-        body: usize,
-    },
     /// The section frame is not orthonormal and right-handed.
     #[error("{field}: not an orthonormal right-handed frame (max |FᵀF − I| = {deviation:.3e}, det = {det:.6})")]
     BadFrame {
@@ -75,41 +52,6 @@ pub enum Error {
         deviation: f64,
         /// Determinant of the frame.
         det: f64,
-    },
-    /// A flare angle outside [−π/2, π/2].
-    #[error("{field}: {beta} rad is outside [-pi/2, pi/2]")]
-    BetaOutOfRange {
-        /// Field path.
-        field: String,
-        /// The flare angle given, rad.
-        beta: f64,
-    },
-    /// A zero hinge axis.
-    #[error("{field}: the axis has zero length")]
-    ZeroAxis {
-        /// Field path.
-        field: String,
-    },
-    /// The child body of a flared hinge does not start where its parent ends.
-    #[error("{field}: the child starts {gap:.3e} m away from the parent's end")]
-    JointGap {
-        /// Field path.
-        field: String,
-        /// Distance between the parent's end and the child's start, m.
-        gap: f64,
-    },
-    /// The section inertias leave the section slopes without mass.
-    #[error(
-        "{field}: the section inertias give D_yy = {d_yy:.3e}, D_zz = {d_zz:.3e} kg·m; both must be positive \
-         (D_yy = (rho_ixx - rho_iyy + rho_izz)/2, D_zz = (rho_ixx + rho_iyy - rho_izz)/2)"
-    )]
-    MasslessSection {
-        /// Field path, e.g. `bodies[0].section`.
-        field: String,
-        /// Mapped inertia on the y-slope, kg·m.
-        d_yy: f64,
-        /// Mapped inertia on the z-slope, kg·m.
-        d_zz: f64,
     },
     /// A joint's equations repeat equations of earlier joints (over-constrained node).
     #[error("joints[{joint}]: its equations are redundant with earlier joints (over-constrained node)")]

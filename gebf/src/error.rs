@@ -6,24 +6,10 @@ pub enum Error {
     /// The scene is not valid (checked once for both formulations).
     #[error(transparent)]
     Scene(#[from] scene::Error),
-    /// A scene feature this formulation does not model.
-    #[error("{field}: not supported by the GEBF formulation")]
-    Unsupported {
-        /// Field path.
-        field: String,
-    },
     /// A number that must be finite is not.
     #[error("{field}: {value} is not finite")]
     NotFinite {
         /// Path of the offending input field, e.g. `bodies[0].start`.
-        field: String,
-        /// The value.
-        value: f64,
-    },
-    /// A quantity that must be positive is not.
-    #[error("{field}: {value} is not positive")]
-    NotPositive {
-        /// Path of the offending input field.
         field: String,
         /// The value.
         value: f64,
@@ -65,44 +51,6 @@ pub enum Error {
         body: usize,
         /// Number of bodies.
         n_bodies: usize,
-    },
-    /// A hinge axis of zero length.
-    #[error("{field}: the axis has zero length")]
-    ZeroAxis {
-        /// Path of the offending input field.
-        field: String,
-    },
-    /// A flared hinge whose child does not start at the parent's end.
-    #[error("{field}: the child starts {gap:.3e} m away from the parent's end")]
-    JointGap {
-        /// Path of the offending input field.
-        field: String,
-        /// Distance, m.
-        gap: f64,
-    },
-    /// A body attached at its start by more than one joint, or a joint to itself.
-    #[error("{field}: body {body} is already attached at its start by joints[{other}]")]
-    DoublyAttached {
-        /// Path of the offending input field.
-        field: String,
-        /// The body.
-        body: usize,
-        /// The earlier joint.
-        other: usize,
-    },
-    /// Flared hinges that form a closed loop.
-    #[error("joints[{joint}]: the flared hinges form a closed loop")]
-    JointLoop {
-        /// A joint on the loop.
-        joint: usize,
-    },
-    /// A flared hinge joining a body to itself.
-    #[error("joints[{joint}]: parent and child are the same body {body}")]
-    SelfJoint {
-        /// The joint.
-        joint: usize,
-        /// The body.
-        body: usize,
     },
     /// A joint index out of range.
     #[error("no joint {joint} (the model has {n_joints})")]
