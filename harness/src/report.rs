@@ -255,20 +255,20 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         let peak = r.metrics.get(&run.formulation).map_or(1.0, |m| m.peak_kinetic).max(f64::MIN_POSITIVE);
         let w = |x: &crate::run::Row| if x.aero_work.is_finite() { x.aero_work } else { 0.0 };
         let d = |x: &crate::run::Row| if x.dissipated.is_finite() { x.dissipated } else { 0.0 };
-        let label =
-            match (run.rows.iter().any(|x| x.aero_work.is_finite()), run.rows.iter().any(|x| x.dissipated.is_finite()))
-            {
-                (true, true) => "(E + W_damp − E0 − W_aero)/max T",
-                (true, false) => "(E − E0 − W_aero)/max T",
-                (false, true) => "(E + W_damp − E0)/max T",
-                (false, false) => "(E − E0)/max T",
-            };
         drift.push(Series {
-            label: format!("{l} {label}"),
+            label: l.to_string(),
             color: run_color(run.formulation),
             points: run.rows.iter().map(|x| (x.t, (x.total + d(x) - e0 - w(x)) / peak)).collect(),
         });
     }
+    // The balance the drift panel shows: the terms the case has.
+    let rows = || r.runs.iter().flat_map(|run| &run.rows);
+    let balance = match (rows().any(|x| x.aero_work.is_finite()), rows().any(|x| x.dissipated.is_finite())) {
+        (true, true) => "(E + W_damp − E0 − W_aero) / max T [-]",
+        (true, false) => "(E − E0 − W_aero) / max T [-]",
+        (false, true) => "(E + W_damp − E0) / max T [-]",
+        (false, false) => "(E − E0) / max T [-]",
+    };
     panels_svg(
         &dir.join("energy.svg"),
         &[
@@ -283,7 +283,7 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
             Panel {
                 title: format!("{} — energy drift", r.name),
                 x_label: "t [s]".into(),
-                y_label: "(E − E0 − W_aero) / max T [-]".into(),
+                y_label: balance.into(),
                 log_y: false,
                 legend_lower_right: false,
                 series: drift,
