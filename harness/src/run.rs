@@ -307,7 +307,9 @@ pub fn simulate<S: Structure>(
     // Validated cases hold a whole number of steps (within a relative 1e-9): round.
     let n_steps = (settings.t_end / dt).round().max(1.0) as usize;
     let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
-    out.rows.reserve(n_steps / every + 2);
+    // Reserve for the expected rows, but never more than a bounded guess up front: the count
+    // comes from user input (`dt`, `t_end`) and the vector grows as rows arrive anyway.
+    out.rows.reserve((n_steps / every + 2).min(1 << 16));
     let mut ga = match model.integrator(settings.params) {
         Ok(g) => g,
         Err(e) => {
