@@ -531,6 +531,19 @@ impl Model {
         }
     }
 
+    /// Project `q` onto the joints' position-level constraints (each joint re-anchors and
+    /// realigns its child body's frame, parents first), as the stabilisation after a time step
+    /// does. The velocity-level joints let a static iteration drift off the joint by second-order
+    /// amounts per update; a static solve that moves far (a continuation over tens of degrees
+    /// of fold) projects after every update.
+    pub fn project_joints(&self, q: &mut [f64]) {
+        let n = self.n_dof();
+        let (mut a, mut b, mut c) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        for &j in &self.projection_order {
+            self.joints[j].project(&self.bodies, q, [&mut a, &mut b, &mut c]);
+        }
+    }
+
     /// Rescale every nodal CRV with |psi| > π to the equivalent one below π, transforming its
     /// rates (`rates = (v, v_dot, a)`) so that the angular velocity and acceleration are kept.
     /// Elements then map their end nodes back onto the middle node's branch (exact chain rule),

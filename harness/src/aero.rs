@@ -29,8 +29,13 @@ use crate::run::Structure;
 pub struct AeroSettings {
     /// Air density, kg/m³.
     pub rho: f64,
-    /// Free-stream velocity, m/s (global).
-    pub v_inf: [f64; 3],
+    /// Free-stream velocity, m/s (global). With `airspeed` it gives only the direction; omitted,
+    /// the free stream is `airspeed` along −Y.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_inf: Option<[f64; 3]>,
+    /// Free-stream speed, m/s: replaces the magnitude of `v_inf` (or flows along −Y without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub airspeed: Option<f64>,
     /// Chord, m.
     pub chord: f64,
     /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
@@ -50,13 +55,59 @@ pub struct AeroSettings {
     /// ≈ −1.3 % lift bias of a 40-row wake); default false (the paper's and SHARPy's set-up).
     #[serde(default)]
     pub wake_closure: bool,
+    /// Mirror planes (at most two, perpendicular): a wind-tunnel wall or floor at a wall-mounted
+    /// model's root, an aircraft's plane of symmetry, the ground. Each reflects every bound and
+    /// wake vortex (image vortices). Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub images: Vec<MirrorPlane>,
     /// Coupling iteration settings.
     #[serde(default)]
     pub coupling: Coupling,
 }
 
+/// A mirror plane of the flow.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MirrorPlane {
+    /// A point of the plane, m (global).
+    pub point: [f64; 3],
+    /// Its normal (any non-zero length), global.
+    pub normal: [f64; 3],
+}
+
+impl AeroSettings {
+    /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images;
+    /// single-threaded (runs are parallel across cases).
+    pub fn uvlm_params(&self, v_inf: [f64; 3]) -> uvlm::UvlmParams {
+        let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
+        params.n_wake_rows = self.n_wake_rows;
+        params.wake_closure = self.wake_closure;
+        params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
+        params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
+        params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
+        params.parallel = uvlm::Parallel::Off;
+        params
+    }
+}
+
 fn default_cutoff() -> f64 {
     1e-6
+}
+
+impl AeroSettings {
+    /// The free-stream velocity, m/s: `v_inf`, scaled to `airspeed` when both are given, or
+    /// `airspeed` along −Y. Validated cases have one of them.
+    pub fn free_stream(&self) -> [f64; 3] {
+        match (self.v_inf, self.airspeed) {
+            (Some(v), None) => v,
+            (Some(v), Some(u)) => {
+                let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                [u * v[0] / n, u * v[1] / n, u * v[2] / n]
+            }
+            (None, Some(u)) => [0.0, -u, 0.0],
+            (None, None) => [0.0; 3],
+        }
+    }
 }
 
 /// Aero-structure coupling per step.
@@ -105,8 +156,10 @@ pub struct StationMap {
     pub body: usize,
     /// Arclength, m.
     pub s: f64,
-    /// Slant of the grid column, rad (β at a flared hinge, 0 elsewhere).
+    /// Slant of the grid column, rad (β at a flared hinge, blended next to it, 0 elsewhere).
     pub slant: f64,
+    /// Whether this is a flared hinge's column.
+    pub hinge: bool,
 }
 
 /// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
@@ -139,13 +192,55 @@ pub fn station_map(case: &Case, aero: &AeroSettings) -> Result<Vec<StationMap>, 
             if let Some(last) = out.last_mut() {
                 let last: &mut StationMap = last;
                 last.slant = beta;
+                last.hinge = true;
             }
         }
         for k in first..=n {
-            out.push(StationMap { body: b, s: body.length * k as f64 / n as f64, slant: 0.0 });
+            out.push(StationMap { body: b, s: body.length * k as f64 / n as f64, slant: 0.0, hinge: false });
         }
     }
+    grade_slants(case, aero, &mut out);
     Ok(out)
+}
+
+/// Blend the columns next to a slanted hinge column towards its slant, so that no panel folds
+/// when the hinge column's ends reach past a neighbouring station (a large flare, a long chord
+/// or narrow panels): a column at arclength distance `d` from the hinge gets
+/// `tan γ = w tan β`, `w = max(0, 1 − d/D)` with `D = 2 max(le, c − le) |tan β|`, which keeps
+/// the leading- and trailing-edge nodes in spanwise order. Only the panel layout changes, not
+/// the planform; columns farther than `D` keep `γ = 0` exactly.
+fn grade_slants(case: &Case, aero: &AeroSettings, map: &mut [StationMap]) {
+    let starts: Vec<f64> = case
+        .bodies
+        .iter()
+        .scan(0.0, |acc, b| {
+            let s0 = *acc;
+            *acc += b.length;
+            Some(s0)
+        })
+        .collect();
+    let arc = |m: &StationMap| starts.get(m.body).copied().unwrap_or(0.0) + m.s;
+    let hinges: Vec<(f64, f64)> = map.iter().filter(|m| m.hinge).map(|m| (arc(m), m.slant)).collect();
+    let reach = aero.le_offset.abs().max((aero.chord - aero.le_offset).abs());
+    for m in map.iter_mut().filter(|m| !m.hinge) {
+        let x = arc(m);
+        let mut t = 0.0;
+        for &(xh, beta) in &hinges {
+            let d_max = 2.0 * reach * beta.tan().abs();
+            let w = if d_max > 0.0 { (1.0 - (x - xh).abs() / d_max).max(0.0) } else { 0.0 };
+            t += w * beta.tan();
+        }
+        if t != 0.0 {
+            m.slant = t.atan();
+        }
+    }
+}
+
+/// The lattice layout of a station map: chordwise panels and the hinge column (the station a
+/// flared hinge drives).
+pub fn lattice_spec(map: &[StationMap], aero: &AeroSettings) -> uvlm::LatticeSpec {
+    let hinge = map.iter().position(|m| m.hinge).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
+    uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) }
 }
 
 /// Pose and velocity of a section by central differences along the retraction.
@@ -180,7 +275,7 @@ pub fn section_state<S: AeroStructure + ?Sized>(
 
 /// Build the lattice stations (and their velocities) of the current structural state.
 #[allow(clippy::too_many_arguments)] // model, state, map, settings and three reused buffers
-fn stations_at<S: AeroStructure + ?Sized>(
+pub(crate) fn stations_at<S: AeroStructure + ?Sized>(
     model: &S,
     q: &[f64],
     v: &[f64],
@@ -245,14 +340,8 @@ pub fn simulate_aero<S: AeroStructure>(
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
-    let hinge = map.iter().position(|m| m.slant != 0.0).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
-    let spec = uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) };
-    let mut params = uvlm::UvlmParams::new(aero.rho, aero.v_inf);
-    params.n_wake_rows = aero.n_wake_rows;
-    params.wake_closure = aero.wake_closure;
-    params.bound_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
-    params.wake_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
-    params.parallel = uvlm::Parallel::Off; // runs are parallel across cases
+    let spec = lattice_spec(map, aero);
+    let params = aero.uvlm_params(aero.free_stream());
     let mut uv = match uvlm::Lattice::from_stations(spec, &stations).and_then(|l| uvlm::Uvlm::new(l, params)) {
         Ok(u) => u,
         Err(e) => return fail(out, format!("aerodynamic lattice: {e}")),
@@ -311,8 +400,8 @@ pub fn simulate_aero<S: AeroStructure>(
                 t.force = Vector3::from(fbuf[j]);
                 t.moment = Vector3::from(mbuf[j]);
             }
-            // Lift ⊥ the free stream aero.v_inf (a direction: a disturbance would not turn it).
-            Ok(uvlm::lift_drag_of(l.total_force(), aero.v_inf, span_dir).0)
+            // Lift ⊥ the free stream (a direction: a disturbance would not turn it).
+            Ok(uvlm::lift_drag_of(l.total_force(), aero.free_stream(), span_dir).0)
         };
         // 2. Wake and aerodynamic solve at the predicted lattice.
         if let Err(e) = uv.advance_wake(dt) {

@@ -39,6 +39,12 @@ pub struct Case {
     /// Gravity vector, m/s² (omit for none).
     #[serde(default)]
     pub gravity: Option<[f64; 3]>,
+    /// Nose-up pitch of the whole scene, degrees, in [−90, 90]: every body's start point and
+    /// section axes are rotated about the global X axis through the origin (Y towards Z) before
+    /// anything else, so that a wing whose leading edge points along +Y (free stream along −Y)
+    /// meets the flow at this incidence. Gravity and the free stream are not rotated. Default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub pitch_deg: f64,
     /// Multiplies every stiffness (EA, GA_y, GA_z, GJ, EI_yy, EI_zz): the paper's `c`. Default 1.
     #[serde(default = "one")]
     pub stiffness_scale: f64,
@@ -75,6 +81,41 @@ pub struct Case {
     /// named runs `<name>__<key>=<value>…`.
     #[serde(default)]
     pub sweep: Vec<SweepAxis>,
+    /// Static aeroelastic equilibria (`harness static`): the airspeeds of the sweep and the
+    /// experiment or model curves to compare with. Needs `aero`.
+    #[serde(default, rename = "static", skip_serializing_if = "Option::is_none")]
+    pub statics: Option<StaticSettings>,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// The static aeroelastic sweep of a case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StaticSettings {
+    /// Airspeeds of the sweep, m/s (positive; the free stream keeps the direction of
+    /// `aero.v_inf`, or −Y). Reported in the order given.
+    pub airspeeds: Vec<f64>,
+    /// Measured or computed coast angles to compare with: CSV files of two columns, airspeed
+    /// (m/s) and fold angle (degrees), relative to the case file's folder.
+    #[serde(default)]
+    pub references: Vec<StaticReference>,
+}
+
+/// A curve of equilibrium fold (coast) angle against airspeed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StaticReference {
+    /// Legend label.
+    pub label: String,
+    /// CSV file (`airspeed_m_s,coast_angle_deg`), relative to the case file's folder.
+    pub file: String,
+    /// An experiment (drawn as points and used for the error metrics) rather than a model
+    /// (drawn as a line, compared for information). Default false.
+    #[serde(default)]
+    pub experiment: bool,
 }
 
 /// One sweep dimension.
@@ -209,7 +250,7 @@ pub enum Joint {
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         locked: bool,
         /// Rotational spring and damper about the hinge axis, on the fold angle (default none;
-        /// not with `locked`).
+        /// inactive while the hinge is `locked`).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         spring: Option<Spring>,
     },
@@ -698,6 +739,10 @@ impl CaseFile {
                 for (k, r) in case.references.iter().enumerate() {
                     check_reference(&self.dir(), &r.file).map_err(|e| err(format!("references[{k}].file: {e}")))?;
                 }
+                for (k, r) in case.statics.iter().flat_map(|s| s.references.iter()).enumerate() {
+                    check_static_reference(&self.dir(), &r.file)
+                        .map_err(|e| err(format!("static.references[{k}].file: {e}")))?;
+                }
                 per.push(case);
             }
             let gebf = per.pop().expect("two formulations");
@@ -708,12 +753,27 @@ impl CaseFile {
     }
 }
 
+/// Most airspeeds in one static sweep.
+pub const MAX_STATIC_POINTS: usize = 10_000;
+
 /// Largest reference file read, bytes.
 pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
 
 /// Check that reference `file` (relative to the case folder `dir`) is a readable regular file
 /// of at most [`MAX_REFERENCE_BYTES`] inside `dir`, holding a curve; the message names the file.
 pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
+    let full = checked_file(dir, file)?;
+    crate::csv::read_curve(&full).map(|_| ()).map_err(|e| e.to_string())
+}
+
+/// Check a static reference as [`check_reference`] does, holding an airspeed–angle curve.
+pub fn check_static_reference(dir: &Path, file: &str) -> Result<(), String> {
+    let full = checked_file(dir, file)?;
+    crate::statics::read_xy(&full).map(|_| ()).map_err(|e| e.to_string())
+}
+
+/// `dir/file`, canonical, when it is a regular file of at most [`MAX_REFERENCE_BYTES`] under `dir`.
+fn checked_file(dir: &Path, file: &str) -> Result<PathBuf, String> {
     let path = dir.join(file);
     let shown = path.display();
     let canon = |p: &Path| p.canonicalize().map_err(|e| format!("{}: {e}", p.display()));
@@ -729,7 +789,7 @@ pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
     if meta.len() > MAX_REFERENCE_BYTES {
         return Err(format!("{shown}: {} bytes, more than the limit of {MAX_REFERENCE_BYTES}", meta.len()));
     }
-    crate::csv::read_curve(&full).map(|_| ()).map_err(|e| e.to_string())
+    Ok(full)
 }
 
 /// Parse JSON text into a [`Value`], refusing a key repeated within one object anywhere in the
@@ -891,12 +951,14 @@ impl Case {
             Formulation::Gebf => &self.gebf.elements_per_body,
         };
         let unit = |v: [f64; 3]| nalgebra::Vector3::from(v).normalize();
+        // Nose-up pitch: a rotation about +X takes +Y (the leading edge) towards +Z.
+        let pitch = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), self.pitch_deg.to_radians());
         let bodies = self
             .bodies
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let (x, y) = (unit(b.x_axis), unit(b.y_axis));
+                let (x, y) = (pitch * unit(b.x_axis), pitch * unit(b.y_axis));
                 let s = &b.section;
                 let section = scene::Section {
                     cg_offset: s.cg_offset,
@@ -906,7 +968,7 @@ impl Case {
                 };
                 scene::BodySpec {
                     name: b.name.clone(),
-                    start: b.start.into(),
+                    start: pitch * nalgebra::Vector3::from(b.start),
                     length: b.length,
                     frame: nalgebra::Matrix3::from_columns(&[x, y, x.cross(&y)]),
                     section: section.with_stiffness_scale(self.stiffness_scale),
@@ -952,6 +1014,9 @@ impl Case {
             .iter()
             .enumerate()
             .filter_map(|(joint, j)| match j {
+                // A locked hinge carries no spring: locking a sprung hinge (`--set
+                // joints.<i>.locked=true`) welds it and its spring does nothing.
+                Joint::FlaredHinge { locked: true, .. } => None,
                 Joint::GroundHinge { spring, .. } | Joint::FlaredHinge { spring, .. } => {
                     spring.map(|s| scene::ForceElement::HingeSpring {
                         joint,
@@ -1015,14 +1080,11 @@ impl Case {
                 Joint::GroundHinge { body: b, .. } => {
                     body(format!("joints[{i}].body"), b)?;
                 }
-                Joint::FlaredHinge { parent, child, flare_deg, locked, spring, .. } => {
+                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
                     body(format!("joints[{i}].parent"), parent)?;
                     body(format!("joints[{i}].child"), child)?;
                     if !(flare_deg.is_finite() && (-90.0..=90.0).contains(flare_deg)) {
                         return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
-                    }
-                    if *locked && spring.is_some() {
-                        return Err(format!("joints[{i}].spring: a locked hinge cannot carry a spring"));
                     }
                 }
                 Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
@@ -1096,8 +1158,13 @@ impl Case {
             }
             pos("aero.rho", a.rho)?;
             pos("aero.chord", a.chord)?;
-            if !finite3(&a.v_inf) || norm3(&a.v_inf) == 0.0 {
-                return Err("aero.v_inf: not a finite non-zero vector".into());
+            match (a.v_inf, a.airspeed) {
+                (None, None) => return Err("aero: give the free stream as `v_inf` or `airspeed`".into()),
+                (Some(v), _) if !finite3(&v) || norm3(&v) == 0.0 => {
+                    return Err("aero.v_inf: not a finite non-zero vector".into());
+                }
+                (_, Some(u)) => pos("aero.airspeed", u)?,
+                _ => {}
             }
             if !a.le_offset.is_finite() {
                 return Err("aero.le_offset: not finite".into());
@@ -1123,6 +1190,28 @@ impl Case {
                         "joints[{i}].flare_deg: {flare_deg} is not below the lattice's limit of ±{}° (aero)",
                         uvlm::lattice::MAX_HINGE_FLARE_DEG
                     ));
+                }
+            }
+        }
+        if !(self.pitch_deg.is_finite() && (-90.0..=90.0).contains(&self.pitch_deg)) {
+            return Err(format!("pitch_deg: {} is not in [-90, 90]", self.pitch_deg));
+        }
+        if let Some(st) = &self.statics {
+            if self.aero.is_none() {
+                return Err("static: a static aeroelastic sweep needs `aero`".into());
+            }
+            if st.airspeeds.is_empty() {
+                return Err("static.airspeeds: empty list".into());
+            }
+            if st.airspeeds.len() > MAX_STATIC_POINTS {
+                return Err(format!("static.airspeeds: {} points, more than {MAX_STATIC_POINTS}", st.airspeeds.len()));
+            }
+            for (k, &u) in st.airspeeds.iter().enumerate() {
+                pos(&format!("static.airspeeds[{k}]"), u)?;
+            }
+            for (k, r) in st.references.iter().enumerate() {
+                if r.label.is_empty() {
+                    return Err(format!("static.references[{k}].label: empty"));
                 }
             }
         }

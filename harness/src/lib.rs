@@ -16,11 +16,14 @@ pub mod csv;
 pub mod driver;
 pub mod energy;
 pub mod gate;
+pub mod loads;
 pub mod metrics;
 pub mod plot;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod static_out;
+pub mod statics;
 pub mod stress;
 pub mod vtk;
 

@@ -135,6 +135,21 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
+    /// Static aeroelastic equilibria over the case's `static.airspeeds`; writes
+    /// `<out>/<case>/static_{ancf,gebf}.csv`, `static_lift_*.csv`, `static_summary.json` and plots.
+    Static {
+        /// Case file (with `aero` and `static` blocks).
+        case: PathBuf,
+        /// Formulation(s) to run.
+        #[arg(long, value_enum, default_value = "both")]
+        formulation: Which,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`), e.g. `pitch_deg=5` or `joints.1.locked=true`.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
     /// List the runs the case files expand into.
     List {
         /// Folder of case files.
@@ -207,6 +222,59 @@ fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String,
         v.push(("wing AoA 15 deg, 20 s".to_string(), CaseFile::read(&wing)?.expand(&ov)?.remove(0)));
     }
     Ok(v)
+}
+
+/// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
+fn run_static_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> harness::static_out::StaticSummary {
+    use rayon::prelude::*;
+    let outs: Vec<_> = fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect();
+    harness::static_out::summarise(&spec.ancf, &spec.dir, outs)
+}
+
+/// Print a sweep's outcome; true when a point failed.
+fn report_static(s: &harness::static_out::StaticSummary) -> bool {
+    for r in &s.runs {
+        let ok = r.points.iter().filter(|p| p.error.is_none()).count();
+        println!(
+            "static {} {}: {ok} of {} airspeeds in {:.3} s ({} steady solves, {} aerodynamic tangents, {} unknowns)",
+            s.name,
+            r.formulation,
+            r.points.len(),
+            r.wall_s,
+            r.n_aero_solves,
+            r.n_tangents,
+            r.n_dof
+        );
+        for p in &r.points {
+            match &p.error {
+                Some(e) => eprintln!("  {} m/s: FAILED: {e}", p.airspeed),
+                None => println!(
+                    "  {:>5} m/s  fold {:>8.3} deg  RBM {:>9.5} N m  torque {:>9.5} N m  hinge {:>9.2e} N m  lift {:>8.4} N  ({} Newton)",
+                    p.airspeed,
+                    p.fold_deg,
+                    p.loads.root_bending_moment,
+                    p.loads.root_torque,
+                    p.loads.hinge_moment,
+                    p.lift,
+                    p.newton_iterations
+                ),
+            }
+        }
+    }
+    for r in &s.references {
+        for (f, rms) in &r.rms_deg {
+            println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label);
+        }
+    }
+    if s.runs.len() == 2 {
+        println!(
+            "static {}: ANCF-GEBF max fold difference {:.4} deg, max root bending moment difference {:.3} %",
+            s.name,
+            s.max_fold_difference_deg,
+            100.0 * s.max_rbm_relative_difference
+        );
+    }
+    s.n_failed > 0 || s.runs.iter().any(|r| r.error.is_some())
 }
 
 /// 2 when any input was bad (whatever else happened), else 1 when a run or a gate failed.
@@ -360,6 +428,33 @@ fn real_main() -> Result<ExitCode> {
                 if let Some(p) = &r.pair {
                     println!("{}: max tip difference ANCF-GEBF {:.3} mm", r.name, 1e3 * p.all.max);
                 }
+            }
+            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
+        Cmd::Static { case, formulation, out, set } => {
+            let file = CaseFile::read(&case)?;
+            let runs = file.expand(&set)?;
+            let fs: Vec<Formulation> = match formulation {
+                Which::Ancf => vec![Formulation::Ancf],
+                Which::Gebf => vec![Formulation::Gebf],
+                Which::Both => Formulation::ALL.to_vec(),
+            };
+            for spec in &runs {
+                if spec.ancf.statics.is_none() {
+                    return Err(harness::Error::Case {
+                        file: case.display().to_string(),
+                        msg: "static: the case has no `static` block (airspeeds to sweep)".into(),
+                    }
+                    .into());
+                }
+            }
+            let mut failed = false;
+            for spec in &runs {
+                let summary = run_static_case(spec, &fs);
+                let dir = out.join(&spec.name);
+                harness::static_out::write(&dir, &summary)?;
+                failed |= report_static(&summary);
+                println!("wrote {}", dir.display());
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }

@@ -71,18 +71,18 @@ fn rigid_locked_wing_lift_matches_steady_uvlm() {
             uvlm::SpanStation { origin, frame, chord: aero.chord, le_offset: aero.le_offset, slant: m.slant }
         })
         .collect();
-    let hinge = map.iter().position(|m| m.slant != 0.0).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
+    let hinge = map.iter().position(|m| m.hinge).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
     assert!(hinge.is_some(), "the lattice has its slanted hinge column");
     let lattice = uvlm::Lattice::from_stations(
         uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) },
         &stations,
     )
     .unwrap();
-    let mut params = uvlm::UvlmParams::new(aero.rho, aero.v_inf);
+    let mut params = uvlm::UvlmParams::new(aero.rho, aero.free_stream());
     params.bound_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
     params.wake_core = uvlm::CoreModel::CutOff { radius: aero.cutoff_radius };
     let mut u = uvlm::Uvlm::new(lattice, params).unwrap();
-    let steady = uvlm::lift_drag_of(u.solve_steady().unwrap().total_force(), aero.v_inf, [1.0, 0.0, 0.0]).0;
+    let steady = uvlm::lift_drag_of(u.solve_steady().unwrap().total_force(), aero.free_stream(), [1.0, 0.0, 0.0]).0;
     for f in Formulation::ALL {
         let out = run(&spec, f);
         let last = out.rows.last().unwrap();

@@ -1,0 +1,308 @@
+//! Wing loads from a free body: the root wrench at a clamp and the hinge moment of a flared
+//! hinge, from the aerodynamic station loads, gravity and (in time histories) the inertia of the
+//! distributed mass and the point masses (docs/outputs.md §6).
+//!
+//! Both formulations are measured by the same rule, written once against [`AeroStructure`]: the
+//! free body is the set of bodies outboard of the cut, and its loads are integrated along the
+//! bodies' section poses (3-point Gauss–Legendre on each of the formulation's elements, so the
+//! rule is exact for the polynomial interpolation inside an element). Accelerations come from the
+//! second central difference of the pose along the model's retraction
+//! `q ∘ exp(±ε v + ½ ε² v̇)`, which matches the trajectory to second order.
+//!
+//! Conventions (the clamp's section frame `x_c` span, `y_c` towards the leading edge, `z_c`):
+//! * root bending moment `−M·y_c`: positive when lift (+`z_c`) bends the wing up;
+//! * root torque `M·x_c`: nose-up positive;
+//! * hinge moment: the moment of the loads on the outboard bodies about the hinge axis, positive
+//!   in the fold-up sense (about `−a`, `a = sin β x + cos β y` of the parent's end section), i.e.
+//!   the moment the hinge must carry: zero for a free hinge at rest, the spring's moment for a
+//!   sprung one, the lock's for a locked one.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::aero::{AeroStructure, SectionLoad};
+use crate::case::{Case, Formulation, Joint};
+
+/// The cut of a free body: its bodies and the point moments are taken about.
+#[derive(Debug, Clone, PartialEq)]
+struct Cut {
+    /// Bodies outboard of the cut.
+    bodies: Vec<usize>,
+}
+
+/// Mass data of one body for the free body.
+#[derive(Debug, Clone, PartialEq)]
+struct BodyMass {
+    length: f64,
+    n_elements: usize,
+    mass: f64,
+    cg: [f64; 2],
+    rho_i: [f64; 3],
+    points: Vec<crate::case::PointMass>,
+}
+
+/// Root and hinge loads of a case's wing at one state.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct WingLoads {
+    /// Root force in the clamp's section frame `[axial, chordwise, normal]`, N (the load the
+    /// wing puts on the clamp).
+    pub root_force: [f64; 3],
+    /// Root moment in the clamp's section frame, about the clamp's axis point, N·m.
+    pub root_moment: [f64; 3],
+    /// Root bending moment, N·m (positive when lift bends the wing up).
+    pub root_bending_moment: f64,
+    /// Root torque, N·m (nose-up positive).
+    pub root_torque: f64,
+    /// Hinge moment about the hinge axis, N·m (fold-up positive; NaN without a flared hinge).
+    pub hinge_moment: f64,
+}
+
+/// What a case's free bodies need: the clamp, the fold hinge, the bodies' mass and gravity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadModel {
+    bodies: Vec<BodyMass>,
+    clamp: Option<(usize, Cut)>,
+    hinge: Option<(usize, f64, Cut)>,
+    gravity: Vector3<f64>,
+}
+
+/// Gauss–Legendre abscissae and weights on [0, 1], 3 points.
+const GAUSS3: [(f64, f64); 3] =
+    [(0.112_701_665_379_258_3, 5.0 / 18.0), (0.5, 8.0 / 18.0), (0.887_298_334_620_741_7, 5.0 / 18.0)];
+
+impl LoadModel {
+    /// The free bodies of `case` as formulation `f` discretises it: the first clamp's body and
+    /// everything joined outboard of it, and the outboard side of the fold hinge
+    /// ([`Case::fold_joint_index`]). `None` when the case has neither.
+    pub fn new(case: &Case, f: Formulation) -> Option<Self> {
+        let n_el = match f {
+            Formulation::Ancf => &case.ancf.elements_per_body,
+            Formulation::Gebf => &case.gebf.elements_per_body,
+        };
+        let bodies: Vec<BodyMass> = case
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BodyMass {
+                length: b.length,
+                n_elements: n_el.for_body(i).max(1),
+                mass: b.section.mass,
+                cg: b.section.cg_offset,
+                rho_i: [b.section.rho_ixx, b.section.rho_iyy, b.section.rho_izz],
+                points: b.point_masses.clone(),
+            })
+            .collect();
+        // Children of each body through flared hinges (locked or not).
+        let children = |b: usize| -> Vec<usize> {
+            case.joints
+                .iter()
+                .filter_map(|j| match j {
+                    Joint::FlaredHinge { parent, child, .. } if case.body_index(parent) == Some(b) => {
+                        case.body_index(child)
+                    }
+                    _ => None,
+                })
+                .collect()
+        };
+        let subtree = |root: usize| -> Cut {
+            let mut out = vec![root];
+            let mut k = 0;
+            while k < out.len() && out.len() <= case.bodies.len() {
+                for c in children(out[k]) {
+                    if !out.contains(&c) {
+                        out.push(c);
+                    }
+                }
+                k += 1;
+            }
+            Cut { bodies: out }
+        };
+        let clamp = case.joints.iter().find_map(|j| match j {
+            Joint::Clamp { body, .. } => case.body_index(body).map(|b| (b, subtree(b))),
+            _ => None,
+        });
+        let hinge = case.fold_joint_index().and_then(|i| match &case.joints[i] {
+            Joint::FlaredHinge { parent, child, flare_deg, .. } => {
+                let (p, c) = (case.body_index(parent)?, case.body_index(child)?);
+                Some((p, flare_deg.to_radians(), subtree(c)))
+            }
+            _ => None,
+        });
+        if clamp.is_none() && hinge.is_none() {
+            return None;
+        }
+        let gravity = case.gravity.map(Vector3::from).unwrap_or_else(Vector3::zeros);
+        Some(Self { bodies, clamp, hinge, gravity })
+    }
+
+    /// Whether the case has a clamp (root loads).
+    pub fn has_root(&self) -> bool {
+        self.clamp.is_some()
+    }
+
+    /// The loads at state `(q, v, v̇)` (`None` for the velocities: at rest) with the
+    /// aerodynamic station loads `aero`.
+    pub fn evaluate<S: AeroStructure + ?Sized>(
+        &self,
+        model: &S,
+        q: &[f64],
+        motion: Option<(&[f64], &[f64])>,
+        aero: &[SectionLoad],
+        scratch: &mut LoadScratch,
+    ) -> WingLoads {
+        let mut out = WingLoads { hinge_moment: f64::NAN, ..WingLoads::default() };
+        scratch.prepare(model, q, motion);
+        if let Some((body, cut)) = &self.clamp {
+            let (p, r) = model.section_pose(q, *body, 0.0);
+            let (f, m) = self.wrench(model, cut, p, aero, scratch);
+            let (fl, ml) = (r.transpose() * f, r.transpose() * m);
+            out.root_force = fl.into();
+            out.root_moment = ml.into();
+            out.root_bending_moment = -ml.y;
+            out.root_torque = ml.x;
+        } else {
+            out.root_force = [f64::NAN; 3];
+            out.root_moment = [f64::NAN; 3];
+            out.root_bending_moment = f64::NAN;
+            out.root_torque = f64::NAN;
+        }
+        if let Some((parent, beta, cut)) = &self.hinge {
+            let (p, r) = model.section_pose(q, *parent, self.bodies[*parent].length);
+            let a = r * Vector3::new(beta.sin(), beta.cos(), 0.0);
+            let (_, m) = self.wrench(model, cut, p, aero, scratch);
+            out.hinge_moment = -m.dot(&a);
+        }
+        out
+    }
+
+    /// Resultant force and moment about `about` of every load on the bodies of `cut`.
+    fn wrench<S: AeroStructure + ?Sized>(
+        &self,
+        model: &S,
+        cut: &Cut,
+        about: Vector3<f64>,
+        aero: &[SectionLoad],
+        scratch: &mut LoadScratch,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
+        for l in aero.iter().filter(|l| cut.bodies.contains(&l.body)) {
+            let (p, _) = model.section_pose(q_of(scratch), l.body, l.s);
+            f += l.force;
+            m += (p - about).cross(&l.force) + l.moment;
+        }
+        for &b in &cut.bodies {
+            let Some(bm) = self.bodies.get(b) else { continue };
+            let h = bm.length / bm.n_elements as f64;
+            for e in 0..bm.n_elements {
+                for (xi, w) in GAUSS3 {
+                    let s = h * (e as f64 + xi);
+                    let k = scratch.kinematics(model, b, s);
+                    let cg = k.offset_point(Vector3::new(0.0, bm.cg[0], bm.cg[1]));
+                    let df = bm.mass * (self.gravity - cg.1) * (w * h);
+                    f += df;
+                    m += (cg.0 - about).cross(&df);
+                    m += k.rotary_moment(Vector3::from(bm.rho_i)) * (w * h);
+                }
+            }
+            for pm in &bm.points {
+                let k = scratch.kinematics(model, b, pm.at);
+                let (x, acc) = k.offset_point(Vector3::from(pm.offset));
+                let df = pm.mass * (self.gravity - acc);
+                f += df;
+                m += (x - about).cross(&df) + k.rotary_moment(Vector3::from(pm.inertia));
+            }
+        }
+        (f, m)
+    }
+}
+
+fn q_of(s: &LoadScratch) -> &[f64] {
+    &s.q[0]
+}
+
+/// Pose, velocity and acceleration of a section.
+struct Kinematics {
+    p: Vector3<f64>,
+    r: Matrix3<f64>,
+    acc: Vector3<f64>,
+    /// Second difference of the frame, R̈ (zero at rest).
+    r_dd: Matrix3<f64>,
+    omega: Vector3<f64>,
+    alpha: Vector3<f64>,
+}
+
+impl Kinematics {
+    /// Position and acceleration of the point at `offset` (section frame) from the axis point.
+    fn offset_point(&self, offset: Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        (self.p + self.r * offset, self.acc + self.r_dd * offset)
+    }
+
+    /// Inertial moment −(J α + ω × J ω) of principal inertias `j` along the section axes.
+    fn rotary_moment(&self, j: Vector3<f64>) -> Vector3<f64> {
+        if j == Vector3::zeros() {
+            return Vector3::zeros();
+        }
+        let jg = self.r * Matrix3::from_diagonal(&j) * self.r.transpose();
+        -(jg * self.alpha + self.omega.cross(&(jg * self.omega)))
+    }
+}
+
+/// Reused buffers of [`LoadModel::evaluate`]: the states `q`, `q(+ε)`, `q(−ε)`.
+#[derive(Debug, Clone, Default)]
+pub struct LoadScratch {
+    q: [Vec<f64>; 3],
+    dq: Vec<f64>,
+    eps: f64,
+    moving: bool,
+}
+
+impl LoadScratch {
+    fn prepare<S: AeroStructure + ?Sized>(&mut self, model: &S, q: &[f64], motion: Option<(&[f64], &[f64])>) {
+        self.q[0].clear();
+        self.q[0].extend_from_slice(q);
+        self.moving = false;
+        let Some((v, a)) = motion else { return };
+        let vmax = v.iter().chain(a).fold(0.0_f64, |m, x| m.max(x.abs()));
+        if vmax == 0.0 {
+            return;
+        }
+        self.moving = true;
+        // Second differences: truncation O(ε²), round-off O(1e-16/ε²) of the positions.
+        self.eps = 1e-4 / vmax.sqrt().max(1.0);
+        let eps = self.eps;
+        for (k, sign) in [(1, 1.0), (2, -1.0)] {
+            self.dq.clear();
+            self.dq.extend(v.iter().zip(a).map(|(v, a)| sign * eps * v + 0.5 * eps * eps * a));
+            self.q[k].resize(q.len(), 0.0);
+            let (head, tail) = self.q.split_at_mut(1);
+            model.retract_inplace(&head[0], &self.dq, &mut tail[k - 1]);
+        }
+    }
+
+    fn kinematics<S: AeroStructure + ?Sized>(&self, model: &S, body: usize, s: f64) -> Kinematics {
+        let (p, r) = model.section_pose(&self.q[0], body, s);
+        if !self.moving {
+            return Kinematics {
+                p,
+                r,
+                acc: Vector3::zeros(),
+                r_dd: Matrix3::zeros(),
+                omega: Vector3::zeros(),
+                alpha: Vector3::zeros(),
+            };
+        }
+        let (pp, rp) = model.section_pose(&self.q[1], body, s);
+        let (pm, rm) = model.section_pose(&self.q[2], body, s);
+        let e2 = self.eps * self.eps;
+        let acc = (pp - 2.0 * p + pm) / e2;
+        let r_dd = (rp - 2.0 * r + rm) / e2;
+        let w = (rp - rm) * r.transpose() / (2.0 * self.eps);
+        let omega = axial(&w);
+        let alpha = axial(&(r_dd * r.transpose()));
+        Kinematics { p, r, acc, r_dd, omega, alpha }
+    }
+}
+
+/// Axial vector of the skew part of `w`.
+fn axial(w: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5
+}

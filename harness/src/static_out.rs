@@ -1,0 +1,460 @@
+//! Outputs of a static aeroelastic sweep (docs/outputs.md §6): `static_<f>.csv`,
+//! `static_lift_<f>.csv`, `static_summary.json`, three SVG plots, and the report's section.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use plotters::prelude::*;
+use serde::Serialize;
+
+use crate::Error;
+use crate::case::{Case, Formulation};
+use crate::csv::write_file;
+use crate::statics::StaticOutput;
+
+/// Column header of `static_<f>.csv`.
+pub const HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
+root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged";
+
+/// Column header of `static_lift_<f>.csv`.
+pub const LIFT_HEADER: &str = "airspeed,strip,s,x,y,z,lift_per_span,cl";
+
+/// The sweep as CSV text (one row per airspeed, NaN where a point failed).
+pub fn to_csv(out: &StaticOutput) -> String {
+    let mut s = String::from(HEADER);
+    s.push('\n');
+    for p in &out.points {
+        let l = &p.loads;
+        let _ = writeln!(
+            s,
+            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{}",
+            p.airspeed,
+            p.fold_deg,
+            p.tip[0],
+            p.tip[1],
+            p.tip[2],
+            l.root_bending_moment,
+            l.root_torque,
+            l.hinge_moment,
+            p.lift,
+            l.root_force[0],
+            l.root_force[1],
+            l.root_force[2],
+            l.root_moment[0],
+            l.root_moment[1],
+            l.root_moment[2],
+            p.newton_iterations,
+            u8::from(p.error.is_none())
+        );
+    }
+    s
+}
+
+/// The spanwise lift distributions as CSV text.
+pub fn lift_csv(out: &StaticOutput) -> String {
+    let mut s = String::from(LIFT_HEADER);
+    s.push('\n');
+    for p in &out.points {
+        for (j, st) in p.strips.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "{},{j},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
+                p.airspeed, st.s, st.position[0], st.position[1], st.position[2], st.lift_per_span, st.cl
+            );
+        }
+    }
+    s
+}
+
+/// A reference curve with its errors.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceErrors {
+    /// Label.
+    pub label: String,
+    /// File, relative to the case folder.
+    pub file: String,
+    /// An experiment (else a model).
+    pub experiment: bool,
+    /// The curve: airspeed (m/s), angle (degrees).
+    pub points: Vec<(f64, f64)>,
+    /// Per formulation: (airspeed, reference angle, computed angle, error = computed − reference)
+    /// at the reference's airspeeds inside the sweep's converged range.
+    pub errors: Vec<(Formulation, Vec<(f64, f64, f64, f64)>)>,
+    /// Per formulation: RMS error over 12–33 m/s, degrees.
+    pub rms_deg: Vec<(Formulation, f64)>,
+}
+
+/// The sweep's summary (`static_summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StaticSummary {
+    /// Case name.
+    pub name: String,
+    /// Case description.
+    pub description: String,
+    /// Each formulation's sweep.
+    pub runs: Vec<StaticOutput>,
+    /// References and the errors against them.
+    pub references: Vec<ReferenceErrors>,
+    /// Largest |fold_ANCF − fold_GEBF| over the airspeeds both solved, degrees.
+    pub max_fold_difference_deg: f64,
+    /// Largest |RBM_ANCF − RBM_GEBF| / |RBM_GEBF| over the airspeeds both solved.
+    pub max_rbm_relative_difference: f64,
+    /// Points without an equilibrium, all formulations.
+    pub n_failed: usize,
+}
+
+/// Linear interpolation of the converged points `(airspeed, value)` (sorted) at `u`; None
+/// outside their range.
+fn interp(pts: &[(f64, f64)], u: f64) -> Option<f64> {
+    let i = pts.iter().position(|p| p.0 >= u)?;
+    if (pts[i].0 - u).abs() < 1e-12 {
+        return Some(pts[i].1);
+    }
+    if i == 0 {
+        return None;
+    }
+    let (a, b) = (pts[i - 1], pts[i]);
+    Some(a.1 + (b.1 - a.1) * (u - a.0) / (b.0 - a.0))
+}
+
+fn curve(out: &StaticOutput, f: impl Fn(&crate::statics::StaticPoint) -> f64) -> Vec<(f64, f64)> {
+    let mut v: Vec<(f64, f64)> = out
+        .points
+        .iter()
+        .filter(|p| p.error.is_none())
+        .map(|p| (p.airspeed, f(p)))
+        .filter(|p| p.1.is_finite())
+        .collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v
+}
+
+/// Evaluate the sweeps against each other and the case's references.
+pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> StaticSummary {
+    let mut references = Vec::new();
+    for r in case.statics.iter().flat_map(|s| &s.references) {
+        let points = crate::statics::read_xy(&dir_of_case.join(&r.file)).unwrap_or_default();
+        let mut errors = Vec::new();
+        let mut rms_deg = Vec::new();
+        for out in &runs {
+            let ours = curve(out, |p| p.fold_deg);
+            let e: Vec<(f64, f64, f64, f64)> =
+                points.iter().filter_map(|&(u, a)| interp(&ours, u).map(|c| (u, a, c, c - a))).collect();
+            let band: Vec<f64> = e.iter().filter(|x| (12.0 - 1e-9..=33.0 + 1e-9).contains(&x.0)).map(|x| x.3).collect();
+            let rms = if band.is_empty() {
+                f64::NAN
+            } else {
+                (band.iter().map(|x| x * x).sum::<f64>() / band.len() as f64).sqrt()
+            };
+            errors.push((out.formulation, e));
+            rms_deg.push((out.formulation, rms));
+        }
+        references.push(ReferenceErrors {
+            label: r.label.clone(),
+            file: r.file.clone(),
+            experiment: r.experiment,
+            points,
+            errors,
+            rms_deg,
+        });
+    }
+    let (mut dfold, mut drbm) = (f64::NAN, f64::NAN);
+    if let [a, g] = runs.as_slice() {
+        for (pa, pg) in a.points.iter().zip(&g.points) {
+            if pa.error.is_none() && pg.error.is_none() {
+                let d = (pa.fold_deg - pg.fold_deg).abs();
+                if d.is_finite() {
+                    dfold = if dfold.is_nan() { d } else { dfold.max(d) };
+                }
+                let (ra, rg) = (pa.loads.root_bending_moment, pg.loads.root_bending_moment);
+                let r = (ra - rg).abs() / rg.abs().max(1e-12);
+                if r.is_finite() {
+                    drbm = if drbm.is_nan() { r } else { drbm.max(r) };
+                }
+            }
+        }
+    }
+    let n_failed = runs.iter().flat_map(|r| &r.points).filter(|p| p.error.is_some()).count();
+    StaticSummary {
+        name: case.name.clone(),
+        description: case.description.clone(),
+        runs,
+        references,
+        max_fold_difference_deg: dfold,
+        max_rbm_relative_difference: drbm,
+        n_failed,
+    }
+}
+
+/// RMS error of a model reference against an experiment reference of the same summary (at the
+/// experiment's airspeeds in 12–33 m/s), degrees.
+pub fn model_rms(summary: &StaticSummary) -> Vec<(String, f64)> {
+    let Some(exp) = summary.references.iter().find(|r| r.experiment) else { return Vec::new() };
+    summary
+        .references
+        .iter()
+        .filter(|r| !r.experiment)
+        .map(|m| {
+            let mut pts = m.points.clone();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let e: Vec<f64> = exp
+                .points
+                .iter()
+                .filter(|p| (12.0 - 1e-9..=33.0 + 1e-9).contains(&p.0))
+                .filter_map(|&(u, a)| interp(&pts, u).map(|c| c - a))
+                .collect();
+            let rms =
+                if e.is_empty() { f64::NAN } else { (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt() };
+            (m.label.clone(), rms)
+        })
+        .collect()
+}
+
+/// Write the sweep's files into `dir`.
+pub fn write(dir: &Path, summary: &StaticSummary) -> Result<(), Error> {
+    for out in &summary.runs {
+        write_file(&dir.join(format!("static_{}.csv", out.formulation)), &to_csv(out))?;
+        write_file(&dir.join(format!("static_lift_{}.csv", out.formulation)), &lift_csv(out))?;
+    }
+    let json = serde_json::to_string_pretty(summary).map_err(|e| Error::Io(e.to_string()))?;
+    write_file(&dir.join("static_summary.json"), &json)?;
+    plot_coast(&dir.join("static_coast.svg"), summary)?;
+    plot_rbm(&dir.join("static_rbm.svg"), summary)?;
+    plot_lift(&dir.join("static_lift.svg"), summary)?;
+    Ok(())
+}
+
+const ANCF: RGBColor = RGBColor(31, 119, 180);
+const GEBF: RGBColor = RGBColor(214, 39, 40);
+const EXP: RGBColor = RGBColor(30, 30, 30);
+const MODEL: RGBColor = RGBColor(44, 160, 44);
+
+fn color(f: Formulation) -> RGBColor {
+    match f {
+        Formulation::Ancf => ANCF,
+        Formulation::Gebf => GEBF,
+    }
+}
+
+fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) =
+        vals.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let d = if hi - lo < 1e-12 { 1.0_f64.max(lo.abs() * 0.1) } else { 0.06 * (hi - lo) };
+    (lo - d, hi + d)
+}
+
+type Curves<'a> = Vec<(String, RGBColor, Vec<(f64, f64)>, bool)>;
+
+/// A panel of curves: (label, colour, points, drawn as markers only).
+fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves<'_>) -> Result<(), Error> {
+    let err = |e: String| Error::Plot { file: path.display().to_string(), msg: e };
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let (x0, x1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.0)));
+    let (y0, y1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.1)));
+    // Legend to the right of the data.
+    let (plot_area, legend_area) = root.split_horizontally(640);
+    let mut chart = ChartBuilder::on(&plot_area)
+        .caption(title, ("sans-serif", 17))
+        .margin(10)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .x_desc(xl)
+        .y_desc(yl)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
+    for (k, (_, c, pts, markers)) in curves.iter().enumerate() {
+        if *markers {
+            chart
+                .draw_series(pts.iter().map(|&p| Cross::new(p, 6, c.stroke_width(2))))
+                .map_err(|e| err(e.to_string()))?;
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+                .map_err(|e| err(e.to_string()))?;
+            // Distinct markers per curve so overlapping lines stay visible.
+            if k % 2 == 0 {
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.stroke_width(1))))
+                    .map_err(|e| err(e.to_string()))?;
+            } else {
+                chart
+                    .draw_series(pts.iter().map(|&p| TriangleMarker::new(p, 5, c.filled())))
+                    .map_err(|e| err(e.to_string()))?;
+            }
+        }
+    }
+    for (k, (label, c, _, markers)) in curves.iter().enumerate() {
+        let y = 40 + 26 * k as i32;
+        let style = TextStyle::from(("sans-serif", 14).into_font()).color(&BLACK);
+        if *markers {
+            legend_area.draw(&Cross::new((16, y), 6, c.stroke_width(2))).map_err(|e| err(e.to_string()))?;
+        } else {
+            legend_area
+                .draw(&PathElement::new(vec![(4, y), (28, y)], c.stroke_width(2)))
+                .map_err(|e| err(e.to_string()))?;
+        }
+        legend_area.draw(&Text::new(label.clone(), (36, y - 7), style)).map_err(|e| err(e.to_string()))?;
+    }
+    root.present().map_err(|e| err(e.to_string()))
+}
+
+fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {
+    let mut curves: Curves<'_> = s
+        .runs
+        .iter()
+        .map(|o| {
+            (
+                format!("{} (UVLM, steady)", o.formulation.as_str().to_uppercase()),
+                color(o.formulation),
+                curve(o, |p| p.fold_deg),
+                false,
+            )
+        })
+        .collect();
+    for r in &s.references {
+        curves.push((r.label.clone(), if r.experiment { EXP } else { MODEL }, r.points.clone(), r.experiment));
+    }
+    panel(path, &format!("{}: coast angle", s.name), "airspeed [m/s]", "fold angle [deg] (tip up +)", &curves)
+}
+
+fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
+    let curves: Curves<'_> = s
+        .runs
+        .iter()
+        .map(|o| {
+            (
+                o.formulation.as_str().to_uppercase(),
+                color(o.formulation),
+                curve(o, |p| p.loads.root_bending_moment),
+                false,
+            )
+        })
+        .collect();
+    panel(path, &format!("{}: root bending moment", s.name), "airspeed [m/s]", "root bending moment [N m]", &curves)
+}
+
+fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
+    let mut curves: Curves<'_> = Vec::new();
+    let shades = |f: Formulation, k: usize| -> RGBColor {
+        let c = color(f);
+        let t = 0.35 * k as f64;
+        let mix = |a: u8| (f64::from(a) + t * (255.0 - f64::from(a))) as u8;
+        RGBColor(mix(c.0), mix(c.1), mix(c.2))
+    };
+    for o in &s.runs {
+        let ok: Vec<_> = o.points.iter().filter(|p| p.error.is_none() && !p.strips.is_empty()).collect();
+        let mut speeds: Vec<f64> = ok.iter().map(|p| p.airspeed).collect();
+        speeds.sort_by(f64::total_cmp);
+        let picks: Vec<f64> = match speeds.len() {
+            0 => Vec::new(),
+            1 | 2 => speeds.clone(),
+            n => vec![speeds[0], speeds[n / 2], speeds[n - 1]],
+        };
+        for (k, u) in picks.iter().enumerate() {
+            if let Some(p) = ok.iter().find(|p| p.airspeed == *u) {
+                curves.push((
+                    format!("{} {u} m/s", o.formulation.as_str().to_uppercase()),
+                    shades(o.formulation, k),
+                    p.strips.iter().map(|st| (st.s, st.lift_per_span)).collect(),
+                    false,
+                ));
+            }
+        }
+    }
+    panel(
+        path,
+        &format!("{}: spanwise lift", s.name),
+        "arclength along the wing [m]",
+        "lift per unit span [N/m]",
+        &curves,
+    )
+}
+
+/// The report's section for a static sweep (HTML fragment; links relative to the report root).
+pub fn section_html(s: &StaticSummary) -> String {
+    let mut h = String::new();
+    let _ = write!(h, "<h2 id=\"static-{0}\">Static: {0}</h2>\n<p>{1}</p>\n", s.name, html_escape(&s.description));
+    let _ = writeln!(
+        h,
+        "<p>ANCF–GEBF: coast angles within {:.3}°, root bending moments within {:.3} %; {} point(s) without an equilibrium.</p>",
+        s.max_fold_difference_deg,
+        100.0 * s.max_rbm_relative_difference,
+        s.n_failed
+    );
+    h.push_str("<table><tr><th>airspeed [m/s]</th>");
+    for r in &s.runs {
+        let f = r.formulation.as_str().to_uppercase();
+        let _ = write!(
+            h,
+            "<th>{f} fold [°]</th><th>{f} RBM [N·m]</th><th>{f} hinge moment [N·m]</th><th>{f} lift [N]</th>"
+        );
+    }
+    for r in &s.references {
+        let _ = write!(h, "<th>{}</th>", html_escape(&r.label));
+    }
+    h.push_str("</tr>\n");
+    if let Some(first) = s.runs.first() {
+        for (i, p) in first.points.iter().enumerate() {
+            let _ = write!(h, "<tr><td>{}</td>", p.airspeed);
+            for r in &s.runs {
+                let q = &r.points[i];
+                if q.error.is_some() {
+                    h.push_str("<td colspan=4>no equilibrium</td>");
+                } else {
+                    let _ = write!(
+                        h,
+                        "<td>{:.2}</td><td>{:.4}</td><td>{:.2e}</td><td>{:.3}</td>",
+                        q.fold_deg, q.loads.root_bending_moment, q.loads.hinge_moment, q.lift
+                    );
+                }
+            }
+            for r in &s.references {
+                match r.points.iter().find(|x| (x.0 - p.airspeed).abs() < 1e-9) {
+                    Some(x) => {
+                        let _ = write!(h, "<td>{:.2}</td>", x.1);
+                    }
+                    None => h.push_str("<td></td>"),
+                }
+            }
+            h.push_str("</tr>\n");
+        }
+    }
+    h.push_str("</table>\n<ul>\n");
+    for r in s.references.iter().filter(|r| r.experiment) {
+        for (f, rms) in &r.rms_deg {
+            let _ = writeln!(
+                h,
+                "<li>{f} against {}: RMS coast-angle error {rms:.2}° over 12–33 m/s</li>",
+                html_escape(&r.label)
+            );
+        }
+    }
+    for (label, rms) in model_rms(s) {
+        let _ = writeln!(h, "<li>{} against the experiment: RMS {rms:.2}° over 12–33 m/s</li>", html_escape(&label));
+    }
+    h.push_str("</ul>\n");
+    for (file, alt) in [
+        ("static_coast.svg", "coast angle against airspeed"),
+        ("static_rbm.svg", "root bending moment against airspeed"),
+        ("static_lift.svg", "spanwise lift at three airspeeds"),
+    ] {
+        let _ = writeln!(h, "<p><img src=\"{}/{file}\" alt=\"{alt}\" width=\"900\"></p>", s.name);
+    }
+    h
+}
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}

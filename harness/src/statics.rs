@@ -1,0 +1,780 @@
+//! Static aeroelastic equilibrium: the structure (gravity, springs, point masses) under the steady
+//! aerodynamic loads of its own deformed lattice, by Newton's method on the coupled residual, with
+//! continuation in airspeed (docs/statics.md).
+//!
+//! The coupled system is the structure's `ConstrainedSystem` with the station loads of a steady
+//! UVLM solve (semi-infinite wake legs along the free stream, [`uvlm::Uvlm::solve_steady`]) at the
+//! current coordinates added to its residual ([`AeroStatic`]). Its tangent is the structure's
+//! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, a forward difference of the
+//! generalised aerodynamic force, one steady solve per tangent coordinate. That costs one
+//! lattice solve per unknown, so the aerodynamic part is kept between iterations and between
+//! airspeeds (scaled by V², the exact scaling at fixed geometry) and refreshed only when Newton
+//! stops contracting. The generic Newton iteration of `genalpha::analysis` does the rest
+//! (constraints, multipliers, convergence tests).
+//!
+//! A sweep starts at the highest airspeed, from the reference configuration (ramping gravity in
+//! if the direct solve fails), and walks down the list, each point from the previous equilibrium;
+//! a point that fails is retried through intermediate airspeeds (bisection), and if it still
+//! fails it is reported and the sweep goes on from the last equilibrium.
+
+use std::cell::RefCell;
+use std::path::Path;
+use std::time::Instant;
+
+use genalpha::analysis::{StaticParams, StaticSolution, StaticSolver};
+use genalpha::{ConstrainedSystem, MatView};
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::Error;
+use crate::aero::{AeroSettings, AeroStructure, SectionLoad, StationMap, station_map, stations_at};
+use crate::case::{Case, Formulation};
+use crate::loads::{LoadModel, LoadScratch, WingLoads};
+
+/// What the static analysis needs beyond the aerodynamic seam: a way to keep stored coordinates
+/// on one branch after every Newton update (GEBF's rotation vectors past π).
+pub trait StaticStructure: AeroStructure {
+    /// Bring stored coordinates back to their canonical branch without changing the
+    /// configuration. Default: nothing.
+    fn normalise(&self, _q: &mut [f64]) {}
+}
+
+impl StaticStructure for ancf::Model {}
+
+impl StaticStructure for gebf::Model {
+    /// Rotation vectors back past π, and the joints' position-level projection: the
+    /// velocity-level hinge rows keep each Newton increment on the joint only to first order.
+    fn normalise(&self, q: &mut [f64]) {
+        self.rescale_rotations(q, None);
+        self.project_joints(q);
+    }
+}
+
+/// The steady aerodynamics of a lattice that follows the structure.
+struct SteadyAero {
+    uv: uvlm::Uvlm,
+    stations: Vec<uvlm::SpanStation>,
+    vel: Vec<uvlm::StationVelocity>,
+    scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+    zeros: Vec<f64>,
+    origins: Vec<[f64; 3]>,
+    fbuf: Vec<[f64; 3]>,
+    mbuf: Vec<[f64; 3]>,
+    n_solves: usize,
+}
+
+impl SteadyAero {
+    /// A steady UVLM on the lattice of `model` at `q`, with free stream `v_inf`.
+    fn new<S: AeroStructure>(
+        model: &S,
+        q: &[f64],
+        map: &[StationMap],
+        aero: &AeroSettings,
+        v_inf: [f64; 3],
+    ) -> Result<Self, String> {
+        let mut s = Self {
+            uv: placeholder_uvlm()?,
+            stations: Vec::new(),
+            vel: Vec::new(),
+            scratch: (Vec::new(), Vec::new(), Vec::new()),
+            zeros: vec![0.0; model.n_dof()],
+            origins: Vec::with_capacity(map.len()),
+            fbuf: vec![[0.0; 3]; map.len()],
+            mbuf: vec![[0.0; 3]; map.len()],
+            n_solves: 0,
+        };
+        stations_at(model, q, &s.zeros, map, aero, &mut s.scratch, &mut s.stations, &mut s.vel);
+        let spec = crate::aero::lattice_spec(map, aero);
+        let params = aero.uvlm_params(v_inf);
+        s.uv = uvlm::Lattice::from_stations(spec, &s.stations)
+            .and_then(|l| uvlm::Uvlm::new(l, params))
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        Ok(s)
+    }
+
+    /// Station loads of the steady solution on the lattice of `model` at `q`, into `out`.
+    fn loads_at<S: AeroStructure>(
+        &mut self,
+        model: &S,
+        q: &[f64],
+        map: &[StationMap],
+        aero: &AeroSettings,
+        out: &mut [SectionLoad],
+    ) -> Result<(), String> {
+        stations_at(model, q, &self.zeros, map, aero, &mut self.scratch, &mut self.stations, &mut self.vel);
+        self.uv.update_stations(&self.stations, None).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
+        self.n_solves += 1;
+        self.origins.clear();
+        self.origins.extend(self.stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
+        l.column_loads_inplace(&self.origins, &mut self.fbuf, &mut self.mbuf);
+        for (j, t) in out.iter_mut().enumerate() {
+            t.force = Vector3::from(self.fbuf[j]);
+            t.moment = Vector3::from(self.mbuf[j]);
+        }
+        Ok(())
+    }
+}
+
+/// A one-ring lattice that stands in until the real one is built (keeps `SteadyAero::new`
+/// free of `Option`s).
+fn placeholder_uvlm() -> Result<uvlm::Uvlm, String> {
+    let st = |x: f64| uvlm::SpanStation {
+        origin: Vector3::new(x, 0.0, 0.0),
+        frame: nalgebra::Matrix3::identity(),
+        chord: 1.0,
+        le_offset: 0.5,
+        slant: 0.0,
+    };
+    uvlm::Lattice::from_stations(uvlm::LatticeSpec::new(1), &[st(0.0), st(1.0)])
+        .and_then(|l| uvlm::Uvlm::new(l, uvlm::UvlmParams::new(1.0, [0.0, -1.0, 0.0])))
+        .map_err(|e| e.to_string())
+}
+
+/// The aerodynamic stiffness and when to refresh it.
+struct AeroTangent {
+    /// `−∂Q_aero/∂q` (row-major, n × n) at airspeed² `speed2`.
+    k: Vec<f64>,
+    speed2: f64,
+    valid: bool,
+    /// Re-evaluate at the next assembly.
+    refresh: bool,
+    n_refresh: usize,
+    // work buffers
+    dq: Vec<f64>,
+    q_tmp: Vec<f64>,
+    r0: Vec<f64>,
+    r1: Vec<f64>,
+    loads: Vec<SectionLoad>,
+}
+
+/// The structure with the steady aerodynamic loads of its own lattice: a [`ConstrainedSystem`]
+/// whose static equilibria are the aeroelastic ones.
+pub struct AeroStatic<'a, S: StaticStructure> {
+    model: RefCell<S>,
+    aero_state: RefCell<SteadyAero>,
+    tangent: RefCell<AeroTangent>,
+    loads: RefCell<Vec<SectionLoad>>,
+    zero_loads: Vec<SectionLoad>,
+    error: RefCell<Option<String>>,
+    map: &'a [StationMap],
+    aero: AeroSettings,
+    speed2: f64,
+    /// Forward-difference step of the aerodynamic stiffness, in the increment weights' units.
+    fd_step: f64,
+}
+
+impl<'a, S: StaticStructure> AeroStatic<'a, S> {
+    /// The coupled system of `model` with the aerodynamics `aero` (its free stream as given) on
+    /// the stations `map`; the lattice is built at `q`.
+    pub fn new(model: S, q: &[f64], map: &'a [StationMap], aero: &AeroSettings, span: f64) -> Result<Self, String> {
+        let v = aero.free_stream();
+        let st = SteadyAero::new(&model, q, map, aero, v)?;
+        let n = model.n_dof();
+        let loads: Vec<SectionLoad> = map
+            .iter()
+            .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+            .collect();
+        let tangent = AeroTangent {
+            k: vec![0.0; n * n],
+            speed2: 0.0,
+            valid: false,
+            refresh: false,
+            n_refresh: 0,
+            dq: vec![0.0; n],
+            q_tmp: vec![0.0; model.n_coords()],
+            r0: vec![0.0; n],
+            r1: vec![0.0; n],
+            loads: loads.clone(),
+        };
+        Ok(Self {
+            model: RefCell::new(model),
+            aero_state: RefCell::new(st),
+            tangent: RefCell::new(tangent),
+            zero_loads: loads.clone(),
+            loads: RefCell::new(loads),
+            error: RefCell::new(None),
+            map,
+            aero: aero.clone(),
+            speed2: v.iter().map(|x| x * x).sum(),
+            fd_step: 1e-7 * span.max(1e-3),
+        })
+    }
+
+    /// Change the airspeed (the free stream keeps its direction): the lattice is rebuilt at `q`;
+    /// the aerodynamic stiffness is kept, scaled by the square of the speed ratio.
+    pub fn set_airspeed(&mut self, airspeed: f64, q: &[f64]) -> Result<(), String> {
+        self.aero.airspeed = Some(airspeed);
+        let v = self.aero.free_stream();
+        let solves = self.aero_state.borrow().n_solves;
+        let mut st = SteadyAero::new(&*self.model.borrow(), q, self.map, &self.aero, v)?;
+        st.n_solves = solves;
+        *self.aero_state.borrow_mut() = st;
+        self.speed2 = v.iter().map(|x| x * x).sum();
+        self.begin_solve(false);
+        Ok(())
+    }
+
+    /// Replace the structural model (same coordinates; e.g. with scaled gravity).
+    pub fn set_model(&mut self, model: S) {
+        *self.model.borrow_mut() = model;
+        self.begin_solve(false);
+    }
+
+    /// Start a solve: re-evaluate the aerodynamic stiffness at the next assembly when `refresh`
+    /// (it is evaluated at the first assembly in any case).
+    pub fn begin_solve(&mut self, refresh: bool) {
+        self.tangent.get_mut().refresh = refresh;
+        *self.error.get_mut() = None;
+    }
+
+    /// The structural model.
+    pub fn model(&self) -> std::cell::Ref<'_, S> {
+        self.model.borrow()
+    }
+
+    /// The airspeed, m/s.
+    pub fn airspeed(&self) -> f64 {
+        self.speed2.sqrt()
+    }
+
+    /// Why the last residual could not be evaluated (the lattice folded, the solve failed).
+    pub fn error(&self) -> Option<String> {
+        self.error.borrow().clone()
+    }
+
+    /// Steady solves and aerodynamic-stiffness evaluations so far.
+    pub fn counters(&self) -> (usize, usize) {
+        (self.aero_state.borrow().n_solves, self.tangent.borrow().n_refresh)
+    }
+
+    /// Station loads and the UVLM's lattice loads at `q`.
+    fn station_loads(&self, q: &[f64], out: &mut [SectionLoad]) -> bool {
+        let model = self.model.borrow();
+        match self.aero_state.borrow_mut().loads_at(&*model, q, self.map, &self.aero, out) {
+            Ok(()) => true,
+            Err(e) => {
+                *self.error.borrow_mut() = Some(e);
+                false
+            }
+        }
+    }
+
+    /// Loads at `q` applied to the model; false when the aerodynamics failed.
+    fn apply_loads(&self, q: &[f64]) -> bool {
+        let mut loads = self.loads.borrow_mut();
+        if !self.station_loads(q, &mut loads) {
+            return false;
+        }
+        self.model.borrow_mut().set_section_loads(&loads);
+        true
+    }
+
+    /// The station loads of the last residual evaluation.
+    pub fn current_loads(&self) -> Vec<SectionLoad> {
+        self.loads.borrow().clone()
+    }
+
+    /// Recompute the aerodynamics at `q` (e.g. at a converged equilibrium, after the difference
+    /// quotients moved the lattice); returns the station loads and the UVLM's loads.
+    pub fn evaluate_at(&self, q: &[f64]) -> Result<(Vec<SectionLoad>, uvlm::Loads, Vec<uvlm::SpanStation>), String> {
+        if !self.apply_loads(q) {
+            return Err(self.error().unwrap_or_default());
+        }
+        let st = self.aero_state.borrow();
+        Ok((self.loads.borrow().clone(), st.uv.loads().clone(), st.stations.clone()))
+    }
+
+    /// Generalised aerodynamic load `r(q, L) − r(q, 0)` (the residual's load part, with the
+    /// minus sign of an external force) of the station loads `loads` at `q`, into `out`.
+    fn load_part(&self, t: f64, q: &[f64], loads: &[SectionLoad], zeros: &[f64], scratch: &mut [f64], out: &mut [f64]) {
+        let mut m = self.model.borrow_mut();
+        m.set_section_loads(loads);
+        m.residual_inplace(t, q, zeros, zeros, out);
+        m.set_section_loads(&self.zero_loads);
+        m.residual_inplace(t, q, zeros, zeros, scratch);
+        for (o, s) in out.iter_mut().zip(scratch.iter()) {
+            *o -= s;
+        }
+    }
+
+    /// Decide whether to refresh the aerodynamic stiffness at `q`, and do it: the forward
+    /// difference of the whole generalised aerodynamic load, so that both the lattice's
+    /// response and the way a formulation applies a station load (ANCF's moments through the
+    /// section slopes) are in it. The model's loads are those of `q` on return.
+    fn update_tangent(&self, t: f64, q: &[f64]) {
+        let mut tg = self.tangent.borrow_mut();
+        let tg = &mut *tg;
+        if tg.valid && !tg.refresh {
+            return;
+        }
+        tg.refresh = false;
+        tg.n_refresh += 1;
+        let n = self.n_dof();
+        let zeros = vec![0.0; n];
+        let mut scratch = vec![0.0; n];
+        let loads_q = self.loads.borrow().clone();
+        self.load_part(t, q, &loads_q, &zeros, &mut scratch, &mut tg.r0);
+        for j in 0..n {
+            let h = self.fd_step / self.model.borrow().increment_weight(j).max(1e-12);
+            tg.dq.iter_mut().for_each(|x| *x = 0.0);
+            tg.dq[j] = h;
+            self.model.borrow().retract_inplace(q, &tg.dq, &mut tg.q_tmp);
+            if !self.station_loads(&tg.q_tmp, &mut tg.loads) {
+                // Keep the structural tangent alone in this column.
+                for i in 0..n {
+                    tg.k[i * n + j] = 0.0;
+                }
+                continue;
+            }
+            self.load_part(t, &tg.q_tmp, &tg.loads, &zeros, &mut scratch, &mut tg.r1);
+            for i in 0..n {
+                tg.k[i * n + j] = (tg.r1[i] - tg.r0[i]) / h;
+            }
+        }
+        tg.speed2 = self.speed2;
+        tg.valid = true;
+        // Back to the loads of q.
+        self.model.borrow_mut().set_section_loads(&loads_q);
+    }
+}
+
+impl<S: StaticStructure> ConstrainedSystem for AeroStatic<'_, S> {
+    fn n_coords(&self) -> usize {
+        self.model.borrow().n_coords()
+    }
+    fn n_dof(&self) -> usize {
+        self.model.borrow().n_dof()
+    }
+    fn n_holonomic(&self) -> usize {
+        self.model.borrow().n_holonomic()
+    }
+    fn n_velocity_constraints(&self) -> usize {
+        self.model.borrow().n_velocity_constraints()
+    }
+    fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
+        self.model.borrow().retract_inplace(q, dq, q_out);
+    }
+    fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        if !self.apply_loads(q) {
+            r.iter_mut().for_each(|x| *x = f64::NAN);
+            return;
+        }
+        self.model.borrow().residual_inplace(t, q, v, v_dot, r);
+    }
+    fn iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        let mut r = vec![0.0; self.n_dof()];
+        self.residual_and_iteration_matrix_inplace(t, q, v, v_dot, &mut r, c_m, c_c, c_k, k);
+    }
+    fn residual_and_iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        r: &mut [f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        // The structure's matrix without loads (their tangent is in the difference quotients),
+        // then the residual with the loads of q.
+        self.model.borrow_mut().set_section_loads(&self.zero_loads);
+        self.model.borrow().residual_and_iteration_matrix_inplace(t, q, v, v_dot, r, c_m, c_c, c_k, k);
+        if !self.apply_loads(q) {
+            r.iter_mut().for_each(|x| *x = f64::NAN);
+            return;
+        }
+        self.model.borrow().residual_inplace(t, q, v, v_dot, r);
+        if c_k == 0.0 {
+            return;
+        }
+        self.update_tangent(t, q);
+        let tg = self.tangent.borrow();
+        let n = self.n_dof();
+        let scale = c_k * self.speed2 / tg.speed2;
+        for i in 0..n {
+            for j in 0..n {
+                let v = tg.k[i * n + j];
+                if v != 0.0 {
+                    k.add(i, j, scale * v);
+                }
+            }
+        }
+    }
+    fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+        self.model.borrow().phi_inplace(t, q, phi);
+    }
+    fn phi_q_inplace(&self, t: f64, q: &[f64], j: &mut MatView<'_>) {
+        self.model.borrow().phi_q_inplace(t, q, j);
+    }
+    fn phi_q_is_constant(&self) -> bool {
+        self.model.borrow().phi_q_is_constant()
+    }
+    fn psi_inplace(&self, t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
+        self.model.borrow().psi_inplace(t, q, v, psi);
+    }
+    fn psi_v_inplace(&self, t: f64, q: &[f64], j: &mut MatView<'_>) {
+        self.model.borrow().psi_v_inplace(t, q, j);
+    }
+    fn psi_q_inplace(&self, t: f64, q: &[f64], v: &[f64], j: &mut MatView<'_>) {
+        self.model.borrow().psi_q_inplace(t, q, v, j);
+    }
+    fn constraint_force_tangent_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        lambda: &[f64],
+        mu: &[f64],
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        self.model.borrow().constraint_force_tangent_inplace(t, q, lambda, mu, c_k, k);
+    }
+    fn increment_weight(&self, i: usize) -> f64 {
+        self.model.borrow().increment_weight(i)
+    }
+}
+
+/// Lift per unit span of one lattice column at an equilibrium.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Strip {
+    /// Arclength of the column's middle along the wing (bodies end to end), m.
+    pub s: f64,
+    /// The column's middle (mean of its two stations' axis points), global, m.
+    pub position: [f64; 3],
+    /// Lift per unit span (perpendicular to the free stream and the global X axis), N/m.
+    pub lift_per_span: f64,
+    /// Section lift coefficient `l / (½ ρ V² c)`.
+    pub cl: f64,
+}
+
+/// One airspeed of a static sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StaticPoint {
+    /// Airspeed, m/s.
+    pub airspeed: f64,
+    /// Fold angle of the fold hinge, degrees (tip up positive; NaN without one).
+    pub fold_deg: f64,
+    /// Tip position, m.
+    pub tip: [f64; 3],
+    /// Root and hinge loads.
+    pub loads: WingLoads,
+    /// Total lift, N.
+    pub lift: f64,
+    /// Newton iterations spent on this point (its intermediate airspeeds included).
+    pub newton_iterations: usize,
+    /// Why the point has no equilibrium, if it has none.
+    pub error: Option<String>,
+    /// Spanwise lift distribution.
+    #[serde(skip)]
+    pub strips: Vec<Strip>,
+}
+
+/// A formulation's static sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StaticOutput {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// One point per airspeed, in the case's order.
+    pub points: Vec<StaticPoint>,
+    /// Wall time of the sweep, s.
+    pub wall_s: f64,
+    /// Steady lattice solves (residuals and difference quotients).
+    pub n_aero_solves: usize,
+    /// Evaluations of the aerodynamic stiffness.
+    pub n_tangents: usize,
+    /// Tangent dimension of the structure.
+    pub n_dof: usize,
+    /// Why the sweep could not start, if it could not.
+    pub error: Option<String>,
+}
+
+/// Run the static sweep of `case` (its `static.airspeeds`) with formulation `f`.
+pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
+    let t0 = Instant::now();
+    let mut out = match f {
+        Formulation::Ancf => sweep(case, f, crate::scene::build_ancf),
+        Formulation::Gebf => sweep(case, f, crate::scene::build_gebf),
+    };
+    out.wall_s = t0.elapsed().as_secs_f64();
+    out
+}
+
+fn failed_output(case: &Case, f: Formulation, msg: String) -> StaticOutput {
+    let speeds = case.statics.as_ref().map(|s| s.airspeeds.clone()).unwrap_or_default();
+    StaticOutput {
+        formulation: f,
+        points: speeds.iter().map(|&u| failed_point(u, msg.clone())).collect(),
+        wall_s: 0.0,
+        n_aero_solves: 0,
+        n_tangents: 0,
+        n_dof: 0,
+        error: Some(msg),
+    }
+}
+
+fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
+    StaticPoint {
+        airspeed,
+        fold_deg: f64::NAN,
+        tip: [f64::NAN; 3],
+        loads: WingLoads {
+            root_force: [f64::NAN; 3],
+            root_moment: [f64::NAN; 3],
+            root_bending_moment: f64::NAN,
+            root_torque: f64::NAN,
+            hinge_moment: f64::NAN,
+        },
+        lift: f64::NAN,
+        newton_iterations: 0,
+        error: Some(msg),
+        strips: Vec::new(),
+    }
+}
+
+/// Newton settings of the static points: the generic defaults, with room for the linear
+/// convergence of a kept aerodynamic stiffness.
+fn static_params() -> StaticParams {
+    StaticParams { max_iter: ROUND_ITERATIONS, tol: 1e-10, rel_residual_tol: 1e-10 }
+}
+
+/// Newton iterations per round of a static solve (one aerodynamic stiffness each).
+const ROUND_ITERATIONS: usize = 6;
+/// Rounds per static solve.
+const ROUNDS: usize = 8;
+
+fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
+    let Some((aero, st)) = case.aero.as_ref().zip(case.statics.as_ref()) else {
+        return failed_output(case, f, "the case has no `aero` and `static` blocks".into());
+    };
+    let map = match station_map(case, aero) {
+        Ok(m) => m,
+        Err(e) => return failed_output(case, f, e),
+    };
+    let model = match build(case) {
+        Ok(m) => m,
+        Err(e) => return failed_output(case, f, e.to_string()),
+    };
+    let q_ref = model.initial_state().q;
+    let n_dof = model.n_dof();
+    let mut order: Vec<usize> = (0..st.airspeeds.len()).collect();
+    order.sort_by(|&a, &b| st.airspeeds[b].total_cmp(&st.airspeeds[a]));
+    let top = st.airspeeds[order[0]];
+    let mut a0 = aero.clone();
+    a0.airspeed = Some(top);
+    let mut sys = match AeroStatic::new(model, &q_ref, &map, &a0, case.span()) {
+        Ok(s) => s,
+        Err(e) => return failed_output(case, f, e),
+    };
+    let mut solver = StaticSolver::new(&sys, static_params());
+    let mut x = StaticSolution::guess(&sys, &q_ref);
+    let loads_model = LoadModel::new(case, f);
+    let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
+    // 1. The first equilibrium at the highest airspeed: directly, or ramping gravity in.
+    let mut iters = 0;
+    // Newton in rounds of a few iterations: the aerodynamic stiffness (the costly part of the
+    // tangent) is kept within a round and from the previous point, and re-evaluated at the start
+    // of every further round.
+    let solve =
+        |sys: &mut AeroStatic<'_, S>, solver: &mut StaticSolver, x: &mut StaticSolution| -> Result<(), String> {
+            let mut last = String::new();
+            for round in 0..ROUNDS {
+                sys.begin_solve(round > 0);
+                let s: &AeroStatic<'_, S> = sys;
+                // Borrowed only for the call: the system borrows the model mutably to apply its loads.
+                match solver.solve_normalised(s, 0.0, x, |q| s.model.borrow().normalise(q)) {
+                    Ok(()) => return Ok(()),
+                    Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
+                    Err(e) => return Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
+                }
+            }
+            Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
+        };
+    let start = x.clone();
+    let direct = solve(&mut sys, &mut solver, &mut x);
+    if let Err(first) = direct {
+        let Some(g) = case.gravity else {
+            return failed_output(case, f, format!("at {top} m/s: {first}"));
+        };
+        x = start;
+        for k in 0..=4 {
+            let mut c = case.clone();
+            let s = f64::from(k) / 4.0;
+            c.gravity = Some([s * g[0], s * g[1], s * g[2]]);
+            match build(&c) {
+                Ok(m) => sys.set_model(m),
+                Err(e) => return failed_output(case, f, e.to_string()),
+            }
+            if let Err(e) = solve(&mut sys, &mut solver, &mut x) {
+                return failed_output(case, f, format!("at {top} m/s, gravity ramped to {s}: {e} (directly: {first})"));
+            }
+        }
+    }
+    iters += x.n_iterations;
+    // 2. Down the airspeeds, bisecting a step that fails.
+    let mut current = top;
+    for &i in &order {
+        let target = st.airspeeds[i];
+        let good = x.clone();
+        let mut path = vec![target];
+        let mut last_err = None;
+        let mut halvings = 0;
+        while let Some(&u) = path.last() {
+            let attempt = sys.set_airspeed(u, &x.q).and_then(|()| solve(&mut sys, &mut solver, &mut x));
+            match attempt {
+                Ok(()) => {
+                    current = u;
+                    path.pop();
+                }
+                Err(e) => {
+                    x = good.clone();
+                    let _ = sys.set_airspeed(current, &x.q);
+                    if halvings >= 6 {
+                        last_err = Some(e);
+                        break;
+                    }
+                    halvings += 1;
+                    // Restart from the last equilibrium towards the midpoint.
+                    path.push(0.5 * (current + u));
+                }
+            }
+        }
+        let n_it = x.n_iterations - iters;
+        iters = x.n_iterations;
+        points[i] = Some(match last_err {
+            Some(e) => {
+                x = good;
+                failed_point(target, format!("no equilibrium at {target} m/s: {e}"))
+            }
+            None => {
+                let mut p = point_at(&sys, &x.q, case, loads_model.as_ref(), &map, aero.rho);
+                p.newton_iterations = n_it;
+                p
+            }
+        });
+    }
+    let (n_aero_solves, n_tangents) = sys.counters();
+    StaticOutput {
+        formulation: f,
+        points: points
+            .into_iter()
+            .zip(&st.airspeeds)
+            .map(|(p, &u)| p.unwrap_or_else(|| failed_point(u, "not reached".into())))
+            .collect(),
+        wall_s: 0.0,
+        n_aero_solves,
+        n_tangents,
+        n_dof,
+        error: None,
+    }
+}
+
+/// The outputs at the equilibrium `q` of `sys`.
+fn point_at<S: StaticStructure>(
+    sys: &AeroStatic<'_, S>,
+    q: &[f64],
+    case: &Case,
+    loads_model: Option<&LoadModel>,
+    map: &[StationMap],
+    rho: f64,
+) -> StaticPoint {
+    let airspeed = sys.airspeed();
+    let (station_loads, uv_loads, stations) = match sys.evaluate_at(q) {
+        Ok(v) => v,
+        Err(e) => return failed_point(airspeed, e),
+    };
+    let model = sys.model();
+    let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(q, j).to_degrees());
+    let loads = loads_model.map_or(
+        WingLoads {
+            root_force: [f64::NAN; 3],
+            root_moment: [f64::NAN; 3],
+            root_bending_moment: f64::NAN,
+            root_torque: f64::NAN,
+            hinge_moment: f64::NAN,
+        },
+        |lm| lm.evaluate(&*model, q, None, &station_loads, &mut LoadScratch::default()),
+    );
+    let v_inf = sys.aero.free_stream();
+    let lift_dir = lift_direction(v_inf);
+    let lift = Vector3::from(uv_loads.total_force()).dot(&lift_dir);
+    // Column j of the lattice lies between stations j and j + 1.
+    let starts: Vec<f64> = case
+        .bodies
+        .iter()
+        .scan(0.0, |acc, b| {
+            let s0 = *acc;
+            *acc += b.length;
+            Some(s0)
+        })
+        .collect();
+    let arc = |m: &StationMap| starts.get(m.body).copied().unwrap_or(0.0) + m.s;
+    let qdyn = 0.5 * rho * airspeed * airspeed;
+    let chord = sys.aero.chord;
+    let strips = (0..stations.len().saturating_sub(1))
+        .filter_map(|j| {
+            let f = uv_loads.strip.get(j)?;
+            let (a, b) = (stations[j].origin, stations[j + 1].origin);
+            let width = (b - a).norm();
+            let l = Vector3::from(*f).dot(&lift_dir) / width;
+            let mid = 0.5 * (a + b);
+            Some(Strip {
+                s: 0.5 * (arc(&map[j]) + arc(&map[j + 1])),
+                position: mid.into(),
+                lift_per_span: l,
+                cl: l / (qdyn * chord),
+            })
+        })
+        .collect();
+    StaticPoint { airspeed, fold_deg: fold, tip: model.tip(q), loads, lift, newton_iterations: 0, error: None, strips }
+}
+
+/// Unit lift direction: perpendicular to the free stream and to the global X axis (the span).
+pub fn lift_direction(v_inf: [f64; 3]) -> Vector3<f64> {
+    let v = Vector3::from(v_inf).normalize();
+    let span = Vector3::x() - v * v.x;
+    v.cross(&span).normalize()
+}
+
+/// Read a two-column CSV (a header line, then `x,y` rows; `#` comments allowed).
+pub fn read_xy(path: &Path) -> Result<Vec<(f64, f64)>, Error> {
+    let file = path.display().to_string();
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
+    parse_xy(&text).map_err(|msg| Error::Reference { file, msg })
+}
+
+/// Parse the text of [`read_xy`].
+pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
+    lines.next().ok_or("no header line")?;
+    let mut out = Vec::new();
+    for (n, line) in lines {
+        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        if f.len() < 2 {
+            return Err(format!("line {}: two columns expected", n + 1));
+        }
+        let num = |s: &str| s.parse::<f64>().map_err(|e| format!("line {}: {e}", n + 1));
+        let (x, y) = (num(f[0])?, num(f[1])?);
+        if !(x.is_finite() && y.is_finite()) {
+            return Err(format!("line {}: not finite", n + 1));
+        }
+        out.push((x, y));
+    }
+    if out.is_empty() {
+        return Err("no data rows".into());
+    }
+    Ok(out)
+}
