@@ -364,9 +364,21 @@ pub fn simulate_aero<S: AeroStructure>(
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s);
+    // Wing loads from the free body of each output state (docs/outputs.md §6).
+    let load_model = settings.loads.as_ref();
+    let mut load_scratch = crate::loads::LoadScratch::default();
+    let mut with_loads = |model: &S, r: &mut crate::run::Row, s: &genalpha::State, loads: &[SectionLoad]| {
+        if let Some(lm) = load_model {
+            let w = lm.evaluate(model, &s.q, Some((&s.v, &s.v_dot)), loads, &mut load_scratch);
+            r.root_bending_moment = w.root_bending_moment;
+            r.root_torque = w.root_torque;
+            r.hinge_moment = w.hinge_moment;
+        }
+    };
     let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
     r0.lift = 0.0;
+    with_loads(model, &mut r0, &s, &loads);
     out.rows.push(r0);
     if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
         return fail(out, format!("output at t = {}: {e}", s.t));
@@ -455,6 +467,7 @@ pub fn simulate_aero<S: AeroStructure>(
             let mut r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
             r.aero_work = work;
             r.lift = lift;
+            with_loads(model, &mut r, &s, &loads);
             out.rows.push(r);
             if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
                 return fail(out, format!("step {k}: output: {e}"));

@@ -10,9 +10,10 @@ use crate::run::Row;
 pub const HEADER: &str =
     "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,constraint_residual,newton_iterations";
 
-/// Column header with aerodynamics (`aero_work` after `total`, `lift` at the end).
-pub const HEADER_AERO: &str =
-    "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,newton_iterations,lift";
+/// Column header with aerodynamics (`aero_work` after `total`, `lift` and the wing loads at the
+/// end).
+pub const HEADER_AERO: &str = "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,\
+newton_iterations,lift,root_bending_moment,root_torque,hinge_moment";
 
 /// Render rows as CSV text: the aerodynamic columns when the run has them, and `spring` (hinge
 /// spring potential) and `dissipated` (work of the dampers since t = 0) after `potential` when
@@ -43,7 +44,7 @@ pub fn to_csv(rows: &[Row]) -> String {
         }
         let _ = write!(s, "{:.3e},{}", r.constraint_residual, r.newton_iterations);
         if aero {
-            let _ = write!(s, ",{:.6e}", r.lift);
+            let _ = write!(s, ",{:.6e},{:.6e},{:.6e},{:.6e}", r.lift, r.root_bending_moment, r.root_torque, r.hinge_moment);
         }
         s.push('\n');
     }

@@ -363,6 +363,14 @@ fn real_main() -> Result<ExitCode> {
                 let pendulums: Vec<_> = runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
                 run_bench(&pendulums, 7, &out)?;
             }
+            let mut static_failed = 0;
+            for spec in runs.iter().filter(|r| r.ancf.statics.is_some()) {
+                let t = std::time::Instant::now();
+                let summary = run_static_case(spec, &Formulation::ALL);
+                harness::static_out::write(&out.join(&spec.name), &summary)?;
+                static_failed += usize::from(report_static(&summary));
+                println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+            }
             write_reports(&out, &results).context("writing reports")?;
             print!("{}", gate::table(&results));
             let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
@@ -378,7 +386,10 @@ fn real_main() -> Result<ExitCode> {
             if gate_failed > 0 {
                 eprintln!("gate: {gate_failed} case(s) fail their tolerances (see the table)");
             }
-            Ok(exit_code(&errors, failed == 0 && gate_failed == 0))
+            if static_failed > 0 {
+                eprintln!("static: {static_failed} sweep(s) have airspeeds without an equilibrium");
+            }
+            Ok(exit_code(&errors, failed == 0 && gate_failed == 0 && static_failed == 0))
         }
         Cmd::Run { case, formulation, out, set, vtk, vtk_stride } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;

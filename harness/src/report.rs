@@ -459,7 +459,7 @@ fn esc(s: &str) -> String {
 /// HTML section for the studies found on disk under `out`: `converge/<case>/`, `bench/` and
 /// `stress/`.
 pub fn studies_html(out: &Path) -> String {
-    let mut s = String::new();
+    let mut s = crate::static_out::sections_html(out);
     let conv = out.join("converge");
     let mut names: Vec<String> = std::fs::read_dir(&conv)
         .map(|rd| {

@@ -177,10 +177,18 @@ pub struct Row {
     pub aero_work: f64,
     /// Aerodynamic lift, N (NaN without aerodynamics).
     pub lift: f64,
+    /// Root bending moment at the clamp, N·m (positive when lift bends the wing up; NaN
+    /// without a clamp or without aerodynamics; see [`crate::loads`]).
+    pub root_bending_moment: f64,
+    /// Root torque at the clamp, N·m (nose-up positive; NaN as `root_bending_moment`).
+    pub root_torque: f64,
+    /// Moment about the fold hinge's axis, N·m (fold-up positive; NaN without one or without
+    /// aerodynamics).
+    pub hinge_moment: f64,
 }
 
 /// Solver settings of one run.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RunSettings {
     /// Integrator parameters.
     pub params: IntegratorParams,
@@ -190,6 +198,8 @@ pub struct RunSettings {
     pub output_dt: Option<f64>,
     /// The flared hinge whose fold angle is the `fold` column (None: NaN).
     pub fold_joint: Option<usize>,
+    /// The free bodies of the wing loads columns (None: NaN).
+    pub loads: Option<crate::loads::LoadModel>,
 }
 
 /// Outcome of one run: what was computed, even when it failed part-way.
@@ -248,6 +258,9 @@ pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &Stat
         newton_iterations,
         aero_work: f64::NAN,
         lift: f64::NAN,
+        root_bending_moment: f64::NAN,
+        root_torque: f64::NAN,
+        hinge_moment: f64::NAN,
     }
 }
 

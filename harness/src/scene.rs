@@ -178,7 +178,9 @@ pub fn settings(case: &Case, f: Formulation) -> RunSettings {
     // fails on soft tips at 2–5 × dt, where step control then recovers them), although its
     // energy error is 2–100 times smaller in most cells.
     params.form = form.to_form();
-    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt, fold_joint: case.fold_joint_index() }
+    // Wing loads are recorded with aerodynamics (the pendulums' outputs stay as they were).
+    let loads = if case.aero.is_some() { crate::loads::LoadModel::new(case, f) } else { None };
+    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt, fold_joint: case.fold_joint_index(), loads }
 }
 
 /// Build the ANCF model of a case (DAE or ODE path as the case says).

@@ -221,7 +221,34 @@ pub fn write(dir: &Path, summary: &StaticSummary) -> Result<(), Error> {
     plot_coast(&dir.join("static_coast.svg"), summary)?;
     plot_rbm(&dir.join("static_rbm.svg"), summary)?;
     plot_lift(&dir.join("static_lift.svg"), summary)?;
-    Ok(())
+    write_file(&dir.join(SECTION_FILE), &section_html(summary))
+}
+
+/// The report fragment each sweep leaves in its folder for `reports/index.html`.
+pub const SECTION_FILE: &str = "static_section.html";
+
+/// The static sections of every sweep written under `out` (`<out>/<case>/static_section.html`),
+/// in name order, with a heading; empty when there are none.
+pub fn sections_html(out: &Path) -> String {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
+        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
+        .unwrap_or_default();
+    files.sort();
+    if files.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "<h2 id=\"static\">Static aeroelastic equilibria</h2>\n<p>Newton on the structure under the steady UVLM loads \
+         of its own deformed lattice (semi-infinite wake along the free stream), continued in airspeed from the \
+         highest; loads from the free body of the wing (docs/statics.md). Files per case: <code>static_ancf.csv</code>, \
+         <code>static_gebf.csv</code>, <code>static_lift_*.csv</code>, <code>static_summary.json</code>.</p>\n",
+    );
+    for f in files {
+        if let Ok(t) = std::fs::read_to_string(&f) {
+            s.push_str(&t);
+        }
+    }
+    s
 }
 
 const ANCF: RGBColor = RGBColor(31, 119, 180);
@@ -385,7 +412,7 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
 /// The report's section for a static sweep (HTML fragment; links relative to the report root).
 pub fn section_html(s: &StaticSummary) -> String {
     let mut h = String::new();
-    let _ = write!(h, "<h2 id=\"static-{0}\">Static: {0}</h2>\n<p>{1}</p>\n", s.name, html_escape(&s.description));
+    let _ = write!(h, "<h3 id=\"static-{0}\">{0}</h3>\n<p>{1}</p>\n", s.name, html_escape(&s.description));
     let _ = writeln!(
         h,
         "<p>ANCF–GEBF: coast angles within {:.3}°, root bending moments within {:.3} %; {} point(s) without an equilibrium.</p>",

@@ -7,4 +7,5 @@ mod gate;
 mod honest;
 mod observer;
 mod properties;
+mod statics;
 mod vtk;

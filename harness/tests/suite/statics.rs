@@ -1,0 +1,145 @@
+//! Static aeroelastic equilibria and the wing loads: the two formulations agree, a damped time
+//! march settles on the static answer, the free body balances, and bad static input is named.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use harness::case::{CaseFile, Formulation, Override};
+use harness::scene::run_formulation;
+use harness::statics::run_static;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
+    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
+    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
+}
+
+/// ANCF and GEBF reach one equilibrium: coast angle within 0.2°, root bending moment within
+/// 0.5 % (of the larger of the point's value and 5 % of the sweep's largest, so that a moment
+/// crossing zero is compared on the sweep's scale), at every airspeed of every Healy case.
+#[test]
+fn both_formulations_reach_one_equilibrium_on_every_healy_case() {
+    for name in ["healy_ffwt_flare10_aoa0.json", "healy_ffwt_flare10_aoa5.json", "healy_ffwt_flare30_aoa10.json"] {
+        let spec = case(name, &[]);
+        let a = run_static(&spec.ancf, Formulation::Ancf);
+        let g = run_static(&spec.gebf, Formulation::Gebf);
+        let scale = g.points.iter().map(|p| p.loads.root_bending_moment.abs()).fold(0.0, f64::max);
+        for (pa, pg) in a.points.iter().zip(&g.points) {
+            assert!(pa.error.is_none() && pg.error.is_none(), "{name} {} m/s: {:?} {:?}", pa.airspeed, pa.error, pg.error);
+            let df = (pa.fold_deg - pg.fold_deg).abs();
+            assert!(df < 0.2, "{name} {} m/s: fold {} vs {}", pa.airspeed, pa.fold_deg, pg.fold_deg);
+            let (ra, rg) = (pa.loads.root_bending_moment, pg.loads.root_bending_moment);
+            assert!((ra - rg).abs() < 5e-3 * rg.abs().max(0.05 * scale), "{name} {} m/s: RBM {ra} vs {rg}", pa.airspeed);
+        }
+    }
+}
+
+/// A damped time march (4 coupling sub-iterations, rho_inf 0.5) of the flare 10°, pitch 5°
+/// case at 20 m/s settles within 0.1° (coast angle) and 0.2 % (root bending moment) of the
+/// static solution, with both formulations.
+#[test]
+fn a_damped_time_march_settles_on_the_static_equilibrium() {
+    let spec = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[20]", "aero.airspeed=20", "t_end=3"]);
+    for f in Formulation::ALL {
+        let st = run_static(spec.case(f), f);
+        let p = &st.points[0];
+        assert!(p.error.is_none(), "{f}: {:?}", p.error);
+        let run = run_formulation(spec.case(f), f);
+        assert!(run.error.is_none(), "{f}: {:?}", run.error);
+        let last = run.rows.last().unwrap();
+        let fold = last.fold.to_degrees();
+        assert!((fold - p.fold_deg).abs() < 0.1, "{f}: march {fold}°, static {}°", p.fold_deg);
+        let rbm = p.loads.root_bending_moment;
+        assert!(
+            (last.root_bending_moment - rbm).abs() < 2e-3 * rbm.abs(),
+            "{f}: march {} N·m, static {rbm} N·m",
+            last.root_bending_moment
+        );
+    }
+}
+
+/// The free body balances: with a free hinge the moment about its axis is the spring's,
+/// `−k θ` seen from the tip (k = 1e-4 N·m/rad), at every airspeed.
+#[test]
+fn the_hinge_moment_of_a_free_hinge_is_its_spring_moment() {
+    let spec = case("healy_ffwt_flare30_aoa10.json", &["static.airspeeds=[14,24,33]"]);
+    for f in Formulation::ALL {
+        for p in &run_static(spec.case(f), f).points {
+            let spring = 1e-4 * p.fold_deg.to_radians();
+            assert!((p.loads.hinge_moment - spring).abs() < 2e-6, "{f} {} m/s: {} vs {spring}", p.airspeed, p.loads.hinge_moment);
+        }
+    }
+}
+
+/// Gravity alone (a locked hinge at a negligible airspeed): the root bending moment and the
+/// lock's moment are the weights' moments, `Σ m g x` over the spar and the point masses.
+#[test]
+fn gravity_alone_gives_the_weights_moments() {
+    let spec = case("healy_ffwt_flare10_aoa0.json", &["static.airspeeds=[0.001]", "joints.1.locked=true"]);
+    let g = 9.80665;
+    let masses = [(20.3e-3, 0.017), (29.6e-3, 0.155), (29.6e-3, 0.255), (23.0e-3, 0.328), (61.0e-3, 0.424)];
+    let rbm = -masses.iter().map(|(m, x)| m * g * x).sum::<f64>()
+        - 0.2592 * g * 0.365f64.powi(2) / 2.0
+        - 0.02592 * g * (0.5f64.powi(2) - 0.365f64.powi(2)) / 2.0;
+    for f in Formulation::ALL {
+        let p = &run_static(spec.case(f), f).points[0];
+        // The spar sags by a few millimetres: its moment arms shorten by less than 1e-4.
+        assert!((p.loads.root_bending_moment - rbm).abs() < 1e-4 * rbm.abs(), "{f}: {} vs {rbm}", p.loads.root_bending_moment);
+        assert!(p.loads.root_torque > 0.0, "{f}: masses behind the spar pitch the wing nose-up");
+    }
+}
+
+fn harness(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_harness")).args(args).current_dir(root()).output().expect("binary runs")
+}
+
+#[test]
+fn bad_static_input_exits_2_naming_the_field() {
+    let c = "cases/healy_ffwt_flare10_aoa5.json";
+    for (set, needle) in [
+        ("static.airspeeds=[]", "static.airspeeds"),
+        ("static.airspeeds=[12,-3]", "static.airspeeds[1]"),
+        ("static.airspeeds=[12,\"NaN\"]", "static.airspeeds[1]"),
+        ("pitch_deg=95", "pitch_deg"),
+        ("aero.airspeed=-1", "aero.airspeed"),
+    ] {
+        let o = harness(&["static", c, "--set", set, "--out", std::env::temp_dir().to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(needle) && !err.contains("panicked"), "{set}: {err}");
+    }
+    // A static sweep without aerodynamics.
+    let dir = std::env::temp_dir().join(format!("harness-static-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("cases/double_pendulum_c1_beta45.json")).unwrap())
+            .unwrap();
+    v["static"] = serde_json::json!({"airspeeds": [10]});
+    let p = dir.join("no_aero.json");
+    std::fs::write(&p, v.to_string()).unwrap();
+    let o = harness(&["static", p.to_str().unwrap(), "--out", dir.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("static") && err.contains("aero"), "{err}");
+    // A case without a static block.
+    let o = harness(&["static", "cases/wing_aoa5.json", "--out", dir.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("static"));
+}
+
+/// `pitch_deg` is the rotation the hand-written section axes used to encode: the paper's wing
+/// at 5° written both ways gives one scene.
+#[test]
+fn pitch_rotates_the_scene_nose_up() {
+    let a = case("wing_aoa5.json", &[]);
+    let b = case("wing_aoa5.json", &["bodies.0.y_axis=[0,1,0]", "bodies.1.y_axis=[0,1,0]", "pitch_deg=5"]);
+    let (sa, sb) = (a.ancf.scene(Formulation::Ancf), b.ancf.scene(Formulation::Ancf));
+    for (x, y) in sa.bodies.iter().zip(&sb.bodies) {
+        assert!((x.frame - y.frame).norm() < 1e-12 && (x.start - y.start).norm() < 1e-12);
+    }
+    // Leading edge (+y) up.
+    assert!(sb.bodies[0].frame[(2, 1)] > 0.08);
+}
