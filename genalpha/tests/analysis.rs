@@ -419,3 +419,43 @@ fn damped_oscillators_complex_eigenvalues() {
         assert_relative_eq!(mode.frequency(), *w, max_relative = 1e-12);
     }
 }
+
+/// A model that cannot evaluate its residual somewhere (NaN entries: an aerodynamic lattice that
+/// folds over) is a non-finite state, not an equilibrium: a NaN must not pass for a zero
+/// residual.
+#[test]
+fn a_residual_with_nan_entries_is_not_an_equilibrium() {
+    struct Partial(Chain);
+    impl ConstrainedSystem for Partial {
+        fn n_coords(&self) -> usize {
+            self.0.n_coords()
+        }
+        fn n_dof(&self) -> usize {
+            self.0.n_dof()
+        }
+        fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+            self.0.residual_inplace(t, q, v, v_dot, r);
+            if q[0] > 0.1 {
+                r[1] = f64::NAN;
+            }
+        }
+        fn iteration_matrix_inplace(
+            &self,
+            t: f64,
+            q: &[f64],
+            v: &[f64],
+            v_dot: &[f64],
+            c_m: f64,
+            c_c: f64,
+            c_k: f64,
+            k: &mut MatView<'_>,
+        ) {
+            self.0.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
+        }
+    }
+    // Loaded to q₀ = 1, past the model's domain.
+    let mut chain = Chain::uniform(2, 1.0, 1.0);
+    chain.f = vec![1.0, 0.0];
+    let err = solve_static(&Partial(chain), 0.0, &[0.0, 0.0], &StaticParams::default()).unwrap_err();
+    assert!(matches!(err, Error::NonFinite { .. }), "{err:?}");
+}

@@ -44,7 +44,8 @@ pub fn to_csv(rows: &[Row]) -> String {
         }
         let _ = write!(s, "{:.3e},{}", r.constraint_residual, r.newton_iterations);
         if aero {
-            let _ = write!(s, ",{:.6e},{:.6e},{:.6e},{:.6e}", r.lift, r.root_bending_moment, r.root_torque, r.hinge_moment);
+            let _ =
+                write!(s, ",{:.6e},{:.6e},{:.6e},{:.6e}", r.lift, r.root_bending_moment, r.root_torque, r.hinge_moment);
         }
         s.push('\n');
     }

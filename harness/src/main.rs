@@ -214,11 +214,8 @@ fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String,
     }
     let wing = dir.join("wing_aoa10.json");
     if wing.exists() {
-        let a = 15f64.to_radians();
-        let y = format!("[0,{},{}]", a.cos(), a.sin());
         let mut ov = set.to_vec();
-        ov.push(format!("bodies.0.y_axis={y}").parse()?);
-        ov.push(format!("bodies.1.y_axis={y}").parse()?);
+        ov.push("pitch_deg=15".parse()?);
         v.push(("wing AoA 15 deg, 20 s".to_string(), CaseFile::read(&wing)?.expand(&ov)?.remove(0)));
     }
     Ok(v)
@@ -265,6 +262,21 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
         for (f, rms) in &r.rms_deg {
             println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label);
         }
+    }
+    for c in &s.history {
+        println!(
+            "static {} {}: time history mean over {:.0}-{:.0} s: tip z {:.4} m, fold {:.3} deg; static {:.4} m ({:+.2} %), {:.3} deg ({:+.3} deg)",
+            s.name,
+            c.formulation,
+            c.window.0,
+            c.window.1,
+            c.tip_z_mean,
+            c.fold_mean_deg,
+            c.static_tip_z,
+            100.0 * c.tip_z_relative_difference,
+            c.static_fold_deg,
+            c.fold_difference_deg
+        );
     }
     if s.runs.len() == 2 {
         println!(
@@ -366,7 +378,10 @@ fn real_main() -> Result<ExitCode> {
             let mut static_failed = 0;
             for spec in runs.iter().filter(|r| r.ancf.statics.is_some()) {
                 let t = std::time::Instant::now();
-                let summary = run_static_case(spec, &Formulation::ALL);
+                let mut summary = run_static_case(spec, &Formulation::ALL);
+                if let Some(r) = results.iter().find(|r| r.name == spec.name) {
+                    harness::static_out::compare_with_history(&mut summary, &spec.ancf, &r.runs);
+                }
                 harness::static_out::write(&out.join(&spec.name), &summary)?;
                 static_failed += usize::from(report_static(&summary));
                 println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());

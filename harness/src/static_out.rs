@@ -101,6 +101,71 @@ pub struct StaticSummary {
     pub max_rbm_relative_difference: f64,
     /// Points without an equilibrium, all formulations.
     pub n_failed: usize,
+    /// The case's own time history (when it was run alongside): its mean over the second half
+    /// of the run against the static solution at the same airspeed.
+    pub history: Vec<HistoryComparison>,
+}
+
+/// A time history's mean over a window against the static equilibrium at its airspeed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HistoryComparison {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Airspeed of the time history, m/s.
+    pub airspeed: f64,
+    /// Averaging window, s.
+    pub window: (f64, f64),
+    /// Mean tip height over the window, m, and its range (min, max).
+    pub tip_z_mean: f64,
+    /// Tip height range over the window, m.
+    pub tip_z_range: (f64, f64),
+    /// Mean fold angle over the window, degrees.
+    pub fold_mean_deg: f64,
+    /// Fold range over the window, degrees.
+    pub fold_range_deg: (f64, f64),
+    /// Static tip height, m.
+    pub static_tip_z: f64,
+    /// Static fold angle, degrees.
+    pub static_fold_deg: f64,
+    /// (static − mean) / |mean| of the tip height.
+    pub tip_z_relative_difference: f64,
+    /// static − mean of the fold, degrees.
+    pub fold_difference_deg: f64,
+}
+
+/// Compare the static points of `summary` with the time histories `runs` of the same case (at
+/// the case's airspeed), averaged over the second half of each run.
+pub fn compare_with_history(summary: &mut StaticSummary, case: &Case, runs: &[crate::run::RunOutput]) {
+    let Some(aero) = &case.aero else { return };
+    let v = aero.free_stream();
+    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    for run in runs.iter().filter(|r| r.error.is_none() && !r.rows.is_empty()) {
+        let Some(st) = summary.runs.iter().find(|o| o.formulation == run.formulation) else { continue };
+        let Some(p) = st.points.iter().find(|p| (p.airspeed - airspeed).abs() < 1e-9 && p.error.is_none()) else {
+            continue;
+        };
+        let t_end = run.rows.last().map_or(0.0, |r| r.t);
+        let window = (0.5 * t_end, t_end);
+        let w: Vec<&crate::run::Row> = run.rows.iter().filter(|r| r.t >= window.0 - 1e-9).collect();
+        let n = w.len() as f64;
+        let tz: Vec<f64> = w.iter().map(|r| r.tip[2]).collect();
+        let fo: Vec<f64> = w.iter().map(|r| r.fold.to_degrees()).collect();
+        let range = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+        let (tz_mean, fo_mean) = (tz.iter().sum::<f64>() / n, fo.iter().sum::<f64>() / n);
+        summary.history.push(HistoryComparison {
+            formulation: run.formulation,
+            airspeed,
+            window,
+            tip_z_mean: tz_mean,
+            tip_z_range: range(&tz),
+            fold_mean_deg: fo_mean,
+            fold_range_deg: range(&fo),
+            static_tip_z: p.tip[2],
+            static_fold_deg: p.fold_deg,
+            tip_z_relative_difference: (p.tip[2] - tz_mean) / tz_mean.abs(),
+            fold_difference_deg: p.fold_deg - fo_mean,
+        });
+    }
 }
 
 /// Linear interpolation of the converged points `(airspeed, value)` (sorted) at `u`; None
@@ -183,6 +248,7 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
         max_fold_difference_deg: dfold,
         max_rbm_relative_difference: drbm,
         n_failed,
+        history: Vec::new(),
     }
 }
 
@@ -470,6 +536,27 @@ pub fn section_html(s: &StaticSummary) -> String {
     }
     for (label, rms) in model_rms(s) {
         let _ = writeln!(h, "<li>{} against the experiment: RMS {rms:.2}° over 12–33 m/s</li>", html_escape(&label));
+    }
+    for c in &s.history {
+        let _ = writeln!(
+            h,
+            "<li>{} time history at {} m/s, mean over {:.0}–{:.0} s: tip height {:.4} m (range {:.4} to {:.4}), fold {:.3}° \
+             (range {:.2} to {:.2}); static: tip height {:.4} m ({:+.2} %), fold {:.3}° ({:+.3}°)</li>",
+            c.formulation.as_str().to_uppercase(),
+            c.airspeed,
+            c.window.0,
+            c.window.1,
+            c.tip_z_mean,
+            c.tip_z_range.0,
+            c.tip_z_range.1,
+            c.fold_mean_deg,
+            c.fold_range_deg.0,
+            c.fold_range_deg.1,
+            c.static_tip_z,
+            100.0 * c.tip_z_relative_difference,
+            c.static_fold_deg,
+            c.fold_difference_deg
+        );
     }
     h.push_str("</ul>\n");
     for (file, alt) in [

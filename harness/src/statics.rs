@@ -582,7 +582,7 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
     let mut x = StaticSolution::guess(&sys, &q_ref);
     let loads_model = LoadModel::new(case, f);
     let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
-    // 1. The first equilibrium at the highest airspeed: directly, or ramping gravity in.
+    // 1. The first equilibrium at the highest airspeed, by load stepping.
     let mut iters = 0;
     // Newton in rounds of a few iterations: the aerodynamic stiffness (the costly part of the
     // tangent) is kept within a round and from the previous point, and re-evaluated at the start
@@ -590,35 +590,65 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
     let solve =
         |sys: &mut AeroStatic<'_, S>, solver: &mut StaticSolver, x: &mut StaticSolution| -> Result<(), String> {
             let mut last = String::new();
+            let x0 = x.clone();
             for round in 0..ROUNDS {
                 sys.begin_solve(round > 0);
                 let s: &AeroStatic<'_, S> = sys;
                 // Borrowed only for the call: the system borrows the model mutably to apply its loads.
                 match solver.solve_normalised(s, 0.0, x, |q| s.model.borrow().normalise(q)) {
+                    // The residual at the converged state is evaluated once more; the lattice
+                    // must still be valid there.
+                    Ok(()) if !x.residual_norm.is_finite() => {
+                        return Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into()));
+                    }
                     Ok(()) => return Ok(()),
                     Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
+                    // A kept aerodynamic stiffness can send the first iterate past the lattice's
+                    // limits: start again from the same estimate with a fresh one.
+                    Err(e) if round == 0 => {
+                        last = sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"));
+                        *x = x0.clone();
+                    }
                     Err(e) => return Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
                 }
             }
             Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
         };
-    let start = x.clone();
-    let direct = solve(&mut sys, &mut solver, &mut x);
-    if let Err(first) = direct {
-        let Some(g) = case.gravity else {
-            return failed_output(case, f, format!("at {top} m/s: {first}"));
-        };
-        x = start;
-        for k in 0..=4 {
+    {
+        // Load stepping from the unloaded reference: gravity λ g and dynamic pressure λ q (the
+        // airspeed √λ V), so that the ratio of weight to air load, which sets the fold, is the
+        // final one at every step while the elastic deflection grows from zero. A step that
+        // fails is halved. (Newton straight to the full load can land on a spurious state of a
+        // folded-over lattice on a flexible wing.)
+        let g = case.gravity.unwrap_or([0.0; 3]);
+        let (mut lambda, mut step) = (0.0_f64, 0.25_f64);
+        let mut good = x.clone();
+        while lambda < 1.0 {
+            let next = (lambda + step).min(1.0);
             let mut c = case.clone();
-            let s = f64::from(k) / 4.0;
-            c.gravity = Some([s * g[0], s * g[1], s * g[2]]);
+            c.gravity = case.gravity.map(|_| [next * g[0], next * g[1], next * g[2]]);
             match build(&c) {
                 Ok(m) => sys.set_model(m),
                 Err(e) => return failed_output(case, f, e.to_string()),
             }
-            if let Err(e) = solve(&mut sys, &mut solver, &mut x) {
-                return failed_output(case, f, format!("at {top} m/s, gravity ramped to {s}: {e} (directly: {first})"));
+            let attempt = sys.set_airspeed(top * next.sqrt(), &x.q).and_then(|()| solve(&mut sys, &mut solver, &mut x));
+            match attempt {
+                Ok(()) => {
+                    lambda = next;
+                    good = x.clone();
+                    step = (1.5 * step).min(0.25);
+                }
+                Err(e) => {
+                    x = good.clone();
+                    step *= 0.5;
+                    if step < 1e-3 {
+                        return failed_output(
+                            case,
+                            f,
+                            format!("at {top} m/s: load stepping stalled at {lambda:.4} of the load: {e}"),
+                        );
+                    }
+                }
             }
         }
     }

@@ -231,7 +231,7 @@ impl StaticSolver {
         self.constraint_rows(system, t, x);
         self.jac.add_mul_transpose_vec_inplace(&self.multipliers, &mut self.r);
         debug_assert_eq!(self.multipliers.len(), n_h + n_v);
-        self.r[..n].iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+        inf_norm(&self.r[..n])
     }
 
     /// `jac = [Φ_q; B]`, `constraint = [Φ; b]` and `multipliers = [λ; μ]` at `x`.
@@ -282,14 +282,20 @@ impl StaticSolver {
         for (b, c) in self.rhs[n..].iter_mut().zip(&self.constraint) {
             *b = -scale * c;
         }
-        self.r.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+        inf_norm(&self.r)
     }
 
     /// The residual and constraint norms at the converged `x`.
     fn finish<S: ConstrainedSystem + ?Sized>(&mut self, system: &S, t: f64, x: &mut StaticSolution) {
         x.residual_norm = self.residual(system, t, x);
-        x.constraint_norm = self.constraint.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        x.constraint_norm = inf_norm(&self.constraint);
     }
+}
+
+/// The infinity norm of `v`, NaN when any entry is NaN (`f64::max` would skip it, and a
+/// residual a model could not evaluate would pass for zero).
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0_f64, |m, x| if x.is_nan() || m.is_nan() { f64::NAN } else { m.max(x.abs()) })
 }
 
 /// The equilibrium of `system` at time `t` under its current loads, by Newton from `q0` with
