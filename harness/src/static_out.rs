@@ -318,7 +318,7 @@ pub fn sections_html(out: &Path) -> String {
 }
 
 const ANCF: RGBColor = RGBColor(31, 119, 180);
-const GEBF: RGBColor = RGBColor(214, 39, 40);
+const GEBF: RGBColor = RGBColor(255, 127, 14);
 const EXP: RGBColor = RGBColor(30, 30, 30);
 const MODEL: RGBColor = RGBColor(44, 160, 44);
 
@@ -339,15 +339,36 @@ fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - d, hi + d)
 }
 
-type Curves<'a> = Vec<(String, RGBColor, Vec<(f64, f64)>, bool)>;
+/// How a curve is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Style {
+    /// Solid line with open circles.
+    Solid,
+    /// Dashed line with filled triangles (drawn over a solid one it stays visible).
+    Dashed,
+    /// Crosses only (measurements).
+    Points,
+}
 
-/// A panel of curves: (label, colour, points, drawn as markers only).
-fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves<'_>) -> Result<(), Error> {
+type Curves = Vec<(String, RGBColor, Vec<(f64, f64)>, Style)>;
+
+/// Decimals that tell neighbouring ticks apart on an axis spanning `lo..hi`.
+fn decimals(lo: f64, hi: f64) -> usize {
+    let step = (hi - lo).abs() / 6.0;
+    if !(step.is_finite() && step > 0.0) {
+        return 2;
+    }
+    (-step.log10().floor()).clamp(0.0, 6.0) as usize
+}
+
+/// A panel of curves with the legend beside the data.
+fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves) -> Result<(), Error> {
     let err = |e: String| Error::Plot { file: path.display().to_string(), msg: e };
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
     let (x0, x1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.0)));
     let (y0, y1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.1)));
+    let (dx, dy) = (decimals(x0, x1), decimals(y0, y1));
     // Legend to the right of the data.
     let (plot_area, legend_area) = root.split_horizontally(640);
     let mut chart = ChartBuilder::on(&plot_area)
@@ -363,48 +384,66 @@ fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves<'_>) -> R
         .y_desc(yl)
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .y_label_formatter(&|v| format!("{v:.3}"))
+        .x_label_formatter(&|v| format!("{v:.dx$}"))
+        .y_label_formatter(&|v| format!("{v:.dy$}"))
         .draw()
         .map_err(|e| err(e.to_string()))?;
-    for (k, (_, c, pts, markers)) in curves.iter().enumerate() {
-        if *markers {
-            chart
-                .draw_series(pts.iter().map(|&p| Cross::new(p, 6, c.stroke_width(2))))
-                .map_err(|e| err(e.to_string()))?;
-        } else {
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(|e| err(e.to_string()))?;
-            // Distinct markers per curve so overlapping lines stay visible.
-            if k % 2 == 0 {
+    for (_, c, pts, style) in curves {
+        match style {
+            Style::Points => {
                 chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.stroke_width(1))))
+                    .draw_series(pts.iter().map(|&p| Cross::new(p, 6, c.stroke_width(2))))
                     .map_err(|e| err(e.to_string()))?;
-            } else {
+            }
+            Style::Solid => {
                 chart
-                    .draw_series(pts.iter().map(|&p| TriangleMarker::new(p, 5, c.filled())))
+                    .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(3)))
+                    .map_err(|e| err(e.to_string()))?;
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 5, c.stroke_width(2))))
+                    .map_err(|e| err(e.to_string()))?;
+            }
+            Style::Dashed => {
+                chart
+                    .draw_series(DashedLineSeries::new(pts.iter().copied(), 8, 5, c.stroke_width(2)))
+                    .map_err(|e| err(e.to_string()))?;
+                chart
+                    .draw_series(pts.iter().map(|&p| TriangleMarker::new(p, 4, c.filled())))
                     .map_err(|e| err(e.to_string()))?;
             }
         }
     }
-    for (k, (label, c, _, markers)) in curves.iter().enumerate() {
+    for (k, (label, c, _, style)) in curves.iter().enumerate() {
         let y = 40 + 26 * k as i32;
-        let style = TextStyle::from(("sans-serif", 14).into_font()).color(&BLACK);
-        if *markers {
-            legend_area.draw(&Cross::new((16, y), 6, c.stroke_width(2))).map_err(|e| err(e.to_string()))?;
-        } else {
-            legend_area
-                .draw(&PathElement::new(vec![(4, y), (28, y)], c.stroke_width(2)))
-                .map_err(|e| err(e.to_string()))?;
+        let text = TextStyle::from(("sans-serif", 14).into_font()).color(&BLACK);
+        let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| err(e.to_string());
+        match style {
+            Style::Points => legend_area.draw(&Cross::new((16, y), 6, c.stroke_width(2))).map_err(e)?,
+            Style::Solid => {
+                legend_area.draw(&PathElement::new(vec![(2, y), (30, y)], c.stroke_width(3))).map_err(e)?;
+                legend_area.draw(&Circle::new((16, y), 5, c.stroke_width(2))).map_err(e)?;
+            }
+            Style::Dashed => {
+                for x in [2, 14, 26] {
+                    legend_area.draw(&PathElement::new(vec![(x, y), (x + 7, y)], c.stroke_width(2))).map_err(e)?;
+                }
+                legend_area.draw(&TriangleMarker::new((16, y), 4, c.filled())).map_err(e)?;
+            }
         }
-        legend_area.draw(&Text::new(label.clone(), (36, y - 7), style)).map_err(|e| err(e.to_string()))?;
+        legend_area.draw(&Text::new(label.clone(), (38, y - 7), text)).map_err(e)?;
     }
     root.present().map_err(|e| err(e.to_string()))
 }
 
+fn style(f: Formulation) -> Style {
+    match f {
+        Formulation::Ancf => Style::Solid,
+        Formulation::Gebf => Style::Dashed,
+    }
+}
+
 fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {
-    let mut curves: Curves<'_> = s
+    let mut curves: Curves = s
         .runs
         .iter()
         .map(|o| {
@@ -412,18 +451,19 @@ fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {
                 format!("{} (UVLM, steady)", o.formulation.as_str().to_uppercase()),
                 color(o.formulation),
                 curve(o, |p| p.fold_deg),
-                false,
+                style(o.formulation),
             )
         })
         .collect();
     for r in &s.references {
-        curves.push((r.label.clone(), if r.experiment { EXP } else { MODEL }, r.points.clone(), r.experiment));
+        let st = if r.experiment { Style::Points } else { Style::Solid };
+        curves.push((r.label.clone(), if r.experiment { EXP } else { MODEL }, r.points.clone(), st));
     }
     panel(path, &format!("{}: coast angle", s.name), "airspeed [m/s]", "fold angle [deg] (tip up +)", &curves)
 }
 
 fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
-    let curves: Curves<'_> = s
+    let curves: Curves = s
         .runs
         .iter()
         .map(|o| {
@@ -431,7 +471,7 @@ fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
                 o.formulation.as_str().to_uppercase(),
                 color(o.formulation),
                 curve(o, |p| p.loads.root_bending_moment),
-                false,
+                style(o.formulation),
             )
         })
         .collect();
@@ -439,13 +479,9 @@ fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
 }
 
 fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
-    let mut curves: Curves<'_> = Vec::new();
-    let shades = |f: Formulation, k: usize| -> RGBColor {
-        let c = color(f);
-        let t = 0.35 * k as f64;
-        let mix = |a: u8| (f64::from(a) + t * (255.0 - f64::from(a))) as u8;
-        RGBColor(mix(c.0), mix(c.1), mix(c.2))
-    };
+    // One colour per airspeed, the formulation's line style.
+    const SPEEDS: [RGBColor; 3] = [RGBColor(31, 119, 180), RGBColor(44, 160, 44), RGBColor(214, 39, 40)];
+    let mut curves: Curves = Vec::new();
     for o in &s.runs {
         let ok: Vec<_> = o.points.iter().filter(|p| p.error.is_none() && !p.strips.is_empty()).collect();
         let mut speeds: Vec<f64> = ok.iter().map(|p| p.airspeed).collect();
@@ -459,9 +495,9 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
             if let Some(p) = ok.iter().find(|p| p.airspeed == *u) {
                 curves.push((
                     format!("{} {u} m/s", o.formulation.as_str().to_uppercase()),
-                    shades(o.formulation, k),
+                    SPEEDS[k % 3],
                     p.strips.iter().map(|st| (st.s, st.lift_per_span)).collect(),
-                    false,
+                    style(o.formulation),
                 ));
             }
         }
