@@ -66,6 +66,9 @@ pub fn lift_csv(out: &StaticOutput) -> String {
     s
 }
 
+/// (airspeed, reference angle, computed angle, error = computed − reference), m/s and degrees.
+pub type PointError = (f64, f64, f64, f64);
+
 /// A reference curve with its errors.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReferenceErrors {
@@ -77,9 +80,9 @@ pub struct ReferenceErrors {
     pub experiment: bool,
     /// The curve: airspeed (m/s), angle (degrees).
     pub points: Vec<(f64, f64)>,
-    /// Per formulation: (airspeed, reference angle, computed angle, error = computed − reference)
-    /// at the reference's airspeeds inside the sweep's converged range.
-    pub errors: Vec<(Formulation, Vec<(f64, f64, f64, f64)>)>,
+    /// Per formulation: the errors at the reference's airspeeds inside the sweep's converged
+    /// range.
+    pub errors: Vec<(Formulation, Vec<PointError>)>,
     /// Per formulation: RMS error over 12–33 m/s, degrees.
     pub rms_deg: Vec<(Formulation, f64)>,
 }
