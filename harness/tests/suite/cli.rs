@@ -153,7 +153,7 @@ fn new_scene_fields_are_validated_by_every_command() {
     let point_mass = json!({"at": 0.5, "offset": [0.0, 0.01, 0.0], "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5]});
     let spring = json!({"stiffness": 1.0, "damping": 0.1, "rest_deg": 0.0});
     type Edit = fn(&mut serde_json::Value, &serde_json::Value, &serde_json::Value);
-    let cases: [(&str, Edit, &str); 10] = [
+    let cases: [(&str, Edit, &str); 9] = [
         (
             "spring_k",
             |v, _, s| {
@@ -179,14 +179,6 @@ fn new_scene_fields_are_validated_by_every_command() {
             // serde reports type errors inside a tagged joint at the joint (`joints[1]`), with the
             // offending type and value
             "joints[1]: invalid type: string \"ninety\", expected f64",
-        ),
-        (
-            "spring_locked",
-            |v, _, s| {
-                v["joints"][1]["spring"] = s.clone();
-                v["joints"][1]["locked"] = json!(true);
-            },
-            "joints[1].spring",
         ),
         (
             "pm_at",
