@@ -59,7 +59,7 @@ pub struct BenchRow {
 /// CPU time consumed by the calling thread, s (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, ns
 /// resolution); `None` off Linux, where the caller falls back to wall time.
 #[cfg(target_os = "linux")]
-fn thread_cpu_s() -> Option<f64> {
+pub(crate) fn thread_cpu_s() -> Option<f64> {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
     // SAFETY: `ts` is a valid, writable timespec; the call only writes to it.
     let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
@@ -67,7 +67,7 @@ fn thread_cpu_s() -> Option<f64> {
 }
 
 #[cfg(not(target_os = "linux"))]
-fn thread_cpu_s() -> Option<f64> {
+pub(crate) fn thread_cpu_s() -> Option<f64> {
     None
 }
 

@@ -76,6 +76,10 @@ pub struct Case {
     /// take 8× the steps with 8× the wake rows, so a shorter window keeps the study in minutes.
     #[serde(default)]
     pub converge_t_end: Option<f64>,
+    /// ParaView files for every run of this case (`harness run` and `harness all`), as `--vtk`
+    /// writes them (docs/outputs.md §7); omit for none.
+    #[serde(default)]
+    pub vtk: Option<crate::vtk::VtkOutput>,
     /// Parameter sweep: each entry maps a `--set`-style path (e.g. `stiffness_scale`,
     /// `joints.1.flare_deg`, `ancf.dt`) to a list of values; the Cartesian product expands into
     /// named runs `<name>__<key>=<value>…`.
@@ -1105,6 +1109,9 @@ impl Case {
         // where the case speaks degrees).
         self.scene(Formulation::Ancf).validate().map_err(|e| e.to_string())?;
         pos("t_end", self.t_end)?;
+        if self.vtk.is_some_and(|v| v.stride == Some(0)) {
+            return Err("vtk.stride: must be at least 1".into());
+        }
         if let Some(t) = self.converge_t_end {
             pos("converge_t_end", t)?;
         }

@@ -10,6 +10,9 @@
 //! Aeroelastic cases keep the wake's physical length on every rung (rows scaled with 1/dt; the
 //! chordwise lattice is fixed) and may use a shorter window (`converge_t_end`).
 //!
+//! Cost of a rung = its thread CPU time (wall time off Linux), the rungs run one after another
+//! on one thread, so that no rung's time includes waiting for a core another rung holds.
+//!
 //! Error of a rung = max over time of the tip distance to its truth. Observed orders come from
 //! successive rungs (`log2(e_k / e_{k+1})` for halving ratios), and a Richardson estimate of the
 //! truth's own error is reported from the last two rungs.
@@ -17,14 +20,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Error;
 use crate::case::{Elements, Formulation, RunSpec};
 use crate::csv::{Curve, read_curve, write_file};
 use crate::metrics::{tip_curve, tip_difference, window_stats};
-use crate::plot::{Panel, Series, colors, panels_svg};
+use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
 use crate::run::RunOutput;
 use crate::scene::run_formulation;
 
@@ -65,6 +67,8 @@ pub struct Rung {
     pub is_truth: bool,
     /// Wall time, s.
     pub wall_s: f64,
+    /// Thread CPU time of the run (wall time off Linux), s: the cost in the work-precision plot.
+    pub cpu_s: f64,
     /// Steps taken.
     pub n_steps: usize,
     /// Max tip distance to the ladder's truth, m (NaN for the truth itself or a failed run).
@@ -97,6 +101,61 @@ pub struct ConvergeResult {
     pub rungs: Vec<Rung>,
     /// Observed orders.
     pub orders: Vec<Order>,
+    /// Peer codes' runs of the same case, drawn as single points.
+    pub peers: Vec<Peer>,
+}
+
+/// A peer code's run of the case: its cost and its tip error against the same truth as the
+/// diagonal ladder (`reference/peer_timings.csv` beside the case file).
+#[derive(Debug, Clone, Serialize)]
+pub struct Peer {
+    /// Label (as the case's reference of the same run).
+    pub label: String,
+    /// Cost of one run, s.
+    pub cost_s: f64,
+    /// What the cost is: `cpu` or `wall`.
+    pub cost_kind: String,
+    /// Largest tip distance to the truth, m.
+    pub error_m: f64,
+    /// Where the error comes from: `measured` (by the harness, against the truth) or `file`
+    /// (the estimate given in the timings file).
+    pub error_source: String,
+}
+
+/// The peers of run `name` listed in `<dir>/reference/peer_timings.csv` (none when the file is
+/// absent), their errors measured against `truth` over `t ≤ t_window` where the file gives none.
+fn peers(
+    dir: &Path,
+    name: &str,
+    truth: Option<&Curve>,
+    shifts: &[(String, f64)],
+    t_window: f64,
+) -> Result<Vec<Peer>, Error> {
+    let path = dir.join("reference").join("peer_timings.csv");
+    let Ok(text) = std::fs::read_to_string(&path) else { return Ok(Vec::new()) };
+    let bad = |msg: String| Error::Reference { file: path.display().to_string(), msg };
+    let mut v = Vec::new();
+    for (k, line) in text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).enumerate().skip(1) {
+        let c: Vec<&str> = line.split(',').map(str::trim).collect();
+        if c.len() != 6 {
+            return Err(bad(format!("data line {k}: {} fields, expected 6", c.len())));
+        }
+        if c[0] != name {
+            continue;
+        }
+        let cost_s: f64 = c[3].parse().map_err(|_| bad(format!("data line {k}: cost_s `{}`", c[3])))?;
+        let (error_m, error_source) = if c[5].is_empty() {
+            let Some(truth) = truth else { continue };
+            let curve = read_curve(&dir.join(c[2]))?;
+            let shift = shifts.iter().find(|s| s.0 == c[1]).map_or(0.0, |s| s.1);
+            let d = tip_difference(truth, &curve, shift);
+            (window_stats(&d, f64::NEG_INFINITY, t_window).max, "measured".to_string())
+        } else {
+            (c[5].parse().map_err(|_| bad(format!("data line {k}: error_m `{}`", c[5])))?, "file".to_string())
+        };
+        v.push(Peer { label: c[1].to_string(), cost_s, cost_kind: c[4].to_string(), error_m, error_source });
+    }
+    Ok(v)
 }
 
 fn rung_spec(spec: &RunSpec, f: Formulation, elements: Elements, dt: f64) -> crate::case::Case {
@@ -182,23 +241,20 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
         None => None,
     };
     let bar = if progress { indicatif::ProgressBar::new(plan.len() as u64) } else { indicatif::ProgressBar::hidden() };
-    // Most expensive first so the two cores stay busy to the end.
-    let mut order: Vec<usize> = (0..plan.len()).collect();
-    order.sort_by(|&a, &b| {
-        let cost = |i: usize| plan[i].2.for_body(0) as f64 / plan[i].3;
-        cost(b).total_cmp(&cost(a))
-    });
-    let mut outs: Vec<(usize, RunOutput)> = order
-        .par_iter()
-        .map(|&i| {
+    // One after another on this thread: each rung's CPU time is its own cost.
+    let mut outs: Vec<(usize, RunOutput, f64)> = (0..plan.len())
+        .map(|i| {
             let (f, _, ref e, dt, _) = plan[i];
+            let c0 = crate::bench::thread_cpu_s();
             let out = run_formulation(&rung_spec(spec, f, e.clone(), dt), f);
+            let cpu = c0.and_then(|c0| Some(crate::bench::thread_cpu_s()? - c0)).unwrap_or(out.wall_s);
             bar.inc(1);
-            (i, out)
+            (i, out, cpu)
         })
         .collect();
     bar.finish_and_clear();
     outs.sort_by_key(|x| x.0);
+    let cpu: Vec<f64> = outs.iter().map(|x| x.2).collect();
     let outs: Vec<RunOutput> = outs.into_iter().map(|x| x.1).collect();
 
     let mut rungs = Vec::new();
@@ -237,6 +293,7 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                     dt,
                     is_truth: is_truth && !use_external,
                     wall_s: o.wall_s,
+                    cpu_s: cpu[i],
                     n_steps: o.stats.n_steps,
                     error_m,
                     against: against.clone(),
@@ -256,22 +313,33 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
             });
         }
     }
-    Ok(ConvergeResult { name: spec.name.clone(), rungs, orders })
+    // Peers against the diagonal ladder's truth: the external reference, else GEBF's finest rung.
+    let gebf_truth = (0..plan.len())
+        .find(|&i| plan[i].0 == Formulation::Gebf && plan[i].1 == Ladder::Diagonal && plan[i].4)
+        .filter(|&i| outs[i].error.is_none())
+        .map(|i| tip_curve(&outs[i].rows));
+    let truth = external.as_ref().map(|e| &e.1).or(gebf_truth.as_ref());
+    let shifts: Vec<(String, f64)> = case.references.iter().map(|r| (r.label.clone(), r.time_shift)).collect();
+    let t_window = case.converge_t_end.map_or(case.t_end, |t| t.min(case.t_end));
+    let peers = peers(&spec.dir, &spec.name, truth, &shifts, t_window)?;
+    Ok(ConvergeResult { name: spec.name.clone(), rungs, orders, peers })
 }
 
 /// Write `converge.csv`, `converge.json`, `work_precision.svg` and `convergence.svg` into `dir`.
 pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
-    let mut csv =
-        String::from("formulation,ladder,elements_per_body,dt,is_truth,wall_s,n_steps,error_m,against,failure\n");
+    let mut csv = String::from(
+        "formulation,ladder,elements_per_body,dt,is_truth,cpu_s,wall_s,n_steps,error_m,against,failure\n",
+    );
     for g in &r.rungs {
         let _ = writeln!(
             csv,
-            "{},{},{},{:.6e},{},{:.6},{},{:.6e},\"{}\",\"{}\"",
+            "{},{},{},{:.6e},{},{:.6},{:.6},{},{:.6e},\"{}\",\"{}\"",
             g.formulation,
             g.ladder.as_str(),
             g.elements,
             g.dt,
             g.is_truth,
+            g.cpu_s,
             g.wall_s,
             g.n_steps,
             g.error_m,
@@ -281,55 +349,68 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
     }
     write_file(&dir.join("converge.csv"), &csv)?;
     write_file(&dir.join("converge.json"), &serde_json::to_string_pretty(r).map_err(|e| Error::Io(e.to_string()))?)?;
-    let color = |f: Formulation, k: usize| match f {
-        Formulation::Ancf => [colors::ANCF, colors::EXTRA[0], colors::REFS[1]][k],
-        Formulation::Gebf => [colors::GEBF, colors::EXTRA[3], colors::REFS[3]][k],
+    // Colour: the formulation; dash and marker: the ladder.
+    let style = |f: Formulation, l: Ladder| {
+        let c = match f {
+            Formulation::Ancf => colors::ANCF,
+            Formulation::Gebf => colors::GEBF,
+        };
+        match l {
+            Ladder::Diagonal => Style::solid(c).marker(Marker::Circle).width(2),
+            Ladder::Time => Style::solid(c).dash(Dash::Dashed).marker(Marker::Square),
+            Ladder::Space => Style::solid(c).dash(Dash::Dotted).marker(Marker::Triangle).width(3),
+        }
     };
     let series = |x: &dyn Fn(&Rung) -> f64, ladders: &[Ladder]| -> Vec<Series> {
         let mut v = Vec::new();
         for f in Formulation::ALL {
-            for (k, &l) in ladders.iter().enumerate() {
+            for &l in ladders {
                 let pts: Vec<(f64, f64)> = r
                     .rungs
                     .iter()
                     .filter(|g| g.formulation == f && g.ladder == l && g.error_m.is_finite() && g.error_m > 0.0)
-                    .map(|g| (x(g).log10(), g.error_m))
+                    .map(|g| (x(g), g.error_m))
                     .collect();
                 if !pts.is_empty() {
-                    v.push(Series {
-                        label: format!("{} {}", f.as_str().to_uppercase(), l.as_str()),
-                        color: color(f, k),
-                        points: pts,
-                    });
+                    v.push(Series::new(format!("{} {}", f.as_str().to_uppercase(), l.as_str()), style(f, l), pts));
                 }
             }
         }
         v
     };
+    let mut wp_series = series(&|g| g.cpu_s.max(1e-6), &[Ladder::Diagonal, Ladder::Time, Ladder::Space]);
+    let peer_markers = [Marker::Diamond, Marker::Cross, Marker::Square, Marker::Triangle];
+    for (k, p) in r.peers.iter().enumerate() {
+        wp_series.push(Series::new(
+            format!("{} ({} time)", p.label, p.cost_kind),
+            Style::solid(colors::REFS[(k + 1) % colors::REFS.len()]).dash(Dash::None).marker(peer_markers[k % 4]),
+            vec![(p.cost_s, p.error_m)],
+        ));
+    }
     let wp = Panel {
         title: format!("{} — work-precision", r.name),
-        x_label: "log10 wall time [s]".into(),
+        x_label: "CPU time per run [s]".into(),
         y_label: "max tip error [m]".into(),
+        log_x: true,
         log_y: true,
-        legend_lower_right: false,
-        series: series(&|g| g.wall_s.max(1e-6), &[Ladder::Diagonal, Ladder::Time, Ladder::Space]),
+        series: wp_series,
     };
-    panels_svg(&dir.join("work_precision.svg"), &[wp], 1, (900, 480))?;
+    panels_svg(&dir.join("work_precision.svg"), &[wp], 1, (1000, 480))?;
     let t = Panel {
         title: format!("{} — error against time step", r.name),
-        x_label: "log10 dt [s]".into(),
+        x_label: "dt [s]".into(),
         y_label: "max tip error [m]".into(),
+        log_x: true,
         log_y: true,
-        legend_lower_right: false,
         series: series(&|g| g.dt, &[Ladder::Time]),
     };
     let s = Panel {
-        title: format!("{} — error against elements per body", r.name),
-        x_label: "log10 elements (first body) [-]".into(),
+        title: format!("{} — error against elements", r.name),
+        x_label: "elements of the first body [-]".into(),
         y_label: "max tip error [m]".into(),
+        log_x: true,
         log_y: true,
-        legend_lower_right: false,
         series: series(&|g| g.elements.for_body(0) as f64, &[Ladder::Space]),
     };
-    panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (600, 420))
+    panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (700, 420))
 }

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use crate::Error;
 use crate::case::{CaseFile, Formulation, Override, RunSpec};
 use crate::csv::write_file;
-use crate::report::{CaseResult, index_html, studies_html, summary_markdown, write_case};
+use crate::report::{CaseResult, index_html, summary_markdown, write_case};
 use crate::run::{NoObserver, Observer};
 use crate::scene::run_formulation_observed;
 
@@ -85,6 +85,6 @@ pub fn write_reports(out: &Path, results: &[CaseResult]) -> Result<(), Error> {
     if let Some(e) = errs.into_iter().next() {
         return Err(e);
     }
-    write_file(&out.join("index.html"), &index_html(results, &studies_html(out)))?;
+    write_file(&out.join("index.html"), &index_html(out, results, &[]))?;
     write_file(&out.join("summary.md"), &summary_markdown(results))
 }

@@ -23,7 +23,7 @@ use crate::Error;
 use crate::case::{Case, FormSetting, Formulation, RunSpec};
 use crate::csv::write_file;
 use crate::metrics::FormulationMetrics;
-use crate::plot::{Panel, Series, colors, panels_svg};
+use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
 use crate::run::RunOutput;
 use crate::scene::run_formulation;
 
@@ -190,11 +190,16 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
     write_file(&dir.join("energy.md"), &md)?;
     let mut cases: Vec<&str> = runs.iter().map(|r| r.case.as_str()).collect();
     cases.dedup();
-    let color = |f: Formulation, form: FormSetting| match (f, form) {
-        (Formulation::Ancf, FormSetting::ArnoldBruls) => colors::ANCF,
-        (Formulation::Gebf, FormSetting::ArnoldBruls) => colors::GEBF,
-        (Formulation::Ancf, FormSetting::ChungHulbert) => colors::EXTRA[0],
-        (Formulation::Gebf, FormSetting::ChungHulbert) => colors::EXTRA[3],
+    // Colour: the formulation; dash and marker: the form.
+    let style = |f: Formulation, form: FormSetting| {
+        let c = match f {
+            Formulation::Ancf => colors::ANCF,
+            Formulation::Gebf => colors::GEBF,
+        };
+        match form {
+            FormSetting::ArnoldBruls => Style::solid(c),
+            FormSetting::ChungHulbert => Style::solid(c).dash(Dash::Dashed).marker(Marker::Circle),
+        }
     };
     let panels: Vec<Panel> = cases
         .iter()
@@ -203,16 +208,18 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
             x_label: "t [s]".into(),
             y_label: "|E − E(0)| / max T (≥ 1e-8)".into(),
             log_y: true,
-            legend_lower_right: true,
             series: runs
                 .iter()
                 .filter(|r| r.case == *c)
-                .map(|r| Series {
-                    label: format!("{} {}", r.formulation.as_str().to_uppercase(), r.form.label()),
-                    color: color(r.formulation, r.form),
-                    points: r.history.iter().map(|&(t, e)| (t, e.abs().max(ENERGY_FLOOR))).collect(),
+                .map(|r| {
+                    Series::new(
+                        format!("{} {}", r.formulation.as_str().to_uppercase(), r.form.label()),
+                        style(r.formulation, r.form),
+                        r.history.iter().map(|&(t, e)| (t, e.abs().max(ENERGY_FLOOR))).collect(),
+                    )
                 })
                 .collect(),
+            ..Panel::default()
         })
         .collect();
     panels_svg(&dir.join("energy.svg"), &panels, 1, (900, 320))

@@ -3,7 +3,7 @@
 //! Reads case files ([`case`]), builds the scene for ANCF and for GEBF ([`scene`]), integrates
 //! each with the shared generalized-α integrator ([`run`]), compares them with each other and with
 //! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
-//! ([`report`], [`plot`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
+//! ([`report`], [`plot`]), a 3-D view ([`view3d`]) and ParaView files ([`vtk`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
 //! ladders ([`converge`]), the stress matrix ([`stress`]), energy by integrator form
 //! ([`energy`]), speed ([`bench`](mod@bench)).
 #![warn(missing_docs)]
@@ -25,6 +25,7 @@ pub mod scene;
 pub mod static_out;
 pub mod statics;
 pub mod stress;
+pub mod view3d;
 pub mod vtk;
 
 /// Errors of the harness library (the binary adds context with anyhow).

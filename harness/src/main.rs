@@ -60,12 +60,13 @@ enum Cmd {
         /// Override a case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
-        /// Also write ParaView files (beams, vortex lattice, wake; .vtp plus a .pvd time series per
-        /// family) to `<out>/<case>/vtk/<formulation>/`.
+        /// Also write ParaView files (beams with section frames, chord ribbon, vortex lattice, wake;
+        /// .vtp plus a .pvd time series per family) to `<out>/<case>/vtk/<formulation>/`; a case
+        /// with a `vtk` block writes them without the flag.
         #[arg(long)]
         vtk: bool,
-        /// With --vtk, write every N-th output step (default: about 100 frames per run,
-        /// max(1, output rows / 100)).
+        /// With --vtk, write every N-th output step (default: the case's `vtk.stride`, else about
+        /// 100 frames per run, max(1, output rows / 100)).
         #[arg(long, value_name = "N", requires = "vtk")]
         vtk_stride: Option<usize>,
     },
@@ -345,7 +346,10 @@ fn real_main() -> Result<ExitCode> {
                 eprintln!("error: {e}");
             }
             let t0 = std::time::Instant::now();
-            let results = run_all(&runs, &Formulation::ALL, true);
+            // Each run also records its 3-D view for the report (and writes VTK where the case asks).
+            let results = harness::driver::run_all_observed(&runs, &Formulation::ALL, true, &|spec, f| {
+                harness::view3d::report_observer(&out, spec, f)
+            });
             let wall = t0.elapsed().as_secs_f64();
             if !quick {
                 for spec in runs.iter().filter(|r| r.ancf.converge) {
@@ -413,14 +417,14 @@ fn real_main() -> Result<ExitCode> {
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
-            let results = if vtk {
-                harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| {
-                    let stride = vtk_stride.unwrap_or_else(|| harness::vtk::default_stride(spec.case(f), f));
-                    Box::new(harness::vtk::VtkWriter::for_run(&out, &spec.name, f, stride))
-                })
-            } else {
-                run_all(&runs, &fs, true)
-            };
+            // VTK when --vtk asks for it or the case's `vtk` block does.
+            let cli = vtk.then_some(vtk_stride);
+            let results = harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| {
+                match harness::vtk::writer_for(&out, spec, f, cli) {
+                    Some(w) => Box::new(w),
+                    None => Box::new(harness::run::NoObserver),
+                }
+            });
             let mut failed = false;
             for r in &results {
                 let dir = out.join(&r.name);

@@ -1,25 +1,108 @@
-//! SVG plots (plotters): every panel has axes with units and a legend.
+//! SVG plots (plotters): every panel has axes with units and a legend beside the data.
+//!
+//! Readable at a glance: each series has its own colour, dash pattern and marker (see
+//! [`Style`]), so that curves lying on top of each other stay visible; the legend is drawn in a
+//! strip right of the plot area, never over the data; logarithmic axes are drawn as such
+//! (`log_x`, `log_y`).
 
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::Error;
+
+/// Line pattern of a series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Dash {
+    /// Continuous line.
+    #[default]
+    Solid,
+    /// Long dashes.
+    Dashed,
+    /// Short dots.
+    Dotted,
+    /// No line: markers only (e.g. a peer code's single measurement).
+    None,
+}
+
+/// Marker drawn on a series (at every point of a short series, at about 12 evenly spaced points
+/// of a long one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Marker {
+    /// Open circle.
+    Circle,
+    /// Filled square.
+    Square,
+    /// Open triangle.
+    Triangle,
+    /// Cross.
+    Cross,
+    /// Filled diamond.
+    Diamond,
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Style {
+    /// Colour.
+    pub color: RGBColor,
+    /// Line pattern.
+    pub dash: Dash,
+    /// Marker, if any.
+    pub marker: Option<Marker>,
+    /// Line width, px.
+    pub width: u32,
+}
+
+impl Style {
+    /// A solid line of `color`, 2 px, no marker.
+    pub const fn solid(color: RGBColor) -> Self {
+        Self { color, dash: Dash::Solid, marker: None, width: 2 }
+    }
+    /// The same style with a dash pattern.
+    pub const fn dash(self, dash: Dash) -> Self {
+        Self { dash, ..self }
+    }
+    /// The same style with a marker.
+    pub const fn marker(self, marker: Marker) -> Self {
+        Self { marker: Some(marker), ..self }
+    }
+    /// The same style with a line width.
+    pub const fn width(self, width: u32) -> Self {
+        Self { width, ..self }
+    }
+    /// The `i`-th of a set of distinct styles (colour, dash and marker all change with `i`), for
+    /// series that have no fixed meaning.
+    pub fn nth(i: usize) -> Self {
+        const DASHES: [Dash; 3] = [Dash::Solid, Dash::Dashed, Dash::Dotted];
+        const MARKERS: [Marker; 5] = [Marker::Circle, Marker::Square, Marker::Triangle, Marker::Cross, Marker::Diamond];
+        let p = colors::PALETTE;
+        Self { color: p[i % p.len()], dash: DASHES[i % 3], marker: Some(MARKERS[i % 5]), width: 2 }
+    }
+}
 
 /// One curve of a panel.
 #[derive(Debug, Clone)]
 pub struct Series {
     /// Legend label.
     pub label: String,
-    /// Colour.
-    pub color: RGBColor,
+    /// How it is drawn.
+    pub style: Style,
     /// Points (x, y).
     pub points: Vec<(f64, f64)>,
 }
 
+impl Series {
+    /// A series.
+    pub fn new(label: impl Into<String>, style: Style, points: Vec<(f64, f64)>) -> Self {
+        Self { label: label.into(), style, points }
+    }
+}
+
 /// One panel: title, axis labels with units, curves.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Panel {
     /// Title above the panel.
     pub title: String,
@@ -27,27 +110,39 @@ pub struct Panel {
     pub x_label: String,
     /// Y axis label with unit.
     pub y_label: String,
+    /// Logarithmic x axis (non-positive values are dropped).
+    pub log_x: bool,
     /// Logarithmic y axis (non-positive values are clipped to the smallest positive one).
     pub log_y: bool,
-    /// Legend in the lower right corner instead of the upper right (for curves that end high).
-    pub legend_lower_right: bool,
     /// Curves.
     pub series: Vec<Series>,
 }
 
-/// Colours used consistently across all plots.
+/// Colours used consistently across all plots (colour-blind-safe where it matters: the two
+/// formulations are blue and vermilion).
 pub mod colors {
     use plotters::style::RGBColor;
     /// ANCF.
-    pub const ANCF: RGBColor = RGBColor(31, 119, 180);
+    pub const ANCF: RGBColor = RGBColor(0, 114, 178);
     /// GEBF.
-    pub const GEBF: RGBColor = RGBColor(214, 39, 40);
+    pub const GEBF: RGBColor = RGBColor(213, 94, 0);
     /// External references, in order.
     pub const REFS: [RGBColor; 4] =
-        [RGBColor(40, 40, 40), RGBColor(44, 160, 44), RGBColor(148, 103, 189), RGBColor(255, 127, 14)];
+        [RGBColor(30, 30, 30), RGBColor(0, 158, 115), RGBColor(204, 121, 167), RGBColor(120, 120, 120)];
     /// Extra curves.
     pub const EXTRA: [RGBColor; 4] =
-        [RGBColor(23, 190, 207), RGBColor(188, 189, 34), RGBColor(140, 86, 75), RGBColor(227, 119, 194)];
+        [RGBColor(86, 180, 233), RGBColor(230, 159, 0), RGBColor(140, 86, 75), RGBColor(148, 103, 189)];
+    /// Distinct colours for series without a fixed meaning.
+    pub const PALETTE: [RGBColor; 8] = [
+        RGBColor(0, 114, 178),
+        RGBColor(213, 94, 0),
+        RGBColor(0, 158, 115),
+        RGBColor(204, 121, 167),
+        RGBColor(30, 30, 30),
+        RGBColor(230, 159, 0),
+        RGBColor(86, 180, 233),
+        RGBColor(140, 86, 75),
+    ];
 }
 
 fn finite_range(it: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
@@ -66,69 +161,185 @@ fn pad(lo: f64, hi: f64) -> (f64, f64) {
     }
 }
 
-fn legend_position(p: &Panel) -> SeriesLabelPosition {
-    if p.legend_lower_right { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperRight }
+/// Range of a log axis: positive values, widened to whole factors.
+fn log_range(it: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = finite_range(it.filter(|v| *v > 0.0)).unwrap_or((1e-12, 1.0));
+    (lo.max(hi * 1e-14) / 1.5, hi * 1.5)
+}
+
+/// Indices of the points of a series of `n` points that carry a marker: all of a short series,
+/// about 12 of a long one, shifted by `phase` (the series' index) so that markers of coincident
+/// curves do not hide each other.
+fn marker_indices(n: usize, phase: usize) -> impl Iterator<Item = usize> {
+    let step = if n <= 30 { 1 } else { n / 12 };
+    let offset = if step == 1 { 0 } else { (phase * step / 5) % step };
+    (offset..n).step_by(step.max(1))
+}
+
+fn shape(style: &Style) -> ShapeStyle {
+    ShapeStyle { color: style.color.to_rgba(), filled: false, stroke_width: style.width }
+}
+
+/// Draw markers `m` of `color` at the points `$pts` with `$draw(iterator of elements)`.
+macro_rules! draw_markers {
+    ($m:expr, $color:expr, $pts:expr, $draw:expr) => {{
+        let line = ShapeStyle { color: $color.to_rgba(), filled: false, stroke_width: 2 };
+        let fill = $color.filled();
+        let r = 4;
+        match $m {
+            Marker::Circle => $draw($pts.map(|c| EmptyElement::at(c) + Circle::new((0, 0), r, line))),
+            Marker::Square => $draw($pts.map(|c| EmptyElement::at(c) + Rectangle::new([(-r, -r), (r, r)], fill))),
+            Marker::Triangle => $draw($pts.map(|c| {
+                EmptyElement::at(c) + PathElement::new(vec![(0, -r - 1), (r + 1, r), (-r - 1, r), (0, -r - 1)], line)
+            })),
+            Marker::Cross => $draw($pts.map(|c| {
+                EmptyElement::at(c)
+                    + PathElement::new(vec![(-r, -r), (r, r)], line)
+                    + PathElement::new(vec![(-r, r), (r, -r)], line)
+            })),
+            Marker::Diamond => $draw($pts.map(|c| {
+                EmptyElement::at(c) + Polygon::new(vec![(0, -r - 1), (r + 1, 0), (0, r + 1), (-r - 1, 0)], fill)
+            })),
+        }
+    }};
+}
+
+/// Draw every series of `p` into a built chart; `fix` maps a point to the drawn point (None: drop).
+macro_rules! draw_series {
+    ($c:expr, $p:expr, $fix:expr) => {{
+        for (k, s) in $p.series.iter().enumerate() {
+            let pts: Vec<(f64, f64)> = s.points.iter().filter_map(|&q| $fix(q)).collect();
+            let st = shape(&s.style);
+            match s.style.dash {
+                Dash::Solid => {
+                    $c.draw_series(LineSeries::new(pts.iter().copied(), st)).map_err(|e| e.to_string())?;
+                }
+                Dash::Dashed => {
+                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 10, 6, st))
+                        .map_err(|e| e.to_string())?;
+                }
+                Dash::Dotted => {
+                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 2, 5, st))
+                        .map_err(|e| e.to_string())?;
+                }
+                Dash::None => {}
+            }
+            if let Some(m) = s.style.marker {
+                let at = marker_indices(pts.len(), k).map(|i| pts[i]);
+                draw_markers!(m, s.style.color, at, |els| $c.draw_series(els).map(|_| ()).map_err(|e| e.to_string()))?;
+            }
+        }
+    }};
+}
+
+fn sci(v: f64) -> String {
+    format!("{v:.0e}")
 }
 
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
-    let xs = finite_range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
-    let (x0, x1) = xs.map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
-    let mut chart = ChartBuilder::on(area);
-    chart.caption(&p.title, ("sans-serif", 18)).margin(8).x_label_area_size(40).y_label_area_size(78);
+    // The legend gets its own strip right of the plot, sized to the longest label.
+    let longest = p.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0);
+    let legend_w = if p.series.is_empty() { 0 } else { (longest as i32 * 8 + 52).clamp(90, 330) };
+    let (w, _) = area.dim_in_pixel();
+    let (plot, legend) = area.split_horizontally((w as i32 - legend_w).max(200));
+    let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
+    let ys = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1));
+    let mut chart = ChartBuilder::on(&plot);
+    chart.caption(&p.title, ("sans-serif", 18)).margin(8).x_label_area_size(40).y_label_area_size(80);
     let label_style = ("sans-serif", 14);
-    if p.log_y {
-        let ys = finite_range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1).filter(|v| *v > 0.0)));
-        let (lo, hi) = ys.unwrap_or((1e-12, 1.0));
-        let (lo, hi) = (lo.max(hi * 1e-14) / 2.0, hi * 2.0);
-        let mut c = chart.build_cartesian_2d(x0..x1, (lo..hi).log_scale()).map_err(|e| e.to_string())?;
-        c.configure_mesh()
-            .x_desc(&p.x_label)
-            .y_desc(&p.y_label)
-            .label_style(label_style)
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for s in &p.series {
-            let color = s.color;
-            c.draw_series(LineSeries::new(s.points.iter().map(|&(x, y)| (x, y.max(lo))), color.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(&s.label)
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2)));
+    match (p.log_x, p.log_y) {
+        (false, false) => {
+            let (x0, x1) = finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
+            let (lo, hi) = finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0));
+            let mut c = chart.build_cartesian_2d(x0..x1, lo..hi).map_err(|e| e.to_string())?;
+            c.configure_mesh()
+                .x_desc(&p.x_label)
+                .y_desc(&p.y_label)
+                .label_style(label_style)
+                .draw()
+                .map_err(|e| e.to_string())?;
+            draw_series!(c, p, |q: (f64, f64)| (q.0.is_finite() && q.1.is_finite()).then_some(q));
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(label_style)
-            .position(legend_position(p))
-            .draw()
-            .map_err(|e| e.to_string())?;
-    } else {
-        let ys = finite_range(p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)));
-        let (lo, hi) = ys.map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0));
-        let mut c = chart.build_cartesian_2d(x0..x1, lo..hi).map_err(|e| e.to_string())?;
-        c.configure_mesh()
-            .x_desc(&p.x_label)
-            .y_desc(&p.y_label)
-            .label_style(label_style)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for s in &p.series {
-            let color = s.color;
-            c.draw_series(LineSeries::new(s.points.iter().copied().filter(|q| q.1.is_finite()), color.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(&s.label)
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2)));
+        (false, true) => {
+            let (x0, x1) = finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
+            let (lo, hi) = log_range(ys);
+            let mut c = chart.build_cartesian_2d(x0..x1, (lo..hi).log_scale()).map_err(|e| e.to_string())?;
+            c.configure_mesh()
+                .x_desc(&p.x_label)
+                .y_desc(&p.y_label)
+                .label_style(label_style)
+                .y_label_formatter(&|v| sci(*v))
+                .draw()
+                .map_err(|e| e.to_string())?;
+            draw_series!(c, p, |q: (f64, f64)| (q.0.is_finite() && q.1.is_finite()).then_some((q.0, q.1.max(lo))));
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(label_style)
-            .position(legend_position(p))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        (true, ly) => {
+            let (x0, x1) = log_range(xs);
+            let (lo, hi) = if ly {
+                log_range(ys)
+            } else {
+                finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0))
+            };
+            if ly {
+                let mut c =
+                    chart.build_cartesian_2d((x0..x1).log_scale(), (lo..hi).log_scale()).map_err(|e| e.to_string())?;
+                c.configure_mesh()
+                    .x_desc(&p.x_label)
+                    .y_desc(&p.y_label)
+                    .label_style(label_style)
+                    .x_label_formatter(&|v| sci(*v))
+                    .y_label_formatter(&|v| sci(*v))
+                    .draw()
+                    .map_err(|e| e.to_string())?;
+                draw_series!(c, p, |q: (f64, f64)| (q.0 > 0.0 && q.0.is_finite() && q.1.is_finite())
+                    .then_some((q.0, q.1.max(lo))));
+            } else {
+                let mut c = chart.build_cartesian_2d((x0..x1).log_scale(), lo..hi).map_err(|e| e.to_string())?;
+                c.configure_mesh()
+                    .x_desc(&p.x_label)
+                    .y_desc(&p.y_label)
+                    .label_style(label_style)
+                    .x_label_formatter(&|v| sci(*v))
+                    .draw()
+                    .map_err(|e| e.to_string())?;
+                draw_series!(c, p, |q: (f64, f64)| (q.0 > 0.0 && q.0.is_finite() && q.1.is_finite()).then_some(q));
+            }
+        }
+    }
+    draw_legend(&legend, p)
+}
+
+/// The legend in its own strip: a sample of each series' line and marker, then its label.
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let y0 = 40;
+    for (k, s) in p.series.iter().enumerate() {
+        let y = y0 + 22 * k as i32;
+        let (x0, x1) = (4, 34);
+        let st = shape(&s.style);
+        match s.style.dash {
+            Dash::Solid => area.draw(&PathElement::new(vec![(x0, y), (x1, y)], st)).map_err(e)?,
+            Dash::Dashed => area.draw(&DashedPathElement::new(vec![(x0, y), (x1, y)], 8, 4, st)).map_err(e)?,
+            Dash::Dotted => area.draw(&DashedPathElement::new(vec![(x0, y), (x1, y)], 2, 4, st)).map_err(e)?,
+            Dash::None => {}
+        }
+        if let Some(m) = s.style.marker {
+            let at = std::iter::once(((x0 + x1) / 2, y));
+            draw_markers!(m, s.style.color, at, |els: _| -> Result<(), String> {
+                for el in els {
+                    area.draw(&el).map_err(e)?;
+                }
+                Ok(())
+            })?;
+        }
+        area.draw(&Text::new(s.label.clone(), (x1 + 6, y - 7), ("sans-serif", 13).into_font().color(&BLACK)))
+            .map_err(e)?;
     }
     Ok(())
 }
@@ -157,24 +368,40 @@ mod tests {
     use super::*;
 
     #[test]
-    fn writes_svg_with_labels_and_legend() {
+    fn writes_svg_with_labels_and_legend_in_every_axis_kind() {
         let dir = std::env::temp_dir().join(format!("harness-plot-{}", std::process::id()));
         let path = dir.join("t.svg");
-        let panel = |log_y| Panel {
+        let panel = |log_x, log_y| Panel {
             title: "tip Z".into(),
             x_label: "t [s]".into(),
             y_label: "Z [m]".into(),
+            log_x,
             log_y,
-            legend_lower_right: log_y,
-            series: vec![Series {
-                label: "ANCF".into(),
-                color: colors::ANCF,
-                points: (0..50).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).sin().abs() + 1e-3)).collect(),
-            }],
+            series: (0..3)
+                .map(|k| {
+                    Series::new(
+                        format!("series {k}"),
+                        Style::nth(k),
+                        (1..50).map(|i| (i as f64 * 0.1, (i as f64 * 0.1).sin().abs() + 1e-3)).collect(),
+                    )
+                })
+                .collect(),
         };
-        panels_svg(&path, &[panel(false), panel(true)], 1, (600, 300)).unwrap();
+        let panels = [panel(false, false), panel(false, true), panel(true, true), panel(true, false)];
+        panels_svg(&path, &panels, 2, (600, 300)).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
-        assert!(svg.contains("t [s]") && svg.contains("Z [m]") && svg.contains("ANCF"));
+        assert!(svg.contains("t [s]") && svg.contains("Z [m]") && svg.contains("series 2"));
+        // Dashed series are drawn as many short segments; dotted ones too.
+        assert!(svg.matches("<polyline").count() > 3 * 4);
         std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn markers_cover_short_series_and_sample_long_ones() {
+        assert_eq!(marker_indices(5, 3).count(), 5);
+        let long: Vec<usize> = marker_indices(2000, 0).collect();
+        assert!((12..=14).contains(&long.len()), "{}", long.len());
+        // Another series' markers sit elsewhere.
+        assert_ne!(marker_indices(2000, 1).next(), Some(0));
     }
 }

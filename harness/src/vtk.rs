@@ -1,5 +1,8 @@
-//! ParaView output: an [`Observer`] that writes XML VTK PolyData files (`.vtp`) of the beams, the
-//! bound vortex lattice and the wake, with a `.pvd` time collection per family.
+//! ParaView output: an [`Observer`] that writes XML VTK PolyData files (`.vtp`) of the beams
+//! (with their section frames), the wing's chord ribbon, the bound vortex lattice (circulation and
+//! pressure jump) and the wake, with a `.pvd` time collection per family; and
+//! [`write_beam_series`], which writes any set of beam geometries (a run's frames, a mode shape's
+//! phases) as such a time series.
 //!
 //! Hand-written ASCII XML rather than the `vtkio` crate: PolyData is a few lines of XML per file,
 //! and `vtkio` would be a large dependency for that.
@@ -7,12 +10,25 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::case::{Case, Formulation};
-use crate::run::{Observer, Snapshot};
-use crate::scene::settings;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
-/// The three file families, in the order they are written.
-const FAMILIES: [&str; 3] = ["beams", "lattice", "wake"];
+use crate::case::{Case, Formulation, RunSpec};
+use crate::run::{BeamGeometry, Observer, Snapshot};
+
+/// The case file's `vtk` block: write ParaView files for every run of the case, as `--vtk`
+/// does (`harness run` and `harness all`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VtkOutput {
+    /// Write every N-th output step (≥ 1; default: about 100 frames per run,
+    /// max(1, output rows / 100)). `--vtk-stride` overrides it.
+    #[serde(default)]
+    pub stride: Option<usize>,
+}
+
+/// The file families, in the order they are written.
+const FAMILIES: [&str; 4] = ["beams", "ribbon", "lattice", "wake"];
 
 /// Writes every `stride`-th snapshot of one run as `beams_<k>.vtp` (and, with aerodynamics,
 /// `lattice_<k>.vtp` and `wake_<k>.vtp`) into `dir`, `k` the output row index, and keeps
@@ -25,15 +41,25 @@ pub struct VtkWriter {
     dir: PathBuf,
     stride: usize,
     created: bool,
+    /// Chord and leading-edge offset of the sections, m, when the case has a lattice.
+    chord: Option<(f64, f64)>,
     /// Per family: (time, file name) of each written step.
-    steps: [Vec<(f64, String)>; 3],
+    steps: [Vec<(f64, String)>; 4],
 }
 
 impl VtkWriter {
     /// A writer into `dir` (created at the first write) of every `stride`-th snapshot (0 is
     /// taken as 1).
     pub fn new(dir: impl Into<PathBuf>, stride: usize) -> Self {
-        Self { dir: dir.into(), stride: stride.max(1), created: false, steps: Default::default() }
+        Self { dir: dir.into(), stride: stride.max(1), created: false, chord: None, steps: Default::default() }
+    }
+
+    /// Also write each section's chord as a ribbon (`ribbon_<k>.vtp`): `chord` long, its leading
+    /// edge `le_offset` ahead of the beam axis along the section's y axis (as the lattice is
+    /// built, docs/uvlm.md).
+    pub fn with_chord(mut self, chord: f64, le_offset: f64) -> Self {
+        self.chord = Some((chord, le_offset));
+        self
     }
 
     /// The writer of formulation `f` of a case under `out`: `<out>/<case>/vtk/<formulation>/`.
@@ -85,10 +111,13 @@ impl Observer for VtkWriter {
             std::fs::create_dir_all(&self.dir).map_err(|e| format!("{}: {e}", self.dir.display()))?;
             self.created = true;
         }
-        self.write_family(0, s.index, s.t, &beams_vtp(s))?;
+        self.write_family(0, s.index, s.t, &beams_vtp(s.beams))?;
+        if let Some((chord, le)) = self.chord {
+            self.write_family(1, s.index, s.t, &ribbon_vtp(s.beams, chord, le))?;
+        }
         if let Some(uv) = s.aero {
-            self.write_family(1, s.index, s.t, &lattice_vtp(uv))?;
-            self.write_family(2, s.index, s.t, &wake_vtp(uv))?;
+            self.write_family(2, s.index, s.t, &lattice_vtp(uv))?;
+            self.write_family(3, s.index, s.t, &wake_vtp(uv))?;
         }
         self.finish()
     }
@@ -97,13 +126,54 @@ impl Observer for VtkWriter {
 /// The default stride of formulation `f` of `case`: about 100 frames over the run,
 /// max(1, output rows / 100).
 pub fn default_stride(case: &Case, f: Formulation) -> usize {
-    let s = settings(case, f);
-    let dt = s.params.dt;
-    // As the time loops count their steps.
-    let n_steps = (s.t_end / dt).round().max(1.0) as usize;
-    let every = s.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
-    let rows = n_steps / every + 1;
-    (rows / 100).max(1)
+    (crate::view3d::output_rows(case, f) / 100).max(1)
+}
+
+/// The VTK writer of formulation `f` of run `spec` under `out`, when `--vtk` asks for one
+/// (`cli = Some(stride)`, the stride given or not) or the case's `vtk` block does; the stride is
+/// `--vtk-stride`, else the case's `vtk.stride`, else [`default_stride`]. With a lattice, the
+/// writer also writes the chord ribbon.
+pub fn writer_for(out: &Path, spec: &RunSpec, f: Formulation, cli: Option<Option<usize>>) -> Option<VtkWriter> {
+    let case = spec.case(f);
+    if cli.is_none() && case.vtk.is_none() {
+        return None;
+    }
+    let stride = cli
+        .flatten()
+        .or(case.vtk.and_then(|v| v.stride))
+        .unwrap_or_else(|| default_stride(case, f));
+    let w = VtkWriter::for_run(out, &spec.name, f, stride);
+    Some(match &case.aero {
+        Some(a) => w.with_chord(a.chord, a.le_offset),
+        None => w,
+    })
+}
+
+/// Several observers fed the same snapshots, in order (the first error stops the run).
+pub struct Fanout(pub Vec<Box<dyn Observer>>);
+
+impl Observer for Fanout {
+    fn wants_snapshots(&self) -> bool {
+        self.0.iter().any(|o| o.wants_snapshots())
+    }
+    fn observe(&mut self, s: &Snapshot<'_>) -> Result<(), String> {
+        self.0.iter_mut().filter(|o| o.wants_snapshots()).try_for_each(|o| o.observe(s))
+    }
+}
+
+/// Write a set of beam geometries as a time series into `dir`: `<name>_<k>.vtp` for each entry
+/// `k` of `frames` ((time or phase, one geometry per body)) and `<name>.pvd` listing them, in
+/// the format of the `beams` family (polylines with the section frames). For a run's frames, a
+/// mode shape animated over its phase, or any other sequence of configurations.
+pub fn write_beam_series(dir: &Path, name: &str, frames: &[(f64, Vec<BeamGeometry>)]) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut steps = Vec::with_capacity(frames.len());
+    for (k, (t, beams)) in frames.iter().enumerate() {
+        let file = format!("{name}_{k:06}.vtp");
+        write(&dir.join(&file), &beams_vtp(beams))?;
+        steps.push((*t, file));
+    }
+    write(&dir.join(format!("{name}.pvd")), &pvd(&steps))
 }
 
 fn write(path: &Path, text: &str) -> Result<(), String> {
@@ -169,23 +239,22 @@ fn cells(x: &mut String, tag: &str, cells: &[Vec<usize>]) {
 
 /// Every body as a polyline through its nodes; point data: frame axes `e1`, `e2`, `e3`,
 /// arclength `s`, `body`.
-fn beams_vtp(s: &Snapshot<'_>) -> String {
-    let n: usize = s.beams.iter().map(|b| b.positions.len()).sum();
+fn beams_vtp(beams: &[BeamGeometry]) -> String {
+    let n: usize = beams.iter().map(|b| b.positions.len()).sum();
     let mut x = String::new();
-    header(&mut x, n, s.beams.len(), 0);
+    header(&mut x, n, beams.len(), 0);
     x.push_str("<PointData Vectors=\"e1\" Scalars=\"s\">\n");
     for (c, name) in ["e1", "e2", "e3"].iter().enumerate() {
-        let v = s.beams.iter().flat_map(|b| &b.frames).flat_map(|r| (0..3).map(move |i| r[(i, c)]));
+        let v = beams.iter().flat_map(|b| &b.frames).flat_map(|r| (0..3).map(move |i| r[(i, c)]));
         array_f64(&mut x, Some(name), 3, v);
     }
-    array_f64(&mut x, Some("s"), 1, s.beams.iter().flat_map(|b| b.arc.iter().copied()));
-    array_i64(&mut x, "body", s.beams.iter().enumerate().flat_map(|(k, b)| std::iter::repeat_n(k, b.positions.len())));
+    array_f64(&mut x, Some("s"), 1, beams.iter().flat_map(|b| b.arc.iter().copied()));
+    array_i64(&mut x, "body", beams.iter().enumerate().flat_map(|(k, b)| std::iter::repeat_n(k, b.positions.len())));
     x.push_str("</PointData>\n<Points>\n");
-    array_f64(&mut x, None, 3, s.beams.iter().flat_map(|b| &b.positions).flat_map(|p| p.iter().copied()));
+    array_f64(&mut x, None, 3, beams.iter().flat_map(|b| &b.positions).flat_map(|p| p.iter().copied()));
     x.push_str("</Points>\n");
     let mut start = 0;
-    let lines: Vec<Vec<usize>> = s
-        .beams
+    let lines: Vec<Vec<usize>> = beams
         .iter()
         .map(|b| {
             let l = (start..start + b.positions.len()).collect();
@@ -198,12 +267,47 @@ fn beams_vtp(s: &Snapshot<'_>) -> String {
     x
 }
 
-/// Quads with cell data `gamma`.
-fn quads_vtp(points: &[[f64; 3]], quads: &[Vec<usize>], gamma: &[f64]) -> String {
+/// Each body's sections as a ribbon: at every node a leading-edge point `le` ahead of the axis
+/// along the section's y axis and a trailing-edge point `chord − le` behind it (points 2i and
+/// 2i + 1 of a body's strip), one quad between neighbouring nodes; point data `s` and `body`.
+fn ribbon_vtp(beams: &[BeamGeometry], chord: f64, le: f64) -> String {
+    let n: usize = beams.iter().map(|b| b.positions.len()).sum();
+    let mut points = Vec::with_capacity(2 * n);
+    let mut quads = Vec::new();
+    for b in beams {
+        let base = points.len();
+        for (p, r) in b.positions.iter().zip(&b.frames) {
+            let y = r.column(1);
+            points.push(p + y * le);
+            points.push(p + y * (le - chord));
+        }
+        for i in 1..b.positions.len() {
+            let (a, c) = (base + 2 * (i - 1), base + 2 * i);
+            quads.push(vec![a, c, c + 1, a + 1]);
+        }
+    }
+    let mut x = String::new();
+    header(&mut x, points.len(), 0, quads.len());
+    x.push_str("<PointData Scalars=\"s\">\n");
+    array_f64(&mut x, Some("s"), 1, beams.iter().flat_map(|b| b.arc.iter().flat_map(|&s| [s, s])));
+    array_i64(&mut x, "body", beams.iter().enumerate().flat_map(|(k, b)| std::iter::repeat_n(k, 2 * b.positions.len())));
+    x.push_str("</PointData>\n<Points>\n");
+    array_f64(&mut x, None, 3, points.iter().flat_map(|p| p.iter().copied()));
+    x.push_str("</Points>\n");
+    cells(&mut x, "Polys", &quads);
+    x.push_str(FOOTER);
+    x
+}
+
+/// Quads with cell data `gamma` (and `delta_p` when given).
+fn quads_vtp(points: &[[f64; 3]], quads: &[Vec<usize>], gamma: &[f64], delta_p: Option<&[f64]>) -> String {
     let mut x = String::new();
     header(&mut x, points.len(), 0, quads.len());
     x.push_str("<CellData Scalars=\"gamma\">\n");
     array_f64(&mut x, Some("gamma"), 1, gamma.iter().copied());
+    if let Some(dp) = delta_p {
+        array_f64(&mut x, Some("delta_p"), 1, dp.iter().copied());
+    }
     x.push_str("</CellData>\n<Points>\n");
     array_f64(&mut x, None, 3, points.iter().flatten().copied());
     x.push_str("</Points>\n");
@@ -212,7 +316,8 @@ fn quads_vtp(points: &[[f64; 3]], quads: &[Vec<usize>], gamma: &[f64]) -> String
     x
 }
 
-/// The bound vortex rings (corners: the ring nodes), circulation `gamma`.
+/// The bound vortex rings (corners: the ring nodes), circulation `gamma` and pressure jump
+/// `delta_p`.
 fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
     let l = uv.lattice();
     let (m, n) = (l.n_chordwise(), l.n_spanwise());
@@ -224,7 +329,46 @@ fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
             gamma.push(uv.gamma()[l.ring_index(i, j)]);
         }
     }
-    quads_vtp(l.ring_nodes(), &quads, &gamma)
+    let dp = pressure_jump(uv);
+    quads_vtp(l.ring_nodes(), &quads, &gamma, Some(&dp))
+}
+
+/// Pressure jump across each bound ring, Pa (positive: the ring's normal side is pushed):
+/// `Δp = F · n / A`, with the ring's force `F` taken as an equal share of the loads on its four
+/// corner nodes among the rings meeting there (the nodal loads of the last solve, steady and
+/// unsteady parts). The shares sum to the nodal loads, so `Σ Δp A n` is the total normal force;
+/// it is a smoothed panel pressure, not a separate solve. Zero before the first solve.
+pub fn pressure_jump(uv: &uvlm::Uvlm) -> Vec<f64> {
+    let l = uv.lattice();
+    let (m, n) = (l.n_chordwise(), l.n_spanwise());
+    let nodal = &uv.loads().nodal;
+    let mut dp = vec![0.0; m * n];
+    if nodal.len() != l.n_nodes() {
+        return dp;
+    }
+    let mut sharing = vec![0usize; l.n_nodes()];
+    for i in 0..m {
+        for j in 0..n {
+            for c in l.ring_corners(i, j) {
+                sharing[c] += 1;
+            }
+        }
+    }
+    for i in 0..m {
+        for j in 0..n {
+            let r = l.ring_index(i, j);
+            let mut f = [0.0; 3];
+            for c in l.ring_corners(i, j) {
+                for (k, fk) in f.iter_mut().enumerate() {
+                    *fk += nodal[c][k] / sharing[c] as f64;
+                }
+            }
+            let nr = l.normals()[r];
+            let a = l.areas()[r];
+            dp[i * n + j] = if a > 0.0 { (f[0] * nr[0] + f[1] * nr[1] + f[2] * nr[2]) / a } else { 0.0 };
+        }
+    }
+    dp
 }
 
 /// The wake rings: node row 0 is the lattice's trailing-edge ring row, node row r + 1 the wake's
@@ -247,5 +391,5 @@ fn wake_vtp(uv: &uvlm::Uvlm) -> String {
             gamma.push(w.gamma(r, j));
         }
     }
-    quads_vtp(&points, &quads, &gamma)
+    quads_vtp(&points, &quads, &gamma, None)
 }
