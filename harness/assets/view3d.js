@@ -49,15 +49,17 @@
     this.radius = Math.max(Math.sqrt(diag) / 2, 1e-3);
     this.hasAero = this.runs.some(function (r) { return r.d.frames[0].le.length > 0; });
     this.reset();
-    this.t = this.t0;
+    // Open on the last frame: the deformed structure and its whole wake; Play starts from t0.
+    this.t = this.t1;
     this.playing = false;
     this.show = { ancf: true, gebf: true };
     this.bind();
+    this.slider.value = "1000";
     this.draw();
   }
 
   View.prototype.reset = function () {
-    this.yaw = -0.6; this.pitch = 0.45; this.zoom = 1;
+    this.yaw = -0.5; this.pitch = 0.6; this.zoom = 1;
   };
 
   View.prototype.bind = function () {

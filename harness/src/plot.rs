@@ -236,13 +236,36 @@ fn sci(v: f64) -> String {
     format!("{v:.0e}")
 }
 
-fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), String>
+/// Width of the legend strip for the longest label of `panels` (the same for every panel of a
+/// file, so that their x axes line up).
+fn legend_width(panels: &[Panel]) -> i32 {
+    let longest = panels.iter().flat_map(|p| &p.series).map(|s| s.label.chars().count()).max().unwrap_or(0);
+    if longest == 0 { 0 } else { (longest as i32 * 7 + 52).clamp(90, 330) }
+}
+
+/// Tick labels of a linear axis spanning `lo..hi`: enough decimals to tell neighbouring ticks
+/// apart, scientific notation for values that are all tiny or huge.
+fn tick_format(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let big = lo.abs().max(hi.abs());
+    let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
+    let sci = big < 1e-3 || big >= 1e6;
+    let decimals = ((-(span / 8.0).log10()).ceil().max(0.0) as usize).min(8);
+    move |v: &f64| {
+        if *v == 0.0 {
+            "0".to_string()
+        } else if sci {
+            format!("{v:.1e}")
+        } else {
+            format!("{v:.decimals$}")
+        }
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel, legend_w: i32) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
-    // The legend gets its own strip right of the plot, sized to the longest label.
-    let longest = p.series.iter().map(|s| s.label.chars().count()).max().unwrap_or(0);
-    let legend_w = if p.series.is_empty() { 0 } else { (longest as i32 * 8 + 52).clamp(90, 330) };
+    // The legend gets its own strip right of the plot.
     let (w, _) = area.dim_in_pixel();
     let (plot, legend) = area.split_horizontally((w as i32 - legend_w).max(200));
     let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
@@ -259,6 +282,8 @@ where
                 .x_desc(&p.x_label)
                 .y_desc(&p.y_label)
                 .label_style(label_style)
+                .x_label_formatter(&tick_format(x0, x1))
+                .y_label_formatter(&tick_format(lo, hi))
                 .draw()
                 .map_err(|e| e.to_string())?;
             draw_series!(c, p, |q: (f64, f64)| (q.0.is_finite() && q.1.is_finite()).then_some(q));
@@ -271,6 +296,7 @@ where
                 .x_desc(&p.x_label)
                 .y_desc(&p.y_label)
                 .label_style(label_style)
+                .x_label_formatter(&tick_format(x0, x1))
                 .y_label_formatter(&|v| sci(*v))
                 .draw()
                 .map_err(|e| e.to_string())?;
@@ -303,6 +329,7 @@ where
                     .y_desc(&p.y_label)
                     .label_style(label_style)
                     .x_label_formatter(&|v| sci(*v))
+                    .y_label_formatter(&tick_format(lo, hi))
                     .draw()
                     .map_err(|e| e.to_string())?;
                 draw_series!(c, p, |q: (f64, f64)| (q.0 > 0.0 && q.0.is_finite() && q.1.is_finite()).then_some(q));
@@ -356,8 +383,9 @@ pub fn panels_svg(path: &Path, panels: &[Panel], cols: usize, panel_size: (u32, 
     let root = SVGBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
     let areas = root.split_evenly((rows, cols));
+    let legend_w = legend_width(panels);
     for (p, a) in panels.iter().zip(areas.iter()) {
-        draw_panel(a, p).map_err(&err)?;
+        draw_panel(a, p, legend_w).map_err(&err)?;
     }
     root.present().map_err(|e| err(e.to_string()))?;
     Ok(())
@@ -403,5 +431,16 @@ mod tests {
         assert!((12..=14).contains(&long.len()), "{}", long.len());
         // Another series' markers sit elsewhere.
         assert_ne!(marker_indices(2000, 1).next(), Some(0));
+    }
+
+    #[test]
+    fn tick_labels_tell_neighbours_apart() {
+        let f = tick_format(-4e-5, 1e-5);
+        assert_eq!(f(&-3e-5), "-3.0e-5");
+        let g = tick_format(-200.0, 60.0);
+        assert_eq!(g(&-150.0), "-150");
+        let h = tick_format(0.0, 2.0);
+        assert_eq!(h(&0.4), "0.4");
+        assert_eq!(h(&0.0), "0");
     }
 }

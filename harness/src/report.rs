@@ -875,7 +875,7 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
 
 const STYLE: &str = "body{font-family:sans-serif;margin:0;color:#111}\
 nav{position:fixed;top:0;left:0;bottom:0;width:250px;overflow-y:auto;background:#f4f4f4;border-right:1px solid #ccc;padding:10px 12px;font-size:13px;box-sizing:border-box}\
-nav h2{font-size:14px;margin:12px 0 4px}nav ul{list-style:none;margin:0;padding:0}nav li{margin:2px 0}\
+nav h2{font-size:14px;margin:12px 0 4px}nav ul{list-style:none;margin:0;padding:0}nav li{margin:2px 0;overflow-wrap:anywhere}\
 nav a{text-decoration:none;color:#124}nav a:hover{text-decoration:underline}\
 main{margin-left:270px;padding:10px 24px;max-width:1150px}\
 section{border-top:2px solid #ddd;padding-top:6px;margin-top:18px}\
