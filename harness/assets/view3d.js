@@ -1,4 +1,4 @@
-// The 3-D views of reports/index.html: each <div class="view3d"> holds a canvas, its controls and
+// The 3-D views of reports/index.html: each div.view3d holds a canvas, its controls and
 // the decimated geometry of both formulations (harness/src/view3d.rs) as JSON. Canvas 2-D with a
 // perspective camera orbiting the model: drag to rotate, wheel to zoom, play/pause and a time
 // slider. No network, no library: works from file://.
@@ -136,7 +136,7 @@
     var depth = cp * yr + sp * pz, up = -sp * yr + cp * pz;
     var dist = 3.2 * this.radius;
     var w = this.canvas.width, h = this.canvas.height;
-    var f = this.zoom * 0.9 * Math.min(w, h) / (2 * this.radius) * dist / Math.max(dist - depth, 0.05 * dist);
+    var f = this.zoom * 1.1 * Math.min(w, h) / (2 * this.radius) * dist / Math.max(dist - depth, 0.05 * dist);
     return [w / 2 + f * xr, h / 2 - f * up, depth];
   };
 

@@ -9,3 +9,6 @@ mod observer;
 mod properties;
 mod statics;
 mod vtk;
+mod browser;
+mod external;
+mod vtk_parse;
