@@ -393,3 +393,62 @@ fn wake_vtp(uv: &uvlm::Uvlm) -> String {
     }
     quads_vtp(&points, &quads, &gamma, None)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix3, Vector3};
+
+    #[test]
+    fn beam_series_lists_every_frame_with_its_time() {
+        let dir = std::env::temp_dir().join(format!("harness-vtk-series-{}", std::process::id()));
+        let body = |phase: f64| {
+            let mut g = BeamGeometry::default();
+            for i in 0..3 {
+                let s = 0.5 * i as f64;
+                g.push(s, Vector3::new(s, 0.0, 0.1 * phase.sin() * s), Matrix3::identity());
+            }
+            g
+        };
+        let frames: Vec<(f64, Vec<BeamGeometry>)> =
+            (0..4).map(|k| (k as f64 * 0.25, vec![body(k as f64), body(k as f64 + 1.0)])).collect();
+        write_beam_series(&dir, "mode1", &frames).unwrap();
+        let pvd = std::fs::read_to_string(dir.join("mode1.pvd")).unwrap();
+        assert_eq!(pvd.matches("<DataSet ").count(), 4);
+        assert!(pvd.contains("timestep=\"7.5e-1\"") && pvd.contains("file=\"mode1_000003.vtp\""));
+        let x = std::fs::read_to_string(dir.join("mode1_000002.vtp")).unwrap();
+        assert!(x.contains("NumberOfPoints=\"6\"") && x.contains("NumberOfLines=\"2\""));
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn case_field_and_flag_choose_the_writer() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../cases/wing_aoa5.json")).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let out = Path::new("/nonexistent");
+        let spec = |v: &serde_json::Value| {
+            let dir = std::env::temp_dir().join(format!("harness-vtk-field-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let p = dir.join("w.json");
+            std::fs::write(&p, serde_json::to_string(v).unwrap()).unwrap();
+            let s = crate::case::CaseFile::read(&p).and_then(|c| c.expand(&[])).map(|mut r| r.remove(0));
+            std::fs::remove_dir_all(dir).ok();
+            s
+        };
+        let s = spec(&v).unwrap();
+        assert!(writer_for(out, &s, Formulation::Gebf, None).is_none());
+        let w = writer_for(out, &s, Formulation::Gebf, Some(None)).unwrap();
+        // 20 s at output_dt 0.01: 2001 rows, about 100 frames.
+        assert_eq!(w.stride, 20);
+        assert!(w.chord == Some((1.0, 0.5)));
+        v["vtk"] = serde_json::json!({ "stride": 7 });
+        let s = spec(&v).unwrap();
+        assert_eq!(writer_for(out, &s, Formulation::Ancf, None).unwrap().stride, 7);
+        assert_eq!(writer_for(out, &s, Formulation::Ancf, Some(Some(3))).unwrap().stride, 3);
+        v["vtk"] = serde_json::json!({ "stride": 0 });
+        let e = spec(&v).unwrap_err().to_string();
+        assert!(e.contains("vtk.stride"), "{e}");
+        v["vtk"] = serde_json::json!({ "every": 2 });
+        assert!(spec(&v).is_err());
+    }
+}

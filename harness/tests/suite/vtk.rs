@@ -136,6 +136,20 @@ fn vtk_wing_writes_lattice_and_wake() {
     let beams = check_family(&dir, "beams");
     let lattice = check_family(&dir, "lattice");
     let wake = check_family(&dir, "wake");
+    let ribbon = check_family(&dir, "ribbon");
+    assert_eq!(ribbon.len(), beams.len());
+    // The chord ribbon: two points per beam node, `chord` apart (1 m), one quad per node interval.
+    for (_, file) in &ribbon {
+        let x = read(&dir.join(file));
+        let p = array(&x, "<Points>");
+        let n = attr(&x, "NumberOfPoints");
+        assert_eq!(n, 2 * 18);
+        assert_eq!(attr(&x, "NumberOfPolys"), 16);
+        for k in 0..n / 2 {
+            let d: f64 = (0..3).map(|i| (p[6 * k + i] - p[6 * k + 3 + i]).powi(2)).sum::<f64>().sqrt();
+            assert!((d - 1.0).abs() < 1e-12, "chord {d}");
+        }
+    }
     // The default stride: max(1, 4 output rows / 100) = 1, every row.
     assert_eq!(beams.len(), 4);
     assert_eq!(beams.len(), lattice.len());
@@ -146,6 +160,9 @@ fn vtk_wing_writes_lattice_and_wake() {
         let n_polys = attr(&x, "NumberOfPolys");
         assert!(n_polys > 0);
         assert_eq!(array(&x, "Name=\"gamma\"").len(), n_polys);
+        let dp = array(&x, "Name=\"delta_p\"");
+        assert_eq!(dp.len(), n_polys);
+        assert!(dp.iter().all(|v| v.is_finite()));
         assert_eq!(array(&x, "<Points>").len(), 3 * attr(&x, "NumberOfPoints"));
         assert_eq!(array(&x, "Name=\"connectivity\"").len(), 4 * n_polys);
     }
