@@ -327,9 +327,8 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
 
 /// Write `converge.csv`, `converge.json`, `work_precision.svg` and `convergence.svg` into `dir`.
 pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
-    let mut csv = String::from(
-        "formulation,ladder,elements_per_body,dt,is_truth,cpu_s,wall_s,n_steps,error_m,against,failure\n",
-    );
+    let mut csv =
+        String::from("formulation,ladder,elements_per_body,dt,is_truth,cpu_s,wall_s,n_steps,error_m,against,failure\n");
     for g in &r.rungs {
         let _ = writeln!(
             csv,

@@ -419,12 +419,13 @@ fn real_main() -> Result<ExitCode> {
             };
             // VTK when --vtk asks for it or the case's `vtk` block does.
             let cli = vtk.then_some(vtk_stride);
-            let results = harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| {
-                match harness::vtk::writer_for(&out, spec, f, cli) {
+            let results =
+                harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| match harness::vtk::writer_for(
+                    &out, spec, f, cli,
+                ) {
                     Some(w) => Box::new(w),
                     None => Box::new(harness::run::NoObserver),
-                }
-            });
+                });
             let mut failed = false;
             for r in &results {
                 let dir = out.join(&r.name);

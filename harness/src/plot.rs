@@ -215,12 +215,10 @@ macro_rules! draw_series {
                     $c.draw_series(LineSeries::new(pts.iter().copied(), st)).map_err(|e| e.to_string())?;
                 }
                 Dash::Dashed => {
-                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 10, 6, st))
-                        .map_err(|e| e.to_string())?;
+                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 10, 6, st)).map_err(|e| e.to_string())?;
                 }
                 Dash::Dotted => {
-                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 2, 5, st))
-                        .map_err(|e| e.to_string())?;
+                    $c.draw_series(DashedLineSeries::new(pts.iter().copied(), 2, 5, st)).map_err(|e| e.to_string())?;
                 }
                 Dash::None => {}
             }
@@ -248,7 +246,7 @@ fn legend_width(panels: &[Panel]) -> i32 {
 fn tick_format(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let big = lo.abs().max(hi.abs());
     let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
-    let sci = big < 1e-3 || big >= 1e6;
+    let sci = !(1e-3..1e6).contains(&big);
     let decimals = ((-(span / 8.0).log10()).ceil().max(0.0) as usize).min(8);
     move |v: &f64| {
         if *v == 0.0 {
@@ -275,7 +273,8 @@ where
     let label_style = ("sans-serif", 14);
     match (p.log_x, p.log_y) {
         (false, false) => {
-            let (x0, x1) = finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
+            let (x0, x1) =
+                finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
             let (lo, hi) = finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0));
             let mut c = chart.build_cartesian_2d(x0..x1, lo..hi).map_err(|e| e.to_string())?;
             c.configure_mesh()
@@ -289,7 +288,8 @@ where
             draw_series!(c, p, |q: (f64, f64)| (q.0.is_finite() && q.1.is_finite()).then_some(q));
         }
         (false, true) => {
-            let (x0, x1) = finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
+            let (x0, x1) =
+                finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
             let (lo, hi) = log_range(ys);
             let mut c = chart.build_cartesian_2d(x0..x1, (lo..hi).log_scale()).map_err(|e| e.to_string())?;
             c.configure_mesh()
@@ -304,11 +304,8 @@ where
         }
         (true, ly) => {
             let (x0, x1) = log_range(xs);
-            let (lo, hi) = if ly {
-                log_range(ys)
-            } else {
-                finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0))
-            };
+            let (lo, hi) =
+                if ly { log_range(ys) } else { finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0)) };
             if ly {
                 let mut c =
                     chart.build_cartesian_2d((x0..x1).log_scale(), (lo..hi).log_scale()).map_err(|e| e.to_string())?;

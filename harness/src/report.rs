@@ -12,8 +12,8 @@ use crate::csv::{Curve, read_curve, to_csv, write_file};
 use crate::gate::{self, GateOutcome};
 use crate::metrics::{FormulationMetrics, PairMetrics, ReferenceMetrics, tip_curve, tip_difference, window_stats};
 use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
-use plotters::style::RGBColor;
 use crate::run::RunOutput;
+use plotters::style::RGBColor;
 
 /// Everything known about one run of a case.
 #[derive(Debug, Clone)]
@@ -159,9 +159,9 @@ fn run_style(f: Formulation) -> Style {
 fn ref_style(i: usize) -> Style {
     const MARKERS: [Marker; 4] = [Marker::Square, Marker::Triangle, Marker::Diamond, Marker::Cross];
     Style::solid(colors::REFS[i % colors::REFS.len()])
-        .dash(if i % 2 == 0 { Dash::Dotted } else { Dash::Solid })
+        .dash(if i.is_multiple_of(2) { Dash::Dotted } else { Dash::Solid })
         .marker(MARKERS[i % MARKERS.len()])
-        .width(if i % 2 == 0 { 3 } else { 1 })
+        .width(if i.is_multiple_of(2) { 3 } else { 1 })
 }
 
 /// Words for a style in a caption.
@@ -280,7 +280,9 @@ pub fn plots(r: &CaseResult) -> Vec<PlotFile> {
     if has_fold(r) {
         v.push(PlotFile {
             file: "fold.svg",
-            caption: format!("Fold angle of the flared hinge against time, unwrapped (continuous through ±180°): {forms}."),
+            caption: format!(
+                "Fold angle of the flared hinge against time, unwrapped (continuous through ±180°): {forms}."
+            ),
         });
     }
     let mut terms = vec!["kinetic", "elastic", "potential"];
@@ -299,7 +301,9 @@ pub fn plots(r: &CaseResult) -> Vec<PlotFile> {
     });
     v.push(PlotFile {
         file: "constraint.svg",
-        caption: format!("Position-level joint violation (gaps in m and axis misalignment in rad, log scale): {forms}."),
+        caption: format!(
+            "Position-level joint violation (gaps in m and axis misalignment in rad, log scale): {forms}."
+        ),
     });
     v
 }
@@ -328,7 +332,11 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 })
                 .collect();
             series.extend(r.runs.iter().rev().map(|run| {
-                Series::new(label(run.formulation), run_style(run.formulation), run.rows.iter().map(|x| (x.t, x.tip[k])).collect())
+                Series::new(
+                    label(run.formulation),
+                    run_style(run.formulation),
+                    run.rows.iter().map(|x| (x.t, x.tip[k])).collect(),
+                )
             }));
             Panel {
                 title: format!("{} — tip {}", r.name, axis[k]),
@@ -433,7 +441,11 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     )?;
 
     let per_run = |get: &dyn Fn(&RunOutput) -> Vec<(f64, f64)>| -> Vec<Series> {
-        r.runs.iter().rev().map(|run| Series::new(label(run.formulation), run_style(run.formulation), get(run))).collect()
+        r.runs
+            .iter()
+            .rev()
+            .map(|run| Series::new(label(run.formulation), run_style(run.formulation), get(run)))
+            .collect()
     };
     panels_svg(
         &dir.join("constraint.svg"),
@@ -686,7 +698,12 @@ pub struct Section {
 }
 
 fn figure(src: &str, caption: &str) -> String {
-    format!("<figure><img src=\"{}\" alt=\"{}\" loading=\"lazy\"><figcaption>{}</figcaption></figure>\n", esc(src), esc(caption), esc(caption))
+    format!(
+        "<figure><img src=\"{}\" alt=\"{}\" loading=\"lazy\"><figcaption>{}</figcaption></figure>\n",
+        esc(src),
+        esc(caption),
+        esc(caption)
+    )
 }
 
 /// The section of one case: its table, data links, 3-D view (when `<out>/<case>/view_*.json`
@@ -824,7 +841,11 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
         if let Some(t) = csv_table(&d.join("converge.csv")) {
             s.push_str(&t);
         }
-        let _ = writeln!(s, "<p>Data: <a href=\"converge/{0}/converge.csv\">converge.csv</a>, <a href=\"converge/{0}/converge.json\">converge.json</a></p>", esc(n));
+        let _ = writeln!(
+            s,
+            "<p>Data: <a href=\"converge/{0}/converge.csv\">converge.csv</a>, <a href=\"converge/{0}/converge.json\">converge.json</a></p>",
+            esc(n)
+        );
         s.push_str(&figure(
             &format!("converge/{n}/work_precision.svg"),
             "Work-precision, log–log: largest tip error against CPU time, one marker per rung; peer codes as single points where measured.",
@@ -842,33 +863,63 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
         });
     }
     if out.join("energy/energy.svg").exists() {
-        let mut s = String::from("<p>No aerodynamics and no numerical dissipation (ρ<sub>∞</sub> = 1): the exact energy (with the dampers' work for the sprung case) is constant, so its change divided by the peak kinetic energy is the scheme's error. Each formulation in the Arnold–Brüls form (forces at the end of the step: the trapezoidal rule) and in the Chung–Hulbert form (forces at the α-weighted state: the implicit midpoint rule), every step recorded, at the case's dt and at dt/2.</p>\n");
+        let mut s = String::from(
+            "<p>No aerodynamics and no numerical dissipation (ρ<sub>∞</sub> = 1): the exact energy (with the dampers' work for the sprung case) is constant, so its change divided by the peak kinetic energy is the scheme's error. Each formulation in the Arnold–Brüls form (forces at the end of the step: the trapezoidal rule) and in the Chung–Hulbert form (forces at the α-weighted state: the implicit midpoint rule), every step recorded, at the case's dt and at dt/2.</p>\n",
+        );
         if let Some(t) = markdown_tables(&out.join("energy/energy.md")) {
             s.push_str(&t);
         }
-        s.push_str("<p>Data: <a href=\"energy/energy.md\">energy.md</a>, <a href=\"energy/energy.csv\">energy.csv</a></p>\n");
-        s.push_str(&figure("energy/energy.svg", "Energy error against time, per case, formulation and integrator form."));
-        v.push(Section { id: "energy".into(), title: "Energy at ρ∞ = 1".into(), group: Group::Study, html: s, badge: None });
+        s.push_str(
+            "<p>Data: <a href=\"energy/energy.md\">energy.md</a>, <a href=\"energy/energy.csv\">energy.csv</a></p>\n",
+        );
+        s.push_str(&figure(
+            "energy/energy.svg",
+            "Energy error against time, per case, formulation and integrator form.",
+        ));
+        v.push(Section {
+            id: "energy".into(),
+            title: "Energy at ρ∞ = 1".into(),
+            group: Group::Study,
+            html: s,
+            badge: None,
+        });
     }
     if out.join("bench/bench.svg").exists() {
-        let mut s = String::from("<p>Median thread CPU time of repeated serial runs at each case's own settings (ANCF on both solve paths), with the Newton work per step. The horizontal lines in the figure are the targets for the paper's pendulums.</p>\n");
+        let mut s = String::from(
+            "<p>Median thread CPU time of repeated serial runs at each case's own settings (ANCF on both solve paths), with the Newton work per step. The horizontal lines in the figure are the targets for the paper's pendulums.</p>\n",
+        );
         if let Some(t) = markdown_tables(&out.join("bench/bench.md")) {
             s.push_str(&t);
         }
-        s.push_str("<p>Data: <a href=\"bench/bench.md\">bench.md</a>, <a href=\"bench/bench.json\">bench.json</a></p>\n");
+        s.push_str(
+            "<p>Data: <a href=\"bench/bench.md\">bench.md</a>, <a href=\"bench/bench.json\">bench.json</a></p>\n",
+        );
         s.push_str(&figure("bench/bench.svg", "CPU time per run, per case and formulation."));
         v.push(Section { id: "bench".into(), title: "Speed".into(), group: Group::Study, html: s, badge: None });
     }
     if out.join("stress/stress_ancf.svg").exists() {
-        let mut s = String::from("<p>The base pendulum over stiffness scale c × flare β × step factor × ρ<sub>∞</sub>, 2 s per cell, both formulations; a cell that fails at fixed steps is rerun with step control. Then two extra hard runs (a 20 s pendulum and the wing at AoA 15°).</p>\n");
+        let mut s = String::from(
+            "<p>The base pendulum over stiffness scale c × flare β × step factor × ρ<sub>∞</sub>, 2 s per cell, both formulations; a cell that fails at fixed steps is rerun with step control. Then two extra hard runs (a 20 s pendulum and the wing at AoA 15°).</p>\n",
+        );
         if let Some(t) = csv_table(&out.join("stress/extras.csv")) {
             s.push_str(&t);
         }
-        s.push_str("<p>Data: <a href=\"stress/stress.csv\">stress.csv</a>, <a href=\"stress/extras.csv\">extras.csv</a></p>\n");
+        s.push_str(
+            "<p>Data: <a href=\"stress/stress.csv\">stress.csv</a>, <a href=\"stress/extras.csv\">extras.csv</a></p>\n",
+        );
         for f in Formulation::ALL {
-            s.push_str(&figure(&format!("stress/stress_{f}.svg"), &format!("Stress matrix, {}: outcome of each cell.", label(f))));
+            s.push_str(&figure(
+                &format!("stress/stress_{f}.svg"),
+                &format!("Stress matrix, {}: outcome of each cell.", label(f)),
+            ));
         }
-        v.push(Section { id: "stress".into(), title: "Stress matrix".into(), group: Group::Study, html: s, badge: None });
+        v.push(Section {
+            id: "stress".into(),
+            title: "Stress matrix".into(),
+            group: Group::Study,
+            html: s,
+            badge: None,
+        });
     }
     v
 }
@@ -894,7 +945,9 @@ img{max-width:100%;border:1px solid #ddd;margin:4px 0}figure{margin:10px 0}figca
 pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> String {
     let mut sections = Vec::new();
     // The overview: the results table.
-    let mut t = String::from("<p>Every case run with both formulations. Tip difference = |p<sub>ANCF</sub>(t) − p<sub>GEBF</sub>(t)| in millimetres; energy drift = the largest change of the case's energy balance (E, plus the dampers' work where there are dampers, minus the aerodynamic work where there is a flow) divided by the peak kinetic energy; constraint = position-level joint gap [m] and axis misalignment [rad]. Gate: pass, FAIL, or – where the case declares no gate.</p>\n<table><tr>");
+    let mut t = String::from(
+        "<p>Every case run with both formulations. Tip difference = |p<sub>ANCF</sub>(t) − p<sub>GEBF</sub>(t)| in millimetres; energy drift = the largest change of the case's energy balance (E, plus the dampers' work where there are dampers, minus the aerodynamic work where there is a flow) divided by the peak kinetic energy; constraint = position-level joint gap [m] and axis misalignment [rad]. Gate: pass, FAIL, or – where the case declares no gate.</p>\n<table><tr>",
+    );
     for h in TABLE_HEAD {
         let _ = write!(t, "<th>{}</th>", esc(h));
     }
@@ -913,7 +966,13 @@ pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> Stri
         t.push_str("</tr>\n");
     }
     t.push_str("</table>\n<p>The same table in Markdown: <a href=\"summary.md\">summary.md</a>.</p>\n");
-    sections.push(Section { id: "results".into(), title: "Results".into(), group: Group::Overview, html: t, badge: None });
+    sections.push(Section {
+        id: "results".into(),
+        title: "Results".into(),
+        group: Group::Overview,
+        html: t,
+        badge: None,
+    });
     sections.extend(results.iter().map(|r| case_section(out, r)));
     sections.extend(study_sections(out));
     sections.extend(extra.iter().cloned());
@@ -942,11 +1001,8 @@ pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> Stri
     }
     s.push_str("</nav>\n<main>\n<h1>Flared-hinge verification harness: ANCF vs GEBF</h1>\n<div id=\"js-errors\" hidden></div>\n");
     for x in &sections {
-        let badge = x
-            .badge
-            .as_ref()
-            .map(|(b, c)| format!(" <span class=\"{c}\">[{}]</span>", esc(b)))
-            .unwrap_or_default();
+        let badge =
+            x.badge.as_ref().map(|(b, c)| format!(" <span class=\"{c}\">[{}]</span>", esc(b))).unwrap_or_default();
         let _ = write!(s, "<section id=\"{}\"><h2>{}{badge}</h2>\n{}</section>\n", esc(&x.id), esc(&x.title), x.html);
     }
     s.push_str("</main>\n");

@@ -138,10 +138,7 @@ pub fn writer_for(out: &Path, spec: &RunSpec, f: Formulation, cli: Option<Option
     if cli.is_none() && case.vtk.is_none() {
         return None;
     }
-    let stride = cli
-        .flatten()
-        .or(case.vtk.and_then(|v| v.stride))
-        .unwrap_or_else(|| default_stride(case, f));
+    let stride = cli.flatten().or(case.vtk.and_then(|v| v.stride)).unwrap_or_else(|| default_stride(case, f));
     let w = VtkWriter::for_run(out, &spec.name, f, stride);
     Some(match &case.aero {
         Some(a) => w.with_chord(a.chord, a.le_offset),
@@ -290,7 +287,11 @@ fn ribbon_vtp(beams: &[BeamGeometry], chord: f64, le: f64) -> String {
     header(&mut x, points.len(), 0, quads.len());
     x.push_str("<PointData Scalars=\"s\">\n");
     array_f64(&mut x, Some("s"), 1, beams.iter().flat_map(|b| b.arc.iter().flat_map(|&s| [s, s])));
-    array_i64(&mut x, "body", beams.iter().enumerate().flat_map(|(k, b)| std::iter::repeat_n(k, 2 * b.positions.len())));
+    array_i64(
+        &mut x,
+        "body",
+        beams.iter().enumerate().flat_map(|(k, b)| std::iter::repeat_n(k, 2 * b.positions.len())),
+    );
     x.push_str("</PointData>\n<Points>\n");
     array_f64(&mut x, None, 3, points.iter().flat_map(|p| p.iter().copied()));
     x.push_str("</Points>\n");

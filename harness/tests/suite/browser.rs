@@ -117,11 +117,8 @@ fn report_loads_and_draws_in_headless_chromium() {
     assert!(!html_tag.contains("data-js-errors"), "the page caught errors: {}", &dom[..dom.len().min(3000)]);
     assert!(dom.contains("<div id=\"js-errors\" hidden=\"\"></div>"), "the page caught errors");
     assert!(html_tag.contains(&format!("data-views-drawn=\"{n_views}\"")), "not every view drew: <html{html_tag}>");
-    let inked: Vec<usize> = dom
-        .split("data-inked=\"")
-        .skip(1)
-        .map(|s| s.split('"').next().unwrap().parse().unwrap())
-        .collect();
+    let inked: Vec<usize> =
+        dom.split("data-inked=\"").skip(1).map(|s| s.split('"').next().unwrap().parse().unwrap()).collect();
     assert_eq!(inked.len(), n_views);
     // A 880 × 440 canvas: the structure, wake and labels cover well over 500 pixels.
     assert!(inked.iter().all(|&n| n > 500), "inked pixels per view: {inked:?}");
@@ -129,10 +126,16 @@ fn report_loads_and_draws_in_headless_chromium() {
     // A screenshot shows the drawing: the first view (the pendulum's) lies within 1800 px.
     let shot = |name: &str, url: &str| -> PathBuf {
         let p = dir.join(name);
-        let args = vec!["--window-size=1400,1800".to_string(), format!("--screenshot={}", p.display())];
+        let args = ["--window-size=1400,1800".to_string(), format!("--screenshot={}", p.display())];
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = chrome(&exe, &dir, url, &refs);
-        assert!(o.status.success() && p.is_file(), "{:?} {}: {}", o.status, p.display(), String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success() && p.is_file(),
+            "{:?} {}: {}",
+            o.status,
+            p.display(),
+            String::from_utf8_lossy(&o.stderr)
+        );
         p
     };
     // The reference: the same page without its script (headless Chromium takes no screenshot

@@ -2,13 +2,13 @@
 //! link instead of one per file).
 
 mod aero;
+mod browser;
 mod cli;
+mod external;
 mod gate;
 mod honest;
 mod observer;
 mod properties;
 mod statics;
 mod vtk;
-mod browser;
-mod external;
 mod vtk_parse;
