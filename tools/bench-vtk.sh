@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The cost of writing ParaView files: the paper's wing (cases/wing_aoa5.json, 20 s) run with and
+# without `--vtk` at the default stride, one formulation at a time, alternating, N times each;
+# prints each run's time (model set-up and time loop, as `harness run` reports it, which includes
+# the VTK writes made inside the loop) and the medians. Release build:
+#   cargo build --release -p harness && tools/bench-vtk.sh [N]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+N="${1:-5}"
+OUT="$(mktemp -d)"
+trap 'rm -rf "$OUT"' EXIT
+median() { sort -g | awk '{a[NR]=$1} END {print (NR%2 ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2)}'; }
+for f in ancf gebf; do
+    : >"$OUT/$f-plain" ; : >"$OUT/$f-vtk"
+    for i in $(seq "$N"); do
+        for mode in plain vtk; do
+            flag=(); [ "$mode" = vtk ] && flag=(--vtk)
+            ms=$(./target/release/harness run cases/wing_aoa5.json --formulation "$f" --out "$OUT/r" "${flag[@]}" 2>/dev/null \
+                | sed -n 's/.* steps in \([0-9.]*\) ms.*/\1/p')
+            echo "$f $mode run $i: $ms ms"
+            echo "$ms" >>"$OUT/$f-$mode"
+        done
+    done
+    p=$(median <"$OUT/$f-plain"); v=$(median <"$OUT/$f-vtk")
+    awk -v f="$f" -v p="$p" -v v="$v" 'BEGIN {printf "%s: median %.0f ms without VTK, %.0f ms with (%+.1f %%)\n", f, p, v, 100*(v-p)/p}'
+done
