@@ -43,7 +43,7 @@ fn main() {
         if path == SolvePath::Dae {
             // one element of the first body at the deformed state
             let o = model.options();
-            let el = Element::new(0.1, &bodies[0].section, o.curvature, o.penalty_factor, o.shear_gradient_factor);
+            let el = Element::new(0.1, &bodies[0].section, o.curvature, o.penalty_factor);
             let e = &s.q[12..36];
             let mut f = [0.0; 24];
             time("element force", 20000, || {

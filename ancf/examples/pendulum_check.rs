@@ -49,7 +49,7 @@ fn main() {
         path,
         curvature,
         penalty_factor: env("PEN", 1.0),
-        shear_gradient_factor: env("KAPPA", Options::default().shear_gradient_factor),
+        joint_tie_factor: env("TIE", Options::default().joint_tie_factor),
     };
     let mut model = Model::new(&bodies, &joints, g, options).expect("valid scene");
     let mut params = IntegratorParams::new(rho, dt);

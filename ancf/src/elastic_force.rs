@@ -424,7 +424,7 @@ mod tests {
     /// max |K − K_fd| / max |K_fd| with K_fd the central difference of the force.
     fn tangent_error(curvature: Curvature, seed: &[f64], amp: f64) -> f64 {
         let l = 0.1;
-        let el = Element::new(l, &section(), curvature, 1.0, 100.0);
+        let el = Element::new(l, &section(), curvature, 1.0);
         let e = deformed(l, seed, amp);
         let mut k = ElementMatrix::zeros();
         el.add_elastic_tangent(&e, 1.0, &mut k);
@@ -447,7 +447,7 @@ mod tests {
     /// max |f − ∇U_fd| / max |f|.
     fn force_error(curvature: Curvature, seed: &[f64], amp: f64) -> f64 {
         let l = 0.1;
-        let el = Element::new(l, &section(), curvature, 1.0, 100.0);
+        let el = Element::new(l, &section(), curvature, 1.0);
         let e = deformed(l, seed, amp);
         let mut f = [0.0; 24];
         el.add_elastic_force(&e, &mut f);
@@ -496,7 +496,7 @@ mod tests {
             let rot = Rotation3::from_scaled_axis(axis.normalize() * angle).into_inner();
             let shift = Vector3::new(shift[0], shift[1], shift[2]);
             for c in ALL_CURVATURES {
-                let el = Element::new(l, &section(), c, 1.0, 100.0);
+                let el = Element::new(l, &section(), c, 1.0);
                 let e0 = apply_rigid(&reference_element(l), &rot, &shift);
                 let mut f = [0.0; 24];
                 let u = el.add_elastic_force(&e0, &mut f);
@@ -519,7 +519,7 @@ mod tests {
     fn gram_strains_match_fields_and_translation() {
         let l = 0.2;
         for c in ALL_CURVATURES {
-            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let el = Element::new(l, &section(), c, 1.0);
             let e = deformed(l, &[0.3, -0.7, 0.2, 0.9, -0.4], 0.05);
             let u = el.elastic_energy(&e);
             let by_kind: f64 = el.elastic_energy_by_kind(&e).iter().sum();
@@ -541,7 +541,7 @@ mod tests {
     fn lanes_equal_single_elements() {
         let l = 0.2;
         for c in ALL_CURVATURES {
-            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let el = Element::new(l, &section(), c, 1.0);
             let es: Vec<[f64; 24]> =
                 (0..4).map(|k| deformed(l, &[0.3, -0.7, 0.2 * k as f64, 0.9, -0.4 + 0.1 * k as f64], 0.1)).collect();
             let mut f = [[0.0; 24]; 4];
@@ -561,7 +561,7 @@ mod tests {
     fn dispatched_kernels_equal_baseline_kernels() {
         let l = 0.2;
         for c in ALL_CURVATURES {
-            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let el = Element::new(l, &section(), c, 1.0);
             let es: Vec<[f64; 24]> =
                 (0..4).map(|k| deformed(l, &[0.3, -0.7, 0.2 * k as f64, 0.9, -0.4 + 0.1 * k as f64], 0.1)).collect();
             let e: [&[f64]; 4] = std::array::from_fn(|k| &es[k][..]);
@@ -579,7 +579,7 @@ mod tests {
     fn tangent_is_symmetric() {
         let l = 0.2;
         for c in ALL_CURVATURES {
-            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let el = Element::new(l, &section(), c, 1.0);
             let e = deformed(l, &[0.3, -0.7, 0.2, 0.9, -0.4], 0.2);
             let mut k = ElementMatrix::zeros();
             el.add_elastic_tangent(&e, 1.0, &mut k);
@@ -593,7 +593,7 @@ mod tests {
     fn upper_kernel_fills_only_the_upper_triangle() {
         let l = 0.2;
         for c in ALL_CURVATURES {
-            let el = Element::new(l, &section(), c, 1.0, 100.0);
+            let el = Element::new(l, &section(), c, 1.0);
             let e = deformed(l, &[0.3, -0.7, 0.2, 0.9, -0.4], 0.2);
             let mut full = ElementMatrix::zeros();
             el.add_elastic_tangent(&e, 1.0, &mut full);

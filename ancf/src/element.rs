@@ -31,9 +31,8 @@ pub struct Element {
 
 impl Element {
     /// Build the kernel for elements of length `l`.
-    /// `penalty_factor` scales the section penalties, `kappa` the shear-gradient stabilisation
-    /// (see [`strain`](crate::strain)).
-    pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> Self {
+    /// `penalty_factor` scales the section penalties (see [`strain`](crate::strain)).
+    pub fn new(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64) -> Self {
         let (d_yy, d_zz) = section.slope_inertias();
         let mut mass = element_mass(section.mass, d_yy, d_zz, l);
         if section.cg_offset != [0.0; 2] {
@@ -57,7 +56,7 @@ impl Element {
             mass_nz: nonzeros(&mass),
             mass_matrix,
             mass,
-            plan: strain_plan(l, section, curvature, penalty_factor, kappa),
+            plan: strain_plan(l, section, curvature, penalty_factor),
             mass_per_length: section.mass,
             cg_offset: section.cg_offset,
         }

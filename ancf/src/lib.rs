@@ -53,6 +53,7 @@ pub mod element;
 mod error;
 pub mod frame;
 mod hinge_spring;
+mod node_tie;
 mod joint;
 mod loads;
 pub mod mass;

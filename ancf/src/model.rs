@@ -5,6 +5,7 @@ use crate::elastic_force::{ElementMatrix, mirror_upper_inplace};
 use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
 use crate::hinge_spring::{Hessian, HingeSpring, Kinematics};
+use crate::node_tie::{NodeTie, TieMatrix};
 use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
 use crate::mass::nonzeros;
@@ -117,6 +118,8 @@ pub struct Model {
     damped: bool,
     /// Point masses (docs/ancf.md §12.2), each on its element.
     point_inertia: Vec<PointInertia>,
+    /// Section ties at the joint nodes whose axis equation involves `r_x` (docs/ancf.md §3.5).
+    ties: Vec<NodeTie>,
 }
 
 impl Model {
@@ -147,13 +150,7 @@ impl Model {
                     spec: spec.clone(),
                     offset,
                     n_nodes: spec.n_elements + 1,
-                    element: Element::new(
-                        l,
-                        &spec.section,
-                        options.curvature,
-                        options.penalty_factor,
-                        options.shear_gradient_factor,
-                    ),
+                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor),
                 };
                 offset += NODE_DOF * b.n_nodes;
                 b
@@ -225,6 +222,7 @@ impl Model {
             })
             .collect();
         let damped = springs.iter().any(|s| s.damping != 0.0);
+        let ties = joint_ties(&joint_list, &bodies, options.joint_tie_factor);
 
         let mut element_z = Vec::new();
         let mut element_reduced = Vec::new();
@@ -281,6 +279,7 @@ impl Model {
             springs,
             damped,
             point_inertia,
+            ties,
         })
     }
 
@@ -494,6 +493,7 @@ impl Model {
             p.add_mass_times(1.0, &vf[range.clone()], &mut mv);
             e.kinetic += 0.5 * mv.iter().zip(&vf[range]).map(|(a, b)| a * b).sum::<f64>();
         }
+        e.elastic += self.ties.iter().map(|t| t.energy(qf)).sum::<f64>();
         e.spring = self.springs.iter().map(|s| s.energy(qf)).sum();
         e.potential =
             -self.gravity_force.iter().zip(qf.iter().zip(&self.q_ref)).map(|(g, (q, q0))| g * (q - q0)).sum::<f64>();
@@ -674,13 +674,6 @@ impl Model {
         Ok(())
     }
 
-    /// The constant generalized external force (full coordinates), for tests that load single
-    /// nodal vectors.
-    #[cfg(test)]
-    pub(crate) fn constant_force_mut(&mut self) -> &mut [f64] {
-        &mut self.point_force
-    }
-
     /// Factor on all external loads (gravity and point loads), 1 by default; the static solver
     /// ramps it.
     pub fn set_load_factor(&mut self, factor: f64) {
@@ -735,6 +728,9 @@ impl Model {
             let range = p.first..p.first + ELEMENT_DOF;
             p.add_mass_times(1.0, &v_dot[range.clone()], &mut r[range]);
         }
+        for tie in &self.ties {
+            tie.add_force(q, r);
+        }
         for spring in &self.springs {
             let kin = spring.kinematics(q, false);
             let rate = match v {
@@ -786,10 +782,35 @@ impl Model {
             }
             self.scatter_element(p.first, p.e_index, &mut ke, k);
         }
+        if c_k != 0.0 {
+            for tie in &self.ties {
+                self.scatter_tie(tie.first, &tie.tangent(q, c_k), k);
+            }
+        }
         for spring in &self.springs {
             let kin = spring.kinematics(q, true);
             let t = spring.tangent(&kin, v, c_c, c_k);
             self.scatter_spring(&kin, &t, k);
+        }
+    }
+
+    /// Add a node tie's 9×9 matrix (the node's `r_x`, `r_y`, `r_z` from `first`) through the
+    /// chosen form.
+    fn scatter_tie(&self, first: usize, t: &TieMatrix, k: &mut MatView<'_>) {
+        for b in 0..9 {
+            for a in 0..9 {
+                let x = t[(a, b)];
+                match self.options.path {
+                    SolvePath::Dae => k.add(first + a, first + b, x),
+                    SolvePath::Ode => {
+                        for &(za, ca) in self.reduction.row(first + a) {
+                            for &(zb, cb) in self.reduction.row(first + b) {
+                                k.add(za, zb, ca * cb * x);
+                            }
+                        }
+                    }
+                }
+            }
         }
     }
 
@@ -891,6 +912,14 @@ impl Model {
                 }
             }
             k.add_block(p.first, p.first, &ke);
+        }
+        for tie in &self.ties {
+            let t = tie.tangent(q, c_k);
+            for b in 0..9 {
+                for a in 0..9 {
+                    k.add(tie.first + a, tie.first + b, t[(a, b)]);
+                }
+            }
         }
         for spring in &self.springs {
             let kin = spring.kinematics(q, true);
@@ -1097,4 +1126,42 @@ impl Model {
     pub fn n_force_elements(&self) -> usize {
         self.springs.len()
     }
+}
+
+/// The section ties of the hinges (docs/ancf.md §3.5): at each node a hinge acts on, the
+/// section's metric strains `½(|r_y|²−1), ½(|r_z|²−1), r_y·r_z`, and where the hinge's axis
+/// equation involves `r_x` also `½(|r_x|²−1), r_x·r_y, r_x·r_z`, each with the stiffness
+/// `c_t max(EI_yy, EI_zz, GJ) / l`. Clamps hold their section's slopes exactly and need none.
+fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
+    // whether an axis `Σ α_b r_b` involves r_x (round-off of a rotated frame is not)
+    let on_x = |alpha: &Vector3<f64>| alpha[0].abs() > 1e-9 * alpha.norm();
+    let mut ties: Vec<NodeTie> = Vec::new();
+    if factor == 0.0 {
+        return ties;
+    }
+    let mut tie = |body: usize, node: usize, with_x: bool| {
+        let b = &bodies[body];
+        let first = b.offset + NODE_DOF * node + 3;
+        let (s, l) = (&b.spec.section, b.element.l);
+        let k = factor * s.ei_yy.max(s.ei_zz).max(s.gj) / l;
+        // order of NodeTie::k: xx, yy, zz, xy, xz, yz
+        let x = if with_x { k } else { 0.0 };
+        let new = [x, k, k, x, x, k];
+        match ties.iter_mut().find(|t| t.first == first) {
+            Some(t) => t.k.iter_mut().zip(new).for_each(|(a, b)| *a = a.max(b)),
+            None => ties.push(NodeTie { first, k: new }),
+        }
+    };
+    for j in joints {
+        match j {
+            Joint::Ground { body, alpha, .. } => tie(*body, 0, on_x(alpha)),
+            Joint::Flared { parent, child, alpha_p, alpha_c, lock, .. } => {
+                let free = lock.is_none();
+                tie(*parent, bodies[*parent].n_nodes - 1, free && on_x(alpha_p));
+                tie(*child, 0, free && on_x(alpha_c));
+            }
+            Joint::Clamp { .. } => {}
+        }
+    }
+    ties
 }

@@ -47,18 +47,16 @@ pub struct Options {
     pub curvature: Curvature,
     /// Factor on the cross-section penalty stiffnesses (EA, EA, GA_y + GA_z); default 1.
     pub penalty_factor: f64,
-    /// Factor κ of the shear-gradient stabilisation `½κ∫[EI_zz γ_y'² + EI_yy γ_z'² + GJ γ_yz'²]dx`
-    /// (see [`strain`](crate::strain)); default 100, 0 switches it off. The node-local joint
-    /// compliance it leaves is about `l/(κ L)` of the physical one. Its stiffness `κ·EI` is not
-    /// bounded by the axial and shear stiffnesses: on thick sections (`EI ≈ EA·l²`, the paper's
-    /// wing chordwise) κ = 1000 made it ~500× EA on quadratic strain measures, and Newton's
-    /// convergence radius collapsed (7–11 iterations, step halvings, failure at AoA 10°).
-    pub shear_gradient_factor: f64,
+    /// Factor `c_t` of the section ties at the hinges' nodes (docs/ancf.md §3.5): stiffness
+    /// `c_t max(EI_yy, EI_zz, GJ)/l` on the metric strains of the node's slopes; default 1000. 0 switches them off, and a hinge's moment then reaches the section
+    /// through the node's shear and penalty stiffness alone (∝ l): a joint compliance that grows
+    /// as the mesh is refined.
+    pub joint_tie_factor: f64,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { path: SolvePath::Dae, curvature: Curvature::Hybrid, penalty_factor: 1.0, shear_gradient_factor: 100.0 }
+        Self { path: SolvePath::Dae, curvature: Curvature::Hybrid, penalty_factor: 1.0, joint_tie_factor: 1000.0 }
     }
 }
 
@@ -68,12 +66,9 @@ impl Options {
         if self.penalty_factor <= 0.0 {
             return Err(Error::NotPositive { field: "options.penalty_factor".into(), value: self.penalty_factor });
         }
-        finite("options.shear_gradient_factor", self.shear_gradient_factor)?;
-        if self.shear_gradient_factor < 0.0 {
-            return Err(Error::Negative {
-                field: "options.shear_gradient_factor".into(),
-                value: self.shear_gradient_factor,
-            });
+        finite("options.joint_tie_factor", self.joint_tie_factor)?;
+        if self.joint_tie_factor < 0.0 {
+            return Err(Error::Negative { field: "options.joint_tie_factor".into(), value: self.joint_tie_factor });
         }
         Ok(())
     }

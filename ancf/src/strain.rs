@@ -26,9 +26,9 @@
 //! directly; the zero-mean linear variation comes from the cubic centreline, so states of
 //! linearly varying curvature (tip loads) are represented exactly. When `F = [r_x r_y r_z]` is a
 //! rotation the two parts agree and `K` is the exact curvature of the skew part of `FᵀF_x`.
-//! Transverse shear at the two Gauss points ties the sections to the centreline: for a cubic
-//! centreline with linearly varying curvature the linear section field matching the slope at
-//! the two Gauss points is continuous from element to element, so there is no shear locking.
+//! Transverse shear at the nodes ties the sections to the centreline: for a cubic centreline
+//! with linearly varying curvature the linear section field that matches the centreline slope at
+//! the nodes is continuous from element to element, so there is no shear locking.
 //!
 //! The alternatives [`Curvature::Kirchhoff`] (`K2 = −r_z·r_xx`, `K3 = r_y·r_xx`, shear at the
 //! nodes) and [`Curvature::Mixed`] (`½(r_x·r_z,x − r_z·r_xx)`, … , shear at the midpoint)
@@ -67,20 +67,10 @@ pub enum StrainKind {
     SectionZZ = 7,
     /// Section in-plane shear (penalty).
     SectionYZ = 8,
-    /// Gradient of the shear γ_y along the element (stabilisation, see the module docs).
-    ShearGradientY = 9,
-    /// Gradient of the shear γ_z along the element (stabilisation).
-    ShearGradientZ = 10,
-    /// Gradient of the section shear γ_yz along the element (stabilisation).
-    SectionShearGradient = 11,
-    /// Gradient of the section stretch ε_yy along the element (stabilisation).
-    SectionStretchGradientY = 12,
-    /// Gradient of the section stretch ε_zz along the element (stabilisation).
-    SectionStretchGradientZ = 13,
 }
 
 /// Number of strain kinds.
-pub const N_STRAINS: usize = 14;
+pub const N_STRAINS: usize = 9;
 
 /// Upper bound of distinct fields per element.
 pub const MAX_FIELDS: usize = 32;
@@ -103,32 +93,17 @@ impl StrainKind {
         StrainKind::SectionYY,
         StrainKind::SectionZZ,
         StrainKind::SectionYZ,
-        StrainKind::ShearGradientY,
-        StrainKind::ShearGradientZ,
-        StrainKind::SectionShearGradient,
-        StrainKind::SectionStretchGradientY,
-        StrainKind::SectionStretchGradientZ,
     ];
 
-    /// Whether this is an artificial term (cross-section penalties and the shear-gradient
-    /// stabilisation), with no beam-theory counterpart.
+    /// Whether this is an artificial term (the cross-section penalties), with no beam-theory
+    /// counterpart.
     pub fn is_penalty(self) -> bool {
-        matches!(
-            self,
-            StrainKind::SectionYY
-                | StrainKind::SectionZZ
-                | StrainKind::SectionYZ
-                | StrainKind::ShearGradientY
-                | StrainKind::ShearGradientZ
-                | StrainKind::SectionShearGradient
-                | StrainKind::SectionStretchGradientY
-                | StrainKind::SectionStretchGradientZ
-        )
+        matches!(self, StrainKind::SectionYY | StrainKind::SectionZZ | StrainKind::SectionYZ)
     }
 
     /// The stiffness of this strain for a section, with the penalty factor `penalty_factor`
-    /// (section penalties) and the stabilisation factor `kappa` (shear gradients) applied.
-    pub fn stiffness(self, s: &Section, penalty_factor: f64, kappa: f64) -> f64 {
+    /// (section penalties) applied.
+    pub fn stiffness(self, s: &Section, penalty_factor: f64) -> f64 {
         match self {
             StrainKind::Axial => s.ea,
             StrainKind::ShearY => s.ga_y,
@@ -138,11 +113,6 @@ impl StrainKind {
             StrainKind::BendZ => s.ei_zz,
             StrainKind::SectionYY | StrainKind::SectionZZ => penalty_factor * s.ea,
             StrainKind::SectionYZ => penalty_factor * (s.ga_y + s.ga_z),
-            StrainKind::ShearGradientY => kappa * s.ei_zz,
-            StrainKind::ShearGradientZ => kappa * s.ei_yy,
-            StrainKind::SectionShearGradient => kappa * s.gj,
-            StrainKind::SectionStretchGradientY => kappa * s.ei_zz,
-            StrainKind::SectionStretchGradientZ => kappa * s.ei_yy,
         }
     }
 }
@@ -315,17 +285,7 @@ impl Builder {
         let l = self.l;
         self.intern(FieldWeights::new(&[(0, -2.0 / l), (1, -0.5), (4, 2.0 / l), (5, -0.5)]))
     }
-    #[allow(clippy::too_many_arguments)] // a strain needs its kind, place, weight, terms and material
-    fn push(
-        &mut self,
-        kind: StrainKind,
-        xi: f64,
-        weight: f64,
-        terms: &[(f64, usize, usize)],
-        section: &Section,
-        pf: f64,
-        kappa: f64,
-    ) {
+    fn push(&mut self, kind: StrainKind, xi: f64, weight: f64, terms: &[(f64, usize, usize)], section: &Section, pf: f64) {
         assert!(terms.len() <= MAX_TERMS);
         let mut t = [(0.0, 0, 0); MAX_TERMS];
         t[..terms.len()].copy_from_slice(terms);
@@ -370,7 +330,7 @@ impl Builder {
             xi,
             n_terms: terms.len(),
             terms: t,
-            stiffness: kind.stiffness(section, pf, kappa) * weight * self.l,
+            stiffness: kind.stiffness(section, pf) * weight * self.l,
             reference: 0.0,
             hessian,
             n_blocks,
@@ -382,7 +342,7 @@ impl Builder {
 }
 
 /// The strain plan of an element of length `l` (docs/ancf.md §3, see the module documentation).
-pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64, kappa: f64) -> StrainPlan {
+pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_factor: f64) -> StrainPlan {
     use Field::*;
     use StrainKind::*;
     let pf = penalty_factor;
@@ -399,7 +359,7 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
 
     for (xi, w) in gauss3 {
         let (x, xx, y, z) = (bld.at(X, xi), bld.at(XX, xi), bld.at(Y, xi), bld.at(Z, xi));
-        bld.push(Axial, xi, w, &[(0.5, x, x)], section, pf, kappa);
+        bld.push(Axial, xi, w, &[(0.5, x, x)], section, pf);
         match curvature {
             Curvature::Hybrid => {
                 let (m0, m1) = (mean_terms[0], mean_terms[1]);
@@ -410,7 +370,6 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
                     &[(1.0, chord, zx), (-1.0, z, xx), (0.5, m0.0, m0.2), (0.5, m1.0, m1.2)],
                     section,
                     pf,
-                    kappa,
                 );
                 bld.push(
                     BendZ,
@@ -419,23 +378,22 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
                     &[(-1.0, chord, yx), (1.0, y, xx), (-0.5, m0.1, m0.2), (-0.5, m1.1, m1.2)],
                     section,
                     pf,
-                    kappa,
                 );
             }
             Curvature::Kirchhoff => {
-                bld.push(BendY, xi, w, &[(-1.0, z, xx)], section, pf, kappa);
-                bld.push(BendZ, xi, w, &[(1.0, y, xx)], section, pf, kappa);
+                bld.push(BendY, xi, w, &[(-1.0, z, xx)], section, pf);
+                bld.push(BendZ, xi, w, &[(1.0, y, xx)], section, pf);
             }
             Curvature::Mixed => {
-                bld.push(BendY, xi, w, &[(0.5, x, zx), (-0.5, z, xx)], section, pf, kappa);
-                bld.push(BendZ, xi, w, &[(0.5, y, xx), (-0.5, x, yx)], section, pf, kappa);
+                bld.push(BendY, xi, w, &[(0.5, x, zx), (-0.5, z, xx)], section, pf);
+                bld.push(BendZ, xi, w, &[(0.5, y, xx), (-0.5, x, yx)], section, pf);
             }
         }
     }
     // K1 is linear in ξ (linear sections, constant derivatives): 2-point Gauss is exact.
     for xi in gauss2 {
         let (y, z) = (bld.at(Y, xi), bld.at(Z, xi));
-        bld.push(Twist, xi, 0.5, &[(0.5, z, yx), (-0.5, y, zx)], section, pf, kappa);
+        bld.push(Twist, xi, 0.5, &[(0.5, z, yx), (-0.5, y, zx)], section, pf);
     }
     let shear_points: Vec<(f64, f64)> = match curvature {
         Curvature::Hybrid | Curvature::Kirchhoff => vec![(0.0, 0.5), (1.0, 0.5)],
@@ -443,25 +401,14 @@ pub fn strain_plan(l: f64, section: &Section, curvature: Curvature, penalty_fact
     };
     for (xi, w) in shear_points {
         let (x, y, z) = (bld.at(X, xi), bld.at(Y, xi), bld.at(Z, xi));
-        bld.push(ShearY, xi, w, &[(1.0, x, y)], section, pf, kappa);
-        bld.push(ShearZ, xi, w, &[(1.0, x, z)], section, pf, kappa);
-    }
-    if curvature != Curvature::Mixed && kappa > 0.0 {
-        // (γ(1) − γ(0))/l for γ_y, γ_z, γ_yz: constant gradients over the element.
-        let (x0, y0, z0) = (bld.at(X, 0.0), bld.at(Y, 0.0), bld.at(Z, 0.0));
-        let (x1, y1, z1) = (bld.at(X, 1.0), bld.at(Y, 1.0), bld.at(Z, 1.0));
-        let il = 1.0 / l;
-        bld.push(ShearGradientY, 0.5, 1.0, &[(il, x1, y1), (-il, x0, y0)], section, pf, kappa);
-        bld.push(ShearGradientZ, 0.5, 1.0, &[(il, x1, z1), (-il, x0, z0)], section, pf, kappa);
-        bld.push(SectionShearGradient, 0.5, 1.0, &[(il, y1, z1), (-il, y0, z0)], section, pf, kappa);
-        bld.push(SectionStretchGradientY, 0.5, 1.0, &[(0.5 * il, y1, y1), (-0.5 * il, y0, y0)], section, pf, kappa);
-        bld.push(SectionStretchGradientZ, 0.5, 1.0, &[(0.5 * il, z1, z1), (-0.5 * il, z0, z0)], section, pf, kappa);
+        bld.push(ShearY, xi, w, &[(1.0, x, y)], section, pf);
+        bld.push(ShearZ, xi, w, &[(1.0, x, z)], section, pf);
     }
     for xi in [0.0, 1.0] {
         let (y, z) = (bld.at(Y, xi), bld.at(Z, xi));
-        bld.push(SectionYY, xi, 0.5, &[(0.5, y, y)], section, pf, kappa);
-        bld.push(SectionZZ, xi, 0.5, &[(0.5, z, z)], section, pf, kappa);
-        bld.push(SectionYZ, xi, 0.5, &[(1.0, y, z)], section, pf, kappa);
+        bld.push(SectionYY, xi, 0.5, &[(0.5, y, y)], section, pf);
+        bld.push(SectionZZ, xi, 0.5, &[(0.5, z, z)], section, pf);
+        bld.push(SectionYZ, xi, 0.5, &[(1.0, y, z)], section, pf);
     }
     let e0 = reference_element(l);
     let f0: Vec<[f64; 3]> = bld.fields.iter().map(|f| f.eval(&e0)).collect();
@@ -499,15 +446,13 @@ mod tests {
     fn quadrature_weights_sum_to_the_length() {
         let l = 0.3;
         for curvature in ALL_CURVATURES {
-            let plan = strain_plan(l, &section(), curvature, 1.0, 100.0);
+            let plan = strain_plan(l, &section(), curvature, 1.0);
             let mut sum = [0.0; N_STRAINS];
             for s in &plan.strains {
-                sum[s.kind as usize] += s.stiffness / s.kind.stiffness(&section(), 1.0, 100.0);
+                sum[s.kind as usize] += s.stiffness / s.kind.stiffness(&section(), 1.0);
             }
-            for (k, v) in sum.iter().enumerate() {
-                if k < 9 {
-                    assert_relative_eq!(*v, l, epsilon = 1e-14);
-                }
+            for v in sum {
+                assert_relative_eq!(v, l, epsilon = 1e-14);
             }
         }
     }
@@ -515,7 +460,7 @@ mod tests {
     #[test]
     fn reference_values_are_those_of_unit_orthonormal_slopes() {
         for curvature in ALL_CURVATURES {
-            for s in &strain_plan(0.4, &section(), curvature, 1.0, 100.0).strains {
+            for s in &strain_plan(0.4, &section(), curvature, 1.0).strains {
                 let expect = match s.kind {
                     StrainKind::Axial | StrainKind::SectionYY | StrainKind::SectionZZ => 0.5,
                     _ => 0.0,
@@ -528,7 +473,7 @@ mod tests {
     #[test]
     fn groups_partition_the_strains_by_block_set() {
         for curvature in ALL_CURVATURES {
-            let plan = strain_plan(0.4, &section(), curvature, 1.0, 100.0);
+            let plan = strain_plan(0.4, &section(), curvature, 1.0);
             let mut seen = vec![0; plan.strains.len()];
             for g in &plan.groups {
                 assert!((1..=MAX_GROUP).contains(&g.n_members));
@@ -542,7 +487,7 @@ mod tests {
             assert!(seen.iter().all(|&n| n == 1), "{curvature:?}: {seen:?}");
         }
         // Hybrid: the three axial Gauss points share blocks {0, 1, 4, 5}.
-        let plan = strain_plan(0.4, &section(), Curvature::Hybrid, 1.0, 100.0);
+        let plan = strain_plan(0.4, &section(), Curvature::Hybrid, 1.0);
         let axial: Vec<usize> =
             (0..plan.strains.len()).filter(|&i| plan.strains[i].kind == StrainKind::Axial).collect();
         assert!(plan.groups.iter().any(|g| g.members() == axial.as_slice()));
@@ -551,7 +496,7 @@ mod tests {
     #[test]
     fn group_hessians_are_the_members_hessians_on_the_compact_blocks() {
         for curvature in ALL_CURVATURES {
-            let plan = strain_plan(0.4, &section(), curvature, 1.0, 100.0);
+            let plan = strain_plan(0.4, &section(), curvature, 1.0);
             for g in &plan.groups {
                 let nb = g.n_blocks;
                 assert!(matches!(nb, 1 | 2 | 4 | 6 | 8), "{curvature:?}: {nb} blocks");
@@ -580,7 +525,7 @@ mod tests {
         // s(e) = ½ eᵀ (a ⊗ I₃) e for every sampled strain, at an arbitrary e.
         let e: [f64; 24] = std::array::from_fn(|i| ((i * 7 + 3) % 11) as f64 * 0.1 - 0.4);
         for curvature in ALL_CURVATURES {
-            let plan = strain_plan(0.7, &section(), curvature, 1.0, 100.0);
+            let plan = strain_plan(0.7, &section(), curvature, 1.0);
             let f: Vec<[f64; 3]> = plan.fields.iter().map(|w| w.eval(&e)).collect();
             for s in &plan.strains {
                 let mut q = 0.0;
@@ -602,7 +547,7 @@ mod tests {
         // (zero nodal shear): K2 = −w'' = −6 a x at every Gauss point, although the linear
         // sections cannot follow the quadratic slope in between.
         let (l, a) = (0.5, 1e-3);
-        let plan = strain_plan(l, &section(), Curvature::Hybrid, 1.0, 100.0);
+        let plan = strain_plan(l, &section(), Curvature::Hybrid, 1.0);
         let w1 = |x: f64| 3.0 * a * x * x;
         let mut e = reference_element(l);
         e[3 + 2] = w1(0.0);

@@ -1,0 +1,176 @@
+//! Section ties at joint nodes (docs/ancf.md §3.5): where a joint's axis equation involves the
+//! centreline slope `r_x` of a node (a flared hinge with β ≠ 0, a ground hinge whose axis is not
+//! in the section plane), the node's `r_x` is tied to the normal of its section,
+//!
+//! $$ U_t = \tfrac12 k_y (r_x\cdot r_y)^2 + \tfrac12 k_z (r_x\cdot r_z)^2 , $$
+//!
+//! so that the joint's axis `Σ α_b r_b` is fixed in the section, as in a geometrically exact
+//! beam, and the joint's moment reaches the section through a stiffness that grows as the mesh
+//! is refined (`k = c_t EI / l`). Without it the moment on `r_x` reaches the section only
+//! through the node's shear, whose stiffness `GA l` vanishes with the element length.
+
+use nalgebra::SMatrix;
+
+/// 9×9 matrix over the node's `(r_x, r_y, r_z)`.
+pub(crate) type TieMatrix = SMatrix<f64, 9, 9>;
+
+/// The six metric strains of the nodal triad `(r_x, r_y, r_z)`: `(a, b)` block pairs.
+const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+
+/// One tied node.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct NodeTie {
+    /// Full index of the node's `r_x` (its `r_y`, `r_z` follow).
+    pub first: usize,
+    /// Stiffness on the metric strains `½(|r_x|²−1), ½(|r_y|²−1), ½(|r_z|²−1), r_x·r_y,
+    /// r_x·r_z, r_y·r_z` (N·m).
+    pub k: [f64; 6],
+}
+
+#[inline]
+fn block(q: &[f64], first: usize, a: usize) -> [f64; 3] {
+    let i = first + 3 * a;
+    [q[i], q[i + 1], q[i + 2]]
+}
+
+#[inline]
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl NodeTie {
+    /// The triad and its six metric strains.
+    #[inline]
+    fn strains(&self, q: &[f64]) -> ([[f64; 3]; 3], [f64; 6]) {
+        let x = [block(q, self.first, 0), block(q, self.first, 1), block(q, self.first, 2)];
+        let s = PAIRS.map(|(a, b)| if a == b { 0.5 * (dot(&x[a], &x[a]) - 1.0) } else { dot(&x[a], &x[b]) });
+        (x, s)
+    }
+
+    /// Energy, J.
+    pub(crate) fn energy(&self, q: &[f64]) -> f64 {
+        let (_, s) = self.strains(q);
+        s.iter().zip(&self.k).map(|(s, k)| 0.5 * k * s * s).sum()
+    }
+
+    /// `r += ∂U/∂q`.
+    pub(crate) fn add_force(&self, q: &[f64], r: &mut [f64]) {
+        let (x, s) = self.strains(q);
+        for (((a, b), s), k) in PAIRS.iter().zip(&s).zip(&self.k) {
+            let f = k * s;
+            for i in 0..3 {
+                if a == b {
+                    r[self.first + 3 * a + i] += f * x[*a][i];
+                } else {
+                    r[self.first + 3 * a + i] += f * x[*b][i];
+                    r[self.first + 3 * b + i] += f * x[*a][i];
+                }
+            }
+        }
+    }
+
+    /// `c · ∂²U/∂q²` on the node's nine slope coordinates (symmetric).
+    pub(crate) fn tangent(&self, q: &[f64], c: f64) -> TieMatrix {
+        let (x, s) = self.strains(q);
+        let mut t = TieMatrix::zeros();
+        for (((a, b), s), k) in PAIRS.iter().zip(&s).zip(&self.k) {
+            let (a, b) = (*a, *b);
+            // gradient of the strain over the nine coordinates
+            let mut g = [0.0; 9];
+            for i in 0..3 {
+                if a == b {
+                    g[3 * a + i] = x[a][i];
+                } else {
+                    g[3 * a + i] = x[b][i];
+                    g[3 * b + i] = x[a][i];
+                }
+            }
+            let ck = c * k;
+            for j in 0..9 {
+                for i in 0..=j {
+                    t[(i, j)] += ck * g[i] * g[j];
+                }
+            }
+            let h = c * k * s;
+            for i in 0..3 {
+                if a == b {
+                    t[(3 * a + i, 3 * a + i)] += h;
+                } else {
+                    t[(3 * a + i, 3 * b + i)] += h; // a < b: upper triangle
+                }
+            }
+        }
+        for j in 0..9 {
+            for i in j + 1..9 {
+                t[(i, j)] = t[(j, i)];
+            }
+        }
+        t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Rotation3, Vector3};
+
+    fn tie() -> NodeTie {
+        NodeTie { first: 2, k: [3.0, 1.5, 2.0, 0.7, 1.1, 0.4] }
+    }
+
+    /// A perturbed triad at indices 2..11 of a 12-vector.
+    fn state(seed: f64) -> Vec<f64> {
+        let mut q: Vec<f64> = (0..12).map(|i| 0.1 * ((i as f64 * 1.7 + seed).sin())).collect();
+        for a in 0..3 {
+            q[2 + 3 * a + a] += 1.0;
+        }
+        q
+    }
+
+    /// The force is the gradient of the energy and the tangent the derivative of the force
+    /// (central differences, relative 1e-7), and the tangent is symmetric.
+    #[test]
+    fn force_and_tangent_match_finite_differences() {
+        let t = tie();
+        for seed in [0.3, 1.1, 2.9] {
+            let q = state(seed);
+            let mut f = vec![0.0; 12];
+            t.add_force(&q, &mut f);
+            let k = t.tangent(&q, 1.0);
+            let h = 1e-6;
+            let fmax = f.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            for j in 0..9 {
+                let (mut qp, mut qm) = (q.clone(), q.clone());
+                qp[2 + j] += h;
+                qm[2 + j] -= h;
+                let du = (t.energy(&qp) - t.energy(&qm)) / (2.0 * h);
+                assert!((du - f[2 + j]).abs() < 1e-7 * fmax, "force {j}: {du} vs {}", f[2 + j]);
+                let (mut fp, mut fm) = (vec![0.0; 12], vec![0.0; 12]);
+                t.add_force(&qp, &mut fp);
+                t.add_force(&qm, &mut fm);
+                for i in 0..9 {
+                    let d = (fp[2 + i] - fm[2 + i]) / (2.0 * h);
+                    assert!((d - k[(i, j)]).abs() < 1e-7 * k.amax(), "tangent ({i}, {j}): {d} vs {}", k[(i, j)]);
+                }
+            }
+            assert_eq!(k, k.transpose());
+            assert!(f[..2].iter().chain(&f[11..]).all(|&x| x == 0.0), "only the triad is loaded");
+        }
+    }
+
+    /// An orthonormal triad in any orientation stores no energy and feels no force.
+    #[test]
+    fn rotated_orthonormal_triad_is_free() {
+        let r = Rotation3::from_scaled_axis(Vector3::new(0.4, -1.3, 2.2)).into_inner();
+        let mut q = vec![0.0; 12];
+        for a in 0..3 {
+            for i in 0..3 {
+                q[2 + 3 * a + i] = r[(i, a)];
+            }
+        }
+        let mut f = vec![0.0; 12];
+        tie().add_force(&q, &mut f);
+        assert!(tie().energy(&q) < 1e-30);
+        assert!(f.iter().all(|x| x.abs() < 1e-14), "{f:?}");
+    }
+}
