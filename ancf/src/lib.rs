@@ -26,8 +26,9 @@
 //! cross-section penalties are sampled at the nodes (no shear or curvature-thickness locking).
 //! Joint loads on single nodal slopes (the flared hinge's `a = sin β r_x + cos β r_y`) would reach
 //! the section only through node-local terms whose stiffness vanishes with the element length;
-//! a shear/section-strain *gradient* stabilisation (zero for uniform shear and section strain)
-//! keeps that compliance small and mesh-independent.
+//! *section ties* at the hinge nodes (docs/ancf.md §3.5: the nodal triad held orthonormal with
+//! a stiffness `∝ EI/l`) fix the joint's axis in the section, so the joint compliance vanishes
+//! under refinement and the element converges to geometrically exact beam theory (§3.7).
 //!
 //! **Force elements and lumped masses** (docs/ancf.md §11–12): a hinge spring and damper
 //! ([`ForceElement::HingeSpring`]) on a ground or free flared hinge adds

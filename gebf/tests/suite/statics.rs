@@ -105,3 +105,89 @@ fn tip_load_elastica_table() {
     }
     assert!(worst < 5e-3, "worst relative error {worst:.2e}");
 }
+
+/// The 45° bend of Bathe and Bolourchi (1979): a cantilever on an eighth of a circle of radius
+/// 100 in the x–y plane (clamped at the origin, tangent along +x, centre at (0, 100, 0)), unit
+/// square section, E = 1e7, ν = 0 (G = 5e6), loaded at the tip by a dead force P along +z.
+/// The arc is built from `n` straight one-element bodies with their nodes on the circle, welded
+/// by locked hinges (the scene has straight bodies only), as the literature's eight straight
+/// elements. Section: EA = 1e7, GA = G·A = 5e6, EI = 1e7/12 and GJ = G(I_y + I_z) = 8.333e5 (the
+/// polar moment, as in the section data of the problem in OpenFAST's BeamDyn regression test
+/// `r-test/modules/beamdyn/bd_curved_beam`).
+fn bend_scene(n: usize) -> gebf::Scene {
+    use gebf::{BodySpec, JointSpec, Scene};
+    use nalgebra::Matrix3;
+    let (r, e, g) = (100.0, 1e7, 5e6);
+    let section = Section {
+        mass: 1.0,
+        rho_ixx: 1.0 / 6.0,
+        rho_iyy: 1.0 / 12.0,
+        rho_izz: 1.0 / 12.0,
+        ea: e,
+        ga_y: g,
+        ga_z: g,
+        gj: g / 6.0,
+        ei_yy: e / 12.0,
+        ei_zz: e / 12.0,
+        cg_offset: [0.0; 2],
+    };
+    let point = |k: usize| {
+        let phi = std::f64::consts::FRAC_PI_4 * k as f64 / n as f64;
+        Vector3::new(r * phi.sin(), r * (1.0 - phi.cos()), 0.0)
+    };
+    let bodies = (0..n)
+        .map(|k| {
+            let chord = point(k + 1) - point(k);
+            let x = chord.normalize();
+            let z = Vector3::z();
+            BodySpec {
+                name: format!("arc{k}"),
+                start: point(k),
+                length: chord.norm(),
+                frame: Matrix3::from_columns(&[x, z.cross(&x), z]),
+                section,
+                n_elements: 1,
+                point_masses: Vec::new(),
+            }
+        })
+        .collect();
+    let mut joints = vec![JointSpec::Clamp { body: 0 }];
+    joints.extend((1..n).map(|k| JointSpec::LockedHinge { parent: k - 1, child: k, beta: 0.0 }));
+    Scene { bodies, joints, forces: Vec::new(), gravity: Vector3::zeros() }
+}
+
+/// Tip positions of the 45° bend at P = 300, 450, 600 against the published eight-element
+/// solution of Simo and Vu-Quoc (1986), "A three-dimensional finite-strain rod model. Part II:
+/// computational aspects", CMAME 58:79–116, example 7.5 (P = 300 and 600), with P = 450 as listed
+/// with them in Exudyn's `geometricallyExactBeamCurvedTest.py`. Acceptance: |tip − published|
+/// within 0.5 % of the published tip's distance from the root, with eight elements.
+///
+/// Fails today: measured 3.5e-3 and 5.4e-3 at P = 300 and 450 (tip (58.65, 22.16, 40.12),
+/// (52.02, 18.36, 48.40)), and refining does not close the gap (32 bodies: 3.9e-3, 5.9e-3,
+/// 7.4e-3 at P = 300, 450, 600). On the
+/// same scene with the square's torsion constant (GJ = 0.141 G) and 32 bodies GEBF's tip at
+/// P = 600 is (46.59, 15.29, 53.52), ANCF's (46.87, 15.56, 53.62) and Exudyn's geometrically exact
+/// beam on the curved arc (46.90, 15.56, 53.60): GEBF converges 0.5 % away from both on this
+/// chain of locked hinges with turning frames. Ignored until that is explained.
+#[test]
+#[ignore = "GEBF's converged tip on the welded 45° bend is 0.5 % from ANCF's and Exudyn's; see the doc comment"]
+fn bathe_bolourchi_bend_matches_simo_vu_quoc() {
+    let published = [
+        (300.0, Vector3::new(58.84, 22.33, 40.08)),
+        (450.0, Vector3::new(52.32, 18.62, 48.39)),
+        (600.0, Vector3::new(47.23, 15.79, 53.37)),
+    ];
+    let scene = bend_scene(8);
+    let last = scene.bodies.len() - 1;
+    for (p, reference) in published {
+        let mut m = Model::from_scene(&scene, Options::default()).unwrap();
+        let tip = m.n_nodes(last) - 1;
+        m.set_nodal_load(last, tip, NodalLoad { force: Vector3::new(0.0, 0.0, p), moment: Vector3::zeros() }).unwrap();
+        let q0 = m.reference_coordinates();
+        let sol = m.solve_static(&q0, &StaticOptions { n_load_steps: 20, ..StaticOptions::default() }).unwrap();
+        let tip = m.tip_position(&sol.q);
+        let err = (tip - reference).norm() / reference.norm();
+        println!("P = {p}: tip ({:.2}, {:.2}, {:.2}), published {reference:?}, relative error {err:.2e}", tip.x, tip.y, tip.z);
+        assert!(err < 5e-3, "P = {p}: tip {tip:?} vs {reference:?}: {err:e}");
+    }
+}
