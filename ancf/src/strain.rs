@@ -285,7 +285,15 @@ impl Builder {
         let l = self.l;
         self.intern(FieldWeights::new(&[(0, -2.0 / l), (1, -0.5), (4, 2.0 / l), (5, -0.5)]))
     }
-    fn push(&mut self, kind: StrainKind, xi: f64, weight: f64, terms: &[(f64, usize, usize)], section: &Section, pf: f64) {
+    fn push(
+        &mut self,
+        kind: StrainKind,
+        xi: f64,
+        weight: f64,
+        terms: &[(f64, usize, usize)],
+        section: &Section,
+        pf: f64,
+    ) {
         assert!(terms.len() <= MAX_TERMS);
         let mut t = [(0.0, 0, 0); MAX_TERMS];
         t[..terms.len()].copy_from_slice(terms);

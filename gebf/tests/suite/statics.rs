@@ -187,7 +187,10 @@ fn bathe_bolourchi_bend_matches_simo_vu_quoc() {
         let sol = m.solve_static(&q0, &StaticOptions { n_load_steps: 20, ..StaticOptions::default() }).unwrap();
         let tip = m.tip_position(&sol.q);
         let err = (tip - reference).norm() / reference.norm();
-        println!("P = {p}: tip ({:.2}, {:.2}, {:.2}), published {reference:?}, relative error {err:.2e}", tip.x, tip.y, tip.z);
+        println!(
+            "P = {p}: tip ({:.2}, {:.2}, {:.2}), published {reference:?}, relative error {err:.2e}",
+            tip.x, tip.y, tip.z
+        );
         assert!(err < 5e-3, "P = {p}: tip {tip:?} vs {reference:?}: {err:e}");
     }
 }
