@@ -1130,8 +1130,10 @@ impl Model {
 
 /// The section ties of the hinges (docs/ancf.md §3.5): at each node a hinge acts on, the
 /// section's metric strains `½(|r_y|²−1), ½(|r_z|²−1), r_y·r_z`, and where the hinge's axis
-/// equation involves `r_x` also `½(|r_x|²−1), r_x·r_y, r_x·r_z`, each with the stiffness
-/// `c_t max(EI_yy, EI_zz, GJ) / l`. Clamps hold their section's slopes exactly and need none.
+/// equation involves `r_x` also `½(|r_x|²−1), r_x·r_y, r_x·r_z`, with the stiffness `c_t EI / l`
+/// of the rotation each one resists: `r_x·r_y` EI_zz, `r_x·r_z` EI_yy, `r_y·r_z` GJ, and each
+/// stretch the larger of its vector's two (a stretch is loaded by moments about both). Clamps
+/// hold their section's slopes exactly and need none.
 fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
     // whether an axis `Σ α_b r_b` involves r_x (round-off of a rotated frame is not)
     let on_x = |alpha: &Vector3<f64>| alpha[0].abs() > 1e-9 * alpha.norm();
@@ -1142,11 +1144,17 @@ fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
     let mut tie = |body: usize, node: usize, with_x: bool| {
         let b = &bodies[body];
         let first = b.offset + NODE_DOF * node + 3;
-        let (s, l) = (&b.spec.section, b.element.l);
-        let k = factor * s.ei_yy.max(s.ei_zz).max(s.gj) / l;
+        let (s, c) = (&b.spec.section, factor / b.element.l);
+        let x = if with_x { c } else { 0.0 };
         // order of NodeTie::k: xx, yy, zz, xy, xz, yz
-        let x = if with_x { k } else { 0.0 };
-        let new = [x, k, k, x, x, k];
+        let new = [
+            x * s.ei_yy.max(s.ei_zz),
+            c * s.gj.max(s.ei_zz),
+            c * s.gj.max(s.ei_yy),
+            x * s.ei_zz,
+            x * s.ei_yy,
+            c * s.gj,
+        ];
         match ties.iter_mut().find(|t| t.first == first) {
             Some(t) => t.k.iter_mut().zip(new).for_each(|(a, b)| *a = a.max(b)),
             None => ties.push(NodeTie { first, k: new }),

@@ -1,13 +1,15 @@
-//! Section ties at joint nodes (docs/ancf.md §3.5): where a joint's axis equation involves the
-//! centreline slope `r_x` of a node (a flared hinge with β ≠ 0, a ground hinge whose axis is not
-//! in the section plane), the node's `r_x` is tied to the normal of its section,
+//! Section ties at the hinge nodes (docs/ancf.md §3.5). A hinge's equations act on single nodal
+//! slopes; in a geometrically exact beam its axis is fixed in the section. At every node a hinge
+//! acts on, the model holds the nodal triad `(r_x, r_y, r_z)` orthonormal with the energy of its
+//! metric strains,
 //!
-//! $$ U_t = \tfrac12 k_y (r_x\cdot r_y)^2 + \tfrac12 k_z (r_x\cdot r_z)^2 , $$
+//! $$ U_t = \tfrac12 \sum_s k_s s^2,\qquad s \in \{\tfrac12(|r_a|^2 - 1),\ r_a\cdot r_b\}, $$
 //!
-//! so that the joint's axis `Σ α_b r_b` is fixed in the section, as in a geometrically exact
-//! beam, and the joint's moment reaches the section through a stiffness that grows as the mesh
-//! is refined (`k = c_t EI / l`). Without it the moment on `r_x` reaches the section only
-//! through the node's shear, whose stiffness `GA l` vanishes with the element length.
+//! `k_s = c_t EI_s / l` with the EI (or GJ) of the rotation each strain resists, zero for the
+//! strains with `r_x` where the hinge's rows do not involve `r_x`. The joint's moment then
+//! reaches the section through a stiffness that grows as the mesh is refined; without it, only
+//! through the node's shear and penalty terms, whose stiffness (`GA l`, `EA l`) vanishes with the
+//! element length.
 
 use nalgebra::SMatrix;
 

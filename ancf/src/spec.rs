@@ -48,7 +48,8 @@ pub struct Options {
     /// Factor on the cross-section penalty stiffnesses (EA, EA, GA_y + GA_z); default 1.
     pub penalty_factor: f64,
     /// Factor `c_t` of the section ties at the hinges' nodes (docs/ancf.md §3.5): stiffness
-    /// `c_t max(EI_yy, EI_zz, GJ)/l` on the metric strains of the node's slopes; default 1000. 0 switches them off, and a hinge's moment then reaches the section
+    /// `c_t EI/l` on the metric strains of the node's slopes, with the EI (or GJ) of the
+    /// rotation each one resists; default 1000. 0 switches them off, and a hinge's moment then reaches the section
     /// through the node's shear and penalty stiffness alone (∝ l): a joint compliance that grows
     /// as the mesh is refined.
     pub joint_tie_factor: f64,
