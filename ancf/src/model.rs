@@ -1132,8 +1132,13 @@ impl Model {
 /// section's metric strains `½(|r_y|²−1), ½(|r_z|²−1), r_y·r_z`, and where the hinge's axis
 /// equation involves `r_x` also `½(|r_x|²−1), r_x·r_y, r_x·r_z`, with the stiffness `c_t EI / l`
 /// of the rotation each one resists: `r_x·r_y` EI_zz, `r_x·r_z` EI_yy, `r_y·r_z` GJ, and each
-/// stretch the larger of its vector's two (a stretch is loaded by moments about both). Clamps
-/// hold their section's slopes exactly and need none.
+/// stretch the larger of its vector's two (a stretch is loaded by moments about both), at most
+/// [`TIE_CAP`] `max(EA, GA) l`. Clamps hold their section's slopes exactly and need none.
+/// Upper bound of a section tie's stiffness in units of the slopes' stiffest node-local term
+/// `max(EA, GA) l` (docs/ancf.md §3.5): stiffer ties on very stiff, thick sections shrink
+/// Newton's convergence radius.
+const TIE_CAP: f64 = 50.0;
+
 fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
     // whether an axis `Σ α_b r_b` involves r_x (round-off of a rotated frame is not)
     let on_x = |alpha: &Vector3<f64>| alpha[0].abs() > 1e-9 * alpha.norm();
@@ -1144,16 +1149,18 @@ fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
     let mut tie = |body: usize, node: usize, with_x: bool| {
         let b = &bodies[body];
         let first = b.offset + NODE_DOF * node + 3;
-        let (s, c) = (&b.spec.section, factor / b.element.l);
-        let x = if with_x { c } else { 0.0 };
+        let (s, l) = (&b.spec.section, b.element.l);
+        // c_t EI/l, at most TIE_CAP times the slopes' own stiffest node-local term (EA l)
+        let k = |ei: f64| (factor * ei / l).min(TIE_CAP * s.ea.max(s.ga_y).max(s.ga_z) * l);
+        let x = if with_x { 1.0 } else { 0.0 };
         // order of NodeTie::k: xx, yy, zz, xy, xz, yz
         let new = [
-            x * s.ei_yy.max(s.ei_zz),
-            c * s.gj.max(s.ei_zz),
-            c * s.gj.max(s.ei_yy),
-            x * s.ei_zz,
-            x * s.ei_yy,
-            c * s.gj,
+            x * k(s.ei_yy.max(s.ei_zz)),
+            k(s.gj.max(s.ei_zz)),
+            k(s.gj.max(s.ei_yy)),
+            x * k(s.ei_zz),
+            x * k(s.ei_yy),
+            k(s.gj),
         ];
         match ties.iter_mut().find(|t| t.first == first) {
             Some(t) => t.k.iter_mut().zip(new).for_each(|(a, b)| *a = a.max(b)),

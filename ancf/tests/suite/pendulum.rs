@@ -84,8 +84,8 @@ fn beta45_against_sharpy() {
 /// The diagonal refinement ladder (elements per body, dt) = (5, 2 ms), (10, 1 ms), (20, 0.5 ms),
 /// (40, 0.25 ms) on c = 1, β = 45° against the converged Exudyn beam (80 elements per body; its
 /// own error ≈ 0.5 mm): the element converges to geometrically exact beam theory, so the error
-/// shrinks at every rung and is within 3.5 mm at the finest. Measured: 7.03, 3.69, 2.82,
-/// 2.63 mm (GEBF: 7.1, 3.7, 2.7, 2.5 mm).
+/// shrinks at every rung and is within 3.5 mm at the finest. Measured: 7.31, 3.81, 2.86,
+/// 2.70 mm (GEBF: 7.10, 3.68, 2.71, 2.46 mm).
 #[test]
 fn beta45_diagonal_ladder_converges_to_the_reference() {
     let reference = reference("exudyn/flex_c1_beta45_gebf_n80_dt0.0005.csv");
