@@ -14,7 +14,9 @@
 //! 4. falls back to the dense partial-pivoting LU ([`genalpha::DenseLu`]) if a pivot is tiny or
 //!    the profile is not much sparser than the full matrix.
 //!
-//! Buffers are sized once in `set_dimension`; factorising and solving do not allocate.
+//! Buffers are sized in `set_dimension` and, for the envelope, when the profile is first known
+//! (its length, never `n²`); the dense fallback's `n × n` storage only if it is used. After the
+//! first factorisation of a given profile, factorising and solving do not allocate.
 
 use genalpha::{Assembled, AssemblyTarget, DenseLu, DenseMatrix, LinearSolver};
 use std::sync::Arc;
@@ -244,7 +246,18 @@ impl SkylineLu {
         }
         self.lptr[n] = lsize;
         self.uptr[n] = usize_;
-        lsize <= self.lval.len() && usize_ <= self.uval.len()
+        // Profiles larger than a third of the matrix go to the dense LU; the envelope storage
+        // grows to what the profile needs (never n²).
+        if lsize > n * n / 6 + n || usize_ > n * n / 6 + 2 * n {
+            return false;
+        }
+        if self.lval.len() < lsize {
+            self.lval.resize(lsize, 0.0);
+        }
+        if self.uval.len() < usize_ {
+            self.uval.resize(usize_, 0.0);
+        }
+        true
     }
 
     /// Factorise the envelope held in `uval` (U columns with the diagonal) and, unless
@@ -806,9 +819,9 @@ impl LinearSolver for SkylineLu {
         self.first = vec![0; n];
         self.lptr = vec![0; n + 1];
         self.uptr = vec![0; n + 1];
-        // profiles larger than a third of the matrix go to the dense LU
-        self.lval = vec![0.0; n * n / 6 + n];
-        self.uval = vec![0.0; n * n / 6 + 2 * n];
+        // sized by `set_pointers` to the profile
+        self.lval = Vec::new();
+        self.uval = Vec::new();
         self.work = vec![0.0; n];
         self.inv_diag = vec![0.0; n];
         self.is_multiplier = vec![false; n];

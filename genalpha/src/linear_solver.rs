@@ -73,7 +73,15 @@ impl AssemblyTarget for DenseLu {
     }
 }
 
-/// Dense LU with partial pivoting (faer, sequential, in place, no allocation after set-up).
+/// Largest dimension the dense LU (and every dense fallback built on it) factorises densely:
+/// above it a matrix that the structured factorisation cannot take goes to faer's sparse LU
+/// (with pivoting) instead of an `n³`-time, `8 n²`-byte dense one.
+pub const DENSE_FALLBACK_MAX: usize = 4000;
+
+/// Dense LU with partial pivoting (faer, sequential, in place). Its `n × n` storage is allocated
+/// at the first dense factorisation, so a solver that only ever takes the structured path never
+/// holds it; matrices larger than [`DENSE_FALLBACK_MAX`] are factorised by faer's sparse LU
+/// (allocating per factorisation: a fallback, not the time loop's path).
 ///
 /// If the system declares a [`BandedBorder`] structure, the matrix is factorised by the
 /// bordered band LU instead (block-banded part without pivoting, by 6×6 node blocks when the
@@ -87,6 +95,8 @@ pub struct DenseLu {
     /// The last factorisation is the structured one.
     use_structured: bool,
     lu: Mat<f64>,
+    /// The sparse LU of the last factorisation above [`DENSE_FALLBACK_MAX`].
+    sparse: Option<faer::sparse::linalg::solvers::Lu<usize, f64>>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     buf: MemBuffer,
@@ -106,6 +116,7 @@ impl Default for DenseLu {
             structure_checked: false,
             use_structured: false,
             lu: Mat::zeros(0, 0),
+            sparse: None,
             perm: Vec::new(),
             perm_inv: Vec::new(),
             buf: MemBuffer::new(StackReq::EMPTY),
@@ -113,17 +124,54 @@ impl Default for DenseLu {
     }
 }
 
-impl LinearSolver for DenseLu {
-    fn set_dimension(&mut self, n: usize) {
-        self.n = n;
+impl DenseLu {
+    /// faer's sparse LU of the non-zeros of `a`; `Err(row)` when it is singular.
+    fn factorize_sparse(&mut self, a: &DenseMatrix) -> Result<(), usize> {
+        use faer::sparse::linalg::LuError;
+        use faer::sparse::{SparseColMat, Triplet};
+        let n = self.n;
+        let data = a.as_slice();
+        let mut entries = Vec::new();
+        for j in 0..n {
+            for (i, &v) in data[j * n..(j + 1) * n].iter().enumerate() {
+                if v != 0.0 {
+                    entries.push(Triplet { row: i, col: j, val: v });
+                }
+            }
+        }
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &entries).map_err(|_| 0_usize)?;
+        match m.sp_lu() {
+            Ok(lu) => {
+                self.sparse = Some(lu);
+                Ok(())
+            }
+            Err(LuError::SymbolicSingular { index }) => Err(index),
+            Err(_) => Err(0),
+        }
+    }
+
+    /// The dense storage and faer's scratch, at the first dense factorisation.
+    fn allocate_dense(&mut self) {
+        let n = self.n;
+        if self.lu.nrows() == n && self.lu.ncols() == n {
+            return;
+        }
         self.lu = Mat::zeros(n, n);
-        self.perm = vec![0; n];
-        self.perm_inv = vec![0; n];
         let req = StackReq::any_of(&[
             lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Spec::<PartialPivLuParams, f64>::default()),
             solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
         ]);
         self.buf = MemBuffer::new(req);
+    }
+}
+
+impl LinearSolver for DenseLu {
+    fn set_dimension(&mut self, n: usize) {
+        self.n = n;
+        self.lu = Mat::zeros(0, 0);
+        self.perm = vec![0; n];
+        self.perm_inv = vec![0; n];
+        self.buf = MemBuffer::new(StackReq::EMPTY);
     }
 
     fn set_structure(&mut self, structure: &BandedBorder) {
@@ -149,6 +197,11 @@ impl LinearSolver for DenseLu {
             }
         }
         self.use_structured = false;
+        self.sparse = None;
+        if self.n > DENSE_FALLBACK_MAX {
+            return self.factorize_sparse(a);
+        }
+        self.allocate_dense();
         let src = MatRef::from_column_major_slice(a.as_slice(), self.n, self.n);
         self.lu.copy_from(src);
         let stack = MemStack::new(&mut self.buf);
@@ -192,6 +245,11 @@ impl LinearSolver for DenseLu {
             && let Some(s) = &mut self.structured
         {
             s.solve_in_place(b);
+            return;
+        }
+        if let Some(lu) = &self.sparse {
+            use faer::linalg::solvers::SolveCore as _;
+            lu.solve_in_place_with_conj(faer::Conj::No, MatMut::from_column_major_slice_mut(b, self.n, 1));
             return;
         }
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, self.n);

@@ -380,7 +380,7 @@ pub fn simulate_aero<S: AeroStructure>(
     r0.lift = 0.0;
     with_loads(model, &mut r0, &s, &loads);
     out.rows.push(r0);
-    if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
+    if let Err(e) = feed.feed(model, &r0, &s.q, Some(&uv)) {
         return fail(out, format!("output at t = {}: {e}", s.t));
     }
     let mut qp = vec![0.0; s.q.len()];
@@ -388,6 +388,10 @@ pub fn simulate_aero<S: AeroStructure>(
     let mut dq = vec![0.0; s.v.len()];
     let mut vp = vec![0.0; s.v.len()];
     for k in 1..=n_steps {
+        if crate::signal::interrupted() {
+            out.error = Some(crate::run::interrupted_message(s.t));
+            break;
+        }
         let t1 = s.t + dt;
         // 1. Predict the structure at t_{n+1} and move the lattice there.
         for i in 0..dq.len() {
@@ -469,7 +473,7 @@ pub fn simulate_aero<S: AeroStructure>(
             r.lift = lift;
             with_loads(model, &mut r, &s, &loads);
             out.rows.push(r);
-            if let Err(e) = feed.feed(model, s.t, &s.q, Some(&uv)) {
+            if let Err(e) = feed.feed(model, &r, &s.q, Some(&uv)) {
                 return fail(out, format!("step {k}: output: {e}"));
             }
         }

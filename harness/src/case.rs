@@ -671,11 +671,44 @@ pub struct CaseFile {
 }
 
 impl CaseFile {
-    /// Read and parse JSON (syntax only; the schema is checked per run).
+    /// Read and parse JSON (syntax only; the schema is checked per run). The file must be a
+    /// regular file of at most [`crate::budget::MAX_CASE_BYTES`].
     pub fn read(path: &Path) -> Result<Self, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-        let raw = parse_unique_keys(&text)
-            .map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
+        let io = |e: std::io::Error| Error::Io(format!("{}: {e}", path.display()));
+        let meta = std::fs::metadata(path).map_err(io)?;
+        let bad = |msg: String| Error::Case { file: path.display().to_string(), msg };
+        if !meta.is_file() {
+            return Err(bad("not a regular file".into()));
+        }
+        if meta.len() > crate::budget::MAX_CASE_BYTES {
+            return Err(bad(format!(
+                "{} bytes, more than the limit of {} for a case file",
+                meta.len(),
+                crate::budget::MAX_CASE_BYTES
+            )));
+        }
+        let mut bytes = Vec::new();
+        use std::io::Read as _;
+        std::fs::File::open(path)
+            .and_then(|f| f.take(crate::budget::MAX_CASE_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(io)?;
+        Self::from_bytes(path, &bytes)
+    }
+
+    /// Parse the bytes of a case file read from `path` (references are resolved against its
+    /// folder). Invalid UTF-8 is reported with its line and column.
+    pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Self, Error> {
+        let bad = |msg: String| Error::Case { file: path.display().to_string(), msg: clip(&msg) };
+        if bytes.len() as u64 > crate::budget::MAX_CASE_BYTES {
+            return Err(bad(format!("more than the limit of {} bytes for a case file", crate::budget::MAX_CASE_BYTES)));
+        }
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            let ok = &bytes[..e.valid_up_to()];
+            let line = ok.iter().filter(|&&b| b == b'\n').count() + 1;
+            let col = ok.len() - ok.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) + 1;
+            bad(format!("invalid UTF-8 at line {line} column {col} (byte {})", e.valid_up_to()))
+        })?;
+        let raw = parse_unique_keys(text).map_err(|e| bad(e.to_string()))?;
         Ok(Self { path: path.to_path_buf(), raw })
     }
 
@@ -687,7 +720,7 @@ impl CaseFile {
     /// Expand the sweep and apply overrides; returns one [`RunSpec`] per sweep point.
     pub fn expand(&self, overrides: &[Override]) -> Result<Vec<RunSpec>, Error> {
         let file = self.path.display().to_string();
-        let err = |msg: String| Error::Case { file: file.clone(), msg };
+        let err = |msg: String| Error::Case { file: file.clone(), msg: clip(&msg) };
         // Global overrides first (they may change the sweep itself).
         let mut base = self.raw.clone();
         for o in overrides.iter().filter(|o| o.only.is_none()) {
@@ -700,11 +733,29 @@ impl CaseFile {
         if let Value::Object(m) = &mut base {
             m.remove("sweep");
         }
-        let mut points: Vec<Vec<(String, Value)>> = vec![Vec::new()];
+        let mut n_points: usize = 1;
         for (k, axis) in sweep.iter().enumerate() {
             if axis.values.is_empty() {
                 return Err(err(format!("sweep[{k}].values: empty list")));
             }
+            n_points = n_points.saturating_mul(axis.values.len());
+            if n_points > crate::budget::MAX_SWEEP_POINTS {
+                return Err(err(format!(
+                    "sweep[{k}].values: the sweep expands into more than {} runs",
+                    crate::budget::MAX_SWEEP_POINTS
+                )));
+            }
+        }
+        // Every point holds a copy of the case: bound their total size too.
+        let size = serde_json::to_string(&base).map_or(0, |t| t.len());
+        if n_points.saturating_mul(size) > crate::budget::MAX_SWEEP_BYTES {
+            return Err(err(format!(
+                "sweep: {n_points} runs of a {size}-byte case are more than {} bytes of cases",
+                crate::budget::MAX_SWEEP_BYTES
+            )));
+        }
+        let mut points: Vec<Vec<(String, Value)>> = vec![Vec::new()];
+        for axis in &sweep {
             points = points
                 .into_iter()
                 .flat_map(|p| {
@@ -717,6 +768,7 @@ impl CaseFile {
                 .collect();
         }
         let mut runs = Vec::new();
+        let mut checked: std::collections::HashSet<String> = Default::default();
         for point in points {
             let mut raw = base.clone();
             let mut suffix = String::new();
@@ -740,8 +792,13 @@ impl CaseFile {
                 let mut case = parse_case(&r).map_err(&err)?;
                 case.name.push_str(&suffix);
                 case.validate().map_err(&err)?;
+                crate::budget::check(&case).map_err(&err)?;
                 for (k, r) in case.references.iter().enumerate() {
+                    if checked.contains(&r.file) {
+                        continue;
+                    }
                     check_reference(&self.dir(), &r.file).map_err(|e| err(format!("references[{k}].file: {e}")))?;
+                    checked.insert(r.file.clone());
                 }
                 for (k, r) in case.statics.iter().flat_map(|s| s.references.iter()).enumerate() {
                     check_static_reference(&self.dir(), &r.file)
@@ -760,6 +817,16 @@ impl CaseFile {
 /// Most airspeeds in one static sweep.
 pub const MAX_STATIC_POINTS: usize = 10_000;
 
+/// Shorten a message that echoes a long value: at most 400 characters, the cut marked.
+pub fn clip(msg: &str) -> String {
+    const MAX: usize = 400;
+    if msg.chars().count() <= MAX {
+        return msg.to_string();
+    }
+    let head: String = msg.chars().take(MAX).collect();
+    format!("{head}… ({} characters in all)", msg.chars().count())
+}
+
 /// Largest reference file read, bytes.
 pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
 
@@ -767,7 +834,21 @@ pub const MAX_REFERENCE_BYTES: u64 = 64 << 20;
 /// of at most [`MAX_REFERENCE_BYTES`] inside `dir`, holding a curve; the message names the file.
 pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
     let full = checked_file(dir, file)?;
-    crate::csv::read_curve(&full).map(|_| ()).map_err(|e| e.to_string())
+    // A file read once (same path, size and modification time) is not parsed again.
+    type Key = (PathBuf, u64, Option<std::time::SystemTime>);
+    static READ: std::sync::Mutex<Vec<Key>> = std::sync::Mutex::new(Vec::new());
+    let meta = std::fs::metadata(&full).map_err(|e| format!("{}: {e}", full.display()))?;
+    let key = (full.clone(), meta.len(), meta.modified().ok());
+    if READ.lock().is_ok_and(|v| v.contains(&key)) {
+        return Ok(());
+    }
+    crate::csv::read_curve(&full).map_err(|e| e.to_string())?;
+    if let Ok(mut v) = READ.lock()
+        && v.len() < 1024
+    {
+        v.push(key);
+    }
+    Ok(())
 }
 
 /// Check a static reference as [`check_reference`] does, holding an airspeed–angle curve.
@@ -1056,6 +1137,25 @@ impl Case {
         if self.bodies.is_empty() {
             return Err("bodies: at least one body is needed".into());
         }
+        // Counts that the checks below (and the scene's) visit in pairs.
+        use crate::budget::{MAX_BODIES, MAX_LIST};
+        let counts = [
+            ("bodies", self.bodies.len(), MAX_BODIES),
+            ("joints", self.joints.len(), MAX_BODIES),
+            ("references", self.references.len(), MAX_LIST),
+            ("gate.windows", self.gate.as_ref().map_or(0, |g| g.windows.len()), MAX_LIST),
+        ];
+        for (field, n, cap) in counts {
+            if n > cap {
+                return Err(format!("{field}: {n} entries, more than the limit of {cap}"));
+            }
+        }
+        if let Some(i) = self.bodies.iter().position(|b| b.point_masses.len() > MAX_LIST) {
+            return Err(format!(
+                "bodies[{i}].point_masses: {} entries, more than the limit of {MAX_LIST}",
+                self.bodies[i].point_masses.len()
+            ));
+        }
         for (i, b) in self.bodies.iter().enumerate() {
             let f = |s: &str| format!("bodies[{i}].{s}");
             if b.name.is_empty() {
@@ -1104,6 +1204,49 @@ impl Case {
         pos("stiffness_scale", self.stiffness_scale)?;
         for (f, n) in [("ancf", &self.ancf.elements_per_body), ("gebf", &self.gebf.elements_per_body)] {
             n.check(&format!("{f}.elements_per_body"), self.bodies.len())?;
+            if let Some(i) = (0..self.bodies.len()).find(|&i| n.for_body(i) > crate::budget::MAX_ELEMENTS_PER_BODY) {
+                return Err(format!(
+                    "{f}.elements_per_body: {} elements on bodies[{i}], more than the limit of {}",
+                    n.for_body(i),
+                    crate::budget::MAX_ELEMENTS_PER_BODY
+                ));
+            }
+        }
+        // Iteration counts and nesting, capped (each multiplies the work of a step).
+        for (f, newton) in [("ancf", &self.ancf.newton), ("gebf", &self.gebf.newton)] {
+            if newton.max_iter > crate::budget::MAX_NEWTON_ITER {
+                return Err(format!(
+                    "{f}.newton.max_iter: {} is more than the limit of {}",
+                    newton.max_iter,
+                    crate::budget::MAX_NEWTON_ITER
+                ));
+            }
+            if newton.max_step_halvings > crate::budget::MAX_STEP_HALVINGS {
+                return Err(format!(
+                    "{f}.newton.max_step_halvings: {} is more than the limit of {}",
+                    newton.max_step_halvings,
+                    crate::budget::MAX_STEP_HALVINGS
+                ));
+            }
+        }
+        if let Some(a) = &self.aero {
+            let caps = [
+                ("aero.n_chordwise", a.n_chordwise, crate::budget::MAX_CHORDWISE),
+                ("aero.n_wake_rows", a.n_wake_rows, crate::budget::MAX_WAKE_ROWS),
+                ("aero.coupling.max_sub_iterations", a.coupling.max_sub_iterations, crate::budget::MAX_SUB_ITERATIONS),
+            ];
+            for (field, v, cap) in caps {
+                if v > cap {
+                    return Err(format!("{field}: {v} is more than the limit of {cap}"));
+                }
+            }
+            if let Some(i) = a.panels_per_body.iter().position(|&p| p > crate::budget::MAX_PANELS_PER_BODY) {
+                return Err(format!(
+                    "aero.panels_per_body[{i}]: {} is more than the limit of {}",
+                    a.panels_per_body[i],
+                    crate::budget::MAX_PANELS_PER_BODY
+                ));
+            }
         }
         // Everything else about the structure, as both formulations will check it (in degrees
         // where the case speaks degrees).

@@ -2,14 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::Error;
+use crate::atomic::{DirLock, claim_dir, clear_outputs};
 use crate::case::{CaseFile, Formulation, Override, RunSpec};
-use crate::csv::write_file;
+use crate::csv::{CsvStream, write_file};
+use crate::progress::{Progress, RunProgress};
 use crate::report::{CaseResult, index_html, summary_markdown, write_case};
-use crate::run::{NoObserver, Observer};
+use crate::run::{NoObserver, Observer, Row, RunOutput, Snapshot};
 use crate::scene::run_formulation_observed;
 
 /// All `*.json` case files in a folder, sorted by name (`*.schema.json` excluded).
@@ -36,8 +37,8 @@ pub fn expand_all(files: &[PathBuf], overrides: &[Override]) -> (Vec<RunSpec>, V
     (runs, errors)
 }
 
-/// Run the given formulations of every run in parallel (rayon), with a progress bar when
-/// `progress` is set; results in input order.
+/// Run the given formulations of every run in parallel (rayon), with per-run progress when
+/// `progress` is set ([`Progress::new`]); results in input order.
 pub fn run_all(runs: &[RunSpec], formulations: &[Formulation], progress: bool) -> Vec<CaseResult> {
     run_all_observed(runs, formulations, progress, &|_, _| Box::new(NoObserver))
 }
@@ -50,28 +51,43 @@ pub fn run_all_observed(
     progress: bool,
     observer: &(dyn Fn(&RunSpec, Formulation) -> Box<dyn Observer> + Sync),
 ) -> Vec<CaseResult> {
+    run_into(runs, formulations, None, &Progress::new(progress), observer)
+}
+
+/// Run the given formulations of every run in parallel, streaming each run's rows to
+/// `<dirs[i]>/<formulation>.csv` as they are computed when `dirs` is given (one folder per run,
+/// claimed with [`claim_outputs`]), showing `progress` and handing the output steps to
+/// `observer`; results in input order.
+pub fn run_into(
+    runs: &[RunSpec],
+    formulations: &[Formulation],
+    dirs: Option<&[PathBuf]>,
+    progress: &Progress,
+    observer: &(dyn Fn(&RunSpec, Formulation) -> Box<dyn Observer> + Sync),
+) -> Vec<CaseResult> {
     let jobs: Vec<(usize, Formulation)> =
         (0..runs.len()).flat_map(|i| formulations.iter().map(move |&f| (i, f))).collect();
-    let bar = if progress {
-        let b = ProgressBar::new(jobs.len() as u64);
-        if let Ok(style) = ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}") {
-            b.set_style(style);
-        }
-        b
-    } else {
-        ProgressBar::hidden()
-    };
     let outputs: Vec<_> = jobs
         .par_iter()
         .map(|&(i, f)| {
-            let mut obs = observer(&runs[i], f);
-            let out = run_formulation_observed(runs[i].case(f), f, &mut *obs);
-            bar.set_message(format!("{} {f}", runs[i].name));
-            bar.inc(1);
+            let case = runs[i].case(f);
+            let csv = match dirs.map(|d| CsvStream::create(&d[i].join(format!("{f}.csv")))).transpose() {
+                Ok(c) => c,
+                Err(e) => return (i, RunOutput::failed(f, e.to_string())),
+            };
+            let dt = match f {
+                Formulation::Ancf => case.ancf.dt,
+                Formulation::Gebf => case.gebf.dt,
+            };
+            let mut obs = Streamed {
+                csv,
+                progress: progress.run(&runs[i].name, f, case.t_end, dt),
+                inner: observer(&runs[i], f),
+            };
+            let out = run_formulation_observed(case, f, &mut obs);
             (i, out)
         })
         .collect();
-    bar.finish_and_clear();
     let mut per: Vec<Vec<_>> = vec![Vec::new(); runs.len()];
     for (i, o) in outputs {
         per[i].push(o);
@@ -79,12 +95,146 @@ pub fn run_all_observed(
     runs.iter().zip(per).map(|(spec, outs)| CaseResult::evaluate(spec, outs)).collect()
 }
 
+/// The observer of a run in [`run_into`]: its rows to the CSV stream and the progress, its
+/// snapshots to the caller's observer.
+struct Streamed {
+    csv: Option<CsvStream>,
+    progress: RunProgress,
+    inner: Box<dyn Observer>,
+}
+
+impl Observer for Streamed {
+    fn wants_snapshots(&self) -> bool {
+        self.inner.wants_snapshots()
+    }
+    fn observe(&mut self, snapshot: &Snapshot<'_>) -> Result<(), String> {
+        self.inner.observe(snapshot)
+    }
+    fn row(&mut self, row: &Row) -> Result<(), String> {
+        if let Some(c) = &mut self.csv {
+            c.push(row)?;
+        }
+        self.progress.update(row.t);
+        self.inner.row(row)
+    }
+}
+
+/// The name of a run's output folder: the run's name, with `__only-<formulation>` when one
+/// formulation runs and `__set_<overrides>` when `--set` overrides apply (the overrides spelt
+/// out when short and plain, else a 16-digit hash of them), so that a variant never writes into
+/// (or compares against the references of) the plain case's folder.
+pub fn variant_name(name: &str, overrides: &[Override], formulations: &[Formulation]) -> String {
+    let mut n = name.to_string();
+    if let [f] = formulations {
+        n.push_str(&format!("__only-{f}"));
+    }
+    if !overrides.is_empty() {
+        let text: Vec<String> = overrides
+            .iter()
+            .map(|o| {
+                let v = match &o.value {
+                    serde_json::Value::String(s) => s.clone(),
+                    v => v.to_string(),
+                };
+                format!("{}{}={v}", o.only.map(|f| format!("{f}-")).unwrap_or_default(), o.path)
+            })
+            .collect();
+        let text = text.join(",");
+        let safe = |c: char| c.is_ascii_alphanumeric() || "._-+=,".contains(c);
+        if text.len() <= 60 && text.chars().all(safe) {
+            n.push_str(&format!("__set_{text}"));
+        } else {
+            // FNV-1a, 64 bits: stable across runs and platforms.
+            let h = text.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+            n.push_str(&format!("__set_{h:016x}"));
+        }
+    }
+    n
+}
+
+/// Claim the output folder of every run (`<out>/<run name>`; see [`crate::atomic::claim_dir`]),
+/// clear what an earlier run left there, and write a `summary.json` whose `"status"` is
+/// `"interrupted"` until [`finish_case`] replaces it: a run killed at any moment leaves a
+/// summary that says so beside its partial CSV. Returns the locks (held until dropped) and the
+/// folders.
+pub fn claim_outputs(out: &Path, runs: &[RunSpec]) -> Result<(Vec<DirLock>, Vec<PathBuf>), Error> {
+    let mut locks = Vec::new();
+    let mut dirs = Vec::new();
+    for r in runs {
+        let dir = out.join(&r.name);
+        let lock = claim_dir(&dir)?;
+        // First the summary that says "interrupted" (replacing the last run's in one rename),
+        // then the last run's other files go: at no moment does a summary sit beside files it
+        // does not describe.
+        let started = serde_json::json!({
+            "case": r.name,
+            "status": "interrupted",
+            "note": "written when the run started and replaced when it ends: a run that was killed leaves this",
+        });
+        crate::atomic::write(&dir.join("summary.json"), started.to_string().as_bytes())?;
+        clear_outputs(&lock, &["summary.json"])?;
+        locks.push(lock);
+        dirs.push(dir);
+    }
+    Ok((locks, dirs))
+}
+
+/// Whether any run of the results was stopped by a signal.
+pub fn any_interrupted(results: &[CaseResult]) -> bool {
+    crate::signal::interrupted()
+        || results
+            .iter()
+            .flat_map(|r| &r.runs)
+            .any(|r| r.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)))
+}
+
+/// Write a case's files ([`write_case`]: CSV, `summary.json`, plots, each atomically) and put the
+/// run's `"status"` (`"complete"` or `"interrupted"`) at the top of its `summary.json`.
+pub fn finish_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
+    write_case(dir, r)?;
+    let interrupted = r.runs.iter().any(|x| x.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)));
+    let status = if interrupted { "interrupted" } else { "complete" };
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+    let marked = match text.strip_prefix('{') {
+        Some(rest) => format!("{{\n  \"status\": \"{status}\",{rest}"),
+        None => text,
+    };
+    crate::atomic::write(&path, marked.as_bytes())
+}
+
+/// Write `index.html` and `summary.md` under `out` (the cases' own files are written already).
+pub fn write_index(out: &Path, results: &[CaseResult]) -> Result<(), Error> {
+    write_file(&out.join("index.html"), &index_html(out, results, &[]))?;
+    write_file(&out.join("summary.md"), &summary_markdown(results))
+}
+
 /// Write every case's files plus `index.html` and `summary.md` under `out`.
 pub fn write_reports(out: &Path, results: &[CaseResult]) -> Result<(), Error> {
-    let errs: Vec<Error> = results.par_iter().filter_map(|r| write_case(&out.join(&r.name), r).err()).collect();
+    let errs: Vec<Error> = results.par_iter().filter_map(|r| finish_case(&out.join(&r.name), r).err()).collect();
     if let Some(e) = errs.into_iter().next() {
         return Err(e);
     }
     write_file(&out.join("index.html"), &index_html(out, results, &[]))?;
     write_file(&out.join("summary.md"), &summary_markdown(results))
+}
+
+/// Shorten every formulation of `spec` to at most `steps` steps of its own `dt` (a smoke test of
+/// a case: `harness run --max-steps`, the fuzz campaign). The end time stays a whole number of
+/// steps.
+pub fn limit_steps(spec: &mut RunSpec, steps: usize) {
+    for f in Formulation::ALL {
+        let case = match f {
+            Formulation::Ancf => &mut spec.ancf,
+            Formulation::Gebf => &mut spec.gebf,
+        };
+        let dt = match f {
+            Formulation::Ancf => case.ancf.dt,
+            Formulation::Gebf => case.gebf.dt,
+        };
+        let t = steps as f64 * dt;
+        if t < case.t_end {
+            case.t_end = t;
+        }
+    }
 }

@@ -9,21 +9,26 @@
 #![warn(missing_docs)]
 
 pub mod aero;
+pub mod atomic;
 pub mod bench;
+pub mod budget;
 pub mod case;
 pub mod converge;
 pub mod csv;
 pub mod driver;
 pub mod energy;
+pub mod fuzz;
 pub mod gate;
 pub mod loads;
 pub mod metrics;
 pub mod plot;
+pub mod progress;
 pub mod report;
 pub mod run;
 pub mod scene;
 pub mod static_out;
 pub mod statics;
+pub mod signal;
 pub mod stress;
 pub mod view3d;
 pub mod vtk;

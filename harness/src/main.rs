@@ -7,9 +7,11 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
 use harness::case::{CaseFile, Formulation, Override, json_schema};
-use harness::csv::{to_csv, write_file};
-use harness::driver::{discover, expand_all, run_all, write_reports};
-use harness::report::write_case;
+use harness::driver::{
+    any_interrupted, claim_outputs, discover, expand_all, finish_case, limit_steps, run_all, run_into, variant_name,
+    write_index,
+};
+use harness::progress::Progress;
 use harness::{bench, converge, energy, gate, stress};
 
 #[derive(Parser)]
@@ -21,6 +23,13 @@ use harness::{bench, converge, energy, gate, stress};
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
+    /// Memory one run may take, GB (default: ¾ of the machine's memory, at most ½ of the
+    /// address-space limit); a case estimated above it is refused (exit 2).
+    #[arg(long, global = true, value_name = "GB")]
+    max_memory: Option<f64>,
+    /// Wall time one run may take, hours (default 48); a case estimated above it is refused.
+    #[arg(long, global = true, value_name = "HOURS")]
+    max_hours: Option<f64>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -69,6 +78,64 @@ enum Cmd {
         /// 100 frames per run, max(1, output rows / 100)).
         #[arg(long, value_name = "N", requires = "vtk")]
         vtk_stride: Option<usize>,
+        /// Stop each run after N steps (a smoke test; the folder name says so).
+        #[arg(long, value_name = "N")]
+        max_steps: Option<usize>,
+    },
+    /// Fuzz campaign: mutants of the case files, each run in its own process (`run --max-steps`)
+    /// under a time and an address-space limit, classified by outcome; writes `<out>/fuzz.json`,
+    /// `fuzz.md` and every crashing input under `crashes/`.
+    Fuzz {
+        /// Folder of seed case files (with their `reference/`).
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "reports/fuzz")]
+        out: PathBuf,
+        /// Number of inputs.
+        #[arg(long, default_value_t = 100_000)]
+        inputs: usize,
+        /// Index of the first input (to continue a campaign with the same seed).
+        #[arg(long, default_value_t = 0)]
+        first: usize,
+        /// Seed of the mutations.
+        #[arg(long, default_value_t = 19)]
+        seed: u64,
+        /// Inputs run at once.
+        #[arg(long, default_value_t = 2)]
+        jobs: usize,
+        /// Time limit of one input, s of CPU time (and 6 × this of wall time).
+        #[arg(long, default_value_t = 20)]
+        timeout: u64,
+        /// Address-space limit of one input, GB.
+        #[arg(long, default_value_t = 4)]
+        address_space_gb: u64,
+        /// Steps each run of an input takes at most.
+        #[arg(long, default_value_t = 3)]
+        max_steps: usize,
+        /// Children run `harness run` (every output file written) instead of `harness check`.
+        #[arg(long)]
+        run: bool,
+        /// A new process per input (`harness check`) instead of long-lived worker processes
+        /// (each still under the limits, restarted after any crash or hang).
+        #[arg(long)]
+        exec_each: bool,
+    },
+    /// The worker of `harness fuzz`: reads input paths from stdin, answers one line each.
+    #[command(hide = true)]
+    FuzzWorker {
+        /// Steps each run takes at most.
+        #[arg(long, default_value_t = 3)]
+        max_steps: usize,
+    },
+    /// Check a case file: parse, validate, build both formulations and run each at most
+    /// `--max-steps` steps, writing nothing; exit 0 (runs), 1 (a run failed), 2 (bad input).
+    Check {
+        /// Case file.
+        case: PathBuf,
+        /// Steps each run takes at most.
+        #[arg(long, default_value_t = 3)]
+        max_steps: usize,
     },
     /// Run the gated cases and check their tolerances; exit 1 when any case fails.
     Gate {
@@ -161,20 +228,20 @@ enum Cmd {
     Schema,
 }
 
-/// Run the benchmark on `runs` and write `<out>/bench/`; the targets apply to the cases without
+/// Run the benchmark on `runs` and write `dir` (`<out>/bench/`); the targets apply to the cases without
 /// aerodynamics (the issues' figures are for the paper's pendulums).
-fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, out: &std::path::Path) -> Result<Vec<bench::BenchRow>> {
+fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, dir: &std::path::Path) -> Result<Vec<bench::BenchRow>> {
     let t = std::time::Instant::now();
     let rows = bench::run(runs, repeats, true);
     let pendulums: Vec<&str> = runs.iter().filter(|r| r.ancf.aero.is_none()).map(|r| r.name.as_str()).collect();
-    bench::write(&out.join("bench"), &rows, |c| pendulums.contains(&c))?;
+    bench::write(dir, &rows, |c| pendulums.contains(&c))?;
     println!("bench: {} configurations x {repeats} runs in {:.1} s", rows.len(), t.elapsed().as_secs_f64());
     Ok(rows)
 }
 
-/// Run the energy study on the c = 1 pendulums among `runs`, write `<out>/energy/` and print the
+/// Run the energy study on the c = 1 pendulums among `runs`, write `dir` (`<out>/energy/`) and print the
 /// drifts; returns whether every run reached its end (true when there is nothing to study).
-fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<bool> {
+fn run_energy(runs: &[harness::case::RunSpec], dir: &std::path::Path) -> Result<bool> {
     let t = std::time::Instant::now();
     let specs = energy::select(runs);
     if specs.is_empty() {
@@ -182,7 +249,7 @@ fn run_energy(runs: &[harness::case::RunSpec], out: &std::path::Path) -> Result<
         return Ok(true);
     }
     let study = energy::run(&specs);
-    energy::write(&out.join("energy"), &study)?;
+    energy::write(dir, &study)?;
     for r in &study {
         let m = &r.metrics;
         println!(
@@ -311,9 +378,95 @@ fn main() -> ExitCode {
     }
 }
 
+/// Claim the runs' output folders, run them streaming their CSVs, write their files; returns the
+/// results and whether a signal stopped them.
+fn run_and_write(
+    runs: &[harness::case::RunSpec],
+    fs: &[Formulation],
+    out: &std::path::Path,
+    progress: &Progress,
+    observer: &(dyn Fn(&harness::case::RunSpec, Formulation) -> Box<dyn harness::run::Observer> + Sync),
+) -> Result<(Vec<harness::report::CaseResult>, bool)> {
+    let (_locks, dirs) = claim_outputs(out, runs)?;
+    let results = run_into(runs, fs, Some(&dirs), progress, observer);
+    for (r, dir) in results.iter().zip(&dirs) {
+        finish_case(dir, r).with_context(|| format!("writing {}", dir.display()))?;
+    }
+    let interrupted = any_interrupted(&results);
+    Ok((results, interrupted))
+}
+
+/// The runs renamed after their variant (`--set`, one formulation, `--max-steps`).
+fn variants(
+    mut runs: Vec<harness::case::RunSpec>,
+    set: &[Override],
+    fs: &[Formulation],
+    max_steps: Option<usize>,
+) -> Vec<harness::case::RunSpec> {
+    for r in &mut runs {
+        r.name = variant_name(&r.name, set, fs);
+        if let Some(n) = max_steps {
+            r.name.push_str(&format!("__max-steps-{n}"));
+            limit_steps(r, n);
+        }
+    }
+    runs
+}
+
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
+    harness::budget::set_limits(cli.max_memory, cli.max_hours);
+    harness::signal::install();
     match cli.cmd {
+        Cmd::Check { case, max_steps } => {
+            use harness::fuzz::Class;
+            let (class, msg) = harness::fuzz::check_file(&case, max_steps);
+            match class {
+                Class::Ok => {
+                    println!("{}: ok", case.display());
+                    Ok(ExitCode::SUCCESS)
+                }
+                Class::RunFailed => {
+                    eprintln!("{}: a run failed: {msg}", case.display());
+                    Ok(ExitCode::FAILURE)
+                }
+                Class::Panic => {
+                    eprintln!("{}: panicked: {msg}", case.display());
+                    Ok(ExitCode::from(101))
+                }
+                _ => {
+                    eprintln!("error: {msg}");
+                    Ok(ExitCode::from(2))
+                }
+            }
+        }
+        Cmd::FuzzWorker { max_steps } => {
+            harness::fuzz::worker_main(max_steps)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Fuzz { cases, out, inputs, first, seed, jobs, timeout, address_space_gb, max_steps, run, exec_each } => {
+            let c = harness::fuzz::Campaign {
+                cases,
+                out: out.clone(),
+                inputs,
+                first,
+                seed,
+                jobs,
+                timeout: std::time::Duration::from_secs(timeout),
+                address_space: address_space_gb << 30,
+                max_steps,
+                run,
+                exec_each,
+            };
+            let r = harness::fuzz::campaign(&c)?;
+            println!("fuzz: {} inputs in {:.0} s, slowest {:.1} s", r.inputs, r.wall_s, r.slowest_s);
+            for (k, n) in &r.classes {
+                println!("  {k:?}: {n}");
+            }
+            println!("wrote {}", out.join("fuzz.md").display());
+            let crashed = r.classes.iter().any(|(k, n)| k.is_crash() && *n > 0);
+            Ok(if crashed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
         Cmd::Schema => {
             use std::io::Write as _;
             // A closed pipe (`| head`) is not an error worth a panic.
@@ -341,32 +494,41 @@ fn real_main() -> Result<ExitCode> {
         }
         Cmd::All { cases, out, set, quick } => {
             let files = discover(&cases)?;
+            let progress = Progress::new(true);
+            progress.phase(&format!("reading {} case files in {}", files.len(), cases.display()));
             let (runs, errors) = expand_all(&files, &set);
             for e in &errors {
                 eprintln!("error: {e}");
             }
+            let runs = variants(runs, &set, &Formulation::ALL, None);
+            // Studies of a run with overrides go to folders that say so too.
+            let study = |name: &str| out.join(variant_name(name, &set, &Formulation::ALL));
             let t0 = std::time::Instant::now();
+            progress.phase(&format!("cases: {} runs x 2 formulations", runs.len()));
             // Each run also records its 3-D view for the report (and writes VTK where the case asks).
-            let results = harness::driver::run_all_observed(&runs, &Formulation::ALL, true, &|spec, f| {
+            let (results, interrupted) = run_and_write(&runs, &Formulation::ALL, &out, &progress, &|spec, f| {
                 harness::view3d::report_observer(&out, spec, f)
-            });
+            })?;
             let wall = t0.elapsed().as_secs_f64();
-            if !quick {
+            if !quick && !interrupted {
                 for spec in runs.iter().filter(|r| r.ancf.converge) {
+                    progress.phase(&format!("refinement ladders of {}", spec.name));
                     let t = std::time::Instant::now();
                     let r = converge::converge(spec, true)?;
-                    converge::write(&out.join("converge").join(&spec.name), &r)?;
+                    converge::write(&study("converge").join(&spec.name), &r)?;
                     println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
                 }
                 let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
                 if let Some(base) = base {
+                    progress
+                        .phase("stress matrix (c x beta x dt x rho_inf, both formulations), then its two long runs");
                     let t = std::time::Instant::now();
                     let spec = CaseFile::read(base).and_then(|c| c.expand(&set))?;
                     let axes = stress::Axes::default();
                     let cells = stress::run(&spec[0], &axes, true);
-                    stress::write(&out.join("stress"), &axes, &cells)?;
+                    stress::write(&study("stress"), &axes, &cells)?;
                     let ex = stress::run_extras(&stress_extras(&cases, &set)?);
-                    stress::write_extras(&out.join("stress"), &ex)?;
+                    stress::write_extras(&study("stress"), &ex)?;
                     for f in Formulation::ALL {
                         let (ok, rec, n) = stress::survival(&cells, f);
                         println!(
@@ -375,12 +537,15 @@ fn real_main() -> Result<ExitCode> {
                     }
                     println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
                 }
-                run_energy(&runs, &out)?;
+                progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
+                run_energy(&runs, &study("energy"))?;
+                progress.phase("speed benchmark (serial repeated runs)");
                 let pendulums: Vec<_> = runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
-                run_bench(&pendulums, 7, &out)?;
+                run_bench(&pendulums, 7, &study("bench"))?;
             }
             let mut static_failed = 0;
-            for spec in runs.iter().filter(|r| r.ancf.statics.is_some()) {
+            for spec in runs.iter().filter(|r| r.ancf.statics.is_some() && !interrupted) {
+                progress.phase(&format!("static sweep of {}", spec.name));
                 let t = std::time::Instant::now();
                 let mut summary = run_static_case(spec, &Formulation::ALL);
                 if let Some(r) = results.iter().find(|r| r.name == spec.name) {
@@ -390,7 +555,8 @@ fn real_main() -> Result<ExitCode> {
                 static_failed += usize::from(report_static(&summary));
                 println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
             }
-            write_reports(&out, &results).context("writing reports")?;
+            progress.phase("reports: index.html, summary.md");
+            write_index(&out, &results).context("writing reports")?;
             print!("{}", gate::table(&results));
             let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
             println!(
@@ -408,34 +574,33 @@ fn real_main() -> Result<ExitCode> {
             if static_failed > 0 {
                 eprintln!("static: {static_failed} sweep(s) have airspeeds without an equilibrium");
             }
+            if interrupted {
+                eprintln!("interrupted: the rows computed so far are written; studies skipped");
+                return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
+            }
             Ok(exit_code(&errors, failed == 0 && gate_failed == 0 && static_failed == 0))
         }
-        Cmd::Run { case, formulation, out, set, vtk, vtk_stride } => {
-            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
+        Cmd::Run { case, formulation, out, set, vtk, vtk_stride, max_steps } => {
             let fs: Vec<Formulation> = match formulation {
                 Which::Ancf => vec![Formulation::Ancf],
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
+            let runs = variants(CaseFile::read(&case).and_then(|c| c.expand(&set))?, &set, &fs, max_steps);
+            let progress = Progress::new(true);
             // VTK when --vtk asks for it or the case's `vtk` block does.
             let cli = vtk.then_some(vtk_stride);
-            let results =
-                harness::driver::run_all_observed(&runs, &fs, true, &|spec, f| match harness::vtk::writer_for(
-                    &out, spec, f, cli,
-                ) {
+            let vtk_out = out.clone();
+            let observer = move |spec: &harness::case::RunSpec, f: Formulation| -> Box<dyn harness::run::Observer> {
+                match harness::vtk::writer_for(&vtk_out, spec, f, cli) {
                     Some(w) => Box::new(w),
                     None => Box::new(harness::run::NoObserver),
-                });
+                }
+            };
+            let (results, interrupted) = run_and_write(&runs, &fs, &out, &progress, &observer)?;
             let mut failed = false;
             for r in &results {
                 let dir = out.join(&r.name);
-                if fs.len() == 2 {
-                    write_case(&dir, r)?;
-                } else {
-                    for run in &r.runs {
-                        write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows))?;
-                    }
-                }
                 for run in &r.runs {
                     let m = &r.metrics[&run.formulation];
                     match &run.error {
@@ -459,6 +624,23 @@ fn real_main() -> Result<ExitCode> {
                 if let Some(p) = &r.pair {
                     println!("{}: max tip difference ANCF-GEBF {:.3} mm", r.name, 1e3 * p.all.max);
                 }
+                // The case's gate, for information (`harness gate` is the command that enforces it).
+                if let Some(g) = &r.gate_outcome {
+                    let lines = g.failed_lines();
+                    println!(
+                        "{}: gate {} ({} failed check(s); `harness gate` enforces it)",
+                        r.name,
+                        if g.pass() { "pass" } else { "FAIL" },
+                        lines.len()
+                    );
+                    for l in lines {
+                        eprintln!("{}: gate: {l}", r.name);
+                    }
+                }
+            }
+            if interrupted {
+                eprintln!("interrupted: the rows computed so far are written; summary.json says \"interrupted\"");
+                return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
@@ -554,7 +736,7 @@ fn real_main() -> Result<ExitCode> {
             for e in &errors {
                 eprintln!("error: {e}");
             }
-            let ok = run_energy(&runs, &out)?;
+            let ok = run_energy(&runs, &out.join("energy"))?;
             Ok(if !errors.is_empty() {
                 ExitCode::from(2)
             } else if ok {
@@ -571,7 +753,7 @@ fn real_main() -> Result<ExitCode> {
                 eprintln!("error: {e}");
             }
             let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
-            let rows = run_bench(&runs, repeats, &out)?;
+            let rows = run_bench(&runs, repeats, &out.join("bench"))?;
             let failed = rows.iter().filter(|r| r.error.is_some()).count();
             Ok(exit_code(&errors, failed == 0))
         }

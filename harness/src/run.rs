@@ -100,6 +100,12 @@ pub trait Observer {
     }
     /// One output step. An error stops the run with the message.
     fn observe(&mut self, snapshot: &Snapshot<'_>) -> Result<(), String>;
+    /// The row of an output step, as it is recorded (before [`observe`](Self::observe) of the same
+    /// step; called whether or not the observer wants snapshots). Default: nothing. An error
+    /// stops the run with the message.
+    fn row(&mut self, _row: &Row) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// The observer of a run that records only its rows.
@@ -127,16 +133,18 @@ impl<'o> SnapshotFeed<'o> {
         Self { observer, beams: Vec::new(), index: 0 }
     }
 
-    /// Hand the state `q` at `t` (and the UVLM, if any) to the observer.
+    /// Hand the output step's row, and its state `q` (and the UVLM, if any), to the observer.
     pub(crate) fn feed<S: Structure + ?Sized>(
         &mut self,
         model: &S,
-        t: f64,
+        row: &Row,
         q: &[f64],
         aero: Option<&uvlm::Uvlm>,
     ) -> Result<(), String> {
         let index = self.index;
+        let t = row.t;
         self.index += 1;
+        self.observer.row(row)?;
         if !self.observer.wants_snapshots() {
             return Ok(());
         }
@@ -298,6 +306,14 @@ impl Dissipation {
     }
 }
 
+/// The error of a run stopped by SIGINT or SIGTERM after the step that reached `t`.
+pub fn interrupted_message(t: f64) -> String {
+    format!("{INTERRUPTED} at t = {t} s (SIGINT or SIGTERM)")
+}
+
+/// How the error of a run stopped by a signal starts.
+pub const INTERRUPTED: &str = "interrupted";
+
 /// Integrate `model` from its reference state to `t_end`, recording rows and handing each output
 /// step to `observer`. A Newton failure ends the run with `error` set and the rows computed so far.
 pub fn simulate<S: Structure>(
@@ -338,18 +354,24 @@ pub fn simulate<S: Structure>(
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s);
-    out.rows.push(row(model, fold, &s, 0));
-    if let Err(e) = feed.feed(model, s.t, &s.q, None) {
+    let r0 = row(model, fold, &s, 0);
+    out.rows.push(r0);
+    if let Err(e) = feed.feed(model, &r0, &s.q, None) {
         out.error = Some(format!("output at t = {}: {e}", s.t));
         return out;
     }
     for k in 1..=n_steps {
+        if crate::signal::interrupted() {
+            out.error = Some(interrupted_message(s.t));
+            break;
+        }
         match ga.step(model, &mut s) {
             Ok(st) => {
                 dissipation.step(model, &s);
                 if k % every == 0 || k == n_steps {
-                    out.rows.push(dissipation.record(row(model, fold, &s, st.n_newton_iters)));
-                    if let Err(e) = feed.feed(model, s.t, &s.q, None) {
+                    let r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
+                    out.rows.push(r);
+                    if let Err(e) = feed.feed(model, &r, &s.q, None) {
                         out.error = Some(format!("step {k}: output: {e}"));
                         break;
                     }

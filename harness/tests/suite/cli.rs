@@ -94,7 +94,10 @@ fn single_formulation_run_writes_its_csv() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(out.join("double_pendulum_c1_beta0/ancf.csv")).unwrap();
+    // One formulation with an override: the folder says both.
+    let dir = out.join("double_pendulum_c1_beta0__only-ancf__set_t_end=0.1");
+    let csv = std::fs::read_to_string(dir.join("ancf.csv")).unwrap();
+    assert!(!dir.join("gebf.csv").exists());
     let mut lines = csv.lines();
     assert_eq!(
         lines.next(),

@@ -5,10 +5,13 @@ mod aero;
 mod browser;
 mod cli;
 mod external;
+mod fuzz;
 mod gate;
 mod honest;
 mod observer;
 mod properties;
 mod statics;
+#[cfg(target_os = "linux")]
+mod streamed;
 mod vtk;
 mod vtk_parse;

@@ -96,7 +96,8 @@ fn vtk_pendulum_beams_match_the_csv_tip() {
     let out = std::env::temp_dir().join(format!("harness-vtk-pendulum-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     run("cases/double_pendulum_c1_beta45.json", "0.02", &out, &["--vtk-stride", "3"]);
-    let case = out.join("double_pendulum_c1_beta45");
+    // `--set` runs write to a folder named after the overrides.
+    let case = out.join("double_pendulum_c1_beta45__set_t_end=0.02");
     for (f, nodes) in [("ancf", 2 * 6), ("gebf", 2 * 11)] {
         let dir = case.join("vtk").join(f);
         let steps = check_family(&dir, "beams");
@@ -132,7 +133,7 @@ fn vtk_wing_writes_lattice_and_wake() {
     let out = std::env::temp_dir().join(format!("harness-vtk-wing-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     run("cases/wing_aoa5.json", "0.03", &out, &["--formulation", "gebf"]);
-    let dir = out.join("wing_aoa5").join("vtk").join("gebf");
+    let dir = out.join("wing_aoa5__only-gebf__set_t_end=0.03").join("vtk").join("gebf");
     let beams = check_family(&dir, "beams");
     let lattice = check_family(&dir, "lattice");
     let wake = check_family(&dir, "wake");

@@ -1,0 +1,121 @@
+//! Output files that appear whole or not at all, and output folders that one run owns at a time.
+//!
+//! * [`write`]: the contents go to a temporary file beside the target, which is then renamed over
+//!   it, so a reader (or a run killed mid-write) sees the old file or the new one, never a part.
+//! * [`claim_dir`]: an exclusive lock on `<dir>/.lock` (`flock`, released by the kernel when the
+//!   process ends, however it ends). A second run into the same folder waits for the first.
+//!   While the lock is held the run clears the files an earlier run left ([`clear_outputs`]).
+
+use std::fs::{File, OpenOptions};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::Error;
+
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Write `contents` to `path` atomically (temporary file in the same folder, then rename),
+/// creating the folder.
+pub fn write(path: &Path, contents: &[u8]) -> Result<(), Error> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}-{}", std::process::id(), COUNTER.fetch_add(1, Ordering::Relaxed)));
+    let done = std::fs::write(&tmp, contents).and_then(|()| std::fs::rename(&tmp, path));
+    done.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::Io(format!("{}: {e}", path.display()))
+    })
+}
+
+/// An output folder held by this process until dropped.
+#[derive(Debug)]
+pub struct DirLock {
+    /// The folder.
+    pub dir: PathBuf,
+    _file: File,
+}
+
+/// Take the exclusive lock of `dir` (created if missing), waiting while another run holds it.
+pub fn claim_dir(dir: &Path) -> Result<DirLock, Error> {
+    let io = |e: std::io::Error| Error::Io(format!("{}: {e}", dir.display()));
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let file = OpenOptions::new().create(true).truncate(false).write(true).open(dir.join(".lock")).map_err(io)?;
+    lock(&file, dir).map_err(io)?;
+    Ok(DirLock { dir: dir.to_path_buf(), _file: file })
+}
+
+#[cfg(target_os = "linux")]
+fn lock(file: &File, dir: &Path) -> std::io::Result<()> {
+    use std::os::fd::AsRawFd;
+    let fd = file.as_raw_fd();
+    // SAFETY: flock on a file descriptor this function borrows; no memory is shared.
+    if unsafe { libc::flock(fd, libc::LOCK_EX | libc::LOCK_NB) } == 0 {
+        return Ok(());
+    }
+    eprintln!("waiting for another run writing {}", dir.display());
+    loop {
+        // SAFETY: as above.
+        if unsafe { libc::flock(fd, libc::LOCK_EX) } == 0 {
+            return Ok(());
+        }
+        let e = std::io::Error::last_os_error();
+        if e.kind() != std::io::ErrorKind::Interrupted {
+            return Err(e);
+        }
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn lock(_file: &File, _dir: &Path) -> std::io::Result<()> {
+    Ok(())
+}
+
+/// Remove what a run writes into its folder (CSV, JSON, SVG, Markdown, HTML, leftover temporary
+/// files, the `vtk/` folder), so that no file of an earlier run stays beside the new run's.
+/// Call it holding the folder's [`DirLock`]; the files named in `keep` stay.
+pub fn clear_outputs(lock: &DirLock, keep: &[&str]) -> Result<(), Error> {
+    let dir = &lock.dir;
+    let io = |e: std::io::Error| Error::Io(format!("{}: {e}", dir.display()));
+    for e in std::fs::read_dir(dir).map_err(io)? {
+        let Ok(e) = e else { continue };
+        let p = e.path();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let is_dir = e.file_type().map(|t| t.is_dir()).unwrap_or(false);
+        // `static_*` files belong to `harness static`, another command writing into the folder.
+        if keep.contains(&name.as_str()) || name.starts_with("static_") {
+            continue;
+        }
+        if is_dir && name == "vtk" {
+            std::fs::remove_dir_all(&p).map_err(io)?;
+        } else if !is_dir {
+            let ours = [".csv", ".json", ".svg", ".md", ".html"].iter().any(|x| name.ends_with(x))
+                || (name.starts_with('.') && name.contains(".tmp-"));
+            if ours {
+                std::fs::remove_file(&p).map_err(io)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn write_replaces_whole_and_leaves_no_temporary() {
+        let d = std::env::temp_dir().join(format!("harness-atomic-{}", std::process::id()));
+        let p = d.join("a.json");
+        write(&p, b"old").unwrap();
+        write(&p, b"new").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"new");
+        let names: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        let lock = claim_dir(&d).unwrap();
+        clear_outputs(&lock, &[]).unwrap();
+        assert!(!p.exists());
+        assert!(d.join(".lock").exists());
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}

@@ -1,0 +1,228 @@
+//! What a run will cost, estimated from the case before anything is allocated, and the limits a
+//! case must stay within.
+//!
+//! The estimate counts what grows with the input: the unknowns `n` of each formulation (ANCF:
+//! 12 per node plus at most 12 constraint rows per joint; GEBF: 12 per element plus 6 per body
+//! and at most 6 rows per joint), the integrator's dense iteration matrix (`8 n²` bytes) and the
+//! dense fallback LU where one is allowed ([`genalpha::DENSE_FALLBACK_MAX`]), the band storage,
+//! the Broyden history (`n × (max_iter + 1)`), the recorded rows, and with aerodynamics the
+//! influence matrix and its LU (`2 × 8 N_b²` for `N_b` bound rings) and the wake. The time is
+//! a per-step cost (a few Newton iterations over a band, the influence matrix, its LU and the
+//! wake's induced velocities) times the steps, with the coupling sub-iterations.
+//! Constants are deliberately generous: the estimate refuses what cannot fit, it does not
+//! predict a run's wall time.
+//!
+//! Limits: memory — the smaller of ¾ of the machine's memory and ½ of the process's
+//! address-space limit (`ulimit -v`), or `--max-memory`; time — 48 hours, or `--max-hours`.
+
+use std::sync::OnceLock;
+
+use crate::case::{Case, Formulation};
+use crate::run::Row;
+
+/// Largest `newton.max_iter`.
+pub const MAX_NEWTON_ITER: usize = 200;
+/// Largest `newton.max_step_halvings` (a step may be cut into up to 2^this pieces).
+pub const MAX_STEP_HALVINGS: usize = 12;
+/// Largest `aero.coupling.max_sub_iterations`.
+pub const MAX_SUB_ITERATIONS: usize = 100;
+/// Largest element count of one body.
+pub const MAX_ELEMENTS_PER_BODY: usize = 1_000_000;
+/// Largest `aero.panels_per_body` entry.
+pub const MAX_PANELS_PER_BODY: usize = 100_000;
+/// Largest `aero.n_chordwise`.
+pub const MAX_CHORDWISE: usize = 10_000;
+/// Largest `aero.n_wake_rows`.
+pub const MAX_WAKE_ROWS: usize = 1_000_000;
+/// Most runs one case file may expand into (the product of its sweep's lists).
+pub const MAX_SWEEP_POINTS: usize = 1_000;
+/// Most bytes of case text a sweep may expand into (points × case size).
+pub const MAX_SWEEP_BYTES: usize = 256 << 20;
+/// Most bodies (and joints) in a case.
+pub const MAX_BODIES: usize = 1_000;
+/// Most entries of a case's other lists (references, gate windows, a body's point masses).
+pub const MAX_LIST: usize = 10_000;
+/// Largest case file, bytes.
+pub const MAX_CASE_BYTES: u64 = 16 << 20;
+
+/// The limits runs are checked against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Memory one run may take, bytes.
+    pub memory_bytes: f64,
+    /// Wall time one run may take, s.
+    pub seconds: f64,
+}
+
+static LIMITS: OnceLock<Limits> = OnceLock::new();
+
+/// Set the limits for this process (the binary's `--max-memory` and `--max-hours`); the first
+/// call wins. `None` keeps the default of that limit.
+pub fn set_limits(memory_gb: Option<f64>, hours: Option<f64>) {
+    let d = default_limits();
+    let _ = LIMITS.set(Limits {
+        memory_bytes: memory_gb.map_or(d.memory_bytes, |g| g * 1e9),
+        seconds: hours.map_or(d.seconds, |h| h * 3600.0),
+    });
+}
+
+/// The limits in force.
+pub fn limits() -> Limits {
+    *LIMITS.get_or_init(default_limits)
+}
+
+fn default_limits() -> Limits {
+    Limits { memory_bytes: machine_memory(), seconds: 48.0 * 3600.0 }
+}
+
+/// ¾ of the physical memory, and at most ½ of the address-space limit (heap, code, thread
+/// stacks and the allocator's slack share it).
+fn machine_memory() -> f64 {
+    let mut m: f64 = 8e9;
+    #[cfg(target_os = "linux")]
+    {
+        if let Ok(s) = std::fs::read_to_string("/proc/meminfo")
+            && let Some(kb) = s
+                .lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|x| x.parse::<f64>().ok())
+        {
+            m = 0.75 * kb * 1024.0;
+        }
+        let mut r = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+        // SAFETY: getrlimit writes into the struct it is given.
+        if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut r) } == 0 && r.rlim_cur != libc::RLIM_INFINITY {
+            m = m.min(0.5 * r.rlim_cur as f64);
+        }
+    }
+    m
+}
+
+/// The estimated cost of one formulation of a case.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// Unknowns of the iteration matrix.
+    pub unknowns: f64,
+    /// Time steps.
+    pub steps: f64,
+    /// Bound vortex rings (0 without aerodynamics).
+    pub bound_rings: f64,
+    /// Wake rings kept (0 without aerodynamics).
+    pub wake_rings: f64,
+    /// Memory, bytes.
+    pub bytes: f64,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// Memory of the structure alone, bytes (what `elements_per_body` drives).
+    pub structure_bytes: f64,
+    /// Memory of the aerodynamics alone, bytes.
+    pub aero_bytes: f64,
+}
+
+/// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
+/// overflows).
+pub fn estimate(case: &Case, f: Formulation) -> Estimate {
+    let (elements, dt, newton) = match f {
+        Formulation::Ancf => (&case.ancf.elements_per_body, case.ancf.dt, case.ancf.newton),
+        Formulation::Gebf => (&case.gebf.elements_per_body, case.gebf.dt, case.gebf.newton),
+    };
+    let nb = case.bodies.len();
+    let nj = case.joints.len() as f64;
+    let el: f64 = (0..nb).map(|i| elements.for_body(i) as f64).sum();
+    let n = match f {
+        Formulation::Ancf => 12.0 * (el + nb as f64) + 12.0 * nj,
+        Formulation::Gebf => 12.0 * el + 6.0 * nb as f64 + 6.0 * nj,
+    };
+    let steps = (case.t_end / dt).round().max(1.0);
+    let every = case.output_dt.map_or(1.0, |o| (o / dt).round().max(1.0));
+    let rows = steps / every + 2.0;
+    let dense_lu = if n <= genalpha::DENSE_FALLBACK_MAX as f64 { 1.0 } else { 0.0 };
+    let structure_bytes = 8.0 * n * n * (1.0 + dense_lu)
+        + 8.0 * n * 600.0
+        + 8.0 * n * (newton.max_iter as f64 + 1.0)
+        + rows * std::mem::size_of::<Row>() as f64;
+    let (mut bound, mut wake, mut aero_bytes, mut aero_step, mut sub) = (0.0, 0.0, 0.0, 0.0, 1.0);
+    if let Some(a) = &case.aero {
+        let span: f64 = a.panels_per_body.iter().map(|&p| p as f64).sum::<f64>() + 1.0;
+        bound = span * a.n_chordwise as f64;
+        wake = span * a.n_wake_rows as f64;
+        aero_bytes = 16.0 * bound * bound + 100.0 * (bound + wake);
+        aero_step = 2e-8 * bound * bound + 1e-9 * bound * bound * bound / 3.0 + 3e-8 * bound * wake;
+        sub = 1.0 + a.coupling.max_sub_iterations as f64;
+    }
+    // A band solve per Newton iteration, plus the dense iteration matrix the integrator clears
+    // and scans (n² per iteration).
+    let structure_step = 5.0 * (2e-6 * n + 1e-9 * n * n);
+    let seconds = steps * sub * (structure_step + aero_step);
+    Estimate {
+        unknowns: n,
+        steps,
+        bound_rings: bound,
+        wake_rings: wake,
+        bytes: structure_bytes + aero_bytes + 50e6,
+        seconds,
+        structure_bytes,
+        aero_bytes,
+    }
+}
+
+fn gb(x: f64) -> String {
+    if x >= 1e15 {
+        format!("{:.3e} GB", x / 1e9)
+    } else if x >= 1e9 {
+        format!("{:.3} GB", x / 1e9)
+    } else {
+        format!("{:.1} MB", x / 1e6)
+    }
+}
+
+fn duration(s: f64) -> String {
+    if s >= 3.6e9 {
+        format!("{:.3e} h", s / 3600.0)
+    } else if s >= 3600.0 {
+        format!("{:.3} h", s / 3600.0)
+    } else {
+        format!("{s:.1} s")
+    }
+}
+
+/// Refuse a case whose run would not fit the [`limits`]: the message names the field that drives
+/// the excess and the estimate.
+pub fn check(case: &Case) -> Result<(), String> {
+    let lim = limits();
+    for f in Formulation::ALL {
+        let e = estimate(case, f);
+        if e.bytes > lim.memory_bytes {
+            let field = if e.aero_bytes > e.structure_bytes {
+                "aero.panels_per_body / aero.n_chordwise / aero.n_wake_rows".to_string()
+            } else if 8.0 * e.unknowns * e.unknowns > 0.5 * e.structure_bytes {
+                format!("{f}.elements_per_body")
+            } else {
+                format!("t_end / {f}.dt / output_dt ({:.3e} steps)", e.steps)
+            };
+            return Err(format!(
+                "{field}: the {f} run needs an estimated {} ({:.0} unknowns, {:.0} bound and {:.0} wake rings, \
+                 {:.3e} steps), more than the limit of {} (--max-memory)",
+                gb(e.bytes),
+                e.unknowns,
+                e.bound_rings,
+                e.wake_rings,
+                e.steps,
+                gb(lim.memory_bytes)
+            ));
+        }
+        if e.seconds > lim.seconds {
+            return Err(format!(
+                "t_end / {f}.dt: the {f} run takes {:.3e} steps, an estimated {} ({:.0} unknowns, {:.0} bound \
+                 rings), more than the limit of {} (--max-hours)",
+                e.steps,
+                duration(e.seconds),
+                e.unknowns,
+                e.bound_rings,
+                duration(lim.seconds)
+            ));
+        }
+    }
+    Ok(())
+}

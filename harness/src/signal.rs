@@ -1,0 +1,40 @@
+//! SIGINT and SIGTERM end runs cleanly: the first signal asks every time loop to stop after its
+//! current step (the rows so far are written and the summary is marked `"interrupted"`); a
+//! second one ends the process at once.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Exit status of a run ended by a signal (128 + SIGINT, as shells report it).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Install the handlers (call once, at the start of the binary).
+pub fn install() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: the handler only touches an atomic and calls the async-signal-safe `_exit`.
+    unsafe {
+        let h = handler as extern "C" fn(libc::c_int) as libc::sighandler_t;
+        libc::signal(libc::SIGINT, h);
+        libc::signal(libc::SIGTERM, h);
+    }
+}
+
+#[cfg(target_os = "linux")]
+extern "C" fn handler(_sig: libc::c_int) {
+    if STOP.swap(true, Ordering::SeqCst) {
+        // SAFETY: `_exit` is async-signal-safe.
+        unsafe { libc::_exit(EXIT_INTERRUPTED as libc::c_int) }
+    }
+}
+
+/// Whether a stop was requested.
+#[inline]
+pub fn interrupted() -> bool {
+    STOP.load(Ordering::Relaxed)
+}
+
+/// Ask the time loops to stop, as a signal does (for tests and embedding programs).
+pub fn request_stop() {
+    STOP.store(true, Ordering::SeqCst);
+}

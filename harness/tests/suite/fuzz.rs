@@ -1,0 +1,93 @@
+//! Structure-aware fuzzing of the real case files through parse, validation, model building and
+//! a short run (`harness::fuzz`), in this process: no input may panic (an abort or a hang would
+//! end or stall the test binary), and every refusal names the file. Also replays every input
+//! that ever crashed (`harness/tests/fuzz_regressions.jsonl`). The long campaign, each input in
+//! its own process under time and memory limits, is `harness fuzz` (README, "Fuzzing").
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use harness::case::set_path;
+use harness::fuzz::{Class, Rng, check, mutate, seeds};
+use serde_json::Value;
+
+fn cases() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../cases")
+}
+
+/// Runs of at most this many steps; memory per run at most 2 GB.
+const STEPS: usize = 2;
+
+fn limits() {
+    harness::budget::set_limits(Some(2.0), None);
+}
+
+#[test]
+fn mutated_case_files_never_panic_and_every_refusal_names_the_file() {
+    limits();
+    let seeds = seeds(&cases()).unwrap();
+    let path = cases().join("fuzz-input.json");
+    let mut counts: BTreeMap<Class, usize> = BTreeMap::new();
+    let mut crashes = Vec::new();
+    // 3,000 inputs, a fixed seed: the same mutants on every machine.
+    for i in 0..3000_usize {
+        let mut rng = Rng::new(0x5eed_0019 ^ (i as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+        let (name, text) = &seeds[i % seeds.len()];
+        let (bytes, muts) = mutate(text, &mut rng);
+        let (class, msg) = check(&path, &bytes, STEPS);
+        *counts.entry(class).or_default() += 1;
+        if class.is_crash() {
+            crashes.push(format!("input {i} ({name}, {muts:?}): {class:?}: {msg}"));
+        }
+    }
+    assert!(crashes.is_empty(), "{} crashes: {:#?}", crashes.len(), &crashes[..crashes.len().min(10)]);
+    // The mutants reach every stage: some are refused, some run.
+    assert!(counts.get(&Class::Rejected).copied().unwrap_or(0) > 300, "{counts:?}");
+    assert!(
+        counts.get(&Class::Ok).copied().unwrap_or(0) + counts.get(&Class::RunFailed).copied().unwrap_or(0) > 100,
+        "{counts:?}"
+    );
+}
+
+fn hex(s: &str) -> Vec<u8> {
+    (0..s.len() / 2).map(|i| u8::from_str_radix(&s[2 * i..2 * i + 2], 16).unwrap()).collect()
+}
+
+/// Every input that ever crashed a command (the issue's reproducers, then what the campaigns
+/// found), replayed: each gives its expected class and message.
+#[test]
+fn every_input_that_ever_crashed_is_handled_fuzz_regressions_issue_19() {
+    limits();
+    let text = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions.jsonl"))
+        .unwrap();
+    let path = cases().join("fuzz-regression.json");
+    let mut n = 0;
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let e: Value = serde_json::from_str(line).unwrap();
+        let name = e["name"].as_str().unwrap();
+        let bytes = if let Some(h) = e["hex"].as_str() {
+            hex(h)
+        } else if let Some(t) = e["text"].as_str() {
+            t.as_bytes().to_vec()
+        } else {
+            let base = std::fs::read_to_string(cases().join(e["base"].as_str().unwrap())).unwrap();
+            let mut v: Value = serde_json::from_str(&base).unwrap();
+            for s in e["set"].as_array().unwrap() {
+                let s = s.as_str().unwrap().replace("LONG", &"x".repeat(100_000));
+                let (k, val) = s.split_once('=').unwrap();
+                let val = serde_json::from_str(val).unwrap_or(Value::String(val.to_string()));
+                set_path(&mut v, k, val).unwrap();
+            }
+            serde_json::to_vec_pretty(&v).unwrap()
+        };
+        let (class, msg) = check(&path, &bytes, STEPS);
+        let expect = e["expect"].as_str().unwrap();
+        assert_eq!(serde_json::to_value(class).unwrap(), expect, "{name}: {msg}");
+        if let Some(needle) = e["needle"].as_str() {
+            assert!(msg.contains(needle), "{name}: `{needle}` not in: {msg}");
+        }
+        assert!(msg.len() < 2000, "{name}: message of {} bytes", msg.len());
+        n += 1;
+    }
+    assert!(n >= 20, "{n} regressions");
+}
