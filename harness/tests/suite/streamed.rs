@@ -5,6 +5,8 @@
 //! moment leaves CSVs whose rows are whole and consecutive output steps from t = 0, and a
 //! `summary.json` that parses and is either complete or says `"interrupted"`. Concurrency test:
 //! pairs of identical runs started together into one output root leave whole, consistent folders.
+//! The counts are small here; `HARNESS_KILLS=50 HARNESS_PAIRS=100 cargo test --release -p harness
+//! --test suite streamed -- --nocapture` runs the larger campaign and prints its figures.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -75,6 +77,11 @@ fn moment(i: u64, max_ms: u64) -> Duration {
     Duration::from_millis(20 + (z ^ (z >> 27)) % max_ms)
 }
 
+/// `var` from the environment, else `default`.
+fn count(var: &str, default: u64) -> u64 {
+    std::env::var(var).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
 /// Kill `n` runs with `signal`; returns (interrupted, complete, interrupted runs whose CSVs
 /// already held rows past t = 0: the rows reached the file while the run went on).
 fn kill_runs(signal: i32, n: u64, name: &str) -> (usize, usize, usize) {
@@ -123,13 +130,17 @@ fn kill_runs(signal: i32, n: u64, name: &str) -> (usize, usize, usize) {
 
 #[test]
 fn sigkill_at_any_moment_leaves_whole_rows_and_an_honest_summary() {
-    let (interrupted, _, streamed) = kill_runs(libc::SIGKILL, 8, "sigkill");
+    let n = count("HARNESS_KILLS", 8);
+    let (interrupted, complete, streamed) = kill_runs(libc::SIGKILL, n, "sigkill");
+    eprintln!("SIGKILL: {n} kills, {interrupted} interrupted ({streamed} with rows on disk), {complete} complete");
     assert!(interrupted >= 1 && streamed >= 1, "{interrupted} interrupted, {streamed} with rows on disk");
 }
 
 #[test]
 fn sigint_finishes_the_step_writes_the_rows_and_marks_the_summary() {
-    let (interrupted, _, streamed) = kill_runs(libc::SIGINT, 6, "sigint");
+    let n = count("HARNESS_KILLS", 6);
+    let (interrupted, complete, streamed) = kill_runs(libc::SIGINT, n, "sigint");
+    eprintln!("SIGINT: {n} signals, {interrupted} interrupted ({streamed} with rows on disk), {complete} complete");
     assert!(interrupted >= 1 && streamed >= 1, "{interrupted} interrupted, {streamed} with rows");
 }
 
@@ -138,18 +149,28 @@ fn concurrent_runs_into_one_folder_never_mix() {
     let out = tmp("pairs");
     let o = out.to_str().unwrap();
     let args = ["run", "cases/double_pendulum_c1_beta45.json", "--set", "t_end=0.2", "--out", o];
-    for pair in 0..4 {
+    let pairs = count("HARNESS_PAIRS", 4);
+    let mut waited = 0;
+    for pair in 0..pairs {
         let (a, b) = (spawn(&args), spawn(&args));
         for c in [a, b] {
             let r = c.wait_with_output().unwrap();
             assert!(r.status.success(), "pair {pair}: {}", String::from_utf8_lossy(&r.stderr));
+            waited += usize::from(String::from_utf8_lossy(&r.stderr).contains("waiting for another run"));
         }
         let dir = out.join("double_pendulum_c1_beta45__set_t_end=0.2");
         assert_eq!(status(&dir).unwrap(), "complete", "pair {pair}");
         for f in ["ancf", "gebf"] {
             assert_eq!(check_csv(&dir.join(format!("{f}.csv")), 0.002).unwrap(), 101, "pair {pair} {f}");
         }
+        let stray: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains(".tmp-"))
+            .collect();
+        assert!(stray.is_empty(), "pair {pair}: {stray:?}");
     }
+    eprintln!("{pairs} concurrent pairs: 0 mixed or corrupt folders; the second run waited for the lock in {waited}");
     let _ = std::fs::remove_dir_all(&out);
 }
 
