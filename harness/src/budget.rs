@@ -118,11 +118,13 @@ pub struct Estimate {
     pub structure_bytes: f64,
     /// Memory of the aerodynamics alone, bytes.
     pub aero_bytes: f64,
+    /// Wall time of the structure alone, s.
+    pub structure_seconds: f64,
 }
 
 /// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
-/// overflows).
-pub fn estimate(case: &Case, f: Formulation) -> Estimate {
+/// overflows), run for at most `max_steps` steps when given.
+pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estimate {
     let (elements, dt, newton) = match f {
         Formulation::Ancf => (&case.ancf.elements_per_body, case.ancf.dt, case.ancf.newton),
         Formulation::Gebf => (&case.gebf.elements_per_body, case.gebf.dt, case.gebf.newton),
@@ -134,7 +136,10 @@ pub fn estimate(case: &Case, f: Formulation) -> Estimate {
         Formulation::Ancf => 12.0 * (el + nb as f64) + 12.0 * nj,
         Formulation::Gebf => 12.0 * el + 6.0 * nb as f64 + 6.0 * nj,
     };
-    let steps = (case.t_end / dt).round().max(1.0);
+    let mut steps = (case.t_end / dt).round().max(1.0);
+    if let Some(m) = max_steps {
+        steps = steps.min(m as f64);
+    }
     let every = case.output_dt.map_or(1.0, |o| (o / dt).round().max(1.0));
     let rows = steps / every + 2.0;
     let dense_lu = if n <= genalpha::DENSE_FALLBACK_MAX as f64 { 1.0 } else { 0.0 };
@@ -152,9 +157,11 @@ pub fn estimate(case: &Case, f: Formulation) -> Estimate {
         sub = 1.0 + a.coupling.max_sub_iterations as f64;
     }
     // A band solve per Newton iteration, plus the dense iteration matrix the integrator clears
-    // and scans (n² per iteration).
-    let structure_step = 5.0 * (2e-6 * n + 1e-9 * n * n);
-    let seconds = steps * sub * (structure_step + aero_step);
+    // and scans (n² per iteration; measured: 3 steps of a 14,500-unknown ANCF wing take 15 s);
+    // the consistent start costs about two steps more.
+    let structure_step = 5.0 * (2e-6 * n + 4e-9 * n * n);
+    let seconds = (steps + 2.0) * sub * (structure_step + aero_step);
+    let structure_seconds = (steps + 2.0) * sub * structure_step;
     Estimate {
         unknowns: n,
         steps,
@@ -164,6 +171,7 @@ pub fn estimate(case: &Case, f: Formulation) -> Estimate {
         seconds,
         structure_bytes,
         aero_bytes,
+        structure_seconds,
     }
 }
 
@@ -190,9 +198,13 @@ fn duration(s: f64) -> String {
 /// Refuse a case whose run would not fit the [`limits`]: the message names the field that drives
 /// the excess and the estimate.
 pub fn check(case: &Case) -> Result<(), String> {
-    let lim = limits();
+    check_within(case, &limits(), None)
+}
+
+/// As [`check`], against `lim`, for runs of at most `max_steps` steps when given.
+pub fn check_within(case: &Case, lim: &Limits, max_steps: Option<usize>) -> Result<(), String> {
     for f in Formulation::ALL {
-        let e = estimate(case, f);
+        let e = estimate(case, f, max_steps);
         if e.bytes > lim.memory_bytes {
             let field = if e.aero_bytes > e.structure_bytes {
                 "aero.panels_per_body / aero.n_chordwise / aero.n_wake_rows".to_string()
@@ -213,8 +225,16 @@ pub fn check(case: &Case) -> Result<(), String> {
             ));
         }
         if e.seconds > lim.seconds {
+            // The field that makes each step dear, or the step count when steps are cheap.
+            let field = if e.steps > 1e4 {
+                format!("t_end / {f}.dt")
+            } else if 2.0 * e.structure_seconds >= e.seconds {
+                format!("{f}.elements_per_body")
+            } else {
+                "aero.panels_per_body / aero.n_chordwise / aero.n_wake_rows".to_string()
+            };
             return Err(format!(
-                "t_end / {f}.dt: the {f} run takes {:.3e} steps, an estimated {} ({:.0} unknowns, {:.0} bound \
+                "{field}: the {f} run takes {:.3e} steps, an estimated {} ({:.0} unknowns, {:.0} bound \
                  rings), more than the limit of {} (--max-hours)",
                 e.steps,
                 duration(e.seconds),

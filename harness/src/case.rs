@@ -719,6 +719,17 @@ impl CaseFile {
 
     /// Expand the sweep and apply overrides; returns one [`RunSpec`] per sweep point.
     pub fn expand(&self, overrides: &[Override]) -> Result<Vec<RunSpec>, Error> {
+        self.expand_within(overrides, &crate::budget::limits(), None)
+    }
+
+    /// As [`expand`](Self::expand), each run checked against `limits` as a run of at most
+    /// `max_steps` steps when given (`harness run --max-steps`, `harness check`).
+    pub fn expand_within(
+        &self,
+        overrides: &[Override],
+        limits: &crate::budget::Limits,
+        max_steps: Option<usize>,
+    ) -> Result<Vec<RunSpec>, Error> {
         let file = self.path.display().to_string();
         let err = |msg: String| Error::Case { file: file.clone(), msg: clip(&msg) };
         // Global overrides first (they may change the sweep itself).
@@ -792,7 +803,7 @@ impl CaseFile {
                 let mut case = parse_case(&r).map_err(&err)?;
                 case.name.push_str(&suffix);
                 case.validate().map_err(&err)?;
-                crate::budget::check(&case).map_err(&err)?;
+                crate::budget::check_within(&case, limits, max_steps).map_err(&err)?;
                 for (k, r) in case.references.iter().enumerate() {
                     if checked.contains(&r.file) {
                         continue;

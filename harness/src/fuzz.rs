@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 use serde_json::Value;
 
+use crate::budget::Limits;
 use crate::case::{CaseFile, Formulation};
 
 /// A small deterministic generator (SplitMix64): the same seed gives the same mutants everywhere.
@@ -355,22 +356,26 @@ impl Class {
 
 /// Run one input in this process: parse, validate and expand as `harness run` does, build both
 /// formulations and run each at most `max_steps` steps. A panic is caught and classified.
-pub fn check(input_path: &Path, bytes: &[u8], max_steps: usize) -> (Class, String) {
-    check_parsed(input_path, || CaseFile::from_bytes(input_path, bytes), max_steps)
+///
+/// The budget ([`crate::budget`]) is checked against `limits` for runs of `max_steps` steps:
+/// what could not finish within the limits is refused.
+pub fn check(input_path: &Path, bytes: &[u8], max_steps: usize, limits: &Limits) -> (Class, String) {
+    check_parsed(input_path, || CaseFile::from_bytes(input_path, bytes), max_steps, limits)
 }
 
 /// As [`check`], reading the file at `path` as `harness run` does (`harness check`).
-pub fn check_file(path: &Path, max_steps: usize) -> (Class, String) {
-    check_parsed(path, || CaseFile::read(path), max_steps)
+pub fn check_file(path: &Path, max_steps: usize, limits: &Limits) -> (Class, String) {
+    check_parsed(path, || CaseFile::read(path), max_steps, limits)
 }
 
 fn check_parsed(
     input_path: &Path,
     read: impl FnOnce() -> Result<CaseFile, crate::Error>,
     max_steps: usize,
+    limits: &Limits,
 ) -> (Class, String) {
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let runs = match read().and_then(|c| c.expand(&[])) {
+        let runs = match read().and_then(|c| c.expand_within(&[], limits, Some(max_steps))) {
             Ok(r) => r,
             Err(e) => {
                 let m = e.to_string();
@@ -445,7 +450,13 @@ struct Worker {
 impl Worker {
     fn start(exe: &Path, c: &Campaign) -> std::io::Result<Self> {
         let mut cmd = Command::new(exe);
-        cmd.arg("fuzz-worker").arg("--max-steps").arg(c.max_steps.to_string());
+        // What cannot finish within half the time limit is refused by the budget.
+        let hours = c.timeout.as_secs_f64() / 2.0 / 3600.0;
+        cmd.arg("fuzz-worker")
+            .arg("--max-steps")
+            .arg(c.max_steps.to_string())
+            .arg("--max-hours")
+            .arg(hours.to_string());
         cmd.stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::null());
         limit(&mut cmd, c.address_space);
         let mut child = cmd.spawn()?;
@@ -523,7 +534,7 @@ pub fn worker_main(max_steps: usize) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     for line in stdin.lock().lines() {
         let line = line?;
-        let (class, msg) = check_file(Path::new(&line), max_steps);
+        let (class, msg) = check_file(Path::new(&line), max_steps, &crate::budget::limits());
         let k = serde_json::to_value(class).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default();
         let msg: String = msg.chars().take(4000).map(|c| if c == '\n' || c == '\t' { ' ' } else { c }).collect();
         writeln!(out, "{k}\t{msg}")?;
@@ -656,7 +667,8 @@ pub fn run_child(exe: &Path, file: &Path, out: &Path, c: &Campaign) -> (Class, S
     } else {
         cmd.arg("check").arg(file);
     }
-    cmd.arg("--max-steps").arg(c.max_steps.to_string());
+    let hours = c.timeout.as_secs_f64() / 2.0 / 3600.0;
+    cmd.arg("--max-steps").arg(c.max_steps.to_string()).arg("--max-hours").arg(hours.to_string());
     cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::piped());
     cmd.env("RUST_BACKTRACE", "0");
     limit(&mut cmd, c.address_space);

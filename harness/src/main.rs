@@ -420,7 +420,7 @@ fn real_main() -> Result<ExitCode> {
     match cli.cmd {
         Cmd::Check { case, max_steps } => {
             use harness::fuzz::Class;
-            let (class, msg) = harness::fuzz::check_file(&case, max_steps);
+            let (class, msg) = harness::fuzz::check_file(&case, max_steps, &harness::budget::limits());
             match class {
                 Class::Ok => {
                     println!("{}: ok", case.display());
@@ -586,7 +586,9 @@ fn real_main() -> Result<ExitCode> {
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
-            let runs = variants(CaseFile::read(&case).and_then(|c| c.expand(&set))?, &set, &fs, max_steps);
+            let limits = harness::budget::limits();
+            let file = CaseFile::read(&case)?;
+            let runs = variants(file.expand_within(&set, &limits, max_steps)?, &set, &fs, max_steps);
             let progress = Progress::new(true);
             // VTK when --vtk asks for it or the case's `vtk` block does.
             let cli = vtk.then_some(vtk_stride);

@@ -289,14 +289,39 @@ fn with_step_control(case: &Case) -> Case {
     k
 }
 
-/// Run extra cases (label, case spec) with both formulations in parallel.
+/// An observer that only reports progress.
+struct Progressed(crate::progress::RunProgress);
+
+impl crate::run::Observer for Progressed {
+    fn wants_snapshots(&self) -> bool {
+        false
+    }
+    fn observe(&mut self, _: &crate::run::Snapshot<'_>) -> Result<(), String> {
+        Ok(())
+    }
+    fn row(&mut self, row: &crate::run::Row) -> Result<(), String> {
+        self.0.update(row.t);
+        Ok(())
+    }
+}
+
+/// Run extra cases (label, case spec) with both formulations in parallel, each rerun with step
+/// control if it fails, with per-run progress.
 pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
+    let progress = crate::progress::Progress::new(true);
+    let progress = &progress;
     let jobs: Vec<(usize, Formulation)> =
         (0..extras.len()).flat_map(|i| Formulation::ALL.into_iter().map(move |f| (i, f))).collect();
     jobs.par_iter()
         .map(|&(i, f)| {
             let case = extras[i].1.case(f);
-            let out = run_formulation(case, f);
+            // These runs take minutes: show their progress (simulated time, steps/s, time left).
+            let dt = match f {
+                Formulation::Ancf => case.ancf.dt,
+                Formulation::Gebf => case.gebf.dt,
+            };
+            let mut progress = Progressed(progress.run(&extras[i].0, f, case.t_end, dt));
+            let out = crate::scene::run_formulation_observed(case, f, &mut progress);
             let recovery =
                 out.error.is_some().then(|| FormulationMetrics::of(&run_formulation(&with_step_control(case), f)));
             Extra { label: extras[i].0.clone(), formulation: f, metrics: FormulationMetrics::of(&out), recovery }

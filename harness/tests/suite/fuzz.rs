@@ -7,6 +7,7 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use harness::budget::Limits;
 use harness::case::set_path;
 use harness::fuzz::{Class, Rng, check, mutate, seeds};
 use serde_json::Value;
@@ -15,16 +16,14 @@ fn cases() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../cases")
 }
 
-/// Runs of at most this many steps; memory per run at most 2 GB.
+/// Runs of at most this many steps.
 const STEPS: usize = 2;
 
-fn limits() {
-    harness::budget::set_limits(Some(2.0), None);
-}
+/// Each input within 2 GB and 10 s (estimated), as a campaign child under 4 GB and 20 s.
+const LIMITS: Limits = Limits { memory_bytes: 2e9, seconds: 10.0 };
 
 #[test]
 fn mutated_case_files_never_panic_and_every_refusal_names_the_file() {
-    limits();
     let seeds = seeds(&cases()).unwrap();
     let path = cases().join("fuzz-input.json");
     let mut counts: BTreeMap<Class, usize> = BTreeMap::new();
@@ -34,7 +33,7 @@ fn mutated_case_files_never_panic_and_every_refusal_names_the_file() {
         let mut rng = Rng::new(0x5eed_0019 ^ (i as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
         let (name, text) = &seeds[i % seeds.len()];
         let (bytes, muts) = mutate(text, &mut rng);
-        let (class, msg) = check(&path, &bytes, STEPS);
+        let (class, msg) = check(&path, &bytes, STEPS, &LIMITS);
         *counts.entry(class).or_default() += 1;
         if class.is_crash() {
             crashes.push(format!("input {i} ({name}, {muts:?}): {class:?}: {msg}"));
@@ -57,7 +56,6 @@ fn hex(s: &str) -> Vec<u8> {
 /// found), replayed: each gives its expected class and message.
 #[test]
 fn every_input_that_ever_crashed_is_handled_fuzz_regressions_issue_19() {
-    limits();
     let text = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions.jsonl"))
         .unwrap();
     let path = cases().join("fuzz-regression.json");
@@ -80,7 +78,7 @@ fn every_input_that_ever_crashed_is_handled_fuzz_regressions_issue_19() {
             }
             serde_json::to_vec_pretty(&v).unwrap()
         };
-        let (class, msg) = check(&path, &bytes, STEPS);
+        let (class, msg) = check(&path, &bytes, STEPS, &LIMITS);
         let expect = e["expect"].as_str().unwrap();
         assert_eq!(serde_json::to_value(class).unwrap(), expect, "{name}: {msg}");
         if let Some(needle) = e["needle"].as_str() {
