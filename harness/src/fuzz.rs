@@ -246,7 +246,7 @@ pub fn mutate(text: &str, rng: &mut Rng) -> (Vec<u8>, Vec<Mutation>) {
                     && let Some(f) = x.as_f64()
                 {
                     let y = f * 10f64.powi(k);
-                    *x = if x.is_u64() && y >= 0.0 && y < 1e15 && y.fract() == 0.0 {
+                    *x = if x.is_u64() && (0.0..1e15).contains(&y) && y.fract() == 0.0 {
                         serde_json::json!(y as u64)
                     } else {
                         serde_json::json!(y)
@@ -277,13 +277,12 @@ pub fn mutate(text: &str, rng: &mut Rng) -> (Vec<u8>, Vec<Mutation>) {
                 // Repeat a key of some object: `"key": 0,` in front of its first occurrence.
                 let keys: Vec<usize> =
                     bytes.windows(3).enumerate().filter(|(_, w)| w == b"\": ").map(|(i, _)| i).collect();
-                if let Some(&end) = keys.get(rng.below(keys.len().max(1))) {
-                    if let Some(start) = bytes[..end].iter().rposition(|&b| b == b'"') {
-                        let key = bytes[start..=end].to_vec();
-                        let mut ins = key;
-                        ins.extend_from_slice(b": 0, ");
-                        bytes.splice(start..start, ins);
-                    }
+                if let Some(&end) = keys.get(rng.below(keys.len().max(1)))
+                    && let Some(start) = bytes[..end].iter().rposition(|&b| b == b'"')
+                {
+                    let mut ins = bytes[start..=end].to_vec();
+                    ins.extend_from_slice(b": 0, ");
+                    bytes.splice(start..start, ins);
                 }
             }
             Mutation::BadUtf8 => {
@@ -512,7 +511,7 @@ impl Worker {
             }
             _ => {
                 let st = self.child.wait();
-                Err(st.map_or(Class::Other, |s| classify_status(s)))
+                Err(st.map_or(Class::Other, classify_status))
             }
         }
     }
