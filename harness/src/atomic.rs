@@ -1,6 +1,6 @@
 //! Output files that appear whole or not at all, and output folders that one run owns at a time.
 //!
-//! * [`write`]: the contents go to a temporary file beside the target, which is then renamed over
+//! * [`write()`]: the contents go to a temporary file beside the target, which is then renamed over
 //!   it, so a reader (or a run killed mid-write) sees the old file or the new one, never a part.
 //! * [`claim_dir`]: an exclusive lock on `<dir>/.lock` (`flock`, released by the kernel when the
 //!   process ends, however it ends). A second run into the same folder waits for the first.
