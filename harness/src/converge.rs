@@ -14,8 +14,8 @@
 //! on one thread, so that no rung's time includes waiting for a core another rung holds.
 //!
 //! Error of a rung = max over time of the tip distance to its truth. Observed orders come from
-//! successive rungs (`log2(e_k / e_{k+1})` for halving ratios), and a Richardson estimate of the
-//! truth's own error is reported from the last two rungs.
+//! successive rungs (`ln(e_k / e_{k+1}) / ln(h_k / h_{k+1})` over the rungs' step or element
+//! ratio), and a Richardson estimate of the truth's own error is reported from the last two rungs.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -275,6 +275,9 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                 against = format!("{against}: failed");
             }
             let mut errs = Vec::new();
+            // The rung's mesh size: dt on the time and diagonal ladders (the diagonal refines
+            // both by one ratio), 1 / elements on the space ladder.
+            let mut sizes = Vec::new();
             for &i in &idx {
                 let (_, _, ref e, dt, is_truth) = plan[i];
                 let o = &outs[i];
@@ -285,6 +288,10 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                 };
                 if !is_truth || use_external {
                     errs.push(error_m);
+                    sizes.push(match ladder {
+                        Ladder::Space => 1.0 / e.for_body(0).max(1) as f64,
+                        _ => dt,
+                    });
                 }
                 rungs.push(Rung {
                     formulation: f,
@@ -300,16 +307,19 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
                     failure: o.error.clone(),
                 });
             }
-            // Orders from successive rungs with ratio 2 (the space ladder's first step may not be 2).
-            let obs: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+            // Orders from successive rungs over their actual refinement ratio (the space ladder's
+            // first step need not be 2): p = ln(e_k / e_{k+1}) / ln(h_k / h_{k+1}).
+            let obs: Vec<f64> =
+                errs.windows(2).zip(sizes.windows(2)).map(|(e, h)| (e[0] / e[1]).ln() / (h[0] / h[1]).ln()).collect();
             let p_last = obs.iter().rev().find(|x| x.is_finite()).copied().unwrap_or(f64::NAN);
             let last = errs.iter().rev().find(|x| x.is_finite()).copied().unwrap_or(f64::NAN);
+            let ratio = sizes.windows(2).last().map_or(2.0, |h| h[0] / h[1]);
             orders.push(Order {
                 formulation: f,
                 ladder,
                 orders: obs,
                 // Richardson needs an observed order clearly above zero; otherwise no estimate.
-                truth_error_estimate_m: if p_last > 0.5 { last / (2f64.powf(p_last) - 1.0) } else { f64::NAN },
+                truth_error_estimate_m: if p_last > 0.5 { last / (ratio.powf(p_last) - 1.0) } else { f64::NAN },
             });
         }
     }
