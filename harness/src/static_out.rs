@@ -290,7 +290,10 @@ pub fn write(dir: &Path, summary: &StaticSummary) -> Result<(), Error> {
     plot_coast(&dir.join("static_coast.svg"), summary)?;
     plot_rbm(&dir.join("static_rbm.svg"), summary)?;
     plot_lift(&dir.join("static_lift.svg"), summary)?;
-    write_file(&dir.join(SECTION_FILE), &section_html(summary))
+    // The section links the plots by the folder they are in (a run's variant folder under
+    // `--set` is not the case's name).
+    let folder = dir.file_name().map_or_else(|| summary.name.clone(), |n| n.to_string_lossy().into_owned());
+    write_file(&dir.join(SECTION_FILE), &section_html(summary, &folder))
 }
 
 /// The report fragment each sweep leaves in its folder for `reports/index.html`.
@@ -515,7 +518,7 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
 }
 
 /// The report's section for a static sweep (HTML fragment; links relative to the report root).
-pub fn section_html(s: &StaticSummary) -> String {
+pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     let mut h = String::new();
     let _ = write!(h, "<h3 id=\"static-{0}\">{0}</h3>\n<p>{1}</p>\n", s.name, html_escape(&s.description));
     let _ = writeln!(
@@ -603,7 +606,7 @@ pub fn section_html(s: &StaticSummary) -> String {
         ("static_rbm.svg", "root bending moment against airspeed"),
         ("static_lift.svg", "spanwise lift at three airspeeds"),
     ] {
-        let _ = writeln!(h, "<p><img src=\"{}/{file}\" alt=\"{alt}\" width=\"900\"></p>", s.name);
+        let _ = writeln!(h, "<p><img src=\"{}/{file}\" alt=\"{alt}\" width=\"900\"></p>", html_escape(folder));
     }
     h
 }

@@ -47,7 +47,13 @@ fn vtk_files_of_the_papers_wing_parse_with_vtks_reader() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r = Command::new(&py).args(["-c", READER]).arg(out.join("wing_aoa5/vtk")).output().unwrap();
+    // The run's folder is named after its variant (`--set`): the one folder of the case.
+    let dir = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("wing_aoa5")) && p.join("vtk").is_dir())
+        .expect("the run wrote its vtk folder");
+    let r = Command::new(&py).args(["-c", READER]).arg(dir.join("vtk")).output().unwrap();
     let text = String::from_utf8_lossy(&r.stdout).to_string();
     assert!(r.status.success(), "{}\n{}", text, String::from_utf8_lossy(&r.stderr));
     eprintln!("{text}");
