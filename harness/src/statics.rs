@@ -585,7 +585,7 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
     let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
     // 1. The first equilibrium at the highest airspeed, by load stepping.
     let mut iters = 0;
-    // Newton in rounds of a few iterations: the aerodynamic stiffness (the costly part of the
+    // Newton in rounds of up to 25 iterations: the aerodynamic stiffness (the costly part of the
     // tangent) is kept within a round and from the previous point, and re-evaluated at the start
     // of every further round.
     let solve =
