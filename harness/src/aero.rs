@@ -162,6 +162,13 @@ pub struct StationMap {
     pub hinge: bool,
 }
 
+impl StationMap {
+    /// Arclength of the station along the wing, the bodies laid end to end, m.
+    pub fn wing_arc(&self, case: &Case) -> f64 {
+        case.bodies.iter().take(self.body).map(|b| b.length).sum::<f64>() + self.s
+    }
+}
+
 /// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
 /// body's panels, the hinge column shared (driven by the inner body's end).
 pub fn station_map(case: &Case, aero: &AeroSettings) -> Result<Vec<StationMap>, String> {
@@ -210,16 +217,7 @@ pub fn station_map(case: &Case, aero: &AeroSettings) -> Result<Vec<StationMap>, 
 /// the leading- and trailing-edge nodes in spanwise order. Only the panel layout changes, not
 /// the planform; columns farther than `D` keep `γ = 0` exactly.
 fn grade_slants(case: &Case, aero: &AeroSettings, map: &mut [StationMap]) {
-    let starts: Vec<f64> = case
-        .bodies
-        .iter()
-        .scan(0.0, |acc, b| {
-            let s0 = *acc;
-            *acc += b.length;
-            Some(s0)
-        })
-        .collect();
-    let arc = |m: &StationMap| starts.get(m.body).copied().unwrap_or(0.0) + m.s;
+    let arc = |m: &StationMap| m.wing_arc(case);
     let hinges: Vec<(f64, f64)> = map.iter().filter(|m| m.hinge).map(|m| (arc(m), m.slant)).collect();
     let reach = aero.le_offset.abs().max((aero.chord - aero.le_offset).abs());
     for m in map.iter_mut().filter(|m| !m.hinge) {

@@ -742,16 +742,7 @@ fn point_at<S: StaticStructure>(
     let lift_dir = lift_direction(v_inf);
     let lift = Vector3::from(uv_loads.total_force()).dot(&lift_dir);
     // Column j of the lattice lies between stations j and j + 1.
-    let starts: Vec<f64> = case
-        .bodies
-        .iter()
-        .scan(0.0, |acc, b| {
-            let s0 = *acc;
-            *acc += b.length;
-            Some(s0)
-        })
-        .collect();
-    let arc = |m: &StationMap| starts.get(m.body).copied().unwrap_or(0.0) + m.s;
+    let arc = |m: &StationMap| m.wing_arc(case);
     let qdyn = 0.5 * rho * airspeed * airspeed;
     let chord = sys.aero.chord;
     let strips = (0..stations.len().saturating_sub(1))
