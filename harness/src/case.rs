@@ -89,6 +89,10 @@ pub struct Case {
     /// experiment or model curves to compare with. Needs `aero`.
     #[serde(default, rename = "static", skip_serializing_if = "Option::is_none")]
     pub statics: Option<StaticSettings>,
+    /// Linearised stability (`harness stability`): airspeeds, modes to track, the state to
+    /// linearise about. Needs `aero`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stability: Option<crate::stability::StabilitySettings>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -1375,6 +1379,12 @@ impl Case {
                     return Err(format!("static.references[{k}].label: empty"));
                 }
             }
+        }
+        if let Some(st) = &self.stability {
+            if self.aero.is_none() {
+                return Err("stability: a stability analysis needs `aero`".into());
+            }
+            st.validate()?;
         }
         if let Some(g) = &self.gate {
             pos("gate.energy_drift", g.energy_drift)?;

@@ -26,6 +26,8 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod stability;
+pub mod stability_out;
 pub mod signal;
 pub mod static_out;
 pub mod statics;

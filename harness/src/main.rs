@@ -218,6 +218,21 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
+    /// Linearised stability over the case's `stability.airspeeds` (flutter, divergence, modes);
+    /// writes `<out>/<case>/stability_{ancf,gebf}.csv`, `.json`, plots and a report fragment.
+    Stability {
+        /// Case file (with `aero` and `stability` blocks).
+        case: PathBuf,
+        /// Formulation(s) to run.
+        #[arg(long, value_enum, default_value = "both")]
+        formulation: Which,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
     /// List the runs the case files expand into.
     List {
         /// Folder of case files.
@@ -287,6 +302,49 @@ fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String,
         v.push(("wing AoA 15 deg, 20 s".to_string(), CaseFile::read(&wing)?.expand(&ov)?.remove(0)));
     }
     Ok(v)
+}
+
+/// The stability sweeps of `spec` with the formulations `fs`, in parallel.
+fn run_stability_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> Vec<harness::stability::StabilityOutput> {
+    use rayon::prelude::*;
+    fs.par_iter().map(|&f| harness::stability::run_stability(spec.case(f), f)).collect()
+}
+
+/// Print a stability sweep's results; true when a point failed.
+fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) -> bool {
+    let mut failed = false;
+    for o in outs {
+        if let Some(e) = &o.error {
+            eprintln!("stability {name} {}: {e}", o.formulation);
+            failed = true;
+            continue;
+        }
+        let bad = o.points.iter().filter(|p| p.error.is_some()).count();
+        let unconverged = o.points.iter().flat_map(|p| &p.roots).filter(|r| !r.converged).count();
+        for p in o.points.iter().filter(|p| p.error.is_some()) {
+            eprintln!("stability {name} {} at {} m/s: {}", o.formulation, p.airspeed, p.error.as_deref().unwrap_or(""));
+        }
+        failed |= bad > 0;
+        let f = |x: Option<f64>| x.map_or_else(|| "none".to_string(), |v| format!("{v:.3}"));
+        println!(
+            "stability {name} {}: flutter {} m/s at {} rad/s, divergence {} m/s; {} points ({} failed, {} unconverged roots), basis {} of {} free motions, {} + {} rings, build {:.3} s, roots {:.3} s, {} D(s) evaluations",
+            o.formulation,
+            f(o.flutter_speed),
+            f(o.flutter_frequency_rad_s),
+            f(o.divergence_speed),
+            o.points.len(),
+            bad,
+            unconverged,
+            o.n_basis,
+            o.n_free,
+            o.n_rings,
+            o.n_wake_rings,
+            o.build_s,
+            o.solve_s,
+            o.n_evaluations
+        );
+    }
+    failed
 }
 
 /// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
@@ -669,6 +727,33 @@ fn real_main() -> Result<ExitCode> {
                 let dir = out.join(&spec.name);
                 harness::static_out::write(&dir, &summary)?;
                 failed |= report_static(&summary);
+                println!("wrote {}", dir.display());
+            }
+            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+        }
+        Cmd::Stability { case, formulation, out, set } => {
+            let file = CaseFile::read(&case)?;
+            let runs = file.expand(&set)?;
+            let fs: Vec<Formulation> = match formulation {
+                Which::Ancf => vec![Formulation::Ancf],
+                Which::Gebf => vec![Formulation::Gebf],
+                Which::Both => Formulation::ALL.to_vec(),
+            };
+            for spec in &runs {
+                if spec.ancf.stability.is_none() {
+                    return Err(harness::Error::Case {
+                        file: case.display().to_string(),
+                        msg: "stability: the case has no `stability` block (airspeeds to analyse)".into(),
+                    }
+                    .into());
+                }
+            }
+            let mut failed = false;
+            for spec in &runs {
+                let outs = run_stability_case(spec, &fs);
+                let dir = out.join(&spec.name);
+                harness::stability_out::write(&dir, &spec.name, &outs)?;
+                failed |= report_stability(&spec.name, &outs);
                 println!("wrote {}", dir.display());
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })

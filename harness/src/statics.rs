@@ -480,6 +480,10 @@ pub struct StaticPoint {
     /// Spanwise lift distribution.
     #[serde(skip)]
     pub strips: Vec<Strip>,
+    /// The equilibrium: coordinates and the multipliers of the holonomic and velocity
+    /// constraints (for the linearisation about it).
+    #[serde(skip)]
+    pub state: Option<(Vec<f64>, Vec<f64>, Vec<f64>)>,
 }
 
 /// A formulation's static sweep.
@@ -541,6 +545,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
         newton_iterations: 0,
         error: Some(msg),
         strips: Vec::new(),
+        state: None,
     }
 }
 
@@ -692,6 +697,7 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
             None => {
                 let mut p = point_at(&sys, &x.q, case, loads_model.as_ref(), &map, aero.rho);
                 p.newton_iterations = n_it;
+                p.state = Some((x.q.clone(), x.lambda.clone(), x.mu.clone()));
                 p
             }
         });
@@ -760,7 +766,17 @@ fn point_at<S: StaticStructure>(
             })
         })
         .collect();
-    StaticPoint { airspeed, fold_deg: fold, tip: model.tip(q), loads, lift, newton_iterations: 0, error: None, strips }
+    StaticPoint {
+        airspeed,
+        fold_deg: fold,
+        tip: model.tip(q),
+        loads,
+        lift,
+        newton_iterations: 0,
+        error: None,
+        strips,
+        state: None,
+    }
 }
 
 /// Unit lift direction: perpendicular to the free stream and to the global X axis (the span).

@@ -4,6 +4,7 @@
 mod common;
 mod flow;
 mod hinge;
+mod linear;
 mod properties;
 mod steady;
 mod theodorsen;

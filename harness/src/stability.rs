@@ -1,0 +1,743 @@
+//! Linearised aeroelastic stability about a static equilibrium (docs/stability.md).
+//!
+//! At each airspeed of the case's `stability` block:
+//!
+//! 1. **Equilibrium**: the static aeroelastic equilibrium of [`crate::statics`] (or the
+//!    undeformed reference configuration, `"about": "undeformed"`), with its multipliers.
+//! 2. **Structure**: the generic linearisation `M, C, K` of `genalpha::analysis::linearise`
+//!    about it (gravity, springs, dampers and the constraint forces' geometric stiffness), the
+//!    constraints eliminated by the null-space basis, and a basis of its first `n_b` natural
+//!    modes `Φ` (mass-normalised).
+//! 3. **Aerodynamics**: the UVLM linearised about the steady solution on the equilibrium's
+//!    lattice ([`uvlm::LinearUvlm`], Laplace domain, frozen wake, the wake's delays exact), coupled
+//!    to the structure through the same seam as the time-domain coupling: the lattice follows the
+//!    structure's stations, and the nodal forces are lumped to station loads and applied by the
+//!    formulation's own `set_section_loads`. The geometric terms (how moving along a mode moves
+//!    the lattice, its normals and its force arms, and how a formulation turns station loads into
+//!    generalised forces at a moved state) are central differences along the modes.
+//! 4. **Flutter equation** in the modal coordinates `η`:
+//!
+//!    $$ D(s)\,\eta = \Big[M s^2 + C s + K + G_x + s\,G_{\dot x}
+//!        - T(s)\,N(s)^{-1}\big(R_x + s\,R_{\dot x}\big)\Big]\eta = 0 ,$$
+//!
+//!    `N(s) = A + Σ_k e^{−sτ_k} W_k E` the non-penetration operator, `T(s)` the generalised load
+//!    of the circulations (Joukowski, unsteady term and wake). Its roots are found per mode by
+//!    Newton's method on `(η, s)` (the p-method; no reduced-frequency approximation), continued
+//!    over the airspeeds from the structural modes.
+//! 5. **Flutter** where a root's real part changes sign (interpolated linearly between airspeeds);
+//!    **divergence** where the smallest real eigenvalue of `M⁻¹D(0)` (the static aeroelastic
+//!    stiffness) changes sign.
+
+use std::time::Instant;
+
+use nalgebra::{Complex, DMatrix, DVector, Vector3};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
+use crate::case::{Case, Formulation};
+use crate::statics::StaticStructure;
+
+type C64 = Complex<f64>;
+
+/// The `stability` block of a case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StabilitySettings {
+    /// Airspeeds of the sweep, m/s, in increasing order.
+    pub airspeeds: Vec<f64>,
+    /// Number of modes to track and report (the lowest structural modes).
+    pub modes: usize,
+    /// The state to linearise about: `"equilibrium"` (default; the static aeroelastic
+    /// equilibrium at each airspeed) or `"undeformed"` (the reference configuration, loads ignored).
+    #[serde(default)]
+    pub about: About,
+    /// Structural modes in the basis of the flutter equation (default: `max(2·modes, 20)`, at most
+    /// the free motions).
+    #[serde(default)]
+    pub basis_modes: Option<usize>,
+    /// The frozen wake of the linear aerodynamics; default: the time-marching wake
+    /// (`aero.n_wake_rows` rows of `airspeed·dt`, closed when `aero.wake_closure`).
+    #[serde(default)]
+    pub wake: Option<WakeSettings>,
+}
+
+/// The state a stability analysis linearises about.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum About {
+    /// The static aeroelastic equilibrium at each airspeed.
+    #[default]
+    Equilibrium,
+    /// The undeformed reference configuration.
+    Undeformed,
+}
+
+/// The frozen wake of the linear aerodynamics.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WakeSettings {
+    /// Length of a wake row along the free stream, m.
+    pub row_length: f64,
+    /// Number of rows.
+    pub rows: usize,
+    /// Close with semi-infinite legs. Default false.
+    #[serde(default)]
+    pub closure: bool,
+}
+
+/// Most airspeeds in one stability sweep.
+pub const MAX_STABILITY_POINTS: usize = 200;
+/// Most wake rings of the linear aerodynamics.
+pub const MAX_LINEAR_WAKE_RINGS: usize = 200_000;
+
+impl StabilitySettings {
+    /// Every impossible value, naming its field.
+    ///
+    /// # Errors
+    /// A message naming the field.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.airspeeds.is_empty() {
+            return Err("stability.airspeeds: empty list".into());
+        }
+        if self.airspeeds.len() > MAX_STABILITY_POINTS {
+            return Err(format!("stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}", self.airspeeds.len()));
+        }
+        for (k, &u) in self.airspeeds.iter().enumerate() {
+            if !(u.is_finite() && u > 0.0) {
+                return Err(format!("stability.airspeeds[{k}]: {u} is not a positive airspeed"));
+            }
+            if k > 0 && u <= self.airspeeds[k - 1] {
+                return Err(format!("stability.airspeeds[{k}]: {u} does not increase"));
+            }
+        }
+        if self.modes == 0 || self.modes > 100 {
+            return Err(format!("stability.modes: {} is not in 1..=100", self.modes));
+        }
+        if let Some(b) = self.basis_modes
+            && (b < self.modes || b > 400)
+        {
+            return Err(format!("stability.basis_modes: {b} is not in modes..=400"));
+        }
+        if let Some(w) = &self.wake {
+            if !(w.row_length.is_finite() && w.row_length > 0.0) {
+                return Err(format!("stability.wake.row_length: {} is not positive", w.row_length));
+            }
+            if w.rows == 0 || w.rows > 4000 {
+                return Err(format!("stability.wake.rows: {} is not in 1..=4000", w.rows));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One root of the flutter equation at one airspeed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Root {
+    /// Index of the structural mode it was continued from (0 = lowest).
+    pub mode: usize,
+    /// Real part of s, 1/s.
+    pub real: f64,
+    /// Imaginary part of s, rad/s.
+    pub imag: f64,
+    /// Whether Newton's method converged.
+    pub converged: bool,
+}
+
+impl Root {
+    /// Damped frequency, Hz.
+    pub fn frequency_hz(&self) -> f64 {
+        self.imag / (2.0 * std::f64::consts::PI)
+    }
+    /// Damping ratio `−Re s / |s|`.
+    pub fn damping_ratio(&self) -> f64 {
+        let n = self.real.hypot(self.imag);
+        if n > 0.0 { -self.real / n } else { 0.0 }
+    }
+}
+
+/// One airspeed of a stability sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilityPoint {
+    /// Airspeed, m/s.
+    pub airspeed: f64,
+    /// Fold angle of the equilibrium, degrees (NaN without a fold hinge).
+    pub fold_deg: f64,
+    /// Tracked roots, one per mode.
+    pub roots: Vec<Root>,
+    /// Smallest real eigenvalue of `M⁻¹ D(0)` (rad²/s²): negative past divergence.
+    pub static_stiffness_min: f64,
+    /// Structural natural frequencies about this equilibrium (no aerodynamics), rad/s.
+    pub structural_rad_s: Vec<f64>,
+    /// Why the point could not be analysed.
+    pub error: Option<String>,
+}
+
+/// A formulation's stability sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StabilityOutput {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// One point per airspeed.
+    pub points: Vec<StabilityPoint>,
+    /// Flutter speed, m/s (the first crossing in the sweep), if any.
+    pub flutter_speed: Option<f64>,
+    /// Flutter frequency, rad/s.
+    pub flutter_frequency_rad_s: Option<f64>,
+    /// Mode that flutters.
+    pub flutter_mode: Option<usize>,
+    /// Divergence speed, m/s, if any.
+    pub divergence_speed: Option<f64>,
+    /// Tangent unknowns of the structure.
+    pub n_dof: usize,
+    /// Free motions (null space of the constraints).
+    pub n_free: usize,
+    /// Structural modes in the basis.
+    pub n_basis: usize,
+    /// Bound rings of the lattice.
+    pub n_rings: usize,
+    /// Wake rings of the frozen wake.
+    pub n_wake_rings: usize,
+    /// Evaluations of `D(s)` in the root searches.
+    pub n_evaluations: usize,
+    /// Time spent building the reduced models (equilibria excluded), s.
+    pub build_s: f64,
+    /// Time spent in the root searches, s.
+    pub solve_s: f64,
+    /// Wall time of the whole sweep, s.
+    pub wall_s: f64,
+    /// Mode shapes of the first airspeed's structure: per mode, the displacement of each
+    /// station's axis point (x, y, z per station) and the station arclengths.
+    #[serde(skip)]
+    pub shapes: Vec<ModeShape>,
+    /// Why the sweep could not start.
+    pub error: Option<String>,
+}
+
+/// Station displacements of one structural mode.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeShape {
+    /// Natural frequency, rad/s.
+    pub omega: f64,
+    /// Wing arclength of each station, m.
+    pub s: Vec<f64>,
+    /// Displacement of each station's axis point, normalised to a largest component of 1.
+    pub displacement: Vec<[f64; 3]>,
+}
+
+/// The flutter equation in modal coordinates at one airspeed.
+pub struct Reduced {
+    m: DMatrix<f64>,
+    c: DMatrix<f64>,
+    k: DMatrix<f64>,
+    /// Aerodynamic parts of the stiffness and damping (geometric terms at fixed circulation).
+    gx: DMatrix<f64>,
+    gv: DMatrix<f64>,
+    /// Airspeed ratio to the one the model was built at: at a fixed geometry every aerodynamic
+    /// term scales exactly with a power of it (see [`Reduced::at_speed_ratio`]).
+    ratio: f64,
+    rx: DMatrix<f64>,
+    rv: DMatrix<f64>,
+    aic: DMatrix<C64>,
+    w_rows: Vec<DMatrix<f64>>,
+    delays: Vec<f64>,
+    te_rings: Vec<usize>,
+    t_gamma: DMatrix<f64>,
+    t_gamma_dot: DMatrix<f64>,
+    t_rows: Vec<DMatrix<f64>>,
+    /// Structural natural frequencies, rad/s (all free motions).
+    pub omega: Vec<f64>,
+    /// Bound rings.
+    pub n_rings: usize,
+    /// Wake rings.
+    pub n_wake_rings: usize,
+}
+
+impl Reduced {
+    /// The same model at `ratio` times the airspeed it was built at, the geometry (and the wake's
+    /// row lengths) held: with the circulations `Γ₀ ∝ U`, `R_x`, `T_Γ`, `T_k` and `G_ẋ` scale with
+    /// the ratio, `G_x` with its square, the delays with its inverse, and `R_ẋ`, `T_Γ̇` not at all.
+    pub fn at_speed_ratio(&mut self, ratio: f64) {
+        self.ratio = ratio;
+    }
+
+    /// `D(s)` (n_b × n_b).
+    pub fn d(&self, s: C64) -> DMatrix<C64> {
+        let r = self.ratio;
+        let delays: Vec<f64> = self.delays.iter().map(|t| t / r).collect();
+        let n = uvlm::with_wake(&self.aic, &self.w_rows, &delays, &self.te_rings, s);
+        let t0 = self.t_gamma.map(|x| C64::from(r * x)) + self.t_gamma_dot.map(|x| s * x);
+        let mut t = uvlm::with_wake(&t0.map(|x| x / r), &self.t_rows, &delays, &self.te_rings, s);
+        t *= C64::from(r);
+        let rhs = self.rx.map(|x| C64::from(r * x)) + self.rv.map(|x| s * x);
+        let x = n.lu().solve(&rhs).unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
+        self.m.map(|x| s * s * x)
+            + (&self.c + &self.gv * r).map(|x| s * x)
+            + (&self.k + &self.gx * (r * r)).map(C64::from)
+            - t * x
+    }
+
+    /// Basis size.
+    pub fn n_basis(&self) -> usize {
+        self.m.nrows()
+    }
+
+    /// Smallest real eigenvalue of `M⁻¹ D(0)`.
+    pub fn static_stiffness_min(&self) -> f64 {
+        let d0 = self.d(C64::new(0.0, 0.0)).map(|x| x.re);
+        let Some(a) = self.m.clone().lu().solve(&d0) else { return f64::NAN };
+        let ev = a.complex_eigenvalues();
+        let scale = ev.iter().map(|x| x.norm()).fold(0.0, f64::max).max(1e-300);
+        ev.iter().filter(|x| x.im.abs() <= 1e-9 * scale).map(|x| x.re).fold(f64::INFINITY, f64::min)
+    }
+
+    /// Newton's method on `D(s) η = 0`, `cᴴ η = 1` from `(s, η)`; returns the root and its vector.
+    /// `dD/ds` is a central difference, kept between iterations while they contract (a chord
+    /// method: one evaluation of `D` per iteration) and refreshed when they do not.
+    pub fn newton(&self, mut s: C64, mut eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
+        let n = self.n_basis();
+        let c = eta.clone() / C64::new(eta.norm_squared().max(1e-300), 0.0);
+        let mut dp: Option<DMatrix<C64>> = None;
+        let mut last_step = f64::INFINITY;
+        for _ in 0..60 {
+            let d = self.d(s);
+            *count += 1;
+            if dp.is_none() {
+                let h = 1e-6 * (1.0 + s.norm());
+                dp = Some((self.d(s + h) - self.d(s - h)) / C64::new(2.0 * h, 0.0));
+                *count += 2;
+            }
+            let dpm = dp.as_ref().expect("set above");
+            let mut j = DMatrix::zeros(n + 1, n + 1);
+            j.view_mut((0, 0), (n, n)).copy_from(&d);
+            j.view_mut((0, n), (n, 1)).copy_from(&(dpm * &eta));
+            for i in 0..n {
+                j[(n, i)] = c[i].conj();
+            }
+            let mut f = DVector::zeros(n + 1);
+            f.rows_mut(0, n).copy_from(&(&d * &eta));
+            f[n] = c.dotc(&eta) - C64::new(1.0, 0.0);
+            let Some(dx) = j.lu().solve(&f) else { return (s, eta, false) };
+            eta -= dx.rows(0, n);
+            s -= dx[n];
+            if !(s.re.is_finite() && s.im.is_finite()) {
+                return (s, eta, false);
+            }
+            let step = dx[n].norm();
+            if step <= 1e-10 * (1.0 + s.norm()) {
+                return (s, eta, true);
+            }
+            if step > 0.5 * last_step {
+                dp = None;
+            }
+            last_step = step;
+        }
+        (s, eta, false)
+    }
+}
+
+/// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`.
+fn load_part<S: StaticStructure>(model: &mut S, q: &[f64], loads: &[SectionLoad], zero: &[SectionLoad]) -> Vec<f64> {
+    let n = model.n_dof();
+    let z = vec![0.0; n];
+    let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+    model.set_section_loads(loads);
+    model.residual_inplace(0.0, q, &z, &z, &mut a);
+    model.set_section_loads(zero);
+    model.residual_inplace(0.0, q, &z, &z, &mut b);
+    a.iter().zip(&b).map(|(x, y)| x - y).collect()
+}
+
+/// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
+/// lattice's own lumping, [`uvlm::Loads::column_loads_inplace`]).
+fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f64]) -> Vec<SectionLoad> {
+    let nc = origins.len();
+    let mut out: Vec<SectionLoad> = map
+        .iter()
+        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+        .collect();
+    for (k, x) in positions.iter().enumerate() {
+        let j = k % nc;
+        let fk = Vector3::new(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
+        let r = Vector3::from(*x) - Vector3::from(origins[j]);
+        out[j].force += fk;
+        out[j].moment += r.cross(&fk);
+    }
+    out
+}
+
+/// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
+/// `aero`, with `nb` basis modes.
+#[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis
+pub fn reduce<S: StaticStructure>(
+    mut model: S,
+    q: &[f64],
+    lambda: &[f64],
+    mu: &[f64],
+    map: &[StationMap],
+    aero: &AeroSettings,
+    wake: &uvlm::LinearWake,
+    nb: usize,
+    shapes_out: Option<(&Case, &mut Vec<ModeShape>)>,
+) -> Result<Reduced, String> {
+    let zero_loads: Vec<SectionLoad> = map
+        .iter()
+        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+        .collect();
+    model.set_section_loads(&zero_loads);
+    let lin = genalpha::analysis::linearise(&model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
+    let modes = lin.natural_modes().map_err(|e| format!("natural modes: {e}"))?;
+    let nb = nb.min(lin.n_free());
+    let phi = modes.shapes.columns(0, nb).into_owned();
+    let m = phi.transpose() * &lin.mass * &phi;
+    let c = phi.transpose() * &lin.damping * &phi;
+    let k = phi.transpose() * &lin.stiffness * &phi;
+    let n_dof = model.n_dof();
+    let zeros = vec![0.0; n_dof];
+    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let (mut stations, mut vel) = (Vec::new(), Vec::new());
+    stations_at(&model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
+    if let Some((case, out)) = shapes_out {
+        let span = case.span().max(1e-3);
+        for i in 0..nb {
+            let col: Vec<f64> = phi.column(i).iter().copied().collect();
+            let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+            let eps = 1e-6 * span / big;
+            let mut qp = vec![0.0; q.len()];
+            let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
+            model.retract_inplace(q, &dq, &mut qp);
+            let (mut st2, mut v2) = (Vec::new(), Vec::new());
+            stations_at(&model, &qp, &zeros, map, aero, &mut scratch, &mut st2, &mut v2);
+            let mut d: Vec<[f64; 3]> =
+                st2.iter().zip(&stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
+            let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+            d.iter_mut().flatten().for_each(|x| *x /= dm);
+            out.push(ModeShape { omega: modes.omega[i], s: map.iter().map(|x| x.wing_arc(case)).collect(), displacement: d });
+        }
+    }
+    let spec = crate::aero::lattice_spec(map, aero);
+    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
+    let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
+    let (nr, nf) = (la.n_rings(), la.n_force());
+    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
+    let ref_pos = la.lattice().ring_nodes().to_vec();
+    // H = Φᵀ P Cl: generalised (modal) load part per unit nodal force, by the linearity of the
+    // load part in the station loads and of the lumping in the nodal forces.
+    let ns = map.len();
+    let mut p = DMatrix::zeros(n_dof, 6 * ns);
+    for j in 0..ns {
+        for comp in 0..6 {
+            let mut l = zero_loads.clone();
+            if comp < 3 {
+                l[j].force[comp] = 1.0;
+            } else {
+                l[j].moment[comp - 3] = 1.0;
+            }
+            let g = load_part(&mut model, q, &l, &zero_loads);
+            p.column_mut(6 * j + comp).copy_from_slice(&g);
+        }
+    }
+    let pt = phi.transpose() * &p; // nb × 6ns
+    let mut h = DMatrix::zeros(nb, nf);
+    let mut unit = vec![0.0; nf];
+    for a in 0..nf {
+        unit.fill(0.0);
+        unit[a] = 1.0;
+        let l = lump(map, &ref_pos, &origins, &unit);
+        for (j, sl) in l.iter().enumerate() {
+            for comp in 0..3 {
+                let (fv, mv) = (sl.force[comp], sl.moment[comp]);
+                if fv != 0.0 {
+                    for i in 0..nb {
+                        h[(i, a)] += pt[(i, 6 * j + comp)] * fv;
+                    }
+                }
+                if mv != 0.0 {
+                    for i in 0..nb {
+                        h[(i, a)] += pt[(i, 6 * j + 3 + comp)] * mv;
+                    }
+                }
+            }
+        }
+    }
+    // Geometric terms along each basis mode.
+    let span = aero.chord.max(1e-3);
+    let mut rx = DMatrix::zeros(nr, nb);
+    let mut rv = DMatrix::zeros(nr, nb);
+    let mut gx = DMatrix::zeros(nb, nb);
+    let mut gv = DMatrix::zeros(nb, nb);
+    let mut lat = la.lattice().clone();
+    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<(Vec<f64>, Vec<f64>), String> {
+        let (mut st, mut ve) = (Vec::new(), Vec::new());
+        stations_at(&*model, qq, vv, map, aero, &mut scratch, &mut st, &mut ve);
+        lat.update_stations(&st, if with_vel { Some(&ve) } else { None })
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let (r, f) = la.evaluate(&lat).map_err(|e| e.to_string())?;
+        let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
+        let loads = lump(map, lat.ring_nodes(), &org, &f);
+        let g = load_part(model, qq, &loads, &zero_loads);
+        Ok((r, g))
+    };
+    for i in 0..nb {
+        let col: Vec<f64> = phi.column(i).iter().copied().collect();
+        let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+        let eps = 1e-6 * span / big;
+        let mut qp = vec![0.0; q.len()];
+        let mut qm = vec![0.0; q.len()];
+        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
+        model.retract_inplace(q, &dq, &mut qp);
+        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
+        model.retract_inplace(q, &dq, &mut qm);
+        let (r1, g1) = eval(&mut model, &qp, &zeros, false)?;
+        let (r2, g2) = eval(&mut model, &qm, &zeros, false)?;
+        for a in 0..nr {
+            rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
+        }
+        let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
+        gx.set_column(i, &gp);
+        // Velocity along the mode: the residual and the loads are linear in it.
+        let (r1, g1) = eval(&mut model, q, &col, true)?;
+        let neg: Vec<f64> = col.iter().map(|x| -x).collect();
+        let (r2, g2) = eval(&mut model, q, &neg, true)?;
+        for a in 0..nr {
+            rv[(a, i)] = 0.5 * (r1[a] - r2[a]);
+        }
+        let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) * 0.5;
+        gv.set_column(i, &gp);
+    }
+    Ok(Reduced {
+        m,
+        c,
+        k,
+        gx,
+        gv,
+        ratio: 1.0,
+        rx,
+        rv,
+        aic: la.aic.map(C64::from),
+        w_rows: la.row_normalwash.clone(),
+        delays: la.row_delays.clone(),
+        te_rings: la.te_rings.clone(),
+        t_gamma: &h * &la.force_gamma,
+        t_gamma_dot: &h * &la.force_gamma_dot,
+        t_rows: la.force_row.iter().map(|f| &h * f).collect(),
+        omega: modes.omega.clone(),
+        n_rings: nr,
+        n_wake_rings: wake.row_lengths.len() * la.te_rings.len(),
+    })
+}
+
+/// The linear wake of `case` at `airspeed`: the stability block's, or the time-marching one.
+pub fn linear_wake(case: &Case, f: Formulation, airspeed: f64) -> uvlm::LinearWake {
+    let aero = case.aero.as_ref().expect("validated: stability needs aero");
+    match case.stability.as_ref().and_then(|s| s.wake) {
+        Some(w) => uvlm::LinearWake::uniform(w.rows, w.row_length, w.closure),
+        None => {
+            let dt = match f {
+                Formulation::Ancf => case.ancf.dt,
+                Formulation::Gebf => case.gebf.dt,
+            };
+            uvlm::LinearWake::uniform(aero.n_wake_rows, airspeed * dt, aero.wake_closure)
+        }
+    }
+}
+
+/// Run the stability sweep of `case` with formulation `f`.
+pub fn run_stability(case: &Case, f: Formulation) -> StabilityOutput {
+    let t0 = Instant::now();
+    let mut out = match f {
+        Formulation::Ancf => sweep(case, f, crate::scene::build_ancf),
+        Formulation::Gebf => sweep(case, f, crate::scene::build_gebf),
+    };
+    out.wall_s = t0.elapsed().as_secs_f64();
+    out
+}
+
+fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
+    StabilityOutput {
+        formulation: f,
+        points: Vec::new(),
+        flutter_speed: None,
+        flutter_frequency_rad_s: None,
+        flutter_mode: None,
+        divergence_speed: None,
+        n_dof: 0,
+        n_free: 0,
+        n_basis: 0,
+        n_rings: 0,
+        n_wake_rings: 0,
+        n_evaluations: 0,
+        build_s: 0.0,
+        solve_s: 0.0,
+        wall_s: 0.0,
+        shapes: Vec::new(),
+        error: err,
+    }
+}
+
+fn sweep<S: StaticStructure>(
+    case: &Case,
+    f: Formulation,
+    build: fn(&Case) -> Result<S, crate::Error>,
+) -> StabilityOutput {
+    let (Some(aero), Some(st)) = (case.aero.as_ref(), case.stability.as_ref()) else {
+        return empty_output(f, Some("the case has no `aero` and `stability` blocks".into()));
+    };
+    let map = match station_map(case, aero) {
+        Ok(m) => m,
+        Err(e) => return empty_output(f, Some(e)),
+    };
+    // Equilibria.
+    let states: Vec<Result<(Vec<f64>, Vec<f64>, Vec<f64>, f64), String>> = match st.about {
+        About::Undeformed => {
+            let model = match build(case) {
+                Ok(m) => m,
+                Err(e) => return empty_output(f, Some(e.to_string())),
+            };
+            let q = model.initial_state().q;
+            let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
+            let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
+            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
+        }
+        About::Equilibrium => {
+            let mut c = case.clone();
+            c.statics = Some(crate::case::StaticSettings { airspeeds: st.airspeeds.clone(), references: Vec::new() });
+            let so = crate::statics::run_static(&c, f);
+            if let Some(e) = so.error {
+                return empty_output(f, Some(e));
+            }
+            so.points
+                .into_iter()
+                .map(|p| match (p.state, p.error) {
+                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
+                    (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
+                })
+                .collect()
+        }
+    };
+    let mut out = empty_output(f, None);
+    let nb_req = st.basis_modes.unwrap_or((2 * st.modes).max(20));
+    // About a fixed state with a wake of fixed row lengths, the model is built once and scaled
+    // with the airspeed (exact, see `Reduced::at_speed_ratio`).
+    let fixed = st.about == About::Undeformed && st.wake.is_some();
+    let mut cache: Option<(f64, Reduced)> = None;
+    let mut tracked: Option<Vec<(C64, DVector<C64>)>> = None;
+    let mut prev: Option<Vec<(C64, DVector<C64>)>> = None;
+    for (i, &u) in st.airspeeds.iter().enumerate() {
+        let mut a = aero.clone();
+        a.airspeed = Some(u);
+        let point = |roots: Vec<Root>, smin: f64, omega: Vec<f64>, fold: f64, error: Option<String>| StabilityPoint {
+            airspeed: u,
+            fold_deg: fold,
+            roots,
+            static_stiffness_min: smin,
+            structural_rad_s: omega,
+            error,
+        };
+        let (q, lam, mu, fold) = match &states[i] {
+            Ok(s) => s.clone(),
+            Err(e) => {
+                out.points.push(point(Vec::new(), f64::NAN, Vec::new(), f64::NAN, Some(e.clone())));
+                continue;
+            }
+        };
+        if !(fixed && cache.is_some()) {
+            let model = match build(case) {
+                Ok(m) => m,
+                Err(e) => return empty_output(f, Some(e.to_string())),
+            };
+            out.n_dof = model.n_dof();
+            let tb = Instant::now();
+            let wake = linear_wake(case, f, u);
+            let shapes = if i == 0 { Some((case, &mut out.shapes)) } else { None };
+            match reduce(model, &q, &lam, &mu, &map, &a, &wake, nb_req, shapes) {
+                Ok(r) => cache = Some((u, r)),
+                Err(e) => {
+                    out.points.push(point(Vec::new(), f64::NAN, Vec::new(), fold, Some(e)));
+                    cache = None;
+                    continue;
+                }
+            }
+            out.build_s += tb.elapsed().as_secs_f64();
+        }
+        let Some((u0, red)) = cache.as_mut() else { continue };
+        red.at_speed_ratio(u / *u0);
+        let red: &Reduced = red;
+        out.n_free = red.omega.len();
+        out.n_basis = red.n_basis();
+        out.n_rings = red.n_rings;
+        out.n_wake_rings = red.n_wake_rings;
+        let ts = Instant::now();
+        let nmodes = st.modes.min(red.n_basis());
+        let starts: Vec<(C64, DVector<C64>)> = match (&tracked, &prev) {
+            (Some(t), Some(p)) if t.len() == nmodes => {
+                // Linear extrapolation in airspeed of the eigenvalue.
+                let du = u - st.airspeeds[i - 1];
+                t.iter()
+                    .zip(p)
+                    .map(|((s1, e1), (s0, _))| {
+                        let back = st.airspeeds[i - 1] - st.airspeeds[i.saturating_sub(2)];
+                        let slope = if back > 0.0 { (s1 - s0) / back } else { C64::new(0.0, 0.0) };
+                        (s1 + slope * du, e1.clone())
+                    })
+                    .collect()
+            }
+            (Some(t), _) if t.len() == nmodes => t.clone(),
+            _ => (0..nmodes)
+                .map(|m| {
+                    let w = red.omega[m].max(1e-3);
+                    let mut e = DVector::zeros(red.n_basis());
+                    e[m] = C64::new(1.0, 0.0);
+                    (C64::new(-0.01 * w, w), e)
+                })
+                .collect(),
+        };
+        let mut roots = Vec::with_capacity(nmodes);
+        let mut next = Vec::with_capacity(nmodes);
+        for (m, (s0, e0)) in starts.into_iter().enumerate() {
+            let (s, e, ok) = red.newton(s0, e0.clone(), &mut out.n_evaluations);
+            let (s, e) = if ok { (s, e) } else { (s0, e0) };
+            roots.push(Root { mode: m, real: s.re, imag: s.im.abs(), converged: ok });
+            next.push((C64::new(s.re, s.im.abs()), e));
+        }
+        let smin = red.static_stiffness_min();
+        out.solve_s += ts.elapsed().as_secs_f64();
+        prev = tracked.take();
+        tracked = Some(next);
+        let omega = red.omega.iter().take(nb_req).copied().collect();
+        out.points.push(point(roots, smin, omega, fold, None));
+    }
+    // Flutter: the first sign change of a root's real part from negative to positive.
+    for w in out.points.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if out.flutter_speed.is_some() {
+            break;
+        }
+        let mut best: Option<(f64, f64, usize)> = None;
+        for (ra, rb) in a.roots.iter().zip(&b.roots) {
+            if ra.converged && rb.converged && ra.real < 0.0 && rb.real >= 0.0 && ra.imag > 1e-6 {
+                let t = ra.real / (ra.real - rb.real);
+                let v = a.airspeed + t * (b.airspeed - a.airspeed);
+                let om = ra.imag + t * (rb.imag - ra.imag);
+                if best.is_none_or(|(bv, _, _)| v < bv) {
+                    best = Some((v, om, ra.mode));
+                }
+            }
+        }
+        if let Some((v, om, m)) = best {
+            out.flutter_speed = Some(v);
+            out.flutter_frequency_rad_s = Some(om);
+            out.flutter_mode = Some(m);
+        }
+    }
+    for w in out.points.windows(2) {
+        let (a, b) = (w[0].static_stiffness_min, w[1].static_stiffness_min);
+        if a > 0.0 && b <= 0.0 {
+            let t = a / (a - b);
+            out.divergence_speed = Some(w[0].airspeed + t * (w[1].airspeed - w[0].airspeed));
+            break;
+        }
+    }
+    out
+}

@@ -1,0 +1,245 @@
+//! Files of a stability sweep: `stability_<f>.csv`, `stability_<f>.json`, the V-g, V-f and
+//! root-locus plots, the mode shapes, and the report fragment (docs/stability.md).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::Error;
+use crate::csv::write_file;
+use crate::case::Formulation;
+use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
+use crate::stability::StabilityOutput;
+
+/// The CSV of one formulation: one row per airspeed and tracked mode.
+pub fn to_csv(out: &StabilityOutput) -> String {
+    let mut s = String::from("airspeed,mode,real,imag,frequency_hz,frequency_rad_s,damping_ratio,converged\n");
+    for p in &out.points {
+        for r in &p.roots {
+            let _ = writeln!(
+                s,
+                "{},{},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{}",
+                p.airspeed,
+                r.mode,
+                r.real,
+                r.imag,
+                r.frequency_hz(),
+                r.imag,
+                r.damping_ratio(),
+                u8::from(r.converged)
+            );
+        }
+    }
+    s
+}
+
+/// The JSON summary of one formulation.
+#[derive(Debug, Serialize)]
+struct Summary<'a> {
+    case: &'a str,
+    formulation: Formulation,
+    flutter_speed: Option<f64>,
+    flutter_frequency_rad_s: Option<f64>,
+    flutter_mode: Option<usize>,
+    divergence_speed: Option<f64>,
+    n_dof: usize,
+    n_free: usize,
+    n_basis: usize,
+    n_rings: usize,
+    n_wake_rings: usize,
+    n_evaluations: usize,
+    build_s: f64,
+    solve_s: f64,
+    wall_s: f64,
+    error: &'a Option<String>,
+    points: &'a [crate::stability::StabilityPoint],
+}
+
+/// Write the sweep's files of every formulation in `runs` into `dir`.
+pub fn write(dir: &Path, name: &str, runs: &[StabilityOutput]) -> Result<(), Error> {
+    for out in runs {
+        write_file(&dir.join(format!("stability_{}.csv", out.formulation)), &to_csv(out))?;
+        let sum = Summary {
+            case: name,
+            formulation: out.formulation,
+            flutter_speed: out.flutter_speed,
+            flutter_frequency_rad_s: out.flutter_frequency_rad_s,
+            flutter_mode: out.flutter_mode,
+            divergence_speed: out.divergence_speed,
+            n_dof: out.n_dof,
+            n_free: out.n_free,
+            n_basis: out.n_basis,
+            n_rings: out.n_rings,
+            n_wake_rings: out.n_wake_rings,
+            n_evaluations: out.n_evaluations,
+            build_s: out.build_s,
+            solve_s: out.solve_s,
+            wall_s: out.wall_s,
+            error: &out.error,
+            points: &out.points,
+        };
+        let json = serde_json::to_string_pretty(&sum).map_err(|e| Error::Io(e.to_string()))?;
+        write_file(&dir.join(format!("stability_{}.json", out.formulation)), &json)?;
+    }
+    plots(dir, runs)?;
+    let folder = dir.file_name().map_or_else(|| name.to_string(), |n| n.to_string_lossy().into_owned());
+    write_file(&dir.join(SECTION_FILE), &section_html(name, &folder, runs))
+}
+
+fn color(f: Formulation) -> plotters::style::RGBColor {
+    match f {
+        Formulation::Ancf => colors::ANCF,
+        Formulation::Gebf => colors::GEBF,
+    }
+}
+
+fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {
+    let n_modes = runs.iter().flat_map(|o| o.points.iter().map(|p| p.roots.len())).max().unwrap_or(0);
+    let mut vg = Panel {
+        title: "V-g: damping ratio of the tracked roots".into(),
+        x_label: "airspeed (m/s)".into(),
+        y_label: "damping ratio ζ (−)".into(),
+        ..Default::default()
+    };
+    let mut vf = Panel {
+        title: "V-f: frequency of the tracked roots".into(),
+        x_label: "airspeed (m/s)".into(),
+        y_label: "frequency (Hz)".into(),
+        ..Default::default()
+    };
+    let mut locus = Panel {
+        title: "Root locus over the sweep".into(),
+        x_label: "Re s (1/s)".into(),
+        y_label: "Im s (rad/s)".into(),
+        ..Default::default()
+    };
+    for out in runs {
+        let dash = if out.formulation == Formulation::Ancf { Dash::Solid } else { Dash::Dashed };
+        for m in 0..n_modes {
+            let pick = |f: &dyn Fn(&crate::stability::Root) -> f64| -> Vec<(f64, f64)> {
+                out.points
+                    .iter()
+                    .filter_map(|p| p.roots.get(m).filter(|r| r.converged).map(|r| (p.airspeed, f(r))))
+                    .collect()
+            };
+            let style = Style { color: Style::nth(m).color, dash, marker: Some(Style::nth(m).marker.unwrap_or(Marker::Circle)), width: 2 };
+            let label = format!("{} mode {}", out.formulation.as_str().to_uppercase(), m + 1);
+            vg.series.push(Series::new(label.clone(), style, pick(&|r| r.damping_ratio())));
+            vf.series.push(Series::new(label.clone(), style, pick(&|r| r.frequency_hz())));
+            let pts: Vec<(f64, f64)> = out
+                .points
+                .iter()
+                .filter_map(|p| p.roots.get(m).filter(|r| r.converged).map(|r| (r.real, r.imag)))
+                .collect();
+            locus.series.push(Series::new(label, style, pts));
+        }
+        let _ = color(out.formulation);
+    }
+    panels_svg(&dir.join("stability_vg.svg"), &[vg, vf], 2, (620, 440))?;
+    panels_svg(&dir.join("stability_locus.svg"), &[locus], 1, (760, 520))?;
+    // Mode shapes of the first airspeed: vertical and chordwise displacement of the axis.
+    let mut panels = Vec::new();
+    for out in runs.iter().take(1) {
+        for (i, sh) in out.shapes.iter().take(6).enumerate() {
+            let z: Vec<(f64, f64)> = sh.s.iter().zip(&sh.displacement).map(|(s, d)| (*s, d[2])).collect();
+            let y: Vec<(f64, f64)> = sh.s.iter().zip(&sh.displacement).map(|(s, d)| (*s, d[1])).collect();
+            let x: Vec<(f64, f64)> = sh.s.iter().zip(&sh.displacement).map(|(s, d)| (*s, d[0])).collect();
+            panels.push(Panel {
+                title: format!("{} mode {}: {:.3} Hz", out.formulation.as_str().to_uppercase(), i + 1, sh.omega / (2.0 * std::f64::consts::PI)),
+                x_label: "wing arclength (m)".into(),
+                y_label: "axis displacement (−)".into(),
+                series: vec![
+                    Series::new("z", Style::solid(colors::ANCF), z),
+                    Series::new("y", Style::solid(colors::GEBF).dash(Dash::Dashed), y),
+                    Series::new("x", Style::nth(2).dash(Dash::Dotted), x),
+                ],
+                ..Default::default()
+            });
+        }
+    }
+    if !panels.is_empty() {
+        panels_svg(&dir.join("stability_modes.svg"), &panels, 3, (420, 300))?;
+    }
+    Ok(())
+}
+
+/// The report fragment each sweep leaves in its folder.
+pub const SECTION_FILE: &str = "stability_section.html";
+
+fn fmt_opt(x: Option<f64>, d: usize) -> String {
+    x.map_or_else(|| "none in the sweep".into(), |v| format!("{v:.d$}"))
+}
+
+/// The section of one case.
+pub fn section_html(name: &str, folder: &str, runs: &[StabilityOutput]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "<h3 id=\"stability-{name}\">{name}</h3>");
+    s.push_str(
+        "<table><tr><th>formulation</th><th>flutter speed (m/s)</th><th>flutter frequency (rad/s)</th>\
+         <th>divergence speed (m/s)</th><th>basis modes</th><th>rings (bound + wake)</th><th>time (s)</th></tr>\n",
+    );
+    for o in runs {
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} + {}</td><td>{:.2}</td></tr>",
+            o.formulation.as_str().to_uppercase(),
+            fmt_opt(o.flutter_speed, 2),
+            fmt_opt(o.flutter_frequency_rad_s, 2),
+            fmt_opt(o.divergence_speed, 2),
+            o.n_basis,
+            o.n_rings,
+            o.n_wake_rings,
+            o.wall_s
+        );
+        if let Some(e) = &o.error {
+            let _ = writeln!(s, "<tr><td colspan=\"7\" class=\"fail\">{}</td></tr>", e.replace('<', "&lt;"));
+        }
+    }
+    s.push_str("</table>\n");
+    // Least-damped roots at each airspeed.
+    s.push_str("<table><tr><th>formulation</th><th>airspeed (m/s)</th><th>fold (deg)</th><th>least-damped root: f (Hz)</th><th>ζ (%)</th><th>Re s (1/s)</th></tr>\n");
+    for o in runs {
+        for p in &o.points {
+            if let Some(r) = p.roots.iter().filter(|r| r.converged).min_by(|a, b| b.real.total_cmp(&a.real)) {
+                let _ = writeln!(
+                    s,
+                    "<tr><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{:.3}</td><td>{:+.4}</td></tr>",
+                    o.formulation.as_str().to_uppercase(),
+                    p.airspeed,
+                    p.fold_deg,
+                    r.frequency_hz(),
+                    100.0 * r.damping_ratio(),
+                    r.real
+                );
+            }
+        }
+    }
+    s.push_str("</table>\n");
+    for (file, cap) in [
+        ("stability_vg.svg", "V-g and V-f (ANCF solid, GEBF dashed)"),
+        ("stability_locus.svg", "Root locus"),
+        ("stability_modes.svg", "Structural mode shapes at the first airspeed"),
+    ] {
+        let _ = writeln!(
+            s,
+            "<figure><img src=\"{folder}/{file}\" alt=\"{cap}\" loading=\"lazy\"><figcaption>{cap}</figcaption></figure>"
+        );
+    }
+    s
+}
+
+/// The stability sections of every sweep written under `out`, in name order.
+pub fn sections_html(out: &Path) -> String {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
+        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
+        .unwrap_or_default();
+    files.sort();
+    let mut s = String::new();
+    for f in files {
+        if let Ok(t) = std::fs::read_to_string(&f) {
+            s.push_str(&t);
+        }
+    }
+    s
+}
