@@ -56,6 +56,11 @@ pub struct StabilitySettings {
     /// the free motions).
     #[serde(default)]
     pub basis_modes: Option<usize>,
+    /// The aerodynamics of the flutter equation: `"uvlm"` (default; the lattice) or `"strip"`
+    /// (2-D Theodorsen strips at the lattice's stations, R. T. Jones' approximation of C; no tip
+    /// loss: the model of strip-theory references such as Patil, Hodges & Cesnik's).
+    #[serde(default)]
+    pub aerodynamics: AeroModel,
     /// The frozen wake of the linear aerodynamics; default: the time-marching wake
     /// (`aero.n_wake_rows` rows of `airspeed·dt`, closed when `aero.wake_closure`).
     #[serde(default)]
@@ -71,6 +76,17 @@ pub enum About {
     Equilibrium,
     /// The undeformed reference configuration.
     Undeformed,
+}
+
+/// The aerodynamic model of a stability analysis.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AeroModel {
+    /// The linearised UVLM.
+    #[default]
+    Uvlm,
+    /// Two-dimensional Theodorsen strips.
+    Strip,
 }
 
 /// The frozen wake of the linear aerodynamics.
@@ -245,6 +261,8 @@ pub struct Reduced {
     t_gamma: DMatrix<f64>,
     t_gamma_dot: DMatrix<f64>,
     t_rows: Vec<DMatrix<f64>>,
+    /// Theodorsen strips instead of the lattice.
+    strip: Option<Strips>,
     /// Structural natural frequencies, rad/s (all free motions).
     pub omega: Vec<f64>,
     /// Bound rings.
@@ -264,6 +282,10 @@ impl Reduced {
     /// `D(s)` (n_b × n_b).
     pub fn d(&self, s: C64) -> DMatrix<C64> {
         let r = self.ratio;
+        if let Some(st) = &self.strip {
+            return self.m.map(|x| s * s * x) + self.c.map(|x| s * x) + self.k.map(C64::from)
+                - st.generalised_force(s, r);
+        }
         let delays: Vec<f64> = self.delays.iter().map(|t| t / r).collect();
         let n = uvlm::with_wake(&self.aic, &self.w_rows, &delays, &self.te_rings, s);
         let t0 = self.t_gamma.map(|x| C64::from(r * x)) + self.t_gamma_dot.map(|x| s * x);
@@ -280,6 +302,42 @@ impl Reduced {
     /// Basis size.
     pub fn n_basis(&self) -> usize {
         self.m.nrows()
+    }
+
+    /// Starting points of the root searches at the first airspeed: for each of the first `n`
+    /// structural modes, the eigenvalue nearest its structural one (`±iω`, or `+√(−ω²)` for an
+    /// unstable static mode) of the quadratic problem `M s² + C s + K + Q(s₀)` with the aerodynamic
+    /// part frozen at that structural value `s₀`, and its eigenvector.
+    pub fn starts(&self, n: usize) -> Vec<(C64, DVector<C64>)> {
+        let nb = self.n_basis();
+        (0..n)
+            .map(|m| {
+                let w2 = self.omega[m].signum() * self.omega[m] * self.omega[m];
+                let s0 = if w2 >= 0.0 { C64::new(0.0, w2.sqrt().max(1e-3)) } else { C64::new((-w2).sqrt(), 0.0) };
+                let mut e = DVector::zeros(nb);
+                e[m] = C64::new(1.0, 0.0);
+                let frozen = self.d(s0) - self.m.map(|x| s0 * s0 * x) - (&self.c + &self.gv * self.ratio).map(|x| s0 * x);
+                // Companion form of M s² + C s + K_f: [0 I; −M⁻¹K_f −M⁻¹C].
+                let Some(lu) = self.m.map(C64::from).lu().try_inverse() else { return (s0, e) };
+                let cc = (&self.c + &self.gv * self.ratio).map(C64::from);
+                let mut a = DMatrix::zeros(2 * nb, 2 * nb);
+                for i in 0..nb {
+                    a[(i, nb + i)] = C64::new(1.0, 0.0);
+                }
+                a.view_mut((nb, 0), (nb, nb)).copy_from(&(-(&lu * &frozen)));
+                a.view_mut((nb, nb), (nb, nb)).copy_from(&(-(&lu * &cc)));
+                let Some(ev) = a.clone().eigenvalues() else { return (s0, e) };
+                let best = ev.iter().copied().min_by(|x, y| (x - s0).norm().total_cmp(&(y - s0).norm())).unwrap_or(s0);
+                // Its vector: the null vector of the frozen quadratic matrix, by one inverse iteration.
+                let q = self.m.map(|x| best * best * x) + cc.map(|x| best * x) + &frozen;
+                let shift = q + DMatrix::identity(nb, nb) * C64::new(1e-10 * (1.0 + self.m.amax() * best.norm_sqr()), 0.0);
+                let v = shift.lu().solve(&e).map(|v| {
+                    let n = v.norm();
+                    if n > 0.0 { v / C64::new(n, 0.0) } else { e.clone() }
+                });
+                (best, v.unwrap_or(e))
+            })
+            .collect()
     }
 
     /// Smallest real eigenvalue of `M⁻¹ D(0)`.
@@ -336,6 +394,56 @@ impl Reduced {
     }
 }
 
+/// Two-dimensional Theodorsen strips at the lattice's stations (Bisplinghoff, Ashley & Halfman
+/// §5-6): per unit span, with `h` the plunge (down), `α` the pitch (nose up) about the axis at
+/// `a` semichords aft of mid-chord,
+///
+/// `L = πρb²(ḧ + Uα̇ − baα̈) + 2πρUb C (ḣ + Uα + b(½ − a)α̇)`,
+/// `M = πρb²(baḧ − Ub(½ − a)α̇ − b²(⅛ + a²)α̈) + 2πρUb²(a + ½) C (ḣ + Uα + b(½ − a)α̇)`,
+///
+/// with R. T. Jones' approximation `C(p) = 1 − 0.165 p/(p + 0.0455) − 0.335 p/(p + 0.3)`,
+/// `p = s b / U`, valid for complex `s`. No tip loss, no sweep: strip theory.
+pub struct Strips {
+    /// Upward displacement of each station's axis along the lift direction per modal
+    /// coordinate (stations × modes).
+    z: DMatrix<f64>,
+    /// Nose-up rotation of each station per modal coordinate (stations × modes).
+    alpha: DMatrix<f64>,
+    /// Span width of each strip, m.
+    width: Vec<f64>,
+    rho: f64,
+    b: f64,
+    a: f64,
+    speed: f64,
+}
+
+impl Strips {
+    /// Generalised aerodynamic force (modes × modes) at `s`, airspeed `ratio` × the built one.
+    fn generalised_force(&self, s: C64, ratio: f64) -> DMatrix<C64> {
+        let (rho, b, a, u) = (self.rho, self.b, self.a, self.speed * ratio);
+        let pi = std::f64::consts::PI;
+        let p = s * b / u;
+        let c = C64::new(1.0, 0.0) - 0.165 * p / (p + 0.0455) - 0.335 * p / (p + 0.3);
+        let nb = self.z.ncols();
+        let mut q = DMatrix::zeros(nb, nb);
+        for j in 0..self.width.len() {
+            let w = self.width[j];
+            for k in 0..nb {
+                let h = C64::from(-self.z[(j, k)]);
+                let al = C64::from(self.alpha[(j, k)]);
+                let circ = c * (s * h + u * al + b * (0.5 - a) * s * al);
+                let l = pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * al) + 2.0 * pi * rho * u * b * circ;
+                let m = pi * rho * b * b * (b * a * s * s * h - u * b * (0.5 - a) * s * al - b * b * (0.125 + a * a) * s * s * al)
+                    + 2.0 * pi * rho * u * b * b * (a + 0.5) * circ;
+                for i in 0..nb {
+                    q[(i, k)] += w * (l * self.z[(j, i)] + m * self.alpha[(j, i)]);
+                }
+            }
+        }
+        q
+    }
+}
+
 /// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`.
 fn load_part<S: StaticStructure>(model: &mut S, q: &[f64], loads: &[SectionLoad], zero: &[SectionLoad]) -> Vec<f64> {
     let n = model.n_dof();
@@ -346,6 +454,49 @@ fn load_part<S: StaticStructure>(model: &mut S, q: &[f64], loads: &[SectionLoad]
     model.set_section_loads(zero);
     model.residual_inplace(0.0, q, &z, &z, &mut b);
     a.iter().zip(&b).map(|(x, y)| x - y).collect()
+}
+
+/// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
+/// held fixed (central differences along the retraction); `None` when they vanish.
+fn held_load_stiffness<S: StaticStructure>(
+    model: &mut S,
+    q: &[f64],
+    map: &[StationMap],
+    aero: &AeroSettings,
+    zero: &[SectionLoad],
+) -> Result<Option<DMatrix<f64>>, String> {
+    let n = model.n_dof();
+    let zeros = vec![0.0; n];
+    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let (mut stations, mut vel) = (Vec::new(), Vec::new());
+    stations_at(&*model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
+    let spec = crate::aero::lattice_spec(map, aero);
+    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
+    let loads = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
+    if loads.nodal.iter().flatten().all(|x| *x == 0.0) {
+        return Ok(None);
+    }
+    let f: Vec<f64> = loads.nodal.iter().flatten().copied().collect();
+    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
+    let l0 = lump(map, &loads.positions, &origins, &f);
+    let mut k = DMatrix::zeros(n, n);
+    let mut qq = vec![0.0; q.len()];
+    let mut dq = vec![0.0; n];
+    for j in 0..n {
+        let h = 1e-6 / model.increment_weight(j).max(1e-12);
+        dq.fill(0.0);
+        dq[j] = h;
+        model.retract_inplace(q, &dq, &mut qq);
+        let gp = load_part(model, &qq, &l0, zero);
+        dq[j] = -h;
+        model.retract_inplace(q, &dq, &mut qq);
+        let gm = load_part(model, &qq, &l0, zero);
+        for i in 0..n {
+            k[(i, j)] = (gp[i] - gm[i]) / (2.0 * h);
+        }
+    }
+    Ok(Some(k))
 }
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
@@ -368,7 +519,7 @@ fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f
 
 /// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
 /// `aero`, with `nb` basis modes.
-#[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis
+#[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
 pub fn reduce<S: StaticStructure>(
     mut model: S,
     q: &[f64],
@@ -379,14 +530,29 @@ pub fn reduce<S: StaticStructure>(
     wake: &uvlm::LinearWake,
     nb: usize,
     shapes_out: Option<(&Case, &mut Vec<ModeShape>)>,
+    strip_case: Option<&Case>,
 ) -> Result<Reduced, String> {
     let zero_loads: Vec<SectionLoad> = map
         .iter()
         .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
         .collect();
     model.set_section_loads(&zero_loads);
-    let lin = genalpha::analysis::linearise(&model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
+    let mut lin =
+        genalpha::analysis::linearise(&model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
+    // The structural modes are those of the structure under its equilibrium's steady station
+    // loads held fixed (their stiffness as each formulation applies them), so that they describe a
+    // state in equilibrium; the flutter equation itself takes every aerodynamic term from the
+    // geometric differences below (the held-load stiffness is part of them).
+    let held = held_load_stiffness(&mut model, q, map, aero, &zero_loads)?;
+    if let Some(kl) = &held {
+        lin.stiffness += kl;
+        lin.reduced_stiffness = lin.null_space.transpose() * &lin.stiffness * &lin.null_space;
+    }
     let modes = lin.natural_modes().map_err(|e| format!("natural modes: {e}"))?;
+    if let Some(kl) = &held {
+        // Back to the unloaded structure's stiffness for the flutter equation.
+        lin.stiffness -= kl;
+    }
     let nb = nb.min(lin.n_free());
     let phi = modes.shapes.columns(0, nb).into_owned();
     let m = phi.transpose() * &lin.mass * &phi;
@@ -414,6 +580,69 @@ pub fn reduce<S: StaticStructure>(
             d.iter_mut().flatten().for_each(|x| *x /= dm);
             out.push(ModeShape { omega: modes.omega[i], s: map.iter().map(|x| x.wing_arc(case)).collect(), displacement: d });
         }
+    }
+    if let Some(case) = strip_case {
+        // Station plunge and pitch along each mode, by central differences of the stations.
+        let lift = crate::statics::lift_direction(aero.free_stream());
+        let ns = map.len();
+        let (mut z, mut alpha) = (DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb));
+        let span_len = case.span().max(1e-3);
+        for i in 0..nb {
+            let col: Vec<f64> = phi.column(i).iter().copied().collect();
+            let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+            let eps = 1e-6 * span_len / big;
+            let mut pm = Vec::new();
+            for sg in [1.0, -1.0] {
+                let mut qq = vec![0.0; q.len()];
+                let dq: Vec<f64> = col.iter().map(|x| sg * eps * x).collect();
+                model.retract_inplace(q, &dq, &mut qq);
+                let (mut s2, mut v2) = (Vec::new(), Vec::new());
+                stations_at(&model, &qq, &zeros, map, aero, &mut scratch, &mut s2, &mut v2);
+                pm.push(s2);
+            }
+            for j in 0..ns {
+                let d = (pm[0][j].origin - pm[1][j].origin) / (2.0 * eps);
+                let w = (pm[0][j].frame - pm[1][j].frame) * stations[j].frame.transpose() / (2.0 * eps);
+                let rot = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
+                // Nose-up axis: the leading-edge direction turned towards the lift.
+                let le = stations[j].frame.column(1).into_owned();
+                let axis = le.cross(&lift).normalize();
+                z[(j, i)] = d.dot(&lift);
+                alpha[(j, i)] = rot.dot(&axis);
+            }
+        }
+        let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();
+        let width = (0..ns)
+            .map(|j| {
+                let lo = if j > 0 { 0.5 * (arcs[j] - arcs[j - 1]) } else { 0.0 };
+                let hi = if j + 1 < ns { 0.5 * (arcs[j + 1] - arcs[j]) } else { 0.0 };
+                lo + hi
+            })
+            .collect();
+        let b = 0.5 * aero.chord;
+        let strips = Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset - b) / b, speed: aero.airspeed.unwrap_or(0.0) };
+        let e = DMatrix::zeros(0, nb);
+        return Ok(Reduced {
+            m,
+            c,
+            k,
+            gx: DMatrix::zeros(nb, nb),
+            gv: DMatrix::zeros(nb, nb),
+            ratio: 1.0,
+            rx: e.clone(),
+            rv: e,
+            aic: DMatrix::zeros(0, 0),
+            w_rows: Vec::new(),
+            delays: Vec::new(),
+            te_rings: Vec::new(),
+            t_gamma: DMatrix::zeros(nb, 0),
+            t_gamma_dot: DMatrix::zeros(nb, 0),
+            t_rows: Vec::new(),
+            strip: Some(strips),
+            omega: modes.omega.clone(),
+            n_rings: 0,
+            n_wake_rings: 0,
+        });
     }
     let spec = crate::aero::lattice_spec(map, aero);
     let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
@@ -522,6 +751,7 @@ pub fn reduce<S: StaticStructure>(
         t_gamma: &h * &la.force_gamma,
         t_gamma_dot: &h * &la.force_gamma_dot,
         t_rows: la.force_row.iter().map(|f| &h * f).collect(),
+        strip: None,
         omega: modes.omega.clone(),
         n_rings: nr,
         n_wake_rings: wake.row_lengths.len() * la.te_rings.len(),
@@ -620,7 +850,7 @@ fn sweep<S: StaticStructure>(
     let nb_req = st.basis_modes.unwrap_or((2 * st.modes).max(20));
     // About a fixed state with a wake of fixed row lengths, the model is built once and scaled
     // with the airspeed (exact, see `Reduced::at_speed_ratio`).
-    let fixed = st.about == About::Undeformed && st.wake.is_some();
+    let fixed = st.about == About::Undeformed && (st.wake.is_some() || st.aerodynamics == AeroModel::Strip);
     let mut cache: Option<(f64, Reduced)> = None;
     let mut tracked: Option<Vec<(C64, DVector<C64>)>> = None;
     let mut prev: Option<Vec<(C64, DVector<C64>)>> = None;
@@ -651,7 +881,8 @@ fn sweep<S: StaticStructure>(
             let tb = Instant::now();
             let wake = linear_wake(case, f, u);
             let shapes = if i == 0 { Some((case, &mut out.shapes)) } else { None };
-            match reduce(model, &q, &lam, &mu, &map, &a, &wake, nb_req, shapes) {
+            let strip = (st.aerodynamics == AeroModel::Strip).then_some(case);
+            match reduce(model, &q, &lam, &mu, &map, &a, &wake, nb_req, shapes, strip) {
                 Ok(r) => cache = Some((u, r)),
                 Err(e) => {
                     out.points.push(point(Vec::new(), f64::NAN, Vec::new(), fold, Some(e)));
@@ -684,22 +915,18 @@ fn sweep<S: StaticStructure>(
                     .collect()
             }
             (Some(t), _) if t.len() == nmodes => t.clone(),
-            _ => (0..nmodes)
-                .map(|m| {
-                    let w = red.omega[m].max(1e-3);
-                    let mut e = DVector::zeros(red.n_basis());
-                    e[m] = C64::new(1.0, 0.0);
-                    (C64::new(-0.01 * w, w), e)
-                })
-                .collect(),
+            _ => red.starts(nmodes),
         };
         let mut roots = Vec::with_capacity(nmodes);
         let mut next = Vec::with_capacity(nmodes);
         for (m, (s0, e0)) in starts.into_iter().enumerate() {
             let (s, e, ok) = red.newton(s0, e0.clone(), &mut out.n_evaluations);
             let (s, e) = if ok { (s, e) } else { (s0, e0) };
-            roots.push(Root { mode: m, real: s.re, imag: s.im.abs(), converged: ok });
-            next.push((C64::new(s.re, s.im.abs()), e));
+            let s = C64::new(s.re, s.im.abs());
+            // Two starts that land on one root: the later one is not a root of its own.
+            let dup = roots.iter().any(|r: &Root| (C64::new(r.real, r.imag) - s).norm() <= 1e-6 * (1.0 + s.norm()));
+            roots.push(Root { mode: m, real: s.re, imag: s.im, converged: ok && !dup });
+            next.push((s, e));
         }
         let smin = red.static_stiffness_min();
         out.solve_s += ts.elapsed().as_secs_f64();
