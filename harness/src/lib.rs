@@ -21,6 +21,7 @@ pub mod fuzz;
 pub mod gate;
 pub mod loads;
 pub mod metrics;
+pub mod pencil;
 pub mod plot;
 pub mod progress;
 pub mod report;

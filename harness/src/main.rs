@@ -613,6 +613,16 @@ fn real_main() -> Result<ExitCode> {
                 static_failed += usize::from(report_static(&summary));
                 println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
             }
+            let mut stability_failed = 0;
+            for spec in runs.iter().filter(|r| r.ancf.stability.is_some() && !interrupted) {
+                progress.phase(&format!("stability sweep of {}", spec.name));
+                let t = std::time::Instant::now();
+                let outs = run_stability_case(spec, &Formulation::ALL);
+                let history = results.iter().find(|r| r.name == spec.name).map(|r| r.metrics.clone());
+                harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, &outs, history.as_ref())?;
+                stability_failed += usize::from(report_stability(&spec.name, &outs));
+                println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+            }
             progress.phase("reports: index.html, summary.md");
             write_index(&out, &results).context("writing reports")?;
             print!("{}", gate::table(&results));
@@ -632,11 +642,14 @@ fn real_main() -> Result<ExitCode> {
             if static_failed > 0 {
                 eprintln!("static: {static_failed} sweep(s) have airspeeds without an equilibrium");
             }
+            if stability_failed > 0 {
+                eprintln!("stability: {stability_failed} sweep(s) have airspeeds that could not be analysed");
+            }
             if interrupted {
                 eprintln!("interrupted: the rows computed so far are written; studies skipped");
                 return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
             }
-            Ok(exit_code(&errors, failed == 0 && gate_failed == 0 && static_failed == 0))
+            Ok(exit_code(&errors, failed == 0 && gate_failed == 0 && static_failed == 0 && stability_failed == 0))
         }
         Cmd::Run { case, formulation, out, set, vtk, vtk_stride, max_steps } => {
             let fs: Vec<Formulation> = match formulation {
@@ -752,7 +765,7 @@ fn real_main() -> Result<ExitCode> {
             for spec in &runs {
                 let outs = run_stability_case(spec, &fs);
                 let dir = out.join(&spec.name);
-                harness::stability_out::write(&dir, &spec.name, &outs)?;
+                harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
                 failed |= report_stability(&spec.name, &outs);
                 println!("wrote {}", dir.display());
             }

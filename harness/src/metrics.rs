@@ -90,6 +90,12 @@ pub struct FormulationMetrics {
     pub error: Option<String>,
     /// Wall time in the aerodynamics, s.
     pub aero_wall_s: f64,
+    /// Dominant oscillation of the fold angle (the tip's vertical position without a fold
+    /// hinge) in four equal windows of the run, by the matrix pencil method
+    /// ([`crate::pencil`]): frequency and growth rate to compare with the stability analysis.
+    pub oscillations: Vec<crate::pencil::Oscillation>,
+    /// The signal of `oscillations`: `fold` or `tip_z`.
+    pub oscillation_signal: &'static str,
 }
 
 impl FormulationMetrics {
@@ -116,7 +122,22 @@ impl FormulationMetrics {
             max_constraint_residual: run.rows.iter().map(|r| r.constraint_residual).fold(0.0, f64::max),
             error: run.error.clone(),
             aero_wall_s: run.aero_wall_s,
+            oscillations: Vec::new(),
+            oscillation_signal: "",
         }
+        .with_oscillations(run)
+    }
+
+    fn with_oscillations(mut self, run: &RunOutput) -> Self {
+        let fold = run.rows.iter().all(|r| r.fold.is_finite());
+        let samples: Vec<(f64, f64)> =
+            run.rows.iter().map(|r| (r.t, if fold { r.fold.to_degrees() } else { r.tip[2] })).collect();
+        let span = samples.last().map_or(0.0, |l| l.0) - samples.first().map_or(0.0, |f| f.0);
+        let window = span / 4.0;
+        // At least two periods in a window.
+        self.oscillations = crate::pencil::windows(&samples, window, 2.0 / window.max(1e-9));
+        self.oscillation_signal = if fold { "fold" } else { "tip_z" };
+        self
     }
 }
 

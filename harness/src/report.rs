@@ -820,6 +820,21 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
             badge: None,
         });
     }
+    let stab = crate::stability_out::sections_html(out);
+    if !stab.is_empty() {
+        v.push(Section {
+            id: "stability".into(),
+            title: "Linearised stability".into(),
+            group: Group::Study,
+            html: format!(
+                "<p>Roots of the flutter equation about each airspeed's equilibrium (or the undeformed wing): \
+                 the structure's modes coupled to the UVLM linearised in the Laplace domain (frozen wake, exact \
+                 delays), continued over the sweep by Newton's method (docs/stability.md). Files per case: \
+                 <code>stability_ancf.csv</code>, <code>stability_gebf.csv</code>, <code>stability_*.json</code>.</p>\n{stab}"
+            ),
+            badge: None,
+        });
+    }
     let conv = out.join("converge");
     let mut names: Vec<String> = std::fs::read_dir(&conv)
         .map(|rd| {

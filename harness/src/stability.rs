@@ -216,9 +216,9 @@ pub struct StabilityOutput {
     pub n_wake_rings: usize,
     /// Evaluations of `D(s)` in the root searches.
     pub n_evaluations: usize,
-    /// Time spent building the reduced models (equilibria excluded), s.
+    /// CPU time spent building the reduced models (equilibria excluded), s.
     pub build_s: f64,
-    /// Time spent in the root searches, s.
+    /// CPU time spent in the root searches, s.
     pub solve_s: f64,
     /// Wall time of the whole sweep, s.
     pub wall_s: f64,
@@ -307,7 +307,7 @@ impl Reduced {
     /// Starting points of the root searches at the first airspeed: for each of the first `n`
     /// structural modes, the eigenvalue nearest its structural one (`±iω`, or `+√(−ω²)` for an
     /// unstable static mode) of the quadratic problem `M s² + C s + K + Q(s₀)` with the aerodynamic
-    /// part frozen at that structural value `s₀`, and its eigenvector.
+    /// part frozen at that structural value `s₀`, and the mode's unit vector.
     pub fn starts(&self, n: usize) -> Vec<(C64, DVector<C64>)> {
         let nb = self.n_basis();
         (0..n)
@@ -328,14 +328,9 @@ impl Reduced {
                 a.view_mut((nb, nb), (nb, nb)).copy_from(&(-(&lu * &cc)));
                 let Some(ev) = a.clone().eigenvalues() else { return (s0, e) };
                 let best = ev.iter().copied().min_by(|x, y| (x - s0).norm().total_cmp(&(y - s0).norm())).unwrap_or(s0);
-                // Its vector: the null vector of the frozen quadratic matrix, by one inverse iteration.
-                let q = self.m.map(|x| best * best * x) + cc.map(|x| best * x) + &frozen;
-                let shift = q + DMatrix::identity(nb, nb) * C64::new(1e-10 * (1.0 + self.m.amax() * best.norm_sqr()), 0.0);
-                let v = shift.lu().solve(&e).map(|v| {
-                    let n = v.norm();
-                    if n > 0.0 { v / C64::new(n, 0.0) } else { e.clone() }
-                });
-                (best, v.unwrap_or(e))
+                // The structural mode's unit vector starts Newton's method and normalises it
+                // (`eᴴη = 1`), which keeps it off a nearby root of another mode.
+                (best, e)
             })
             .collect()
     }
@@ -773,6 +768,13 @@ pub fn linear_wake(case: &Case, f: Formulation, airspeed: f64) -> uvlm::LinearWa
     }
 }
 
+/// Thread CPU time where the platform has it (so that the cost of a sweep does not depend on
+/// the machine's load), else wall time since the first call, s.
+fn cpu_now() -> f64 {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    crate::bench::thread_cpu_s().unwrap_or_else(|| START.get_or_init(Instant::now).elapsed().as_secs_f64())
+}
+
 /// Run the stability sweep of `case` with formulation `f`.
 pub fn run_stability(case: &Case, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
@@ -878,7 +880,7 @@ fn sweep<S: StaticStructure>(
                 Err(e) => return empty_output(f, Some(e.to_string())),
             };
             out.n_dof = model.n_dof();
-            let tb = Instant::now();
+            let tb = cpu_now();
             let wake = linear_wake(case, f, u);
             let shapes = if i == 0 { Some((case, &mut out.shapes)) } else { None };
             let strip = (st.aerodynamics == AeroModel::Strip).then_some(case);
@@ -890,18 +892,40 @@ fn sweep<S: StaticStructure>(
                     continue;
                 }
             }
-            out.build_s += tb.elapsed().as_secs_f64();
+            out.build_s += cpu_now() - tb;
         }
         let Some((u0, red)) = cache.as_mut() else { continue };
-        red.at_speed_ratio(u / *u0);
+        let target = u / *u0;
+        let nmodes = st.modes.min(red.n_basis());
+        // The first airspeed's roots are continued from a quarter of it, where the structural
+        // modes are still near their aerodynamically coupled roots (the model scaled at its
+        // geometry: exact about a fixed state, a starting guess otherwise).
+        let first = if tracked.is_none() {
+            red.at_speed_ratio(0.25 * target);
+            let mut guess = red.starts(nmodes);
+            for frac in [0.5, 0.75] {
+                red.at_speed_ratio(frac * target);
+                guess = guess
+                    .into_iter()
+                    .map(|(s, e)| match red.newton(s, e.clone(), &mut out.n_evaluations) {
+                        (s2, e2, true) => (C64::new(s2.re, s2.im.abs()), e2),
+                        _ => (s, e),
+                    })
+                    .collect();
+            }
+            Some(guess)
+        } else {
+            None
+        };
+        red.at_speed_ratio(target);
         let red: &Reduced = red;
         out.n_free = red.omega.len();
         out.n_basis = red.n_basis();
         out.n_rings = red.n_rings;
         out.n_wake_rings = red.n_wake_rings;
-        let ts = Instant::now();
-        let nmodes = st.modes.min(red.n_basis());
+        let ts = cpu_now();
         let starts: Vec<(C64, DVector<C64>)> = match (&tracked, &prev) {
+            _ if first.is_some() => first.unwrap_or_default(),
             (Some(t), Some(p)) if t.len() == nmodes => {
                 // Linear extrapolation in airspeed of the eigenvalue.
                 let du = u - st.airspeeds[i - 1];
@@ -929,7 +953,7 @@ fn sweep<S: StaticStructure>(
             next.push((s, e));
         }
         let smin = red.static_stiffness_min();
-        out.solve_s += ts.elapsed().as_secs_f64();
+        out.solve_s += cpu_now() - ts;
         prev = tracked.take();
         tracked = Some(next);
         let omega = red.omega.iter().take(nb_req).copied().collect();

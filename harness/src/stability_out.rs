@@ -56,8 +56,13 @@ struct Summary<'a> {
     points: &'a [crate::stability::StabilityPoint],
 }
 
-/// Write the sweep's files of every formulation in `runs` into `dir`.
-pub fn write(dir: &Path, name: &str, runs: &[StabilityOutput]) -> Result<(), Error> {
+/// Per-formulation metrics of the case's time-domain run (for the damping comparison).
+pub type History = std::collections::BTreeMap<Formulation, crate::metrics::FormulationMetrics>;
+
+/// Write the sweep's files of every formulation in `runs` into `dir`; with the case's
+/// time-domain metrics, the section compares the least-damped roots with the dominant
+/// oscillation of the run (matrix pencil, last window).
+pub fn write_with_history(dir: &Path, name: &str, runs: &[StabilityOutput], history: Option<&History>) -> Result<(), Error> {
     for out in runs {
         write_file(&dir.join(format!("stability_{}.csv", out.formulation)), &to_csv(out))?;
         let sum = Summary {
@@ -84,7 +89,46 @@ pub fn write(dir: &Path, name: &str, runs: &[StabilityOutput]) -> Result<(), Err
     }
     plots(dir, runs)?;
     let folder = dir.file_name().map_or_else(|| name.to_string(), |n| n.to_string_lossy().into_owned());
-    write_file(&dir.join(SECTION_FILE), &section_html(name, &folder, runs))
+    let mut html = section_html(name, &folder, runs);
+    if let Some(h) = history {
+        html.push_str(&history_table(runs, h));
+    }
+    write_file(&dir.join(SECTION_FILE), &html)
+}
+
+/// The eigen-analysis's root nearest in frequency to the time history's dominant oscillation
+/// (last window), per formulation, at the first airspeed.
+fn history_table(runs: &[StabilityOutput], h: &History) -> String {
+    let mut s = String::from(
+        "<table><tr><th>formulation</th><th>time history (last window)</th><th>f (Hz)</th><th>growth (1/s)</th>\
+         <th>eigen-analysis f (Hz)</th><th>growth (1/s)</th></tr>\n",
+    );
+    for o in runs {
+        let (Some(m), Some(p)) = (h.get(&o.formulation), o.points.first()) else { continue };
+        let Some(osc) = m.oscillations.last() else { continue };
+        let Some(r) = p
+            .roots
+            .iter()
+            .filter(|r| r.converged)
+            .min_by(|a, b| (a.frequency_hz() - osc.frequency_hz).abs().total_cmp(&(b.frequency_hz() - osc.frequency_hz).abs()))
+        else {
+            continue;
+        };
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{} {:.1}–{:.1} s</td><td>{:.4}</td><td>{:+.4}</td><td>{:.4}</td><td>{:+.4}</td></tr>",
+            o.formulation.as_str().to_uppercase(),
+            m.oscillation_signal,
+            osc.t_start,
+            osc.t_end,
+            osc.frequency_hz,
+            osc.growth_rate,
+            r.frequency_hz(),
+            r.real
+        );
+    }
+    s.push_str("</table>\n");
+    s
 }
 
 fn color(f: Formulation) -> plotters::style::RGBColor {

@@ -90,3 +90,25 @@ fn every_input_that_ever_crashed_is_handled_fuzz_regressions_issue_19() {
     }
     assert!(n >= 20, "{n} regressions");
 }
+
+/// A campaign over a seed folder without `reference/` (the structural static cases of
+/// `cases/statics`) counts every input: it once skipped them all, uncounted, because its work
+/// folder was only created by copying the references. Every input is checked in a worker under
+/// the limits, and none crashes.
+#[test]
+fn a_campaign_over_cases_without_references_counts_every_input() {
+    let out = std::env::temp_dir().join(format!("harness-fuzz-statics-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let r = std::process::Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["fuzz", "--cases", "cases/statics", "--inputs", "60", "--jobs", "1", "--out"])
+        .arg(&out)
+        .current_dir(cases().join(".."))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(out.join("fuzz.json")).unwrap()).unwrap();
+    assert_eq!(report["inputs"], 60, "{report}");
+    let counted: u64 = report["classes"].as_object().unwrap().values().map(|v| v.as_u64().unwrap()).sum();
+    assert_eq!(counted, 60, "{report}");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -10,6 +10,7 @@ mod gate;
 mod honest;
 mod observer;
 mod properties;
+mod stability;
 mod statics;
 #[cfg(target_os = "linux")]
 mod streamed;
