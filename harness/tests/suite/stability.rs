@@ -118,20 +118,28 @@ fn goland_flutter_converges_to_the_vortex_lattice_value() {
     assert!(rel(vx, 165.0) < 0.03 && rel(wx, 70.0) < 0.03, "{vx} m/s {wx} rad/s");
 }
 
-/// The paper's wing with its free hinge about its 25 m/s equilibria: the two formulations'
-/// least-damped roots (and every tracked root) agree within 0.5 % in frequency and 0.005 1/s in
+/// The paper's wing with its free hinge about its 25 m/s equilibria: every lightly damped root
+/// (ζ < 0.2) of one formulation has a root of the other within 0.5 % in frequency and 0.005 1/s in
 /// growth rate; at AoA 5° the 1.65 Hz mode decays (growth rate −0.12 1/s, ζ ≈ 1.2 %).
+/// (Heavily damped roots are compared by the report, not here: from the structural modes the two
+/// formulations' root searches may land on different over-damped roots.)
 #[test]
 fn paper_wing_roots_agree_and_the_aoa5_mode_decays() {
     for aoa in [0, 5, 10] {
         let (a, g) = both(&format!("wing_aoa{aoa}.json"), &[]);
-        let (pa, pg) = (&a.points[0], &g.points[0]);
-        for (ra, rg) in pa.roots.iter().zip(&pg.roots).filter(|(x, y)| x.converged && y.converged) {
-            assert!(rel(ra.imag.max(1e-9), rg.imag.max(1e-9)) < 5e-3 || (ra.imag - rg.imag).abs() < 1e-3, "AoA {aoa} mode {}: {ra:?} {rg:?}", ra.mode);
-            assert!((ra.real - rg.real).abs() < 5e-3, "AoA {aoa} mode {}: {ra:?} {rg:?}", ra.mode);
+        let light = |o: &StabilityOutput| -> Vec<harness::stability::Root> {
+            o.points[0].roots.iter().copied().filter(|r| r.converged && r.damping_ratio() < 0.2 && r.imag > 0.0).collect()
+        };
+        let (la, lg) = (light(&a), light(&g));
+        assert!(la.len() >= 5, "AoA {aoa}: {la:?}");
+        for (x, other) in [(&la, &lg), (&lg, &la)] {
+            for r in x.iter() {
+                let m = other.iter().min_by(|p, q| (p.imag - r.imag).abs().total_cmp(&(q.imag - r.imag).abs())).unwrap();
+                assert!(rel(m.imag, r.imag) < 5e-3 && (m.real - r.real).abs() < 5e-3, "AoA {aoa}: {r:?} vs {m:?}");
+            }
         }
         if aoa == 5 {
-            let r = pa.roots.iter().find(|r| r.converged && (r.frequency_hz() - 1.65).abs() < 0.1).expect("the 1.65 Hz mode");
+            let r = la.iter().find(|r| (r.frequency_hz() - 1.65).abs() < 0.1).expect("the 1.65 Hz mode");
             println!("AoA 5: {:.4} Hz, growth {:.4} 1/s, zeta {:.4}", r.frequency_hz(), r.real, r.damping_ratio());
             assert!(r.real < 0.0 && r.damping_ratio() > 0.005 && r.damping_ratio() < 0.03, "{r:?}");
         }
@@ -164,4 +172,59 @@ fn bad_stability_input_is_named() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// Linear against nonlinear: the HALE wing (16 spanwise panels, 60 wake rows of 0.25 m closed by
+/// legs, in both analyses) pitched by 0.05° and released into the stream, marched with GEBF
+/// (ρ∞ = 1, dt = row length / U, 4 coupling sub-iterations): over 1–3 s the tip's oscillation
+/// near the flutter root grows or decays at the eigen-analysis's rate within 2 %, below flutter
+/// (36 m/s) and above it (38 m/s).
+#[test]
+fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
+    for u in [36.0_f64, 38.0] {
+        let dt = 0.25 / u;
+        let set: Vec<String> = vec![
+            "aero.panels_per_body=[16]".into(),
+            "stability.wake.rows=60".into(),
+            format!("stability.airspeeds=[{u}]"),
+            format!("aero.airspeed={u}"),
+            "pitch_deg=0.05".into(),
+            format!("gebf.dt={dt}"),
+            format!("ancf.dt={dt}"),
+            format!("output_dt={dt}"),
+            "gebf.rho_inf=1".into(),
+            "aero.n_wake_rows=60".into(),
+            "aero.wake_closure=true".into(),
+            "t_end=3".into(),
+            "aero.coupling.max_sub_iterations=4".into(),
+            "aero.coupling.tolerance=1e-6".into(),
+        ];
+        let set: Vec<&str> = set.iter().map(String::as_str).collect();
+        let spec = case("hale_flutter.json", &set);
+        // The linear analysis about the undeformed wing at pitch 0 (0.05° changes nothing at
+        // first order).
+        let mut lin_case = spec.gebf.clone();
+        lin_case.pitch_deg = 0.0;
+        let lin = run_stability(&lin_case, Formulation::Gebf);
+        let run = harness::scene::run_formulation(&spec.gebf, Formulation::Gebf);
+        assert!(run.error.is_none(), "{u} m/s: {:?}", run.error);
+        let samples: Vec<(f64, f64)> = run.rows.iter().filter(|r| r.t >= 1.0 - 1e-9).map(|r| (r.t, r.tip[2])).collect();
+        let osc = harness::pencil::windows(&samples, 2.0, 1.0);
+        let o = osc.first().expect("an oscillation");
+        let root = lin.points[0]
+            .roots
+            .iter()
+            .filter(|r| r.converged)
+            .min_by(|a, b| (a.imag - 2.0 * std::f64::consts::PI * o.frequency_hz).abs().total_cmp(&(b.imag - 2.0 * std::f64::consts::PI * o.frequency_hz).abs()))
+            .unwrap();
+        println!(
+            "{u} m/s: time history {:.4} rad/s growth {:+.4} 1/s; eigen {:.4} rad/s {:+.4} 1/s ({:+.2} %)",
+            2.0 * std::f64::consts::PI * o.frequency_hz,
+            o.growth_rate,
+            root.imag,
+            root.real,
+            100.0 * (o.growth_rate / root.real - 1.0)
+        );
+        assert!(rel(o.growth_rate, root.real) < 0.02, "{u} m/s: {o:?} vs {root:?}");
+    }
 }
