@@ -33,7 +33,7 @@ pub struct Oscillation {
 /// Poles `s` (1/s) and complex amplitudes of `y` sampled at `dt`, at most `max_order` of them.
 pub fn poles(y: &[f64], dt: f64, max_order: usize) -> Vec<(C64, C64)> {
     let n = y.len();
-    if n < 8 || !(dt > 0.0) || y.iter().any(|v| !v.is_finite()) {
+    if n < 8 || dt.is_nan() || dt <= 0.0 || y.iter().any(|v| !v.is_finite()) {
         return Vec::new();
     }
     let l = n / 3;
@@ -83,7 +83,7 @@ pub fn dominant(y: &[f64], t0: f64, dt: f64, min_hz: f64) -> Option<Oscillation>
 /// (the last shorter window is dropped), each resampled uniformly with at most 400 points.
 pub fn windows(samples: &[(f64, f64)], window: f64, min_hz: f64) -> Vec<Oscillation> {
     let (Some(first), Some(last)) = (samples.first(), samples.last()) else { return Vec::new() };
-    if !(window > 0.0) || samples.len() < 16 {
+    if window.is_nan() || window <= 0.0 || samples.len() < 16 {
         return Vec::new();
     }
     let mut out = Vec::new();
@@ -132,14 +132,20 @@ mod tests {
         let o = dominant(&y, 0.0, dt, 0.05).unwrap();
         assert!((o.frequency_hz - 1.65).abs() < 1e-6 && (o.growth_rate + 0.12).abs() < 1e-6, "{o:?}");
         let p = poles(&y, dt, 12);
-        assert!(p.iter().any(|(s, _)| (s.im - 2.0 * std::f64::consts::PI * 0.31).abs() < 1e-6 && (s.re + 0.7).abs() < 1e-6));
+        assert!(
+            p.iter().any(|(s, _)| (s.im - 2.0 * std::f64::consts::PI * 0.31).abs() < 1e-6 && (s.re + 0.7).abs() < 1e-6)
+        );
         // Windows of a growing oscillation.
         let samples: Vec<(f64, f64)> =
             (0..1000).map(|k| (k as f64 * dt, (0.08 * k as f64 * dt).exp() * (10.0 * k as f64 * dt).sin())).collect();
         let w = windows(&samples, 3.0, 0.1);
         assert_eq!(w.len(), 3);
         for o in &w {
-            assert!((o.growth_rate - 0.08).abs() < 1e-5 && (o.frequency_hz - 10.0 / (2.0 * std::f64::consts::PI)).abs() < 1e-5, "{o:?}");
+            assert!(
+                (o.growth_rate - 0.08).abs() < 1e-5
+                    && (o.frequency_hz - 10.0 / (2.0 * std::f64::consts::PI)).abs() < 1e-5,
+                "{o:?}"
+            );
         }
     }
 }

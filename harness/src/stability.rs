@@ -18,7 +18,7 @@
 //! 4. **Flutter equation** in the modal coordinates `η`:
 //!
 //!    $$ D(s)\,\eta = \Big[M s^2 + C s + K + G_x + s\,G_{\dot x}
-//!        - T(s)\,N(s)^{-1}\big(R_x + s\,R_{\dot x}\big)\Big]\eta = 0 ,$$
+//!    - T(s)\,N(s)^{-1}\big(R_x + s\,R_{\dot x}\big)\Big]\eta = 0 ,$$
 //!
 //!    `N(s) = A + Σ_k e^{−sτ_k} W_k E` the non-penetration operator, `T(s)` the generalised load
 //!    of the circulations (Joukowski, unsteady term and wake). Its roots are found per mode by
@@ -117,7 +117,10 @@ impl StabilitySettings {
             return Err("stability.airspeeds: empty list".into());
         }
         if self.airspeeds.len() > MAX_STABILITY_POINTS {
-            return Err(format!("stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}", self.airspeeds.len()));
+            return Err(format!(
+                "stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}",
+                self.airspeeds.len()
+            ));
         }
         for (k, &u) in self.airspeeds.iter().enumerate() {
             if !(u.is_finite() && u > 0.0) {
@@ -292,7 +295,10 @@ impl Reduced {
         let mut t = uvlm::with_wake(&t0.map(|x| x / r), &self.t_rows, &delays, &self.te_rings, s);
         t *= C64::from(r);
         let rhs = self.rx.map(|x| C64::from(r * x)) + self.rv.map(|x| s * x);
-        let x = n.lu().solve(&rhs).unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
+        let x = n
+            .lu()
+            .solve(&rhs)
+            .unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
         self.m.map(|x| s * s * x)
             + (&self.c + &self.gv * r).map(|x| s * x)
             + (&self.k + &self.gx * (r * r)).map(C64::from)
@@ -316,7 +322,8 @@ impl Reduced {
                 let s0 = if w2 >= 0.0 { C64::new(0.0, w2.sqrt().max(1e-3)) } else { C64::new((-w2).sqrt(), 0.0) };
                 let mut e = DVector::zeros(nb);
                 e[m] = C64::new(1.0, 0.0);
-                let frozen = self.d(s0) - self.m.map(|x| s0 * s0 * x) - (&self.c + &self.gv * self.ratio).map(|x| s0 * x);
+                let frozen =
+                    self.d(s0) - self.m.map(|x| s0 * s0 * x) - (&self.c + &self.gv * self.ratio).map(|x| s0 * x);
                 // Companion form of M s² + C s + K_f: [0 I; −M⁻¹K_f −M⁻¹C].
                 let Some(lu) = self.m.map(C64::from).lu().try_inverse() else { return (s0, e) };
                 let cc = (&self.c + &self.gv * self.ratio).map(C64::from);
@@ -427,8 +434,13 @@ impl Strips {
                 let h = C64::from(-self.z[(j, k)]);
                 let al = C64::from(self.alpha[(j, k)]);
                 let circ = c * (s * h + u * al + b * (0.5 - a) * s * al);
-                let l = pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * al) + 2.0 * pi * rho * u * b * circ;
-                let m = pi * rho * b * b * (b * a * s * s * h - u * b * (0.5 - a) * s * al - b * b * (0.125 + a * a) * s * s * al)
+                let l =
+                    pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * al) + 2.0 * pi * rho * u * b * circ;
+                let m = pi
+                    * rho
+                    * b
+                    * b
+                    * (b * a * s * s * h - u * b * (0.5 - a) * s * al - b * b * (0.125 + a * a) * s * s * al)
                     + 2.0 * pi * rho * u * b * b * (a + 0.5) * circ;
                 for i in 0..nb {
                     q[(i, k)] += w * (l * self.z[(j, i)] + m * self.alpha[(j, i)]);
@@ -573,7 +585,11 @@ pub fn reduce<S: StaticStructure>(
                 st2.iter().zip(&stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
             let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
             d.iter_mut().flatten().for_each(|x| *x /= dm);
-            out.push(ModeShape { omega: modes.omega[i], s: map.iter().map(|x| x.wing_arc(case)).collect(), displacement: d });
+            out.push(ModeShape {
+                omega: modes.omega[i],
+                s: map.iter().map(|x| x.wing_arc(case)).collect(),
+                displacement: d,
+            });
         }
     }
     if let Some(case) = strip_case {
@@ -615,7 +631,15 @@ pub fn reduce<S: StaticStructure>(
             })
             .collect();
         let b = 0.5 * aero.chord;
-        let strips = Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset - b) / b, speed: aero.airspeed.unwrap_or(0.0) };
+        let strips = Strips {
+            z,
+            alpha,
+            width,
+            rho: aero.rho,
+            b,
+            a: (aero.le_offset - b) / b,
+            speed: aero.airspeed.unwrap_or(0.0),
+        };
         let e = DMatrix::zeros(0, nb);
         return Ok(Reduced {
             m,
@@ -768,6 +792,9 @@ pub fn linear_wake(case: &Case, f: Formulation, airspeed: f64) -> uvlm::LinearWa
     }
 }
 
+/// An equilibrium: coordinates, holonomic and velocity multipliers, fold angle (degrees).
+type Equilibrium = (Vec<f64>, Vec<f64>, Vec<f64>, f64);
+
 /// Thread CPU time where the platform has it (so that the cost of a sweep does not depend on
 /// the machine's load), else wall time since the first call, s.
 fn cpu_now() -> f64 {
@@ -821,7 +848,7 @@ fn sweep<S: StaticStructure>(
         Err(e) => return empty_output(f, Some(e)),
     };
     // Equilibria.
-    let states: Vec<Result<(Vec<f64>, Vec<f64>, Vec<f64>, f64), String>> = match st.about {
+    let states: Vec<Result<Equilibrium, String>> = match st.about {
         About::Undeformed => {
             let model = match build(case) {
                 Ok(m) => m,

@@ -7,8 +7,8 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::Error;
-use crate::csv::write_file;
 use crate::case::Formulation;
+use crate::csv::write_file;
 use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
 use crate::stability::StabilityOutput;
 
@@ -62,7 +62,12 @@ pub type History = std::collections::BTreeMap<Formulation, crate::metrics::Formu
 /// Write the sweep's files of every formulation in `runs` into `dir`; with the case's
 /// time-domain metrics, the section compares the least-damped roots with the dominant
 /// oscillation of the run (matrix pencil, last window).
-pub fn write_with_history(dir: &Path, name: &str, runs: &[StabilityOutput], history: Option<&History>) -> Result<(), Error> {
+pub fn write_with_history(
+    dir: &Path,
+    name: &str,
+    runs: &[StabilityOutput],
+    history: Option<&History>,
+) -> Result<(), Error> {
     for out in runs {
         write_file(&dir.join(format!("stability_{}.csv", out.formulation)), &to_csv(out))?;
         let sum = Summary {
@@ -106,12 +111,9 @@ fn history_table(runs: &[StabilityOutput], h: &History) -> String {
     for o in runs {
         let (Some(m), Some(p)) = (h.get(&o.formulation), o.points.first()) else { continue };
         let Some(osc) = m.oscillations.last() else { continue };
-        let Some(r) = p
-            .roots
-            .iter()
-            .filter(|r| r.converged)
-            .min_by(|a, b| (a.frequency_hz() - osc.frequency_hz).abs().total_cmp(&(b.frequency_hz() - osc.frequency_hz).abs()))
-        else {
+        let Some(r) = p.roots.iter().filter(|r| r.converged).min_by(|a, b| {
+            (a.frequency_hz() - osc.frequency_hz).abs().total_cmp(&(b.frequency_hz() - osc.frequency_hz).abs())
+        }) else {
             continue;
         };
         let _ = writeln!(
@@ -167,7 +169,12 @@ fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {
                     .filter_map(|p| p.roots.get(m).filter(|r| r.converged).map(|r| (p.airspeed, f(r))))
                     .collect()
             };
-            let style = Style { color: Style::nth(m).color, dash, marker: Some(Style::nth(m).marker.unwrap_or(Marker::Circle)), width: 2 };
+            let style = Style {
+                color: Style::nth(m).color,
+                dash,
+                marker: Some(Style::nth(m).marker.unwrap_or(Marker::Circle)),
+                width: 2,
+            };
             let label = format!("{} mode {}", out.formulation.as_str().to_uppercase(), m + 1);
             vg.series.push(Series::new(label.clone(), style, pick(&|r| r.damping_ratio())));
             vf.series.push(Series::new(label.clone(), style, pick(&|r| r.frequency_hz())));
@@ -190,7 +197,23 @@ fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {
             let y: Vec<(f64, f64)> = sh.s.iter().zip(&sh.displacement).map(|(s, d)| (*s, d[1])).collect();
             let x: Vec<(f64, f64)> = sh.s.iter().zip(&sh.displacement).map(|(s, d)| (*s, d[0])).collect();
             panels.push(Panel {
-                title: format!("{} mode {}: {:.3} Hz", out.formulation.as_str().to_uppercase(), i + 1, sh.omega / (2.0 * std::f64::consts::PI)),
+                title: if sh.omega >= 0.0 {
+                    format!(
+                        "{} mode {}: {:.3} Hz",
+                        out.formulation.as_str().to_uppercase(),
+                        i + 1,
+                        sh.omega / (2.0 * std::f64::consts::PI)
+                    )
+                } else {
+                    // ω² < 0: statically unstable with the aerodynamic loads held (the lift's
+                    // stiffness is in the flutter equation, not in these modes).
+                    format!(
+                        "{} mode {}: ω² < 0, |f| = {:.3} Hz",
+                        out.formulation.as_str().to_uppercase(),
+                        i + 1,
+                        -sh.omega / (2.0 * std::f64::consts::PI)
+                    )
+                },
                 x_label: "wing arclength (m)".into(),
                 y_label: "axis displacement (−)".into(),
                 series: vec![

@@ -11,6 +11,8 @@ use uvlm::samples::{SpanSpacing, rectangular_wing};
 use uvlm::*;
 
 type C = Complex<f64>;
+/// Residual and nodal-force derivatives of one motion.
+type Pair = (DVector<f64>, DVector<f64>);
 
 /// Theodorsen's C(k) by linear interpolation of the reference table (k in the table only).
 fn theodorsen_c(table: &[Vec<f64>], k: f64) -> C {
@@ -44,7 +46,11 @@ fn moved(base: &[SpanStation], al: f64, h: f64, al_dot: f64, h_dot: f64) -> (Vec
         .iter()
         .map(|s| {
             let qc = Vector3::new(0.25, s.origin.y, 0.0);
-            SpanStation { origin: qc + r * (s.origin - qc) + Vector3::new(0.0, 0.0, h), frame: r.matrix() * s.frame, ..*s }
+            SpanStation {
+                origin: qc + r * (s.origin - qc) + Vector3::new(0.0, 0.0, h),
+                frame: r.matrix() * s.frame,
+                ..*s
+            }
         })
         .collect();
     let om = Vector3::new(0.0, al_dot, 0.0);
@@ -83,7 +89,7 @@ fn lift_moment(w: &Wing, f: &DVector<C>) -> (C, C) {
 
 /// Lift and moment per unit amplitude of a motion with geometric terms (R_x, F_x) and rate
 /// terms (R_ẋ, F_ẋ), at s = i k / b.
-fn response(w: &Wing, s: C, geo: &(DVector<f64>, DVector<f64>), rate: &(DVector<f64>, DVector<f64>)) -> (C, C) {
+fn response(w: &Wing, s: C, geo: &Pair, rate: &Pair) -> (C, C) {
     let rhs: DVector<C> = geo.0.map(C::from) + rate.0.map(|x| s * x);
     let dgamma = -w.lin.normalwash_matrix(s).lu().solve(&rhs).unwrap();
     let f: DVector<C> = w.lin.force_matrix(s) * dgamma + geo.1.map(C::from) + rate.1.map(|x| s * x);
@@ -92,7 +98,7 @@ fn response(w: &Wing, s: C, geo: &(DVector<f64>, DVector<f64>), rate: &(DVector<
 
 /// Derivatives of (residual, forces) along pitch or plunge: central difference in position, and
 /// the exact (linear) velocity part.
-fn derivatives(w: &Wing, pitch: bool) -> ((DVector<f64>, DVector<f64>), (DVector<f64>, DVector<f64>)) {
+fn derivatives(w: &Wing, pitch: bool) -> (Pair, Pair) {
     let e = 1e-6;
     let (a, h) = if pitch { (e, 0.0) } else { (0.0, e) };
     let (rp, fp) = eval(w, a, h, 0.0, 0.0);
@@ -169,8 +175,7 @@ fn linear_uvlm_converges_to_theodorsen_pitch_and_plunge() {
     let coarse = theodorsen_errors(8);
     let fine = theodorsen_errors(16);
     for (i, &k) in KS.iter().enumerate() {
-        for m in 0..2 {
-            let e = fine[i][m];
+        for (m, e) in fine[i].iter().take(2).enumerate() {
             assert!((e.norm() - 1.0).abs() < 0.05 && e.arg().to_degrees().abs() < 3.0, "k = {k} lift {m}: {e}");
         }
         for m in 2..4 {
