@@ -66,7 +66,9 @@
 //!   [`Uvlm::stats`], [`Uvlm::velocity_at`]; the clock [`Uvlm::time`] / [`Uvlm::set_time`].
 //! * External flow ([`flow`]): [`FlowField`] (`velocity(x, t)`, batch `add_velocity_inplace`),
 //!   [`Uniform`], [`Flow`] (free stream + optional disturbance); attach a gust with
-//!   [`Uvlm::set_disturbance`].
+//!   [`Uvlm::set_disturbance`]. Gusts ([`gust`]): [`OneMinusCosine`], [`SharpEdged`],
+//!   [`Sinusoidal`], [`VonKarman`], frozen and convected ([`Convection`]); thin-aerofoil theory
+//!   to check them against ([`gust_theory`]: Sears, exact Küssner).
 //! * Loads: [`Loads::nodal`] (per ring node, N), [`Loads::strip`] (per panel column),
 //!   [`Loads::total_force`], [`Loads::moment_about`], [`Loads::lift_drag`],
 //!   [`Loads::column_loads_inplace`] (force + moment about each station origin).
@@ -90,6 +92,8 @@ pub mod biot_savart;
 mod dense_lu;
 mod error;
 pub mod flow;
+pub mod gust;
+pub mod gust_theory;
 pub mod images;
 mod induce;
 pub mod lattice;
@@ -105,6 +109,7 @@ mod wake;
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
 pub use error::{Result, UvlmError};
 pub use flow::{Flow, FlowField, Uniform};
+pub use gust::{Convection, OneMinusCosine, SharpEdged, Sinusoidal, VonKarman, VonKarmanParams};
 pub use images::ImagePlane;
 pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
