@@ -63,6 +63,9 @@ pub struct AeroSettings {
     /// Coupling iteration settings.
     #[serde(default)]
     pub coupling: Coupling,
+    /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<crate::gust::GustSpec>,
 }
 
 /// A mirror plane of the flow.
@@ -303,7 +306,8 @@ fn power(loads: &[SectionLoad], vel: &[uvlm::StationVelocity]) -> f64 {
     loads.iter().zip(vel).map(|(l, v)| l.force.dot(&v.linear) + l.moment.dot(&v.angular)).sum()
 }
 
-/// Integrate an aeroelastic case (see the module docs for the scheme).
+/// Integrate an aeroelastic case (see the module docs for the scheme), from the model's initial
+/// state with an empty wake (an impulsive start).
 pub fn simulate_aero<S: AeroStructure>(
     formulation: crate::case::Formulation,
     model: &mut S,
@@ -311,6 +315,24 @@ pub fn simulate_aero<S: AeroStructure>(
     aero: &AeroSettings,
     map: &[StationMap],
     observer: &mut dyn crate::run::Observer,
+) -> crate::run::RunOutput {
+    simulate_aero_from(formulation, model, settings, aero, map, observer, None)
+}
+
+/// [`simulate_aero`], optionally from `equilibrium`: the coordinates of a static aeroelastic
+/// equilibrium (docs/statics.md), at rest, with the steady solution of the lattice there, its wake
+/// prefilled along the free stream ([`uvlm::Uvlm::prefill_wake`]) and its loads applied before the
+/// initial accelerations, so that without a disturbance the run stays at the equilibrium
+/// (docs/gust.md §3). A gust (`aero.gust`) is attached in both cases, its front placed relative to
+/// the initial lattice's most upstream leading-edge point.
+pub fn simulate_aero_from<S: AeroStructure>(
+    formulation: crate::case::Formulation,
+    model: &mut S,
+    settings: &crate::run::RunSettings,
+    aero: &AeroSettings,
+    map: &[StationMap],
+    observer: &mut dyn crate::run::Observer,
+    equilibrium: Option<&[f64]>,
 ) -> crate::run::RunOutput {
     use crate::run::{Dissipation, RunOutput, SnapshotFeed, row};
     use genalpha::State;
@@ -332,8 +354,12 @@ pub fn simulate_aero<S: AeroStructure>(
         Err(e) => return fail(out, e.to_string()),
     };
     let mut s = model.initial_state();
-    if let Err(e) = ga.initialize(model, &mut s) {
-        return fail(out, format!("initial accelerations: {e}"));
+    if let Some(q) = equilibrium {
+        if q.len() != s.q.len() {
+            return fail(out, format!("equilibrium: {} coordinates for a model of {}", q.len(), s.q.len()));
+        }
+        s.q.copy_from_slice(q);
+        s.v.iter_mut().for_each(|x| *x = 0.0);
     }
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
@@ -344,8 +370,8 @@ pub fn simulate_aero<S: AeroStructure>(
         Ok(u) => u,
         Err(e) => return fail(out, format!("aerodynamic lattice: {e}")),
     };
-    // The flow is the free stream alone (no disturbance); the UVLM's clock, at which a
-    // disturbance would be evaluated, starts at the structure's and advances with each commit.
+    // The UVLM's clock, at which a disturbance is evaluated, starts at the structure's and
+    // advances with each commit.
     if let Err(e) = uv.set_time(s.t) {
         return fail(out, format!("aerodynamic clock: {e}"));
     }
@@ -357,6 +383,35 @@ pub fn simulate_aero<S: AeroStructure>(
     let mut new_loads = loads.clone();
     let mut obuf: Vec<[f64; 3]> = Vec::with_capacity(map.len());
     let (mut fbuf, mut mbuf) = (vec![[0.0; 3]; map.len()], vec![[0.0; 3]; map.len()]);
+    let mut lift0 = 0.0;
+    if equilibrium.is_some() {
+        // The steady solution on the equilibrium's lattice, its wake laid out as the unsteady
+        // solver would have shed it, its loads applied before the initial accelerations.
+        let l = match uv.solve_steady() {
+            Ok(l) => l,
+            Err(e) => return fail(out, format!("steady aerodynamics at the equilibrium: {e}")),
+        };
+        obuf.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
+        l.column_loads_inplace(&obuf, &mut fbuf, &mut mbuf);
+        for (j, t) in loads.iter_mut().enumerate() {
+            t.force = Vector3::from(fbuf[j]);
+            t.moment = Vector3::from(mbuf[j]);
+        }
+        lift0 = uvlm::lift_drag_of(l.total_force(), aero.free_stream(), span_dir).0;
+        if let Err(e) = uv.prefill_wake(dt) {
+            return fail(out, format!("steady wake at the equilibrium: {e}"));
+        }
+        model.set_section_loads(&loads);
+    }
+    if let Some(g) = &aero.gust {
+        match crate::gust::disturbance(g, aero, &stations, settings.t_end, s.t) {
+            Ok(d) => uv.set_disturbance(Some(d)),
+            Err(e) => return fail(out, format!("aero.gust: {e}")),
+        }
+    }
+    if let Err(e) = ga.initialize(model, &mut s) {
+        return fail(out, format!("initial accelerations: {e}"));
+    }
     let mut work = 0.0;
     let mut lift;
     let fold = settings.fold_joint;
@@ -375,7 +430,7 @@ pub fn simulate_aero<S: AeroStructure>(
     };
     let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
-    r0.lift = 0.0;
+    r0.lift = lift0;
     with_loads(model, &mut r0, &s, &loads);
     out.rows.push(r0);
     if let Err(e) = feed.feed(model, &r0, &s.q, Some(&uv)) {

@@ -93,6 +93,10 @@ pub struct Case {
     /// linearise about. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stability: Option<crate::stability::StabilitySettings>,
+    /// Gust sweep (`harness gust`): the gradients (or gust frequencies) of the case's 1-cos
+    /// `aero.gust` and the hinge states to fly through them (docs/gust.md). Needs `aero.gust`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<crate::gust::GustSweep>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -1360,6 +1364,12 @@ impl Case {
         }
         if !(self.pitch_deg.is_finite() && (-90.0..=90.0).contains(&self.pitch_deg)) {
             return Err(format!("pitch_deg: {} is not in [-90, 90]", self.pitch_deg));
+        }
+        if let Some(g) = self.aero.as_ref().and_then(|a| a.gust.as_ref()) {
+            g.validate()?;
+        }
+        if let Some(g) = &self.gust {
+            g.validate(self)?;
         }
         if let Some(st) = &self.statics {
             if self.aero.is_none() {

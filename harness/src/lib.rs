@@ -19,6 +19,8 @@ pub mod driver;
 pub mod energy;
 pub mod fuzz;
 pub mod gate;
+pub mod gust;
+pub mod gust_out;
 pub mod loads;
 pub mod metrics;
 pub mod pencil;

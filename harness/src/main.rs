@@ -233,6 +233,22 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
+    /// Gust sweep over the case's `gust` block (gradients x hinge states) from the static
+    /// equilibrium; writes `<out>/<case>/gust_{ancf,gebf}.csv`, `gust_history_*.csv`,
+    /// `gust_summary.json` and plots (docs/gust.md).
+    Gust {
+        /// Case file (with `aero.gust` and a `gust` block).
+        case: PathBuf,
+        /// Formulation(s) to run.
+        #[arg(long, value_enum, default_value = "both")]
+        formulation: Which,
+        /// Output folder.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Override a case value (see `all`), e.g. `gust.gradients_m=[30]`.
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<Override>,
+    },
     /// List the runs the case files expand into.
     List {
         /// Folder of case files.
@@ -345,6 +361,74 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
         );
     }
     failed
+}
+
+/// `harness gust`: every run of the case file through its gust sweep; exit 2 without a `gust`
+/// block, 1 when a run failed.
+fn run_gust(case: &std::path::Path, which: Which, out: &std::path::Path, set: &[Override]) -> Result<ExitCode> {
+    let runs = CaseFile::read(case)?.expand(set)?;
+    let fs: Vec<Formulation> = match which {
+        Which::Ancf => vec![Formulation::Ancf],
+        Which::Gebf => vec![Formulation::Gebf],
+        Which::Both => Formulation::ALL.to_vec(),
+    };
+    let file = case.display().to_string();
+    for spec in &runs {
+        if spec.ancf.gust.is_none() {
+            let msg = "gust: the case has no `gust` block (gradients and hinge states to sweep)".into();
+            return Err(harness::Error::Case { file, msg }.into());
+        }
+    }
+    let mut failed = false;
+    for spec in &runs {
+        let sweep =
+            harness::gust::run_sweep(spec, &fs).map_err(|msg| harness::Error::Case { file: file.clone(), msg })?;
+        let summary = harness::gust_out::summarise(sweep);
+        let dir = out.join(&spec.name);
+        harness::gust_out::write(&dir, &summary)?;
+        for r in &summary.runs {
+            match &r.error {
+                Some(e) => {
+                    failed = true;
+                    eprintln!(
+                        "gust {} {} {} H = {} m: FAILED: {e}",
+                        spec.name,
+                        r.formulation,
+                        r.hinge.label(),
+                        r.gradient_m
+                    );
+                }
+                None => println!(
+                    "gust {} {} {:<6} H = {:>8.3} m ({:.3} Hz, {:.3} m/s): peak dM_root {:>11.5} N m at {:.2} s, peak dfold {:>8.3} deg, {:.2} s CPU",
+                    spec.name,
+                    r.formulation,
+                    r.hinge.label(),
+                    r.gradient_m,
+                    r.frequency_hz,
+                    r.gust_velocity,
+                    r.peak_delta_root_bending_moment.0,
+                    r.peak_delta_root_bending_moment.1,
+                    r.peak_delta_fold_deg.0,
+                    r.cpu_s
+                ),
+            }
+        }
+        for a in &summary.alleviation {
+            println!(
+                "  {} {} H = {:.3} m: alleviation {:.1} %",
+                a.formulation,
+                a.hinge.label(),
+                a.gradient_m,
+                a.root_bending_moment_percent
+            );
+        }
+        println!(
+            "gust {}: ANCF-GEBF peak dM_root within {:.3} %, peak fold within {:.3} deg; sweep {:.1} s wall",
+            spec.name, summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg, summary.wall_s
+        );
+        println!("wrote {}", dir.display());
+    }
+    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
 }
 
 /// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
@@ -771,6 +855,7 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
+        Cmd::Gust { case, formulation, out, set } => run_gust(&case, formulation, &out, &set),
         Cmd::Converge { case, out, set } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
             for spec in &runs {

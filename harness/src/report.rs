@@ -804,7 +804,7 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
 }
 
 /// The sections of the studies found on disk under `out`: the static equilibria
-/// (`<case>/static_section.html`), `converge/<case>/`, `energy/`, `bench/` and `stress/` (each
+/// (`<case>/static_section.html`), the gust sweeps (`<case>/gust_section.html`), `converge/<case>/`, `energy/`, `bench/` and `stress/` (each
 /// table first, then its figures).
 pub fn study_sections(out: &Path) -> Vec<Section> {
     let mut v = Vec::new();
@@ -832,6 +832,16 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
                  delays), continued over the sweep by Newton's method (docs/stability.md). Files per case: \
                  <code>stability_ancf.csv</code>, <code>stability_gebf.csv</code>, <code>stability_*.json</code>.</p>\n{stab}"
             ),
+            badge: None,
+        });
+    }
+    let gusts = crate::gust_out::sections_html(out);
+    if !gusts.is_empty() {
+        v.push(Section {
+            id: "gust".into(),
+            title: "Gust response and load alleviation".into(),
+            group: Group::Study,
+            html: gusts,
             badge: None,
         });
     }

@@ -347,7 +347,7 @@ fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// How a curve is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Style {
+pub(crate) enum Style {
     /// Solid line with open circles.
     Solid,
     /// Dashed line with filled triangles (drawn over a solid one it stays visible).
@@ -356,7 +356,7 @@ enum Style {
     Points,
 }
 
-type Curves = Vec<(String, RGBColor, Vec<(f64, f64)>, Style)>;
+pub(crate) type Curves = Vec<(String, RGBColor, Vec<(f64, f64)>, Style)>;
 
 /// Decimals that tell neighbouring ticks apart on an axis spanning `lo..hi`.
 fn decimals(lo: f64, hi: f64) -> usize {
@@ -368,7 +368,7 @@ fn decimals(lo: f64, hi: f64) -> usize {
 }
 
 /// A panel of curves with the legend beside the data.
-fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves) -> Result<(), Error> {
+pub(crate) fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves) -> Result<(), Error> {
     let err = |e: String| Error::Plot { file: path.display().to_string(), msg: e };
     let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;

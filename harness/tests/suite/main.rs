@@ -7,6 +7,7 @@ mod cli;
 mod external;
 mod fuzz;
 mod gate;
+mod gust;
 mod honest;
 mod observer;
 mod properties;

@@ -3,6 +3,7 @@
 
 mod common;
 mod flow;
+mod gust;
 mod hinge;
 mod linear;
 mod properties;

@@ -1,0 +1,774 @@
+//! Gust response and load alleviation (docs/gust.md): the case field `aero.gust` (a frozen gust
+//! or turbulence field convected with the free stream), the top-level `gust` sweep block (gust
+//! gradients × hinge states), a gust run from the static aeroelastic equilibrium
+//! ([`gust_history`]) and the sweep ([`run_sweep`]). Outputs are in [`crate::gust_out`].
+//!
+//! A gust run starts at rest at the static equilibrium of its hinge state (docs/statics.md),
+//! with the steady wake of that lattice laid out behind it, so that without a gust it stays
+//! there and every load it records, minus its value at t = 0, is the gust's alone.
+
+use std::time::Instant;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use uvlm::FlowField;
+
+use crate::aero::{AeroSettings, AeroStructure, simulate_aero_from, station_map};
+use crate::case::{Case, Formulation, Joint, Spring, StaticSettings};
+
+/// Sea-level density of the standard atmosphere, kg/m³ (equivalent to true airspeed).
+pub const RHO_SEA_LEVEL: f64 = 1.225;
+
+fn up() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn default_modes() -> usize {
+    200
+}
+
+/// A gust or turbulence field (`aero.gust`). Every kind is frozen in the air and convected with
+/// the free stream; its front is `x0` metres upstream of the wing's most upstream leading-edge
+/// point when the run starts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum GustSpec {
+    /// The certification discrete gust `½ U_ds (1 − cos(π s/H))` over `0 ≤ s ≤ 2H`.
+    OneMinusCosine {
+        /// Gust gradient H, m (half the gust length; CS-25: 9 to 107 m).
+        gradient_m: f64,
+        /// Peak gust velocity U_ds, m/s (true airspeed). Give this or `certification`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        velocity: Option<f64>,
+        /// U_ds from the certification rule instead of `velocity`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        certification: Option<Certification>,
+        /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
+        #[serde(default)]
+        x0: f64,
+        /// Direction of the gust velocity, global (any non-zero length; default up, +Z).
+        #[serde(default = "up")]
+        direction: [f64; 3],
+    },
+    /// A sharp-edged gust of `velocity` behind its front.
+    SharpEdged {
+        /// Gust velocity, m/s.
+        velocity: f64,
+        /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
+        #[serde(default)]
+        x0: f64,
+        /// Direction of the gust velocity (default +Z).
+        #[serde(default = "up")]
+        direction: [f64; 3],
+    },
+    /// A sinusoidal gust `velocity · sin(2π s/λ)` behind its front.
+    Sinusoidal {
+        /// Amplitude, m/s.
+        velocity: f64,
+        /// Frequency seen by a fixed point, Hz (λ = airspeed / f). Give this or `wavelength_m`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        frequency_hz: Option<f64>,
+        /// Wavelength λ, m.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        wavelength_m: Option<f64>,
+        /// Whole waves behind the front (default: unbounded).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cycles: Option<f64>,
+        /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
+        #[serde(default)]
+        x0: f64,
+        /// Direction of the gust velocity (default +Z).
+        #[serde(default = "up")]
+        direction: [f64; 3],
+    },
+    /// Continuous turbulence: a seeded realisation of the von Kármán spectrum.
+    VonKarman {
+        /// RMS velocity σ, m/s.
+        intensity: f64,
+        /// Length scale L, m (762 m in the certification rule; scale with the wing).
+        length_scale_m: f64,
+        /// Seed of the random phases (required: a realisation is reproducible only from it).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        seed: Option<u64>,
+        /// Spectral lines (default 200).
+        #[serde(default = "default_modes")]
+        n_modes: usize,
+        /// Shortest resolved wavelength, m (default: the chord).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        min_wavelength_m: Option<f64>,
+        /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
+        #[serde(default)]
+        x0: f64,
+        /// Direction of the turbulent velocity (default +Z).
+        #[serde(default = "up")]
+        direction: [f64; 3],
+    },
+}
+
+/// The certification design gust velocity, `U_ds = scale · U_ref(altitude) · F_g · (H/107)^{1/6}`
+/// (CS-25.341(a)), U_ref in equivalent airspeed converted to true airspeed with `aero.rho`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Certification {
+    /// Altitude, m (U_ref 17.07 m/s EAS at sea level, 13.41 at 4 572 m, 6.36 at 18 288 m and above).
+    pub altitude_m: f64,
+    /// Flight profile alleviation factor F_g, in (0, 1] (default 1).
+    #[serde(default = "one")]
+    pub f_g: f64,
+    /// Factor on the design velocity (default 1): a scaled model or a scaled regime.
+    #[serde(default = "one")]
+    pub scale: f64,
+}
+
+impl GustSpec {
+    /// The kind as spelled in the case file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            GustSpec::OneMinusCosine { .. } => "one_minus_cosine",
+            GustSpec::SharpEdged { .. } => "sharp_edged",
+            GustSpec::Sinusoidal { .. } => "sinusoidal",
+            GustSpec::VonKarman { .. } => "von_karman",
+        }
+    }
+
+    /// Check every value, naming the field (`aero.gust.<field>`).
+    pub fn validate(&self) -> Result<(), String> {
+        let f = |n: &str| format!("aero.gust.{n}");
+        let finite = |n: &str, v: f64| if v.is_finite() { Ok(()) } else { Err(format!("{}: {v} is not finite", f(n))) };
+        let length = |n: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{}: {v} is not a positive, finite length", f(n)))
+            }
+        };
+        let dir_ok = |d: &[f64; 3]| {
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if n.is_finite() && n > 0.0 { Ok(()) } else { Err(format!("{}: {d:?} is not a direction", f("direction"))) }
+        };
+        let x0_ok = |x0: f64| {
+            if x0.is_finite() && x0 >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{}: {x0} is not a non-negative, finite distance", f("x0")))
+            }
+        };
+        match self {
+            GustSpec::OneMinusCosine { gradient_m, velocity, certification, x0, direction } => {
+                length("gradient_m", *gradient_m)?;
+                match (velocity, certification) {
+                    (Some(v), None) => finite("velocity", *v)?,
+                    (None, Some(c)) => {
+                        finite("certification.altitude_m", c.altitude_m)?;
+                        if !(c.f_g.is_finite() && c.f_g > 0.0 && c.f_g <= 1.0) {
+                            return Err(format!("{}: {} is not in (0, 1]", f("certification.f_g"), c.f_g));
+                        }
+                        if !(c.scale.is_finite() && c.scale > 0.0) {
+                            return Err(format!("{}: {} is not a positive number", f("certification.scale"), c.scale));
+                        }
+                    }
+                    _ => return Err(format!("{}: give exactly one of `velocity` and `certification`", f("velocity"))),
+                }
+                x0_ok(*x0)?;
+                dir_ok(direction)
+            }
+            GustSpec::SharpEdged { velocity, x0, direction } => {
+                finite("velocity", *velocity)?;
+                x0_ok(*x0)?;
+                dir_ok(direction)
+            }
+            GustSpec::Sinusoidal { velocity, frequency_hz, wavelength_m, cycles, x0, direction } => {
+                finite("velocity", *velocity)?;
+                match (frequency_hz, wavelength_m) {
+                    (Some(hz), None) => length("frequency_hz", *hz)?,
+                    (None, Some(l)) => length("wavelength_m", *l)?,
+                    _ => {
+                        return Err(format!(
+                            "{}: give exactly one of `frequency_hz` and `wavelength_m`",
+                            f("wavelength_m")
+                        ));
+                    }
+                }
+                if let Some(c) = cycles {
+                    length("cycles", *c)?;
+                }
+                x0_ok(*x0)?;
+                dir_ok(direction)
+            }
+            GustSpec::VonKarman { intensity, length_scale_m, seed, n_modes, min_wavelength_m, x0, direction } => {
+                if !(intensity.is_finite() && *intensity >= 0.0) {
+                    return Err(format!("{}: {intensity} is not a non-negative, finite velocity", f("intensity")));
+                }
+                length("length_scale_m", *length_scale_m)?;
+                if seed.is_none() {
+                    return Err(format!(
+                        "{}: von Kármán turbulence needs a seed (a realisation is reproducible only from it)",
+                        f("seed")
+                    ));
+                }
+                if !(2..=10_000).contains(n_modes) {
+                    return Err(format!("{}: {n_modes} is not in 2..=10000", f("n_modes")));
+                }
+                if let Some(l) = min_wavelength_m {
+                    length("min_wavelength_m", *l)?;
+                }
+                x0_ok(*x0)?;
+                dir_ok(direction)
+            }
+        }
+    }
+
+    /// Peak (or amplitude, or RMS) gust velocity, m/s true airspeed.
+    pub fn velocity(&self, aero: &AeroSettings) -> f64 {
+        match self {
+            GustSpec::OneMinusCosine { gradient_m, velocity, certification, .. } => match (velocity, certification) {
+                (Some(v), _) => *v,
+                (None, Some(c)) => {
+                    let eas = c.scale
+                        * uvlm::gust::design_velocity(
+                            *gradient_m,
+                            uvlm::gust::cs25_reference_velocity(c.altitude_m),
+                            c.f_g,
+                        );
+                    eas * (RHO_SEA_LEVEL / aero.rho).sqrt()
+                }
+                (None, None) => f64::NAN,
+            },
+            GustSpec::SharpEdged { velocity, .. } | GustSpec::Sinusoidal { velocity, .. } => *velocity,
+            GustSpec::VonKarman { intensity, .. } => *intensity,
+        }
+    }
+
+    /// The same gust with gradient `h` (a 1-cos gust; others unchanged).
+    pub fn with_gradient(&self, h: f64) -> Self {
+        let mut g = self.clone();
+        if let GustSpec::OneMinusCosine { gradient_m, .. } = &mut g {
+            *gradient_m = h;
+        }
+        g
+    }
+
+    /// The gradient of a 1-cos gust, m (NaN for other kinds).
+    pub fn gradient(&self) -> f64 {
+        match self {
+            GustSpec::OneMinusCosine { gradient_m, .. } => *gradient_m,
+            _ => f64::NAN,
+        }
+    }
+}
+
+/// The disturbance field of `spec` for a lattice whose stations are `stations` at time `t0`
+/// (the front `x0` upstream of the most upstream leading-edge point), for a run to `t_end`.
+pub fn disturbance(
+    spec: &GustSpec,
+    aero: &AeroSettings,
+    stations: &[uvlm::SpanStation],
+    t_end: f64,
+    t0: f64,
+) -> Result<Box<dyn FlowField>, String> {
+    let v_inf = aero.free_stream();
+    let u = (v_inf[0] * v_inf[0] + v_inf[1] * v_inf[1] + v_inf[2] * v_inf[2]).sqrt();
+    if !(u.is_finite() && u > 0.0) {
+        return Err("the free stream is zero".into());
+    }
+    let dir = nalgebra::Vector3::from(v_inf) / u;
+    let lead = stations
+        .iter()
+        .map(|st| st.origin + st.frame.column(1) * st.le_offset)
+        .min_by(|a, b| dir.dot(a).total_cmp(&dir.dot(b)))
+        .ok_or("no lattice stations")?;
+    let x0 = match spec {
+        GustSpec::OneMinusCosine { x0, .. }
+        | GustSpec::SharpEdged { x0, .. }
+        | GustSpec::Sinusoidal { x0, .. }
+        | GustSpec::VonKarman { x0, .. } => *x0,
+    };
+    let front = lead - dir * x0;
+    let e = |e: uvlm::UvlmError| e.to_string();
+    let conv = uvlm::Convection::new(v_inf, front.into(), t0).map_err(e)?;
+    Ok(match spec {
+        GustSpec::OneMinusCosine { gradient_m, direction, .. } => {
+            Box::new(uvlm::OneMinusCosine::new(conv, *gradient_m, spec.velocity(aero), *direction).map_err(e)?)
+        }
+        GustSpec::SharpEdged { velocity, direction, .. } => {
+            Box::new(uvlm::SharpEdged::new(conv, *velocity, *direction).map_err(e)?)
+        }
+        GustSpec::Sinusoidal { velocity, frequency_hz, wavelength_m, cycles, direction, .. } => {
+            let lambda = wavelength_m.unwrap_or_else(|| u / frequency_hz.unwrap_or(f64::NAN));
+            Box::new(uvlm::Sinusoidal::new(conv, *velocity, lambda, *cycles, false, *direction).map_err(e)?)
+        }
+        GustSpec::VonKarman { intensity, length_scale_m, seed, n_modes, min_wavelength_m, direction, .. } => {
+            let params = uvlm::VonKarmanParams {
+                intensity: *intensity,
+                length_scale: *length_scale_m,
+                seed: seed.ok_or("seed: von Kármán turbulence needs a seed")?,
+                n_modes: *n_modes,
+                min_wavelength: min_wavelength_m.unwrap_or(aero.chord),
+                table_length: u * (t_end - t0).max(0.0) + x0 + 4.0 * aero.chord,
+            };
+            Box::new(uvlm::VonKarman::new(conv, params, *direction).map_err(e)?)
+        }
+    })
+}
+
+/// A state of the fold hinge in a gust sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "state", rename_all = "snake_case", deny_unknown_fields)]
+pub enum HingeState {
+    /// The hinge as the case has it, unlocked (with the case's own spring, if any).
+    Free,
+    /// The hinge locked at its reference fold (the conventional wing).
+    Locked,
+    /// Unlocked, with a rotational spring (and damper) replacing the case's own.
+    Spring {
+        /// Stiffness, N·m/rad.
+        stiffness: f64,
+        /// Damping, N·m·s/rad (default 0).
+        #[serde(default)]
+        damping: f64,
+    },
+}
+
+impl HingeState {
+    /// `free`, `locked` or `spring` (the CSV's `hinge` column).
+    pub fn label(&self) -> &'static str {
+        match self {
+            HingeState::Free => "free",
+            HingeState::Locked => "locked",
+            HingeState::Spring { .. } => "spring",
+        }
+    }
+
+    /// The spring stiffness, N·m/rad (NaN unless sprung).
+    pub fn stiffness(&self) -> f64 {
+        match self {
+            HingeState::Spring { stiffness, .. } => *stiffness,
+            _ => f64::NAN,
+        }
+    }
+
+    /// `case` with its fold hinge in this state.
+    pub fn apply(&self, case: &Case) -> Result<Case, String> {
+        let mut c = case.clone();
+        let j = c.fold_joint_index().ok_or("gust.hinges: the case has no flared hinge to free, lock or spring")?;
+        if let Joint::FlaredHinge { locked, spring, .. } = &mut c.joints[j] {
+            match self {
+                HingeState::Free => *locked = false,
+                HingeState::Locked => *locked = true,
+                HingeState::Spring { stiffness, damping } => {
+                    *locked = false;
+                    let rest_deg = spring.map_or(0.0, |s| s.rest_deg);
+                    *spring = Some(Spring { stiffness: *stiffness, damping: *damping, rest_deg });
+                }
+            }
+        } else {
+            return Err(format!("fold_joint: joints[{j}] is not a flared hinge"));
+        }
+        Ok(c)
+    }
+}
+
+/// The gust sweep of a case (`gust`): 1-cos gusts of the case's `aero.gust` over gradients (or
+/// gust frequencies `f = V/(2H)`) and hinge states.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GustSweep {
+    /// Gust gradients H, m. Give this or `frequencies_hz`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gradients_m: Vec<f64>,
+    /// Gust frequencies `f = V/(2H)`, Hz (the gust's length passes a point in 1/f).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub frequencies_hz: Vec<f64>,
+    /// Hinge states, e.g. `[{"state": "free"}, {"state": "locked"}, {"state": "spring",
+    /// "stiffness": 100}]`.
+    pub hinges: Vec<HingeState>,
+    /// Duration of each gust run, s (default: the case's `t_end`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_end: Option<f64>,
+}
+
+/// Gust runs per sweep, at most.
+pub const MAX_GUST_RUNS: usize = 400;
+
+impl GustSweep {
+    /// Check the block against its case (which must have `aero` with a 1-cos `aero.gust` and a
+    /// flared hinge), naming the field.
+    pub fn validate(&self, case: &Case) -> Result<(), String> {
+        let Some(aero) = &case.aero else {
+            return Err("gust: a gust sweep needs aerodynamics (`aero`)".into());
+        };
+        match &aero.gust {
+            Some(GustSpec::OneMinusCosine { .. }) => {}
+            Some(g) => {
+                return Err(format!(
+                    "aero.gust.kind: the sweep varies the gradient of a one_minus_cosine gust, not a {}",
+                    g.kind()
+                ));
+            }
+            None => return Err("aero.gust: a gust sweep needs the gust it varies (`aero.gust`)".into()),
+        }
+        let (name, list) = match (self.gradients_m.is_empty(), self.frequencies_hz.is_empty()) {
+            (false, true) => ("gust.gradients_m", &self.gradients_m),
+            (true, false) => ("gust.frequencies_hz", &self.frequencies_hz),
+            _ => return Err("gust.gradients_m: give exactly one of `gradients_m` and `frequencies_hz`".into()),
+        };
+        for (k, &v) in list.iter().enumerate() {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name}[{k}]: {v} is not a positive, finite number"));
+            }
+        }
+        if self.hinges.is_empty() {
+            return Err("gust.hinges: empty list".into());
+        }
+        for (k, h) in self.hinges.iter().enumerate() {
+            if let HingeState::Spring { stiffness, damping } = h {
+                if !(stiffness.is_finite() && *stiffness >= 0.0) {
+                    return Err(format!("gust.hinges[{k}].stiffness: {stiffness} is not a non-negative number"));
+                }
+                if !(damping.is_finite() && *damping >= 0.0) {
+                    return Err(format!("gust.hinges[{k}].damping: {damping} is not a non-negative number"));
+                }
+            }
+        }
+        if case.fold_joint_index().is_none() {
+            return Err("gust.hinges: the case has no flared hinge".into());
+        }
+        if let Some(t) = self.t_end
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(format!("gust.t_end: {t} is not a positive number"));
+        }
+        if list.len() * self.hinges.len() > MAX_GUST_RUNS {
+            return Err(format!(
+                "gust: {} gradients x {} hinge states is more than {MAX_GUST_RUNS} runs",
+                list.len(),
+                self.hinges.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// The gradients of the sweep, m, for free-stream speed `airspeed`.
+    pub fn gradients(&self, airspeed: f64) -> Vec<f64> {
+        if self.gradients_m.is_empty() {
+            self.frequencies_hz.iter().map(|f| airspeed / (2.0 * f)).collect()
+        } else {
+            self.gradients_m.clone()
+        }
+    }
+}
+
+/// The values of the loads at the equilibrium a gust run starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Equilibrium {
+    /// Root bending moment, N·m.
+    pub root_bending_moment: f64,
+    /// Root torque, N·m.
+    pub root_torque: f64,
+    /// Hinge moment, N·m.
+    pub hinge_moment: f64,
+    /// Fold angle, degrees.
+    pub fold_deg: f64,
+    /// Lift, N.
+    pub lift: f64,
+}
+
+/// One gust run: the incremental loads over their equilibrium values, at the output times.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GustHistory {
+    /// Times, s (0 at the equilibrium; the gust's front starts `x0` upstream of the wing).
+    pub t: Vec<f64>,
+    /// Root bending moment minus its equilibrium value, N·m.
+    pub delta_root_bending_moment: Vec<f64>,
+    /// Root torque minus its equilibrium value, N·m.
+    pub delta_root_torque: Vec<f64>,
+    /// Hinge moment minus its equilibrium value, N·m.
+    pub delta_hinge_moment: Vec<f64>,
+    /// Fold angle minus its equilibrium value, degrees.
+    pub delta_fold_deg: Vec<f64>,
+    /// Lift minus its equilibrium value, N.
+    pub delta_lift: Vec<f64>,
+    /// The equilibrium.
+    pub equilibrium: Equilibrium,
+    /// CPU time of the time march, s (thread CPU time; wall time off Linux).
+    pub cpu_s: f64,
+    /// CPU time of the static equilibrium, s.
+    pub static_cpu_s: f64,
+    /// Why the run stopped before `t_end`, if it did (the rows up to there are kept).
+    pub error: Option<String>,
+}
+
+fn cpu_now() -> (Instant, Option<f64>) {
+    (Instant::now(), crate::bench::thread_cpu_s())
+}
+
+fn cpu_since(t: (Instant, Option<f64>)) -> f64 {
+    match (t.1, crate::bench::thread_cpu_s()) {
+        (Some(a), Some(b)) => b - a,
+        _ => t.0.elapsed().as_secs_f64(),
+    }
+}
+
+/// The static aeroelastic equilibrium of `case` at its airspeed: its coordinates.
+pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let v = aero.free_stream();
+    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let mut c = case.clone();
+    c.statics = Some(StaticSettings { airspeeds: vec![airspeed], references: Vec::new() });
+    let out = crate::statics::run_static(&c, f);
+    if let Some(e) = out.error {
+        return Err(format!("static equilibrium: {e}"));
+    }
+    let p = out.points.into_iter().next().ok_or("static equilibrium: no point")?;
+    match (p.error, p.state) {
+        (Some(e), _) => Err(format!("static equilibrium: {e}")),
+        (None, Some((q, _, _))) => Ok(q),
+        (None, None) => Err("static equilibrium: no state".into()),
+    }
+}
+
+/// Run `case` (with its `aero.gust`, its hinge state applied) with formulation `f` from the
+/// static equilibrium `q_eq` (from [`equilibrium_q`]; computed when `None`) to `case.t_end`, and
+/// return the incremental loads. The function to call for one gust time history, e.g. to
+/// compare with a linearised model: `delta_root_bending_moment` against `t`.
+pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result<GustHistory, String> {
+    let t0 = cpu_now();
+    let owned;
+    let q = match q_eq {
+        Some(q) => q,
+        None => {
+            owned = equilibrium_q(case, f)?;
+            &owned
+        }
+    };
+    let static_cpu_s = cpu_since(t0);
+    let t1 = cpu_now();
+    let out = match f {
+        Formulation::Ancf => {
+            let mut m = crate::scene::build_ancf(case).map_err(|e| e.to_string())?;
+            march(case, f, &mut m, q)?
+        }
+        Formulation::Gebf => {
+            let mut m = crate::scene::build_gebf(case).map_err(|e| e.to_string())?;
+            march(case, f, &mut m, q)?
+        }
+    };
+    let cpu_s = cpu_since(t1);
+    let r0 = out.rows.first().ok_or_else(|| out.error.clone().unwrap_or_else(|| "no output".into()))?;
+    let eq = Equilibrium {
+        root_bending_moment: r0.root_bending_moment,
+        root_torque: r0.root_torque,
+        hinge_moment: r0.hinge_moment,
+        fold_deg: r0.fold.to_degrees(),
+        lift: r0.lift,
+    };
+    let col = |g: &dyn Fn(&crate::run::Row) -> f64, v0: f64| out.rows.iter().map(|r| g(r) - v0).collect::<Vec<f64>>();
+    Ok(GustHistory {
+        t: out.rows.iter().map(|r| r.t).collect(),
+        delta_root_bending_moment: col(&|r| r.root_bending_moment, eq.root_bending_moment),
+        delta_root_torque: col(&|r| r.root_torque, eq.root_torque),
+        delta_hinge_moment: col(&|r| r.hinge_moment, eq.hinge_moment),
+        delta_fold_deg: col(&|r| r.fold.to_degrees(), eq.fold_deg),
+        delta_lift: col(&|r| r.lift, eq.lift),
+        equilibrium: eq,
+        cpu_s,
+        static_cpu_s,
+        error: out.error,
+    })
+}
+
+fn march<S: AeroStructure>(
+    case: &Case,
+    f: Formulation,
+    model: &mut S,
+    q: &[f64],
+) -> Result<crate::run::RunOutput, String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let map = station_map(case, aero)?;
+    let settings = crate::scene::settings(case, f);
+    Ok(simulate_aero_from(f, model, &settings, aero, &map, &mut crate::run::NoObserver, Some(q)))
+}
+
+/// The largest-magnitude value of `v` (signed) and its time; (NaN, NaN) when empty.
+pub fn peak(t: &[f64], v: &[f64]) -> (f64, f64) {
+    let mut best = (f64::NAN, f64::NAN);
+    for (&ti, &x) in t.iter().zip(v) {
+        if x.is_finite() && !(x.abs() <= best.0.abs()) {
+            best = (x, ti);
+        }
+    }
+    best
+}
+
+/// One run of a gust sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GustRun {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Hinge state.
+    pub hinge: HingeState,
+    /// Gust gradient H, m.
+    pub gradient_m: f64,
+    /// Gust frequency `V/(2H)`, Hz.
+    pub frequency_hz: f64,
+    /// Peak gust velocity U_ds, m/s.
+    pub gust_velocity: f64,
+    /// Peak incremental root bending moment (largest magnitude, signed), N·m, and its time, s.
+    pub peak_delta_root_bending_moment: (f64, f64),
+    /// Peak incremental root torque, N·m, and its time.
+    pub peak_delta_root_torque: (f64, f64),
+    /// Peak incremental hinge moment, N·m, and its time.
+    pub peak_delta_hinge_moment: (f64, f64),
+    /// Peak incremental fold angle, degrees, and its time.
+    pub peak_delta_fold_deg: (f64, f64),
+    /// Peak incremental lift, N, and its time.
+    pub peak_delta_lift: (f64, f64),
+    /// The history (skipped in the JSON summary; in `gust_history_<f>.csv`).
+    #[serde(skip)]
+    pub history: Option<GustHistory>,
+    /// The equilibrium.
+    pub equilibrium: Option<Equilibrium>,
+    /// CPU time of the time march, s.
+    pub cpu_s: f64,
+    /// Why the run failed or stopped early.
+    pub error: Option<String>,
+}
+
+/// A formulation's sweep or a failure to start it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GustSweepOutput {
+    /// Case (run) name.
+    pub name: String,
+    /// Airspeed, m/s.
+    pub airspeed: f64,
+    /// The gust of the case (its gradient replaced by each run's).
+    pub gust: GustSpec,
+    /// Every run, in the order formulation, hinge state, gradient.
+    pub runs: Vec<GustRun>,
+    /// Wall time of the sweep, s.
+    pub wall_s: f64,
+}
+
+/// Run the gust sweep of `spec` (its `gust` block) with the formulations `fs`: first the static
+/// equilibria of every (formulation, hinge state), then every gust run, each set in parallel
+/// (rayon).
+pub fn run_sweep(spec: &crate::case::RunSpec, fs: &[Formulation]) -> Result<GustSweepOutput, String> {
+    use rayon::prelude::*;
+    let t0 = Instant::now();
+    let case = &spec.ancf;
+    let sweep = case.gust.as_ref().ok_or("the case has no `gust` block")?;
+    for &f in fs {
+        spec.case(f).gust.as_ref().ok_or("the case has no `gust` block")?.validate(spec.case(f))?;
+    }
+    let aero = case.aero.as_ref().ok_or("gust: needs `aero`")?;
+    let gust = aero.gust.clone().ok_or("aero.gust: missing")?;
+    let v = aero.free_stream();
+    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let gradients = sweep.gradients(airspeed);
+    // 1. Equilibria per (formulation, hinge state).
+    let pairs: Vec<(Formulation, HingeState)> =
+        fs.iter().flat_map(|&f| sweep.hinges.iter().map(move |&h| (f, h))).collect();
+    let equilibria: Vec<Result<(Case, Vec<f64>), String>> = pairs
+        .par_iter()
+        .map(|&(f, h)| {
+            let mut base = spec.case(f).clone();
+            if let Some(t) = sweep.t_end {
+                base.t_end = t;
+            }
+            let c = h.apply(&base)?;
+            let q = equilibrium_q(&c, f)?;
+            Ok((c, q))
+        })
+        .collect();
+    // 2. Gust runs.
+    let jobs: Vec<(usize, f64)> = (0..pairs.len()).flat_map(|p| gradients.iter().map(move |&h| (p, h))).collect();
+    let runs: Vec<GustRun> = jobs
+        .par_iter()
+        .map(|&(p, h)| {
+            let (f, hinge) = pairs[p];
+            let g = gust.with_gradient(h);
+            let mut run = GustRun {
+                formulation: f,
+                hinge,
+                gradient_m: h,
+                frequency_hz: airspeed / (2.0 * h),
+                gust_velocity: g.velocity(aero),
+                peak_delta_root_bending_moment: (f64::NAN, f64::NAN),
+                peak_delta_root_torque: (f64::NAN, f64::NAN),
+                peak_delta_hinge_moment: (f64::NAN, f64::NAN),
+                peak_delta_fold_deg: (f64::NAN, f64::NAN),
+                peak_delta_lift: (f64::NAN, f64::NAN),
+                history: None,
+                equilibrium: None,
+                cpu_s: f64::NAN,
+                error: None,
+            };
+            let (c, q) = match &equilibria[p] {
+                Ok(x) => x,
+                Err(e) => {
+                    run.error = Some(e.clone());
+                    return run;
+                }
+            };
+            let mut c = c.clone();
+            if let Some(a) = c.aero.as_mut() {
+                a.gust = Some(g);
+            }
+            match gust_history(&c, f, Some(q)) {
+                Ok(hist) => {
+                    run.peak_delta_root_bending_moment = peak(&hist.t, &hist.delta_root_bending_moment);
+                    run.peak_delta_root_torque = peak(&hist.t, &hist.delta_root_torque);
+                    run.peak_delta_hinge_moment = peak(&hist.t, &hist.delta_hinge_moment);
+                    run.peak_delta_fold_deg = peak(&hist.t, &hist.delta_fold_deg);
+                    run.peak_delta_lift = peak(&hist.t, &hist.delta_lift);
+                    run.equilibrium = Some(hist.equilibrium);
+                    run.cpu_s = hist.cpu_s;
+                    run.error = hist.error.clone();
+                    run.history = Some(hist);
+                }
+                Err(e) => run.error = Some(e),
+            }
+            run
+        })
+        .collect();
+    Ok(GustSweepOutput { name: case.name.clone(), airspeed, gust, runs, wall_s: t0.elapsed().as_secs_f64() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> Result<GustSpec, String> {
+        serde_json::from_str::<GustSpec>(s).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn spec_parses_and_validates() {
+        let g = parse(
+            r#"{"kind": "one_minus_cosine", "gradient_m": 30, "velocity": 1.2, "x0": 0, "direction": [0, 0, 1]}"#,
+        )
+        .unwrap();
+        g.validate().unwrap();
+        assert_eq!(g.gradient(), 30.0);
+        let bad = parse(r#"{"kind": "one_minus_cosine", "gradient_m": -3, "velocity": 1.2}"#).unwrap();
+        assert!(bad.validate().unwrap_err().starts_with("aero.gust.gradient_m"));
+        let bad = parse(r#"{"kind": "von_karman", "intensity": 1, "length_scale_m": 100}"#).unwrap();
+        assert!(bad.validate().unwrap_err().starts_with("aero.gust.seed"));
+        let bad = parse(r#"{"kind": "sinusoidal", "velocity": 1, "wavelength_m": 1e400}"#);
+        assert!(bad.is_err() || bad.unwrap().validate().is_err());
+        assert!(parse(r#"{"kind": "sharp_edged", "velocity": 1, "typo": 2}"#).is_err());
+        let bad = parse(r#"{"kind": "sharp_edged", "velocity": 1, "x0": -2}"#).unwrap();
+        assert!(bad.validate().unwrap_err().starts_with("aero.gust.x0"));
+    }
+
+    #[test]
+    fn peak_is_signed_largest_magnitude() {
+        assert_eq!(peak(&[0.0, 1.0, 2.0], &[0.5, -2.0, 1.5]), (-2.0, 1.0));
+        assert!(peak(&[], &[]).0.is_nan());
+    }
+}

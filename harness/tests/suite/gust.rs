@@ -1,0 +1,134 @@
+//! Gust runs (docs/gust.md): a run from the static equilibrium without a gust stays there, ANCF
+//! and GEBF agree on the paper's wing in a gust, and bad gust input exits 2 naming the field.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use harness::case::{CaseFile, Formulation, Override};
+use harness::gust::{HingeState, gust_history, peak};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
+    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
+    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// Without a gust, 2 s from the static equilibrium (the steady wake prefilled, its loads applied
+/// before the initial accelerations) of the paper's wing, hinge free and locked, both
+/// formulations: the root bending moment stays within 0.05 N·m of its equilibrium value (the
+/// gusts of `cases/wing_gust.json` raise it by 250–600 N·m) and the fold within 1e-3°.
+/// Measured (release): printed.
+#[test]
+fn no_gust_stays_at_equilibrium() {
+    let spec = case("wing_gust.json", &["t_end=2"]);
+    for f in Formulation::ALL {
+        for h in [HingeState::Free, HingeState::Locked] {
+            let mut c = h.apply(spec.case(f)).unwrap();
+            c.aero.as_mut().unwrap().gust = None;
+            let hist = gust_history(&c, f, None).unwrap();
+            assert!(hist.error.is_none(), "{f} {}: {:?}", h.label(), hist.error);
+            let (m, th) = (max_abs(&hist.delta_root_bending_moment), max_abs(&hist.delta_fold_deg));
+            println!(
+                "{f} {}: equilibrium RBM {:.3} N m, fold {:.3} deg; without a gust over 2 s: |dRBM| <= {m:.2e} N m, |dfold| <= {th:.2e} deg, |dlift| <= {:.2e} N",
+                h.label(),
+                hist.equilibrium.root_bending_moment,
+                hist.equilibrium.fold_deg,
+                max_abs(&hist.delta_lift)
+            );
+            assert!(m < 0.05, "{f} {}: the root bending moment drifts by {m} N m", h.label());
+            assert!(th < 1e-3, "{f} {}: the fold drifts by {th} deg", h.label());
+        }
+    }
+}
+
+/// The paper's wing in the shortest and the longest certification gusts of `wing_gust.json`
+/// (H = 9 and 107 m), hinge free and locked: ANCF and GEBF peak incremental root bending moments
+/// within 1 % and peak incremental folds within 0.5°.
+#[test]
+fn wing_gust_ancf_and_gebf_agree() {
+    let spec = case("wing_gust.json", &["gust.gradients_m=[9, 107]"]);
+    let out = harness::gust::run_sweep(&spec, &Formulation::ALL).unwrap();
+    let s = harness::gust_out::summarise(out);
+    assert_eq!(s.n_failed, 0);
+    for d in &s.ancf_gebf {
+        println!(
+            "{} H = {} m: peak dRBM differs by {:.3} %, peak dfold by {:.4} deg",
+            d.hinge.label(),
+            d.gradient_m,
+            d.peak_rbm_percent,
+            d.peak_fold_deg
+        );
+        assert!(d.peak_rbm_percent < 1.0, "{d:?}");
+        assert!(d.peak_fold_deg < 0.5, "{d:?}");
+    }
+    assert_eq!(s.ancf_gebf.len(), 4);
+    for r in &s.runs {
+        let h = r.history.as_ref().unwrap();
+        // The peak is the largest magnitude of the recorded series.
+        assert_eq!(peak(&h.t, &h.delta_root_bending_moment), r.peak_delta_root_bending_moment);
+        println!(
+            "{} {} H = {} m: {:.2} s CPU for {} s simulated",
+            r.formulation,
+            r.hinge.label(),
+            r.gradient_m,
+            r.cpu_s,
+            h.t.last().unwrap()
+        );
+    }
+}
+
+fn harness_bin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_harness")).args(args).current_dir(root()).output().expect("binary runs")
+}
+
+fn tmp_case(from: &str, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("cases").join(from)).unwrap()).unwrap();
+    edit(&mut v);
+    let p = std::env::temp_dir().join(format!("harness-gust-{}", std::process::id())).join(name);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+    p
+}
+
+/// Bad gust input: exit 2 with one line naming the field, before any run.
+#[test]
+fn bad_gust_input_exits_2_naming_the_field() {
+    let out = std::env::temp_dir().join(format!("harness-gust-out-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    let check = |file: &PathBuf, set: &[&str], needle: &str| {
+        let mut args = vec!["gust", file.to_str().unwrap(), "--out", out];
+        for s in set {
+            args.push("--set");
+            args.push(s);
+        }
+        let o = harness_bin(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{needle}: {err}");
+        assert!(!err.contains("panicked"), "panic: {err}");
+        assert!(err.contains(needle), "stderr does not name `{needle}`: {err}");
+    };
+    let wing = root().join("cases/wing_gust.json");
+    check(&wing, &["aero.gust.gradient_m=-30"], "aero.gust.gradient_m");
+    check(&wing, &["aero.gust.x0=-1"], "aero.gust.x0");
+    check(&wing, &["gust.gradients_m=[30, -9]"], "gust.gradients_m[1]");
+    check(&wing, &["gust.gradients_m=[30, 1e999]"], "gust.gradients_m");
+    check(&wing, &["gust.hinges=[{\"state\": \"spring\", \"stiffness\": -1}]"], "gust.hinges[0].stiffness");
+    let turb = tmp_case("wing_gust.json", "turbulence.json", |v| {
+        v["aero"]["gust"] = serde_json::json!({"kind": "von_karman", "intensity": 1.0, "length_scale_m": 100.0});
+    });
+    check(&turb, &[], "aero.gust.seed");
+    let no_aero = tmp_case("double_pendulum_c1_beta45.json", "no_aero.json", |v| {
+        v["gust"] = serde_json::json!({"gradients_m": [30], "hinges": [{"state": "free"}]});
+    });
+    check(&no_aero, &[], "gust: a gust sweep needs aerodynamics");
+    let no_sweep = root().join("cases/wing_aoa5.json");
+    check(&no_sweep, &[], "no `gust` block");
+}
