@@ -598,7 +598,7 @@ fn march<S: AeroStructure>(
 pub fn peak(t: &[f64], v: &[f64]) -> (f64, f64) {
     let mut best = (f64::NAN, f64::NAN);
     for (&ti, &x) in t.iter().zip(v) {
-        if x.is_finite() && !(x.abs() <= best.0.abs()) {
+        if x.is_finite() && (best.0.is_nan() || x.abs() > best.0.abs()) {
             best = (x, ti);
         }
     }
