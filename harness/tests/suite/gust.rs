@@ -49,8 +49,9 @@ fn no_gust_stays_at_equilibrium() {
 }
 
 /// The paper's wing in the shortest and the longest certification gusts of `wing_gust.json`
-/// (H = 9 and 107 m), hinge free and locked: ANCF and GEBF peak incremental root bending moments
-/// within 1 % and peak incremental folds within 0.5°.
+/// (H = 9 and 107 m), hinge free, locked and sprung: ANCF and GEBF peak incremental root bending moments
+/// within 1 % and peak incremental folds within 0.5°. Measured (release): at most 0.098 % and
+/// 0.0063°; each 10 s run about 1.9 s of CPU.
 #[test]
 fn wing_gust_ancf_and_gebf_agree() {
     let spec = case("wing_gust.json", &["gust.gradients_m=[9, 107]"]);
@@ -68,7 +69,7 @@ fn wing_gust_ancf_and_gebf_agree() {
         assert!(d.peak_rbm_percent < 1.0, "{d:?}");
         assert!(d.peak_fold_deg < 0.5, "{d:?}");
     }
-    assert_eq!(s.ancf_gebf.len(), 4);
+    assert_eq!(s.ancf_gebf.len(), 6);
     for r in &s.runs {
         let h = r.history.as_ref().unwrap();
         // The peak is the largest magnitude of the recorded series.
