@@ -288,8 +288,8 @@ pub fn von_karman_spectrum(omega: f64, intensity: f64, length_scale: f64) -> f64
 /// A frozen von Kármán turbulence field: a sum of `n_modes` cosines
 /// `Σ a_k cos(Ω_k s + φ_k)`, `a_k = √(2 Φ_w(Ω_k) ΔΩ_k)`, log-spaced wavenumbers from `0.01/L`
 /// to `2π/λ_min`, phases from a seeded generator (SplitMix64). The realisation is tabulated on
-/// `[0, table_length]` at a twentieth of the shortest wavelength and interpolated linearly; ahead
-/// of the front (`s < 0`) the air is calm.
+/// `[0, table_length]` (at most 2 million entries) at a twentieth of the shortest wavelength and
+/// interpolated linearly, summed directly beyond; ahead of the front (`s < 0`) the air is calm.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VonKarman {
     /// Convection of the frozen field.
@@ -345,7 +345,10 @@ impl VonKarman {
             })
             .collect();
         let ds = lam / 20.0;
-        let n_tab = ((len / ds).ceil() as usize).clamp(2, 50_000_000);
+        // At most 2 million entries and 2e8 mode evaluations to build (beyond the table the modes
+        // are summed directly, which is exact but slower).
+        let cap = (200_000_000 / n).clamp(2, 2_000_000);
+        let n_tab = ((len / ds).ceil().min(cap as f64) as usize).max(2);
         let table = (0..=n_tab).map(|i| Self::sum(&modes, i as f64 * ds)).collect();
         Ok(Self { conv, direction: unit(direction)?, params, modes, ds, table })
     }
