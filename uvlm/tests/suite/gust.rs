@@ -66,7 +66,7 @@ fn sharp_edged_gust_follows_exact_kussner() {
                     (worst, at) = (e, s);
                 }
             }
-            if (s - s.round()).abs() < 1e-9 && (s.round() as usize) % 2 == 0 && s <= 24.0 {
+            if (s - s.round()).abs() < 1e-9 && (s.round() as usize).is_multiple_of(2) && s <= 24.0 {
                 println!("Kussner nc = {nc}: s = {s:5.2}: L/L_inf = {l:.4}, exact psi = {:.4}", psi.psi(s));
             }
         }
