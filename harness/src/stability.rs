@@ -117,7 +117,10 @@ impl StabilitySettings {
             return Err("stability.airspeeds: empty list".into());
         }
         if self.airspeeds.len() > MAX_STABILITY_POINTS {
-            return Err(format!("stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}", self.airspeeds.len()));
+            return Err(format!(
+                "stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}",
+                self.airspeeds.len()
+            ));
         }
         for (k, &u) in self.airspeeds.iter().enumerate() {
             if !(u.is_finite() && u > 0.0) {
@@ -292,7 +295,10 @@ impl Reduced {
         let mut t = uvlm::with_wake(&t0.map(|x| x / r), &self.t_rows, &delays, &self.te_rings, s);
         t *= C64::from(r);
         let rhs = self.rx.map(|x| C64::from(r * x)) + self.rv.map(|x| s * x);
-        let x = n.lu().solve(&rhs).unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
+        let x = n
+            .lu()
+            .solve(&rhs)
+            .unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
         self.m.map(|x| s * s * x)
             + (&self.c + &self.gv * r).map(|x| s * x)
             + (&self.k + &self.gx * (r * r)).map(C64::from)
@@ -579,7 +585,11 @@ pub fn reduce<S: StaticStructure>(
                 st2.iter().zip(&stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
             let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
             d.iter_mut().flatten().for_each(|x| *x /= dm);
-            out.push(ModeShape { omega: modes.omega[i], s: map.iter().map(|x| x.wing_arc(case)).collect(), displacement: d });
+            out.push(ModeShape {
+                omega: modes.omega[i],
+                s: map.iter().map(|x| x.wing_arc(case)).collect(),
+                displacement: d,
+            });
         }
     }
     if let Some(case) = strip_case {
