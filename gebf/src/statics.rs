@@ -84,14 +84,12 @@ impl Model {
                     model.rescale_rotations(q, None);
                     model.project_joints(q);
                 })
-                .map_err(|_| {
-                Error::StaticDiverged {
+                .map_err(|_| Error::StaticDiverged {
                     load_factor,
                     iter: x.n_iterations,
                     residual_norm: x.residual_norm,
                     increment_norm: x.increment_norm,
-                }
-            })?;
+                })?;
         }
         Ok(StaticSolution { q: x.q, mu: x.mu, n_iterations: x.n_iterations })
     }

@@ -28,6 +28,50 @@ pub fn write(path: &Path, contents: &[u8]) -> Result<(), Error> {
     })
 }
 
+/// A temporary file beside a target, for a writer that creates its file itself (such as an
+/// SVG backend, which also writes on drop): [`commit`](Self::commit) renames it over the target;
+/// dropped without that, the temporary file is removed. Declare it before the writer, so that
+/// the writer (dropped first) cannot leave its file behind on an early return.
+#[derive(Debug)]
+pub struct TempFile {
+    tmp: PathBuf,
+    target: PathBuf,
+    done: bool,
+}
+
+impl TempFile {
+    /// A temporary path beside `target` (its folder created); nothing is written yet.
+    pub fn new(target: &Path) -> Result<Self, Error> {
+        let dir = target.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
+        let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let tmp = dir.join(format!(".{name}.tmp-{}-{}", std::process::id(), COUNTER.fetch_add(1, Ordering::Relaxed)));
+        Ok(Self { tmp, target: target.to_path_buf(), done: false })
+    }
+
+    /// The temporary path to write.
+    pub fn path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Rename the finished temporary file over the target.
+    pub fn commit(mut self) -> Result<(), Error> {
+        self.done = true;
+        std::fs::rename(&self.tmp, &self.target).map_err(|e| {
+            let _ = std::fs::remove_file(&self.tmp);
+            Error::Io(format!("{}: {e}", self.target.display()))
+        })
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
 /// An output folder held by this process until dropped.
 #[derive(Debug)]
 pub struct DirLock {

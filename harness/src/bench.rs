@@ -210,7 +210,9 @@ fn svg(path: &Path, rows: &[BenchRow], targets: &impl Fn(&str) -> bool) -> Resul
     let ok = |r: &&BenchRow| r.error.is_none() && r.cpu_median_ms.is_finite();
     let y_max = rows.iter().filter(ok).map(|r| r.cpu_median_ms).fold(100.0_f64, f64::max) * 1.5; // room for the legend
     let width = (160 * cases.len().max(1) + 120) as u32;
-    let root = SVGBackend::new(path, (width, 480)).into_drawing_area();
+    let file = crate::atomic::TempFile::new(path)?;
+    let tmp = file.path().to_path_buf();
+    let root = SVGBackend::new(&tmp, (width, 480)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption("Thread CPU time per run (median), one thread", ("sans-serif", 18))
@@ -269,7 +271,7 @@ fn svg(path: &Path, rows: &[BenchRow], targets: &impl Fn(&str) -> bool) -> Resul
         .border_style(BLACK)
         .draw()?;
     root.present()?;
-    Ok(())
+    Ok(file.commit()?)
 }
 
 #[cfg(test)]

@@ -108,12 +108,41 @@ fn is_zero(v: &f64) -> bool {
 #[serde(deny_unknown_fields)]
 pub struct StaticSettings {
     /// Airspeeds of the sweep, m/s (positive; the free stream keeps the direction of
-    /// `aero.v_inf`, or −Y). Reported in the order given.
+    /// `aero.v_inf`, or −Y). Reported in the order given. Required with `aero`; must be absent
+    /// or empty without it.
+    #[serde(default)]
     pub airspeeds: Vec<f64>,
+    /// Dead point loads of a structural static case (a case without `aero`): forces and moments
+    /// in global components at body sections, applied by `harness static` only (the time
+    /// domain ignores them), scaled by each of `load_factors`. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub point_loads: Vec<StaticPointLoad>,
+    /// Load factors of a structural static case: one equilibrium per factor, each reached by
+    /// load steps of at most 0.05 of the full load from the previous one (increasing order).
+    /// Required with `point_loads`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub load_factors: Vec<f64>,
     /// Measured or computed coast angles to compare with: CSV files of two columns, airspeed
     /// (m/s) and fold angle (degrees), relative to the case file's folder.
     #[serde(default)]
     pub references: Vec<StaticReference>,
+}
+
+/// A dead point load of a structural static case (`static.point_loads`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StaticPointLoad {
+    /// Body name.
+    pub body: String,
+    /// Arclength of the loaded section from the body's start, m, in [0, length]. Default: the
+    /// body's end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<f64>,
+    /// Force, N, global components (held fixed: a dead load).
+    pub force: [f64; 3],
+    /// Moment, N·m, global components. Default zero.
+    #[serde(default)]
+    pub moment: [f64; 3],
 }
 
 /// A curve of equilibrium fold (coast) angle against airspeed.
@@ -1371,9 +1400,67 @@ impl Case {
         if let Some(g) = &self.gust {
             g.validate(self)?;
         }
-        if let Some(st) = &self.statics {
-            if self.aero.is_none() {
-                return Err("static: a static aeroelastic sweep needs `aero`".into());
+        if let Some(st) = &self.statics
+            && self.aero.is_none()
+        {
+            // A structural static case: dead point loads at load factors.
+            if st.point_loads.is_empty() {
+                return Err("static: a case without `aero` needs `static.point_loads` (a static aeroelastic sweep needs `aero`)".into());
+            }
+            if !st.airspeeds.is_empty() {
+                return Err("static.airspeeds: a case without `aero` has no airspeeds".into());
+            }
+            if st.point_loads.len() > crate::budget::MAX_LIST {
+                return Err(format!(
+                    "static.point_loads: {} loads, more than {}",
+                    st.point_loads.len(),
+                    crate::budget::MAX_LIST
+                ));
+            }
+            for (k, l) in st.point_loads.iter().enumerate() {
+                let Some(b) = self.bodies.iter().find(|b| b.name == l.body) else {
+                    return Err(format!("static.point_loads[{k}].body: no body named `{}`", clip(&l.body)));
+                };
+                if let Some(at) = l.at
+                    && !(at.is_finite() && (0.0..=b.length).contains(&at))
+                {
+                    return Err(format!(
+                        "static.point_loads[{k}].at: {at} is not in [0, {}] (the body's length)",
+                        b.length
+                    ));
+                }
+                for (what, v) in [("force", l.force), ("moment", l.moment)] {
+                    if let Some(i) = v.iter().position(|x| !(x.is_finite() && x.abs() <= 1e12)) {
+                        return Err(format!(
+                            "static.point_loads[{k}].{what}[{i}]: {} is not a finite value of at most 1e12",
+                            v[i]
+                        ));
+                    }
+                }
+            }
+            if st.load_factors.is_empty() {
+                return Err("static.load_factors: empty list".into());
+            }
+            if st.load_factors.len() > MAX_STATIC_POINTS {
+                return Err(format!(
+                    "static.load_factors: {} points, more than {MAX_STATIC_POINTS}",
+                    st.load_factors.len()
+                ));
+            }
+            for (k, &f) in st.load_factors.iter().enumerate() {
+                if !(f.is_finite() && f > 0.0 && f <= 1e3) {
+                    return Err(format!("static.load_factors[{k}]: {f} is not in (0, 1000]"));
+                }
+                if k > 0 && f <= st.load_factors[k - 1] {
+                    return Err(format!("static.load_factors[{k}]: {f} does not increase"));
+                }
+            }
+            if !st.references.is_empty() {
+                return Err("static.references: coast-angle curves need `aero`".into());
+            }
+        } else if let Some(st) = &self.statics {
+            if !st.point_loads.is_empty() || !st.load_factors.is_empty() {
+                return Err("static.point_loads: point loads are for a structural static case (without `aero`)".into());
             }
             if st.airspeeds.is_empty() {
                 return Err("static.airspeeds: empty list".into());

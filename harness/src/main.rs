@@ -203,7 +203,8 @@ enum Cmd {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
     },
-    /// Static aeroelastic equilibria over the case's `static.airspeeds`; writes
+    /// Static aeroelastic equilibria over the case's `static.airspeeds` (or, for a case without
+    /// `aero`, the equilibria under its `static.point_loads` at `static.load_factors`); writes
     /// `<out>/<case>/static_{ancf,gebf}.csv`, `static_lift_*.csv`, `static_summary.json` and plots.
     Static {
         /// Case file (with `aero` and `static` blocks).
@@ -440,19 +441,32 @@ fn run_static_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> harness
 
 /// Print a sweep's outcome; true when a point failed.
 fn report_static(s: &harness::static_out::StaticSummary) -> bool {
+    let structural = s.runs.iter().flat_map(|r| &r.points).any(|p| p.load_factor.is_some());
     for r in &s.runs {
         let ok = r.points.iter().filter(|p| p.error.is_none()).count();
         println!(
-            "static {} {}: {ok} of {} airspeeds in {:.3} s ({} steady solves, {} aerodynamic tangents, {} unknowns)",
+            "static {} {}: {ok} of {} {} in {:.3} s ({} steady solves, {} aerodynamic tangents, {} unknowns)",
             s.name,
             r.formulation,
             r.points.len(),
+            if structural { "load factors" } else { "airspeeds" },
             r.wall_s,
             r.n_aero_solves,
             r.n_tangents,
             r.n_dof
         );
         for p in &r.points {
+            if let Some(lf) = p.load_factor {
+                // A structural static case: tip positions at the load factors.
+                match &p.error {
+                    Some(e) => eprintln!("  load factor {lf}: FAILED: {e}"),
+                    None => println!(
+                        "  load factor {lf:>6}  tip ({:.4}, {:.4}, {:.4})  ({} Newton)",
+                        p.tip[0], p.tip[1], p.tip[2], p.newton_iterations
+                    ),
+                }
+                continue;
+            }
             match &p.error {
                 Some(e) => eprintln!("  {} m/s: FAILED: {e}", p.airspeed),
                 None => println!(
@@ -488,7 +502,16 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             c.fold_difference_deg
         );
     }
-    if s.runs.len() == 2 {
+    if let (true, [a, g]) = (structural, s.runs.as_slice()) {
+        let d = a
+            .points
+            .iter()
+            .zip(&g.points)
+            .filter(|(pa, pg)| pa.error.is_none() && pg.error.is_none())
+            .map(|(pa, pg)| (0..3).map(|i| (pa.tip[i] - pg.tip[i]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        println!("static {}: ANCF-GEBF max tip distance {d:.4e} m", s.name);
+    } else if s.runs.len() == 2 {
         println!(
             "static {}: ANCF-GEBF max fold difference {:.4} deg, max root bending moment difference {:.3} %",
             s.name,

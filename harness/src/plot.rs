@@ -368,16 +368,17 @@ where
     Ok(())
 }
 
-/// Draw panels stacked vertically (or in `cols` columns) into one SVG file.
+/// Draw panels stacked vertically (or in `cols` columns) into one SVG file, written atomically
+/// (a temporary file renamed over `path`).
 pub fn panels_svg(path: &Path, panels: &[Panel], cols: usize, panel_size: (u32, u32)) -> Result<(), Error> {
     let err = |msg: String| Error::Plot { file: path.display().to_string(), msg };
-    if let Some(d) = path.parent() {
-        std::fs::create_dir_all(d).map_err(|e| err(e.to_string()))?;
-    }
     let cols = cols.max(1);
     let rows = panels.len().div_ceil(cols).max(1);
     let size = (panel_size.0 * cols as u32, panel_size.1 * rows as u32);
-    let root = SVGBackend::new(path, size).into_drawing_area();
+    // Drawn to a temporary file beside the target and renamed over it once complete.
+    let file = crate::atomic::TempFile::new(path)?;
+    let tmp = file.path().to_path_buf();
+    let root = SVGBackend::new(&tmp, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
     let areas = root.split_evenly((rows, cols));
     let legend_w = legend_width(panels);
@@ -385,7 +386,7 @@ pub fn panels_svg(path: &Path, panels: &[Panel], cols: usize, panel_size: (u32, 
         draw_panel(a, p, legend_w).map_err(&err)?;
     }
     root.present().map_err(|e| err(e.to_string()))?;
-    Ok(())
+    file.commit()
 }
 
 #[cfg(test)]

@@ -279,8 +279,40 @@ pub fn model_rms(summary: &StaticSummary) -> Vec<(String, f64)> {
         .collect()
 }
 
-/// Write the sweep's files into `dir`.
+/// Column header of `static_<f>.csv` of a structural static case (`static.point_loads`).
+pub const LOAD_HEADER: &str = "load_factor,tip_x,tip_y,tip_z,fold_deg,newton_iterations,converged";
+
+/// A structural static case's points as CSV text (one row per load factor, NaN where a point
+/// failed).
+pub fn load_csv(out: &StaticOutput) -> String {
+    let mut s = String::from(LOAD_HEADER);
+    s.push('\n');
+    for p in &out.points {
+        let _ = writeln!(
+            s,
+            "{},{:.9e},{:.9e},{:.9e},{:.6},{},{}",
+            p.load_factor.unwrap_or(f64::NAN),
+            p.tip[0],
+            p.tip[1],
+            p.tip[2],
+            p.fold_deg,
+            p.newton_iterations,
+            u8::from(p.error.is_none())
+        );
+    }
+    s
+}
+
+/// Write the sweep's files into `dir`. A structural static case (its points carry load
+/// factors) writes `static_<f>.csv` ([`LOAD_HEADER`]) and `static_summary.json` only.
 pub fn write(dir: &Path, summary: &StaticSummary) -> Result<(), Error> {
+    if summary.runs.iter().flat_map(|r| &r.points).any(|p| p.load_factor.is_some()) {
+        for out in &summary.runs {
+            write_file(&dir.join(format!("static_{}.csv", out.formulation)), &load_csv(out))?;
+        }
+        let json = serde_json::to_string_pretty(summary).map_err(|e| Error::Io(e.to_string()))?;
+        return write_file(&dir.join("static_summary.json"), &json);
+    }
     for out in &summary.runs {
         write_file(&dir.join(format!("static_{}.csv", out.formulation)), &to_csv(out))?;
         write_file(&dir.join(format!("static_lift_{}.csv", out.formulation)), &lift_csv(out))?;
@@ -370,7 +402,9 @@ fn decimals(lo: f64, hi: f64) -> usize {
 /// A panel of curves with the legend beside the data.
 pub(crate) fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curves) -> Result<(), Error> {
     let err = |e: String| Error::Plot { file: path.display().to_string(), msg: e };
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let file = crate::atomic::TempFile::new(path)?;
+    let tmp = file.path().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
     let (x0, x1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.0)));
     let (y0, y1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.1)));
@@ -438,7 +472,8 @@ pub(crate) fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curve
         }
         legend_area.draw(&Text::new(label.clone(), (38, y - 7), text)).map_err(e)?;
     }
-    root.present().map_err(|e| err(e.to_string()))
+    root.present().map_err(|e| err(e.to_string()))?;
+    file.commit()
 }
 
 fn style(f: Formulation) -> Style {

@@ -477,6 +477,10 @@ pub struct StaticPoint {
     pub newton_iterations: usize,
     /// Why the point has no equilibrium, if it has none.
     pub error: Option<String>,
+    /// The load factor of a structural static case's point (`static.load_factors`; its
+    /// airspeed is 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load_factor: Option<f64>,
     /// Spanwise lift distribution.
     #[serde(skip)]
     pub strips: Vec<Strip>,
@@ -505,7 +509,8 @@ pub struct StaticOutput {
     pub error: Option<String>,
 }
 
-/// Run the static sweep of `case` (its `static.airspeeds`) with formulation `f`.
+/// Run the static sweep of `case` (its `static.airspeeds`, or for a structural case its
+/// `static.load_factors`) with formulation `f`.
 pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
     let t0 = Instant::now();
     let mut out = match f {
@@ -544,6 +549,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
         lift: f64::NAN,
         newton_iterations: 0,
         error: Some(msg),
+        load_factor: None,
         strips: Vec::new(),
         state: None,
     }
@@ -561,7 +567,85 @@ const ROUND_ITERATIONS: usize = 25;
 /// Rounds per static solve.
 const ROUNDS: usize = 8;
 
+/// Largest load step of a structural static case, as a fraction of the full load.
+const MAX_LOAD_STEP: f64 = 0.05;
+
+/// A structural static case (no `aero`): the dead point loads `static.point_loads` at each of
+/// `static.load_factors`, each equilibrium reached from the previous one by equal load steps of
+/// at most [`MAX_LOAD_STEP`]. A point that fails ends the sweep (the later ones are reported as
+/// not reached).
+fn structural_sweep<S: StaticStructure>(
+    case: &Case,
+    f: Formulation,
+    build: fn(&Case) -> Result<S, Error>,
+) -> StaticOutput {
+    let Some(st) = case.statics.as_ref() else {
+        return failed_output(case, f, "the case has no `static` block".into());
+    };
+    let mut model = match build(case) {
+        Ok(m) => m,
+        Err(e) => return failed_output(case, f, e.to_string()),
+    };
+    let mut loads = Vec::with_capacity(st.point_loads.len());
+    for (k, l) in st.point_loads.iter().enumerate() {
+        let Some(body) = case.body_index(&l.body) else {
+            return failed_output(case, f, format!("static.point_loads[{k}].body: no body `{}`", l.body));
+        };
+        let s = l.at.unwrap_or(case.bodies[body].length);
+        loads.push(SectionLoad { body, s, force: Vector3::from(l.force), moment: Vector3::from(l.moment) });
+    }
+    let q_ref = model.initial_state().q;
+    let n_dof = model.n_dof();
+    let mut solver = StaticSolver::new(&model, StaticParams { max_iter: 30, tol: 1e-10, rel_residual_tol: 1e-12 });
+    let mut x = StaticSolution::guess(&model, &q_ref);
+    let mut scaled = loads.clone();
+    let (mut lambda, mut failed) = (0.0_f64, None::<String>);
+    let mut points = Vec::with_capacity(st.load_factors.len());
+    for &target in &st.load_factors {
+        let fail = |msg: String| StaticPoint { airspeed: 0.0, load_factor: Some(target), ..failed_point(0.0, msg) };
+        if let Some(e) = &failed {
+            points.push(fail(format!("not reached: {e}")));
+            continue;
+        }
+        let n_steps = ((target - lambda) / MAX_LOAD_STEP).ceil().max(1.0) as usize;
+        let it0 = x.n_iterations;
+        for k in 1..=n_steps {
+            let l = lambda + (target - lambda) * k as f64 / n_steps as f64;
+            for (a, b) in scaled.iter_mut().zip(&loads) {
+                a.force = l * b.force;
+                a.moment = l * b.moment;
+            }
+            model.set_section_loads(&scaled);
+            let m = &model;
+            if let Err(e) = solver.solve_normalised(m, 0.0, &mut x, |q| m.normalise(q)) {
+                failed = Some(format!("no equilibrium at load factor {l:.6}: {e}"));
+                break;
+            }
+        }
+        match &failed {
+            Some(e) => points.push(fail(e.clone())),
+            None => {
+                lambda = target;
+                let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&x.q, j).to_degrees());
+                points.push(StaticPoint {
+                    airspeed: 0.0,
+                    fold_deg: fold,
+                    tip: model.tip(&x.q),
+                    newton_iterations: x.n_iterations - it0,
+                    error: None,
+                    load_factor: Some(target),
+                    ..failed_point(0.0, String::new())
+                });
+            }
+        }
+    }
+    StaticOutput { formulation: f, points, wall_s: 0.0, n_aero_solves: 0, n_tangents: 0, n_dof, error: None }
+}
+
 fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
+    if case.aero.is_none() && case.statics.as_ref().is_some_and(|s| !s.point_loads.is_empty()) {
+        return structural_sweep(case, f, build);
+    }
     let Some((aero, st)) = case.aero.as_ref().zip(case.statics.as_ref()) else {
         return failed_output(case, f, "the case has no `aero` and `static` blocks".into());
     };
@@ -774,6 +858,7 @@ fn point_at<S: StaticStructure>(
         lift,
         newton_iterations: 0,
         error: None,
+        load_factor: None,
         strips,
         state: None,
     }

@@ -208,7 +208,9 @@ fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<
     let (cw, ch, left, top) = (74i32, 26i32, 150i32, 90i32);
     let w = (left + cw * cols.len() as i32 + 20) as u32;
     let h = (top + ch * rows.len() as i32 + 70) as u32;
-    let root = SVGBackend::new(path, (w, h)).into_drawing_area();
+    let file = crate::atomic::TempFile::new(path)?;
+    let tmp = file.path().to_path_buf();
+    let root = SVGBackend::new(&tmp, (w, h)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
     let txt = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), ("sans-serif", size).into_font());
     let title = format!(
@@ -257,7 +259,8 @@ fn heat_map(path: &Path, axes: &Axes, cells: &[Cell], f: Formulation) -> Result<
         root.draw(&Rectangle::new([(x, ly), (x + 16, ly + 14)], col.filled())).map_err(|e| err(e.to_string()))?;
         root.draw(&txt(s, x + 22, ly, 13)).map_err(|e| err(e.to_string()))?;
     }
-    root.present().map_err(|e| err(e.to_string()))
+    root.present().map_err(|e| err(e.to_string()))?;
+    file.commit()
 }
 
 /// (cells reaching t_end at fixed steps, cells recovered with step control, cells) per formulation.

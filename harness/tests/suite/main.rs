@@ -13,6 +13,7 @@ mod observer;
 mod properties;
 mod stability;
 mod statics;
+mod statics_bend;
 #[cfg(target_os = "linux")]
 mod streamed;
 mod vtk;
