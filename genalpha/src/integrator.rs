@@ -55,7 +55,13 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     n_h: usize,
     n_v: usize,
     solver: L,
+    /// The dense `n_all × n_all` iteration matrix, allocated at its first use only: a solver
+    /// that takes the matrix into its own storage ([`LinearSolver::assembly_target`]) never
+    /// needs it unless it falls back to the dense path, so a banded problem holds no `n²`
+    /// buffer.
     matrix: DenseMatrix,
+    /// Its dimension once allocated, `n + n_h + n_v`.
+    n_all: usize,
     /// Φ_q and B at the end of the step: the constraint rows (and, in the Arnold–Brüls form,
     /// the constraint forces).
     phi_q: DenseMatrix,
@@ -267,7 +273,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             n_h,
             n_v,
             solver,
-            matrix: DenseMatrix::zeros(n_all, n_all),
+            matrix: DenseMatrix::zeros(0, 0),
+            n_all,
             phi_q: DenseMatrix::zeros(n_h, n),
             b_mat: DenseMatrix::zeros(n_v, n),
             phi_q_alpha: DenseMatrix::zeros(n_hw, n_w),
@@ -344,14 +351,16 @@ impl<L: LinearSolver> GenAlpha<L> {
         let rows = assembling || !self.weighted;
         if self.n_h > 0 && !(self.phi_q_ready && sys.phi_q_is_constant()) {
             // Forget the previous Φ_q in the assembled matrix: its non-zero columns may move.
+            // (Nothing to forget before the dense matrix exists.)
             let (n, n_h) = (self.n, self.n_h);
-            if rows {
+            let dense = self.matrix.n_rows() > 0;
+            if rows && dense {
                 for &j in &self.phi_q_cols {
                     (0..n_h).for_each(|i| *self.matrix.get_mut(n + i, j) = 0.0);
                 }
             }
             let force_cols = if self.weighted { &self.phi_q_alpha_cols } else { &self.phi_q_cols };
-            for &j in force_cols {
+            for &j in force_cols.iter().filter(|_| dense) {
                 (0..n_h).for_each(|i| *self.matrix.get_mut(j, n + i) = 0.0);
             }
             if rows {
@@ -412,6 +421,28 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
     }
 
+    /// Allocate the dense matrix at its first use (zero, as the constraint blocks' bookkeeping
+    /// assumes).
+    fn ensure_dense(&mut self) {
+        if self.matrix.n_rows() != self.n_all {
+            self.matrix = DenseMatrix::zeros(self.n_all, self.n_all);
+        }
+    }
+
+    /// Free the dense matrix (and forget which columns of Bᵀ it held).
+    fn discard_dense(&mut self) {
+        if self.matrix.n_rows() > 0 {
+            self.matrix = DenseMatrix::zeros(0, 0);
+            self.b_cols_written.iter_mut().for_each(|w| *w = false);
+        }
+    }
+
+    /// Whether the dense `n_all × n_all` matrix has been allocated (it is only on a dense
+    /// assembly: a solver without its own storage, or a fallback).
+    pub fn holds_dense_matrix(&self) -> bool {
+        self.matrix.n_rows() > 0
+    }
+
     /// Zero the blocks of the assembled matrix that the model adds to (K, and the velocity
     /// constraint rows that receive ∂Ψ/∂q); the Φ_q blocks are overwritten by
     /// [`place_constraint_blocks`](Self::place_constraint_blocks) and the multiplier block
@@ -462,10 +493,13 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.q_alpha.copy_from_slice(&s.q);
         }
         self.update_jacobians(sys, s.t, &s.q, true);
-        self.matrix.fill_zero();
-        sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));
-        self.place_constraint_blocks();
-        self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })?;
+        if !self.factorize_mass_direct(sys, s)? {
+            self.ensure_dense();
+            self.matrix.fill_zero();
+            sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));
+            self.place_constraint_blocks();
+            self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })?;
+        }
         self.have_factorization = false; // this is the mass matrix, not the iteration matrix
         let zeros = vec![0.0; n];
         sys.residual_inplace(s.t, &s.q, &s.v, &zeros, &mut self.r);
@@ -492,7 +526,47 @@ impl<L: LinearSolver> GenAlpha<L> {
         s.a.copy_from_slice(&self.rhs[..n]);
         s.lambda.copy_from_slice(&self.rhs[n..n + n_h]);
         s.mu.copy_from_slice(&self.rhs[n + n_h..]);
+        if self.solver.assembly_target().is_some() {
+            // The mass matrix took the dense path (a solver whose structured factorisation needs
+            // pivoting for it): the iteration matrices go to the solver's storage, so the dense
+            // matrix is not kept (it is allocated again, zero, if a fallback needs it).
+            self.discard_dense();
+        }
         Ok(())
+    }
+
+    /// `[M Φ_qᵀ Bᵀ; Φ_q 0 0; B 0 0]` at `s` (the Jacobians evaluated at `s.q`) assembled into the
+    /// solver's own storage and factorised there; false when the solver has no such storage or
+    /// asks for the dense path.
+    fn factorize_mass_direct<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &State) -> Result<bool, Error> {
+        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        let Some(target) = self.solver.assembly_target() else { return Ok(false) };
+        target.clear();
+        {
+            let mut k = MatView::direct(&mut *target, 0, 0, n, n);
+            sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut k);
+        }
+        // At the start the weighted state is the state itself: one Φ_q and B for both sides.
+        for &j in &self.phi_q_cols {
+            for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
+                let x = self.phi_q.get(i, j);
+                target.add(n + i, j, x);
+                target.add(j, n + i, x);
+            }
+        }
+        if n_v > 0 {
+            for &j in &self.b_nz_cols {
+                let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
+                for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+                    target.add(n + n_h + i, j, x);
+                    target.add(j, n + n_h + i, x);
+                }
+            }
+        }
+        match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })? {
+            Assembled::Factorized => Ok(true),
+            Assembled::UseDense => Ok(false),
+        }
     }
 
     /// Advance `s` by one step `dt`. If Newton fails, the step is retried as two half steps
@@ -945,6 +1019,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             return;
         }
         self.assembled_direct = false;
+        self.ensure_dense();
         self.clear_added_blocks();
         let (t_f, q_f, v_f) =
             if self.weighted { (self.t_alpha, &self.q_alpha[..], &self.v_alpha[..]) } else { (t1, &s.q[..], &s.v[..]) };

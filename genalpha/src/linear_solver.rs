@@ -44,8 +44,8 @@ pub enum Assembled {
     UseDense,
 }
 
-/// Direct assembly into the bordered band storage (offered only with a declared structure that a
-/// dense matrix has confirmed).
+/// Direct assembly into the bordered band storage (offered whenever a structure is declared; an
+/// entry outside it sends that matrix to the dense path).
 impl AssemblyTarget for DenseLu {
     fn clear(&mut self) {
         if let Some(s) = &mut self.structured {
@@ -217,8 +217,10 @@ impl LinearSolver for DenseLu {
     }
 
     fn assembly_target(&mut self) -> Option<&mut dyn AssemblyTarget> {
-        // once a dense matrix has confirmed the declared structure
-        if self.structure_checked && self.structured.is_some() { Some(self) } else { None }
+        // From the first matrix on: the storage records an entry outside the declared structure
+        // (then `factorize_assembled` asks for the dense path, which checks the structure
+        // against the whole matrix), so no dense matrix need confirm it first.
+        if self.structured.is_some() { Some(self) } else { None }
     }
 
     fn factorize_assembled(&mut self) -> Result<Assembled, usize> {
@@ -236,6 +238,12 @@ impl LinearSolver for DenseLu {
             return Ok(Assembled::UseDense); // the dense path retries and falls back to the dense LU
         }
         self.use_structured = true;
+        // A dense fallback's storage is not kept beside the structured factors: a banded
+        // problem holds no n² buffer between fallbacks.
+        if self.lu.nrows() > 0 || self.sparse.is_some() {
+            self.lu = Mat::zeros(0, 0);
+            self.sparse = None;
+        }
         Ok(Assembled::Factorized)
     }
 

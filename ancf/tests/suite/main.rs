@@ -8,6 +8,7 @@ mod generic_analysis;
 mod inertia;
 mod invariance;
 mod jacobians;
+mod memory;
 mod modal;
 mod pendulum;
 mod properties;

@@ -6,6 +6,7 @@ mod energy;
 mod frame_retraction;
 mod generic_analysis;
 mod inertia;
+mod memory;
 mod modes;
 mod paper_cases;
 mod paper_reference;
