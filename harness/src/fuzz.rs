@@ -722,6 +722,9 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
     let work = c.out.join("work");
     let crashes = c.out.join("crashes");
     std::fs::create_dir_all(&crashes).map_err(|e| io(&crashes, e))?;
+    // The mutants' folder, also without a `reference/` to copy (a seed folder of its own, such
+    // as `cases/statics`).
+    std::fs::create_dir_all(&work).map_err(|e| io(&work, e))?;
     let refs = c.cases.join("reference");
     if refs.is_dir() {
         copy_dir(&refs, &work.join("reference")).map_err(|e| io(&work, e))?;
@@ -744,11 +747,11 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
                     }
                     let (name, bytes, muts) = input(seeds, c.seed, i);
                     let file = work.join(format!("w{w}_{name}.json"));
-                    if std::fs::write(&file, &bytes).is_err() {
-                        continue;
-                    }
                     let out = work.join(format!("out{w}"));
-                    let (class, err, secs) = if c.exec_each || c.run {
+                    let (class, err, secs) = if let Err(e) = std::fs::write(&file, &bytes) {
+                        // Counted, not skipped: a campaign that cannot write its inputs says so.
+                        (Class::Other, format!("{}: {e}", file.display()), 0.0)
+                    } else if c.exec_each || c.run {
                         let r = run_child(exe, &file, &out, c);
                         let _ = std::fs::remove_dir_all(&out);
                         r
