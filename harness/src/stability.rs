@@ -861,7 +861,12 @@ fn sweep<S: StaticStructure>(
         }
         About::Equilibrium => {
             let mut c = case.clone();
-            c.statics = Some(crate::case::StaticSettings { airspeeds: st.airspeeds.clone(), references: Vec::new(), point_loads: Vec::new(), load_factors: Vec::new() });
+            c.statics = Some(crate::case::StaticSettings {
+                airspeeds: st.airspeeds.clone(),
+                references: Vec::new(),
+                point_loads: Vec::new(),
+                load_factors: Vec::new(),
+            });
             let so = crate::statics::run_static(&c, f);
             if let Some(e) = so.error {
                 return empty_output(f, Some(e));
