@@ -38,3 +38,9 @@ pub fn interrupted() -> bool {
 pub fn request_stop() {
     STOP.store(true, Ordering::SeqCst);
 }
+
+/// Clear a stop request once the runs it stopped have returned (an embedding program that goes
+/// on after an interrupt: the Python package after a `KeyboardInterrupt`).
+pub fn clear_stop() {
+    STOP.store(false, Ordering::SeqCst);
+}

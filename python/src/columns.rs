@@ -1,0 +1,156 @@
+//! Rows as NumPy columns named as in the CLI's CSV files, and back.
+
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::{PyKeyError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use harness::run::Row;
+use harness::statics::StaticOutput;
+
+/// One column of the time-history CSV: its name and how to read it from a row.
+type Getter = fn(&Row) -> f64;
+
+/// Every column a row can have, by its CSV name.
+const COLUMNS: [(&str, Getter); 18] = [
+    ("t", |r| r.t),
+    ("tip_x", |r| r.tip[0]),
+    ("tip_y", |r| r.tip[1]),
+    ("tip_z", |r| r.tip[2]),
+    ("fold", |r| r.fold),
+    ("kinetic", |r| r.kinetic),
+    ("elastic", |r| r.elastic),
+    ("potential", |r| r.potential),
+    ("spring", |r| r.spring),
+    ("dissipated", |r| r.dissipated),
+    ("total", |r| r.total),
+    ("aero_work", |r| r.aero_work),
+    ("constraint_residual", |r| r.constraint_residual),
+    ("newton_iterations", |r| r.newton_iterations as f64),
+    ("lift", |r| r.lift),
+    ("root_bending_moment", |r| r.root_bending_moment),
+    ("root_torque", |r| r.root_torque),
+    ("hinge_moment", |r| r.hinge_moment),
+];
+
+/// The CSV column names of these rows (`harness::csv::header`: aerodynamic columns when the run
+/// has them, `spring` and `dissipated` when the model has force elements).
+fn header(rows: &[Row]) -> Vec<String> {
+    let aero = rows.iter().any(|r| r.aero_work.is_finite());
+    let springs = rows.iter().any(|r| r.spring.is_finite());
+    harness::csv::header(aero, springs).split(',').map(str::to_string).collect()
+}
+
+/// The rows as a dict of NumPy arrays keyed by the CSV's column names (`newton_iterations` as
+/// int64, the others float64, each value the row's `f64` unrounded).
+pub fn run_columns<'py>(py: Python<'py>, rows: &[Row]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for name in header(rows) {
+        let (_, get) = COLUMNS.iter().find(|(n, _)| *n == name).expect("every CSV column has a getter");
+        if name == "newton_iterations" {
+            let v: Vec<i64> = rows.iter().map(|r| r.newton_iterations as i64).collect();
+            d.set_item(name, PyArray1::from_vec(py, v))?;
+        } else {
+            let v: Vec<f64> = rows.iter().map(get).collect();
+            d.set_item(name, PyArray1::from_vec(py, v))?;
+        }
+    }
+    Ok(d)
+}
+
+/// A column of a dict as `f64`s (integer arrays converted).
+fn column(d: &Bound<'_, PyDict>, name: &str) -> PyResult<Option<Vec<f64>>> {
+    let Some(v) = d.get_item(name)? else { return Ok(None) };
+    if let Ok(a) = v.extract::<PyReadonlyArray1<'_, f64>>() {
+        return Ok(Some(a.as_array().to_vec()));
+    }
+    if let Ok(a) = v.extract::<PyReadonlyArray1<'_, i64>>() {
+        return Ok(Some(a.as_array().iter().map(|&x| x as f64).collect()));
+    }
+    Err(PyValueError::new_err(format!("column `{name}`: not a one-dimensional float64 or int64 array")))
+}
+
+/// Rows from a dict of columns (the inverse of [`run_columns`]; absent columns are NaN).
+pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
+    let t = column(d, "t")?.ok_or_else(|| PyKeyError::new_err("t"))?;
+    let n = t.len();
+    let nan = Row {
+        t: f64::NAN,
+        tip: [f64::NAN; 3],
+        fold: f64::NAN,
+        kinetic: f64::NAN,
+        elastic: f64::NAN,
+        potential: f64::NAN,
+        spring: f64::NAN,
+        dissipated: f64::NAN,
+        total: f64::NAN,
+        constraint_residual: f64::NAN,
+        newton_iterations: 0,
+        aero_work: f64::NAN,
+        lift: f64::NAN,
+        root_bending_moment: f64::NAN,
+        root_torque: f64::NAN,
+        hinge_moment: f64::NAN,
+    };
+    let mut rows = vec![nan; n];
+    let setters: [(&str, fn(&mut Row, f64)); 18] = [
+        ("t", |r, x| r.t = x),
+        ("tip_x", |r, x| r.tip[0] = x),
+        ("tip_y", |r, x| r.tip[1] = x),
+        ("tip_z", |r, x| r.tip[2] = x),
+        ("fold", |r, x| r.fold = x),
+        ("kinetic", |r, x| r.kinetic = x),
+        ("elastic", |r, x| r.elastic = x),
+        ("potential", |r, x| r.potential = x),
+        ("spring", |r, x| r.spring = x),
+        ("dissipated", |r, x| r.dissipated = x),
+        ("total", |r, x| r.total = x),
+        ("aero_work", |r, x| r.aero_work = x),
+        ("constraint_residual", |r, x| r.constraint_residual = x),
+        ("newton_iterations", |r, x| r.newton_iterations = x as usize),
+        ("lift", |r, x| r.lift = x),
+        ("root_bending_moment", |r, x| r.root_bending_moment = x),
+        ("root_torque", |r, x| r.root_torque = x),
+        ("hinge_moment", |r, x| r.hinge_moment = x),
+    ];
+    for (name, set) in setters {
+        if let Some(v) = column(d, name)? {
+            if v.len() != n {
+                return Err(PyValueError::new_err(format!("column `{name}` has {} values, `t` has {n}", v.len())));
+            }
+            for (r, x) in rows.iter_mut().zip(v) {
+                set(r, x);
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// A static sweep as a dict of arrays keyed by the columns of `static_<f>.csv`
+/// (`harness::static_out::HEADER`; `newton_iterations` int64, `converged` bool).
+pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let p = &out.points;
+    let f = |g: fn(&harness::statics::StaticPoint) -> f64| PyArray1::from_vec(py, p.iter().map(g).collect());
+    d.set_item("airspeed", f(|p| p.airspeed))?;
+    d.set_item("fold_deg", f(|p| p.fold_deg))?;
+    d.set_item("tip_x", f(|p| p.tip[0]))?;
+    d.set_item("tip_y", f(|p| p.tip[1]))?;
+    d.set_item("tip_z", f(|p| p.tip[2]))?;
+    d.set_item("root_bending_moment", f(|p| p.loads.root_bending_moment))?;
+    d.set_item("root_torque", f(|p| p.loads.root_torque))?;
+    d.set_item("hinge_moment", f(|p| p.loads.hinge_moment))?;
+    d.set_item("lift", f(|p| p.lift))?;
+    d.set_item("root_force_x", f(|p| p.loads.root_force[0]))?;
+    d.set_item("root_force_y", f(|p| p.loads.root_force[1]))?;
+    d.set_item("root_force_z", f(|p| p.loads.root_force[2]))?;
+    d.set_item("root_moment_x", f(|p| p.loads.root_moment[0]))?;
+    d.set_item("root_moment_y", f(|p| p.loads.root_moment[1]))?;
+    d.set_item("root_moment_z", f(|p| p.loads.root_moment[2]))?;
+    let it: Vec<i64> = p.iter().map(|p| p.newton_iterations as i64).collect();
+    d.set_item("newton_iterations", PyArray1::from_vec(py, it))?;
+    let ok: Vec<bool> = p.iter().map(|p| p.error.is_none()).collect();
+    d.set_item("converged", PyArray1::from_vec(py, ok))?;
+    debug_assert_eq!(d.len(), harness::static_out::HEADER.split(',').count());
+    Ok(d)
+}

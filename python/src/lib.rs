@@ -1,0 +1,224 @@
+//! `flexmb._core`: the Rust side of the `flexmb` Python package.
+//!
+//! Every function here goes through the harness library exactly as the `harness` command line
+//! does: [`CaseFile::read`]/[`CaseFile::from_bytes`], [`CaseFile::expand`] with the `--set`
+//! overrides, then [`harness::scene::run_formulation`] per formulation (in parallel, as
+//! `harness run` runs them) or [`harness::statics::run_static`]. The arrays handed to Python are
+//! the `f64`s of the rows the command line formats into its CSV files, column by column, so a
+//! value printed by the CLI is the Python value rounded by that format ([`to_csv`] re-renders them
+//! with the CLI's own writer).
+//!
+//! A run releases the GIL. It runs on a worker thread while the calling thread waits with the GIL
+//! released and, every [`POLL`], takes it back to let Python handle pending signals: a Ctrl-C
+//! (`KeyboardInterrupt`) sets the harness's stop flag ([`harness::signal::request_stop`]), which
+//! both time loops read before each step, waits for the run to stop, clears the flag and raises.
+#![warn(missing_docs)]
+
+mod columns;
+mod errors;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+
+use harness::case::{CaseFile, Formulation, Override, RunSpec};
+use harness::run::RunOutput;
+
+use crate::errors::{CaseError, FlexmbError, RunError, to_py};
+
+/// How often a waiting call takes the GIL back to let Python run its signal handlers.
+const POLL: Duration = Duration::from_millis(20);
+
+/// Parse the formulation names (`"ancf"`, `"gebf"`).
+fn formulations(names: &[String]) -> PyResult<Vec<Formulation>> {
+    names
+        .iter()
+        .map(|n| match n.as_str() {
+            "ancf" => Ok(Formulation::Ancf),
+            "gebf" => Ok(Formulation::Gebf),
+            other => {
+                let e = CaseError::new_err(format!(
+                    "formulation: `{other}` is not one of \"ancf\", \"gebf\", \"both\""
+                ));
+                Python::with_gil(|py| -> PyResult<()> { e.value(py).setattr("field", "formulation") })?;
+                Err(e)
+            }
+        })
+        .collect()
+}
+
+/// Read a case (a path, or JSON text whose references resolve against `base_dir`), apply the
+/// overrides and expand its sweep.
+fn load(case: &str, from_path: bool, base_dir: &str, overrides: &[String]) -> Result<Vec<RunSpec>, harness::Error> {
+    let ovs = overrides.iter().map(|s| s.parse::<Override>()).collect::<Result<Vec<_>, _>>()?;
+    let file = if from_path {
+        CaseFile::read(Path::new(case))
+    } else {
+        CaseFile::from_bytes(&PathBuf::from(base_dir).join("<dict>"), case.as_bytes())
+    }?;
+    file.expand(&ovs)
+}
+
+/// Run `work` on a worker thread with the GIL released; Ctrl-C stops it through the harness's
+/// stop flag and raises `KeyboardInterrupt` once the worker has returned.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    std::thread::scope(|s| {
+        let caller = std::thread::current();
+        let worker = s.spawn(move || {
+            let r = work();
+            caller.unpark();
+            r
+        });
+        loop {
+            py.allow_threads(|| std::thread::park_timeout(POLL));
+            if worker.is_finished() {
+                break;
+            }
+            if let Err(e) = py.check_signals() {
+                harness::signal::request_stop();
+                let _ = py.allow_threads(|| worker.join());
+                harness::signal::clear_stop();
+                return Err(e);
+            }
+        }
+        py.allow_threads(|| worker.join())
+            .map_err(|_| FlexmbError::new_err("the run panicked (a bug: please report the case)"))
+    })
+}
+
+/// The runs of every spec and formulation, in parallel (rayon, as `harness run`).
+fn run_specs(specs: &[RunSpec], fs: &[Formulation]) -> Vec<Vec<RunOutput>> {
+    let jobs: Vec<(usize, Formulation)> = (0..specs.len()).flat_map(|i| fs.iter().map(move |&f| (i, f))).collect();
+    let outs: Vec<(usize, RunOutput)> =
+        jobs.par_iter().map(|&(i, f)| (i, harness::scene::run_formulation(specs[i].case(f), f))).collect();
+    let mut per: Vec<Vec<RunOutput>> = vec![Vec::new(); specs.len()];
+    for (i, o) in outs {
+        per[i].push(o);
+    }
+    per
+}
+
+/// Run a case: returns `[(run name, {formulation: (columns, error or None)})]`, one entry per
+/// sweep point, the columns named as in the CLI's CSV.
+#[pyfunction]
+#[pyo3(signature = (case, from_path, base_dir, formulations, overrides))]
+fn run<'py>(
+    py: Python<'py>,
+    case: &str,
+    from_path: bool,
+    base_dir: &str,
+    formulations: Vec<String>,
+    overrides: Vec<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let fs = self::formulations(&formulations)?;
+    let specs = py.allow_threads(|| load(case, from_path, base_dir, &overrides)).map_err(|e| to_py(py, e))?;
+    let outs = interruptible(py, || run_specs(&specs, &fs))?;
+    if harness::signal::interrupted() {
+        harness::signal::clear_stop();
+    }
+    let list = PyList::empty(py);
+    for (spec, runs) in specs.iter().zip(outs) {
+        let per = PyDict::new(py);
+        for out in runs {
+            let cols = columns::run_columns(py, &out.rows)?;
+            per.set_item(out.formulation.as_str(), (cols, out.error))?;
+        }
+        list.append((spec.name.as_str(), per))?;
+    }
+    Ok(list)
+}
+
+/// The static sweep of a case: `[(run name, {formulation: (columns, error or None)})]`, the
+/// columns named as in `static_<f>.csv`.
+#[pyfunction]
+#[pyo3(signature = (case, from_path, base_dir, formulations, overrides))]
+fn static_sweep<'py>(
+    py: Python<'py>,
+    case: &str,
+    from_path: bool,
+    base_dir: &str,
+    formulations: Vec<String>,
+    overrides: Vec<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let fs = self::formulations(&formulations)?;
+    let specs = py.allow_threads(|| load(case, from_path, base_dir, &overrides)).map_err(|e| to_py(py, e))?;
+    if let Some(s) = specs.iter().find(|s| s.ancf.statics.is_none()) {
+        let e = CaseError::new_err(format!("{}: static: the case has no `static` block (airspeeds to sweep)", s.name));
+        e.value(py).setattr("field", "static")?;
+        return Err(e);
+    }
+    let outs = interruptible(py, || {
+        specs
+            .iter()
+            .map(|spec| fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect::<Vec<_>>())
+            .collect::<Vec<_>>()
+    })?;
+    let list = PyList::empty(py);
+    for (spec, runs) in specs.iter().zip(outs) {
+        let per = PyDict::new(py);
+        for out in runs {
+            let cols = columns::static_columns(py, &out)?;
+            per.set_item(out.formulation.as_str(), (cols, out.error))?;
+        }
+        list.append((spec.name.as_str(), per))?;
+    }
+    Ok(list)
+}
+
+/// The CSV text the CLI writes for a run with these columns (`harness::csv::to_csv`).
+#[pyfunction]
+fn to_csv(columns: &Bound<'_, PyDict>) -> PyResult<String> {
+    let rows = columns::rows_of(columns)?;
+    Ok(harness::csv::to_csv(&rows))
+}
+
+/// The ANCF–GEBF tip distance as the CLI computes it (`harness::metrics::tip_difference`, no time
+/// shift): `(t, d)` with the maximum being the CLI's "max tip difference".
+#[pyfunction]
+fn tip_difference(a: &Bound<'_, PyDict>, b: &Bound<'_, PyDict>) -> PyResult<(Vec<f64>, Vec<f64>)> {
+    let (ra, rb) = (columns::rows_of(a)?, columns::rows_of(b)?);
+    let (ca, cb) = (harness::metrics::tip_curve(&ra), harness::metrics::tip_curve(&rb));
+    Ok(harness::metrics::tip_difference(&ca, &cb, 0.0).into_iter().unzip())
+}
+
+/// The benchmark's reference: the same load and runs as [`run`], timed inside Rust with no Python
+/// object built (s, wall time).
+#[pyfunction]
+#[pyo3(signature = (case, from_path, base_dir, formulations, overrides))]
+fn native_seconds(
+    py: Python<'_>,
+    case: &str,
+    from_path: bool,
+    base_dir: &str,
+    formulations: Vec<String>,
+    overrides: Vec<String>,
+) -> PyResult<f64> {
+    let fs = self::formulations(&formulations)?;
+    py.allow_threads(|| {
+        let t = Instant::now();
+        let specs = load(case, from_path, base_dir, &overrides)?;
+        let outs = run_specs(&specs, &fs);
+        std::hint::black_box(&outs);
+        Ok(t.elapsed().as_secs_f64())
+    })
+    .map_err(|e| to_py(py, e))
+}
+
+/// The Rust extension of `flexmb`.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("FlexmbError", py.get_type::<FlexmbError>())?;
+    m.add("CaseError", py.get_type::<CaseError>())?;
+    m.add("RunError", py.get_type::<RunError>())?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(static_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(to_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(tip_difference, m)?)?;
+    m.add_function(wrap_pyfunction!(native_seconds, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
