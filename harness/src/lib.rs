@@ -5,7 +5,8 @@
 //! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
 //! ([`report`], [`plot`]), a 3-D view ([`view3d`]) and ParaView files ([`vtk`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
 //! ladders ([`converge`]), the stress matrix ([`stress`]), energy by integrator form
-//! ([`energy`]), speed ([`bench`](mod@bench)).
+//! ([`energy`]), speed ([`bench`](mod@bench)). Sweeps split across processes or a SLURM job array
+//! ([`shard`]) and are merged into one report ([`merge`]).
 #![warn(missing_docs)]
 
 pub mod aero;
@@ -22,6 +23,7 @@ pub mod gate;
 pub mod gust;
 pub mod gust_out;
 pub mod loads;
+pub mod merge;
 pub mod metrics;
 pub mod pencil;
 pub mod plot;
@@ -29,6 +31,7 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod shard;
 pub mod signal;
 pub mod stability;
 pub mod stability_out;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use harness::case::{CaseFile, Formulation, Override, json_schema};
 use harness::driver::{
@@ -12,6 +12,7 @@ use harness::driver::{
     write_index,
 };
 use harness::progress::Progress;
+use harness::shard::{Plan, ShardArg, Unit, run_unit, runs_here};
 use harness::{bench, converge, energy, gate, stress};
 
 #[derive(Parser)]
@@ -30,6 +31,16 @@ struct Cli {
     /// Wall time one run may take, hours (default 48); a case estimated above it is refused.
     #[arg(long, global = true, value_name = "HOURS")]
     max_hours: Option<f64>,
+}
+
+/// `--shard` of the commands that expand sweeps (`#[command(flatten)] shard: ShardOpt`).
+#[derive(Args, Clone, Copy)]
+struct ShardOpt {
+    /// Run only shard k of N of the command's runs (1-based; runs dealt by estimated cost, the
+    /// same way in every shard), or `slurm` for the task's share of a job array
+    /// (SLURM_ARRAY_TASK_ID/COUNT). Each shard writes its own runs; `harness merge` makes the report.
+    #[arg(long, value_name = "k/N|slurm")]
+    shard: Option<ShardArg>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -55,6 +66,8 @@ enum Cmd {
         /// Skip the refinement ladders, the stress matrix and the speed benchmark (cases only).
         #[arg(long)]
         quick: bool,
+        #[command(flatten)]
+        shard: ShardOpt,
     },
     /// Run one case file.
     Run {
@@ -158,6 +171,8 @@ enum Cmd {
         /// Override a case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        #[command(flatten)]
+        shard: ShardOpt,
     },
     /// The stress matrix (c × β × dt × rho_inf) on a base case, for both formulations.
     Stress {
@@ -170,6 +185,8 @@ enum Cmd {
         /// Override a base-case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        #[command(flatten)]
+        shard: ShardOpt,
     },
     /// Energy at rho_inf = 1 of the c = 1 pendulums, each formulation in both generalized-α forms
     /// (Arnold–Brüls, Chung–Hulbert), at dt and dt/2; writes `<out>/energy/` (energy.md, energy.csv,
@@ -218,6 +235,18 @@ enum Cmd {
         /// Override a case value (see `all`), e.g. `pitch_deg=5` or `joints.1.locked=true`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        #[command(flatten)]
+        shard: ShardOpt,
+    },
+    /// Merge the outputs of the shards of a sweep (`--shard`) into one report and summary; exits 1
+    /// naming the runs no shard finished.
+    Merge {
+        /// The shards' output folders (each holds `shards/*.json`; shards may share one).
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output folder of the merged report.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
     },
     /// Linearised stability over the case's `stability.airspeeds` (flutter, divergence, modes);
     /// writes `<out>/<case>/stability_{ancf,gebf}.csv`, `.json`, plots and a report fragment.
@@ -233,6 +262,8 @@ enum Cmd {
         /// Override a case value (see `all`).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        #[command(flatten)]
+        shard: ShardOpt,
     },
     /// Gust sweep over the case's `gust` block (gradients x hinge states) from the static
     /// equilibrium; writes `<out>/<case>/gust_{ancf,gebf}.csv`, `gust_history_*.csv`,
@@ -430,6 +461,74 @@ fn run_gust(case: &std::path::Path, which: Which, out: &std::path::Path, set: &[
         println!("wrote {}", dir.display());
     }
     Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// Rough multiples of one run's estimated cost for the studies of `harness all` (only the ratios
+/// between units matter to [`harness::shard::assign`]): a refinement ladder set, the energy study
+/// (both forms at dt and dt/2) and the benchmark (7 serial repeats, ANCF on two paths).
+const LADDER_COST: f64 = 30.0;
+const ENERGY_COST: f64 = 6.0;
+const BENCH_COST: f64 = 10.0;
+
+/// Every unit of work of `harness all`: each case run (with its static sweep), and unless
+/// `quick` each refinement ladder, stress cell and extra run, the energy study and the benchmark.
+fn all_units(
+    runs: &[harness::case::RunSpec],
+    quick: bool,
+    stress_base: Option<&harness::case::RunSpec>,
+    axes: &stress::Axes,
+    extras: &[(String, harness::case::RunSpec)],
+) -> Vec<Unit> {
+    use harness::shard::run_cost;
+    let mut u: Vec<Unit> = runs.iter().map(|r| Unit { id: run_unit(&r.name), cost: run_cost(r) }).collect();
+    if quick {
+        return u;
+    }
+    for r in runs.iter().filter(|r| r.ancf.converge) {
+        u.push(Unit { id: format!("converge:{}", r.name), cost: LADDER_COST * run_cost(r) });
+    }
+    if let Some(base) = stress_base {
+        u.extend(stress_units(base, axes, extras));
+    }
+    let energy: f64 = energy::select(runs).iter().map(run_cost).sum();
+    u.push(Unit { id: "energy".into(), cost: ENERGY_COST * energy });
+    let bench: f64 = runs.iter().filter(|r| r.ancf.aero.is_none()).map(run_cost).sum();
+    u.push(Unit { id: "bench".into(), cost: BENCH_COST * bench });
+    u
+}
+
+/// The units of the stress study: every cell of the matrix, then each extra run.
+fn stress_units(
+    base: &harness::case::RunSpec,
+    axes: &stress::Axes,
+    extras: &[(String, harness::case::RunSpec)],
+) -> Vec<Unit> {
+    let mut u: Vec<Unit> =
+        stress::jobs(axes).iter().map(|j| Unit { id: stress::job_id(j), cost: stress::job_cost(base, j) }).collect();
+    u.extend(
+        extras.iter().map(|(l, r)| Unit { id: harness::merge::extra_unit(l), cost: harness::shard::run_cost(r) }),
+    );
+    u
+}
+
+/// Run this shard's cells and extra runs of the stress study (all of them without a plan),
+/// adding their units to `done`.
+fn run_stress(
+    base: &harness::case::RunSpec,
+    axes: &stress::Axes,
+    extras: &[(String, harness::case::RunSpec)],
+    plan: Option<&Plan>,
+    done: &mut Vec<String>,
+) -> (Vec<stress::Cell>, Vec<stress::Extra>) {
+    let jobs: Vec<stress::Job> =
+        stress::jobs(axes).into_iter().filter(|j| runs_here(plan, &stress::job_id(j))).collect();
+    let cells = stress::run_jobs(base, &jobs, true);
+    done.extend(jobs.iter().map(stress::job_id));
+    let mine: Vec<_> =
+        extras.iter().filter(|(l, _)| runs_here(plan, &harness::merge::extra_unit(l))).cloned().collect();
+    let ex = stress::run_extras(&mine);
+    done.extend(mine.iter().map(|(l, _)| harness::merge::extra_unit(l)));
+    (cells, ex)
 }
 
 /// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
@@ -657,7 +756,7 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
         }
-        Cmd::All { cases, out, set, quick } => {
+        Cmd::All { cases, out, set, quick, shard } => {
             let files = discover(&cases)?;
             let progress = Progress::new(true);
             progress.phase(&format!("reading {} case files in {}", files.len(), cases.display()));
@@ -665,9 +764,23 @@ fn real_main() -> Result<ExitCode> {
             for e in &errors {
                 eprintln!("error: {e}");
             }
-            let runs = variants(runs, &set, &Formulation::ALL, None);
+            let all_runs = variants(runs, &set, &Formulation::ALL, None);
             // Studies of a run with overrides go to folders that say so too.
             let study = |name: &str| out.join(variant_name(name, &set, &Formulation::ALL));
+            // The stress matrix's base case and extra runs (read here: a shard plans every unit).
+            let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
+            let axes = stress::Axes::default();
+            let stress_base = match base {
+                Some(b) if !quick => Some(CaseFile::read(b).and_then(|c| c.expand(&set))?.remove(0)),
+                _ => None,
+            };
+            let extras = if stress_base.is_some() { stress_extras(&cases, &set)? } else { Vec::new() };
+            let plan = harness::shard::plan("all", shard.shard, || {
+                all_units(&all_runs, quick, stress_base.as_ref(), &axes, &extras)
+            })?;
+            let here = |id: &str| runs_here(plan.as_ref(), id);
+            let mut done: Vec<String> = Vec::new();
+            let runs: Vec<_> = all_runs.iter().filter(|r| here(&run_unit(&r.name))).cloned().collect();
             let t0 = std::time::Instant::now();
             progress.phase(&format!("cases: {} runs x 2 formulations", runs.len()));
             // Each run also records its 3-D view for the report (and writes VTK where the case asks).
@@ -675,25 +788,30 @@ fn real_main() -> Result<ExitCode> {
                 harness::view3d::report_observer(&out, spec, f)
             })?;
             let wall = t0.elapsed().as_secs_f64();
+            if !interrupted {
+                done.extend(runs.iter().map(|r| run_unit(&r.name)));
+            }
             if !quick && !interrupted {
-                for spec in runs.iter().filter(|r| r.ancf.converge) {
+                for spec in all_runs.iter().filter(|r| r.ancf.converge && here(&format!("converge:{}", r.name))) {
                     progress.phase(&format!("refinement ladders of {}", spec.name));
                     let t = std::time::Instant::now();
                     let r = converge::converge(spec, true)?;
                     converge::write(&study("converge").join(&spec.name), &r)?;
                     println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+                    done.push(format!("converge:{}", spec.name));
                 }
-                let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
-                if let Some(base) = base {
+                if let Some(spec) = &stress_base {
                     progress
                         .phase("stress matrix (c x beta x dt x rho_inf, both formulations), then its two long runs");
                     let t = std::time::Instant::now();
-                    let spec = CaseFile::read(base).and_then(|c| c.expand(&set))?;
-                    let axes = stress::Axes::default();
-                    let cells = stress::run(&spec[0], &axes, true);
-                    stress::write(&study("stress"), &axes, &cells)?;
-                    let ex = stress::run_extras(&stress_extras(&cases, &set)?);
-                    stress::write_extras(&study("stress"), &ex)?;
+                    let (cells, ex) = run_stress(spec, &axes, &extras, plan.as_ref(), &mut done);
+                    match &plan {
+                        Some(p) => harness::merge::save_stress(&p.data_dir(&out), &cells, &ex)?,
+                        None => {
+                            stress::write(&study("stress"), &axes, &cells)?;
+                            stress::write_extras(&study("stress"), &ex)?;
+                        }
+                    }
                     for f in Formulation::ALL {
                         let (ok, rec, n) = stress::survival(&cells, f);
                         println!(
@@ -702,11 +820,17 @@ fn real_main() -> Result<ExitCode> {
                     }
                     println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
                 }
-                progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
-                run_energy(&runs, &study("energy"))?;
-                progress.phase("speed benchmark (serial repeated runs)");
-                let pendulums: Vec<_> = runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
-                run_bench(&pendulums, 7, &study("bench"))?;
+                if here("energy") {
+                    progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
+                    run_energy(&all_runs, &study("energy"))?;
+                    done.push("energy".into());
+                }
+                if here("bench") {
+                    progress.phase("speed benchmark (serial repeated runs)");
+                    let pendulums: Vec<_> = all_runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
+                    run_bench(&pendulums, 7, &study("bench"))?;
+                    done.push("bench".into());
+                }
             }
             let mut static_failed = 0;
             for spec in runs.iter().filter(|r| r.ancf.statics.is_some() && !interrupted) {
@@ -730,8 +854,21 @@ fn real_main() -> Result<ExitCode> {
                 stability_failed += usize::from(report_stability(&spec.name, &outs));
                 println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
             }
-            progress.phase("reports: index.html, summary.md");
-            write_index(&out, &results).context("writing reports")?;
+            match &plan {
+                Some(p) => {
+                    progress.phase("shard: the exact runs and the manifest for `harness merge`");
+                    for (spec, r) in runs.iter().zip(&results) {
+                        harness::merge::save_case(&p.data_dir(&out), spec, r)?;
+                    }
+                    let stress_dir = variant_name("stress", &set, &Formulation::ALL);
+                    let args = serde_json::json!({ "report": true, "stress_dir": stress_dir, "axes": axes });
+                    p.write_manifest(&out, args, &done)?;
+                }
+                None => {
+                    progress.phase("reports: index.html, summary.md");
+                    write_index(&out, &results).context("writing reports")?;
+                }
+            }
             print!("{}", gate::table(&results));
             let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
             println!(
@@ -824,9 +961,14 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
-        Cmd::Static { case, formulation, out, set } => {
+        Cmd::Static { case, formulation, out, set, shard } => {
             let file = CaseFile::read(&case)?;
             let runs = file.expand(&set)?;
+            let plan = harness::shard::plan("static", shard.shard, || {
+                runs.iter()
+                    .map(|r| Unit { id: format!("static:{}", r.name), cost: harness::shard::run_cost(r) })
+                    .collect()
+            })?;
             let fs: Vec<Formulation> = match formulation {
                 Which::Ancf => vec![Formulation::Ancf],
                 Which::Gebf => vec![Formulation::Gebf],
@@ -842,16 +984,21 @@ fn real_main() -> Result<ExitCode> {
                 }
             }
             let mut failed = false;
-            for spec in &runs {
+            let mut done = Vec::new();
+            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("static:{}", r.name))) {
                 let summary = run_static_case(spec, &fs);
                 let dir = out.join(&spec.name);
                 harness::static_out::write(&dir, &summary)?;
                 failed |= report_static(&summary);
                 println!("wrote {}", dir.display());
+                done.push(format!("static:{}", spec.name));
+            }
+            if let Some(p) = &plan {
+                p.write_manifest(&out, serde_json::json!({}), &done)?;
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
-        Cmd::Stability { case, formulation, out, set } => {
+        Cmd::Stability { case, formulation, out, set, shard } => {
             let file = CaseFile::read(&case)?;
             let runs = file.expand(&set)?;
             let fs: Vec<Formulation> = match formulation {
@@ -868,20 +1015,36 @@ fn real_main() -> Result<ExitCode> {
                     .into());
                 }
             }
+            let plan = harness::shard::plan("stability", shard.shard, || {
+                runs.iter()
+                    .map(|r| Unit { id: format!("stability:{}", r.name), cost: harness::shard::run_cost(r) })
+                    .collect()
+            })?;
             let mut failed = false;
-            for spec in &runs {
+            let mut done = Vec::new();
+            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("stability:{}", r.name))) {
                 let outs = run_stability_case(spec, &fs);
                 let dir = out.join(&spec.name);
                 harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
                 failed |= report_stability(&spec.name, &outs);
                 println!("wrote {}", dir.display());
+                done.push(format!("stability:{}", spec.name));
+            }
+            if let Some(p) = &plan {
+                p.write_manifest(&out, serde_json::json!({}), &done)?;
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
         Cmd::Gust { case, formulation, out, set } => run_gust(&case, formulation, &out, &set),
-        Cmd::Converge { case, out, set } => {
+        Cmd::Converge { case, out, set, shard } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
-            for spec in &runs {
+            let plan = harness::shard::plan("converge", shard.shard, || {
+                runs.iter()
+                    .map(|r| Unit { id: format!("converge:{}", r.name), cost: LADDER_COST * harness::shard::run_cost(r) })
+                    .collect()
+            })?;
+            let mut done = Vec::new();
+            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("converge:{}", r.name))) {
                 let r = converge::converge(spec, true)?;
                 let dir = out.join("converge").join(&spec.name);
                 converge::write(&dir, &r)?;
@@ -897,24 +1060,61 @@ fn real_main() -> Result<ExitCode> {
                     );
                 }
                 println!("wrote {}", dir.display());
+                done.push(format!("converge:{}", spec.name));
+            }
+            if let Some(p) = &plan {
+                p.write_manifest(&out, serde_json::json!({}), &done)?;
             }
             Ok(ExitCode::SUCCESS)
         }
-        Cmd::Stress { case, out, set } => {
+        Cmd::Merge { dirs, out } => {
+            let m = harness::merge::merge(&dirs, &out)?;
+            let shards: Vec<String> = m.shards.iter().map(|(c, k)| format!("{c} {k}")).collect();
+            println!(
+                "merge: {} shard(s) ({}); {} case run(s), {} stress cell(s); wrote {}",
+                m.shards.len(),
+                shards.join(", "),
+                m.results.len(),
+                m.stress_cells,
+                out.display()
+            );
+            if !m.results.is_empty() {
+                print!("{}", gate::table(&m.results));
+            }
+            if m.missing.is_empty() {
+                return Ok(ExitCode::SUCCESS);
+            }
+            eprintln!("merge: {} run(s) missing (no shard finished them):", m.missing.len());
+            for (cmd, unit, k) in &m.missing {
+                eprintln!("  {cmd} {unit} (shard {k})");
+            }
+            Ok(ExitCode::FAILURE)
+        }
+        Cmd::Stress { case, out, set, shard } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
             let base = runs.first().context("the base case expands into no run")?;
             let axes = stress::Axes::default();
+            let extras = stress_extras(&case.with_file_name(""), &set)?;
+            let plan = harness::shard::plan("stress", shard.shard, || stress_units(base, &axes, &extras))?;
             let t0 = std::time::Instant::now();
-            let cells = stress::run(base, &axes, true);
+            let mut done = Vec::new();
+            let (cells, ex) = run_stress(base, &axes, &extras, plan.as_ref(), &mut done);
             let dir = out.join("stress");
-            stress::write(&dir, &axes, &cells)?;
             for f in Formulation::ALL {
                 let (ok, rec, n) = stress::survival(&cells, f);
                 println!("{f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
             }
-            let extras = stress_extras(&case.with_file_name(""), &set)?;
-            let ex = stress::run_extras(&extras);
-            stress::write_extras(&dir, &ex)?;
+            match &plan {
+                Some(p) => {
+                    harness::merge::save_stress(&p.data_dir(&out), &cells, &ex)?;
+                    let args = serde_json::json!({ "report": false, "stress_dir": "stress", "axes": axes });
+                    p.write_manifest(&out, args, &done)?;
+                }
+                None => {
+                    stress::write(&dir, &axes, &cells)?;
+                    stress::write_extras(&dir, &ex)?;
+                }
+            }
             for e in &ex {
                 let m = &e.metrics;
                 println!(

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::Error;
 use crate::case::{Case, Formulation, Joint, RunSpec};
@@ -19,7 +19,7 @@ use crate::metrics::FormulationMetrics;
 use crate::scene::run_formulation;
 
 /// The axes of the matrix.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Axes {
     /// Stiffness scales c.
     pub c: Vec<f64>,
@@ -100,8 +100,11 @@ fn cell_case(base: &Case, c: f64, beta: f64, dt_factor: f64, rho: f64) -> Case {
     k
 }
 
-/// Run the matrix on `base` (rayon over cells).
-pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
+/// One cell to run: formulation, c, β (degrees), dt factor, rho_inf.
+pub type Job = (Formulation, f64, f64, f64, f64);
+
+/// The cells of the matrix in their order (formulation, then c, β, dt factor, rho_inf).
+pub fn jobs(axes: &Axes) -> Vec<Job> {
     let mut jobs = Vec::new();
     for f in Formulation::ALL {
         for &c in &axes.c {
@@ -114,6 +117,26 @@ pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
             }
         }
     }
+    jobs
+}
+
+/// The name of a cell as a unit of a sharded sweep (`stress:gebf:c=1:beta=45:dt=2:rho=0.8`).
+pub fn job_id(&(f, c, b, d, r): &Job) -> String {
+    format!("stress:{f}:c={c}:beta={b}:dt={d}:rho={r}")
+}
+
+/// The estimated cost of a cell, s ([`crate::budget::estimate`] of its case).
+pub fn job_cost(base: &RunSpec, &(f, c, b, d, r): &Job) -> f64 {
+    crate::budget::estimate(&cell_case(base.case(f), c, b, d, r), f, None).seconds
+}
+
+/// Run the matrix on `base` (rayon over cells).
+pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
+    run_jobs(base, &jobs(axes), progress)
+}
+
+/// Run the given cells of the matrix on `base` (rayon over cells), in their order.
+pub fn run_jobs(base: &RunSpec, jobs: &[Job], progress: bool) -> Vec<Cell> {
     let bar = if progress { indicatif::ProgressBar::new(jobs.len() as u64) } else { indicatif::ProgressBar::hidden() };
     let cells = jobs
         .par_iter()
