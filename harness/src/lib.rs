@@ -58,6 +58,10 @@ pub enum Error {
     /// Reading or writing a file failed.
     #[error("{0}")]
     Io(String),
+    /// A `--shard` is malformed, or the SLURM array it reads is unusable, or the shards to merge
+    /// do not fit together.
+    #[error("--shard: {0}")]
+    Shard(String),
     /// A reference CSV is malformed.
     #[error("reference {file}: {msg}")]
     Reference {

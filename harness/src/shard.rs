@@ -90,9 +90,9 @@ impl ShardArg {
             Self::Slurm => {
                 let get = |name: &str| -> Result<usize, Error> {
                     let v = env(name).ok_or_else(|| {
-                        Error::Override(format!("--shard slurm: {name} is not set (not inside an sbatch --array task?)"))
+                        Error::Shard(format!("slurm: {name} is not set (not inside an sbatch --array task?)"))
                     })?;
-                    v.trim().parse().map_err(|_| Error::Override(format!("--shard slurm: {name}={v} is not a number")))
+                    v.trim().parse().map_err(|_| Error::Shard(format!("slurm: {name}={v} is not a number")))
                 };
                 let id = get("SLURM_ARRAY_TASK_ID")?;
                 let count = get("SLURM_ARRAY_TASK_COUNT")?;
@@ -101,19 +101,19 @@ impl ShardArg {
                 if let Some(step) = env("SLURM_ARRAY_TASK_STEP").and_then(|s| s.trim().parse::<usize>().ok())
                     && step != 1
                 {
-                    return Err(Error::Override(format!(
-                        "--shard slurm: the array has step {step}; give it as --array=A-B (contiguous)"
+                    return Err(Error::Shard(format!(
+                        "slurm: the array has step {step}; give it as --array=A-B (contiguous)"
                     )));
                 }
                 if max + 1 != min + count {
-                    return Err(Error::Override(format!(
-                        "--shard slurm: the array {min}-{max} has {count} tasks, not contiguous; give it as --array=A-B"
+                    return Err(Error::Shard(format!(
+                        "slurm: the array {min}-{max} has {count} tasks, not contiguous; give it as --array=A-B"
                     )));
                 }
                 if id < min || id > max {
-                    return Err(Error::Override(format!("--shard slurm: task {id} outside the array {min}-{max}")));
+                    return Err(Error::Shard(format!("slurm: task {id} outside the array {min}-{max}")));
                 }
-                Shard::new(id - min + 1, count).map_err(Error::Override)
+                Shard::new(id - min + 1, count).map_err(|e| Error::Shard(format!("slurm: {e}")))
             }
         }
     }
@@ -172,7 +172,7 @@ impl Plan {
     pub fn new(command: &str, shard: Shard, units: Vec<Unit>) -> Result<Self, Error> {
         let mut seen = std::collections::HashSet::new();
         if let Some(u) = units.iter().find(|u| !seen.insert(u.id.as_str())) {
-            return Err(Error::Override(format!("--shard: two units of work are both named `{}`", u.id)));
+            return Err(Error::Shard(format!("two units of work are both named `{}`", u.id)));
         }
         let costs: Vec<f64> = units.iter().map(|u| u.cost).collect();
         let owner = assign(&costs, shard.n).into_iter().map(|s| s + 1).collect();

@@ -11,6 +11,9 @@ mod gust;
 mod honest;
 mod observer;
 mod properties;
+mod shard;
+#[cfg(target_os = "linux")]
+mod slurm;
 mod stability;
 mod statics;
 mod statics_bend;
