@@ -505,9 +505,7 @@ fn stress_units(
 ) -> Vec<Unit> {
     let mut u: Vec<Unit> =
         stress::jobs(axes).iter().map(|j| Unit { id: stress::job_id(j), cost: stress::job_cost(base, j) }).collect();
-    u.extend(
-        extras.iter().map(|(l, r)| Unit { id: harness::merge::extra_unit(l), cost: harness::shard::run_cost(r) }),
-    );
+    u.extend(extras.iter().map(|(l, r)| Unit { id: harness::merge::extra_unit(l), cost: harness::shard::run_cost(r) }));
     u
 }
 
@@ -1040,7 +1038,10 @@ fn real_main() -> Result<ExitCode> {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
             let plan = harness::shard::plan("converge", shard.shard, || {
                 runs.iter()
-                    .map(|r| Unit { id: format!("converge:{}", r.name), cost: LADDER_COST * harness::shard::run_cost(r) })
+                    .map(|r| Unit {
+                        id: format!("converge:{}", r.name),
+                        cost: LADDER_COST * harness::shard::run_cost(r),
+                    })
                     .collect()
             })?;
             let mut done = Vec::new();

@@ -465,8 +465,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged, Error> {
                 .get("axes")
                 .and_then(|a| serde_json::from_value(a.clone()).ok())
                 .ok_or_else(|| Error::Io(format!("merge: the `{cmd}` manifests have no stress-matrix axes")))?;
-            let ordered: Vec<Cell> =
-                plan.units.iter().filter_map(|u| cells.get(&u.id)).cloned().collect();
+            let ordered: Vec<Cell> = plan.units.iter().filter_map(|u| cells.get(&u.id)).cloned().collect();
             if !ordered.is_empty() {
                 crate::stress::write(&out.join(stress_dir), &axes, &ordered)?;
             }

@@ -208,7 +208,10 @@ impl Plan {
     pub fn write_manifest(&self, out: &Path, args: serde_json::Value, done: &[String]) -> Result<(), Error> {
         let m = Manifest { plan: self.clone(), args, done: done.to_vec() };
         let json = serde_json::to_string_pretty(&m).map_err(|e| Error::Io(e.to_string()))?;
-        crate::atomic::write(&out.join(SHARDS_DIR).join(format!("{}.json", self.shard.stem(&self.command))), json.as_bytes())
+        crate::atomic::write(
+            &out.join(SHARDS_DIR).join(format!("{}.json", self.shard.stem(&self.command))),
+            json.as_bytes(),
+        )
     }
 
     /// One line for the log: this shard's units and estimated load against the others'.

@@ -33,8 +33,9 @@ pub fn field_of(msg: &str) -> Option<String> {
         let r = rest.strip_prefix("unknown field `")?;
         Some(r[..r.find('`')?].to_string())
     };
-    // A formulation-specific override's error starts with the formulation.
-    let msg = msg.strip_prefix("ancf: --set: ").or_else(|| msg.strip_prefix("gebf: --set: ")).unwrap_or(msg);
+    // An override's error inside a case error: `[ancf: |gebf: ]--set: `path`: …`.
+    let msg = msg.strip_prefix("ancf: ").or_else(|| msg.strip_prefix("gebf: ")).unwrap_or(msg);
+    let msg = msg.strip_prefix("--set: ").unwrap_or(msg);
     if let Some(u) = unknown(msg) {
         return Some(u);
     }
@@ -48,9 +49,10 @@ pub fn field_of(msg: &str) -> Option<String> {
         return None;
     }
     let head = head.trim().to_string();
+    // serde_path_to_error's path ends with an unknown key already; a path that does not gets it.
     Some(match unknown(rest) {
-        Some(u) => format!("{head}.{u}"),
-        None => head,
+        Some(u) if head != u && !head.ends_with(&format!(".{u}")) => format!("{head}.{u}"),
+        _ => head,
     })
 }
 

@@ -18,6 +18,7 @@ mod columns;
 mod errors;
 
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
@@ -40,9 +41,8 @@ fn formulations(names: &[String]) -> PyResult<Vec<Formulation>> {
             "ancf" => Ok(Formulation::Ancf),
             "gebf" => Ok(Formulation::Gebf),
             other => {
-                let e = CaseError::new_err(format!(
-                    "formulation: `{other}` is not one of \"ancf\", \"gebf\", \"both\""
-                ));
+                let e =
+                    CaseError::new_err(format!("formulation: `{other}` is not one of \"ancf\", \"gebf\", \"both\""));
                 Python::with_gil(|py| -> PyResult<()> { e.value(py).setattr("field", "formulation") })?;
                 Err(e)
             }
@@ -62,31 +62,43 @@ fn load(case: &str, from_path: bool, base_dir: &str, overrides: &[String]) -> Re
     file.expand(&ovs)
 }
 
-/// Run `work` on a worker thread with the GIL released; Ctrl-C stops it through the harness's
-/// stop flag and raises `KeyboardInterrupt` once the worker has returned.
-fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    std::thread::scope(|s| {
-        let caller = std::thread::current();
-        let worker = s.spawn(move || {
-            let r = work();
-            caller.unpark();
-            r
-        });
-        loop {
-            py.allow_threads(|| std::thread::park_timeout(POLL));
-            if worker.is_finished() {
-                break;
+/// Run `work` on rayon's pool with the GIL released, waiting on a channel in slices of [`POLL`];
+/// between slices the caller takes the GIL to let Python run its signal handlers. A Ctrl-C
+/// (`KeyboardInterrupt`) sets the harness's stop flag, which the time loops read before each step,
+/// waits for the work to return, clears the flag and raises.
+fn interruptible<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    let (tx, mut rx) = mpsc::sync_channel(1);
+    rayon::spawn(move || {
+        let _ = tx.send(work());
+    });
+    let mut interrupt: Option<PyErr> = None;
+    loop {
+        let (got, back) = py.allow_threads(move || (rx.recv_timeout(POLL), rx));
+        rx = back;
+        match got {
+            Ok(r) => {
+                return match interrupt {
+                    Some(e) => {
+                        harness::signal::clear_stop();
+                        Err(e)
+                    }
+                    None => Ok(r),
+                };
             }
-            if let Err(e) = py.check_signals() {
-                harness::signal::request_stop();
-                let _ = py.allow_threads(|| worker.join());
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if interrupt.is_none()
+                    && let Err(e) = py.check_signals()
+                {
+                    harness::signal::request_stop();
+                    interrupt = Some(e);
+                }
+            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
                 harness::signal::clear_stop();
-                return Err(e);
+                return Err(FlexmbError::new_err("the run panicked (a bug: please report the case)"));
             }
         }
-        py.allow_threads(|| worker.join())
-            .map_err(|_| FlexmbError::new_err("the run panicked (a bug: please report the case)"))
-    })
+    }
 }
 
 /// The runs of every spec and formulation, in parallel (rayon, as `harness run`).
@@ -115,10 +127,11 @@ fn run<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let fs = self::formulations(&formulations)?;
     let specs = py.allow_threads(|| load(case, from_path, base_dir, &overrides)).map_err(|e| to_py(py, e))?;
-    let outs = interruptible(py, || run_specs(&specs, &fs))?;
-    if harness::signal::interrupted() {
-        harness::signal::clear_stop();
-    }
+    let specs = std::sync::Arc::new(specs);
+    let outs = {
+        let (specs, fs) = (specs.clone(), fs.clone());
+        interruptible(py, move || run_specs(&specs, &fs))?
+    };
     let list = PyList::empty(py);
     for (spec, runs) in specs.iter().zip(outs) {
         let per = PyDict::new(py);
@@ -150,12 +163,16 @@ fn static_sweep<'py>(
         e.value(py).setattr("field", "static")?;
         return Err(e);
     }
-    let outs = interruptible(py, || {
-        specs
-            .iter()
-            .map(|spec| fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect::<Vec<_>>())
-            .collect::<Vec<_>>()
-    })?;
+    let specs = std::sync::Arc::new(specs);
+    let outs = {
+        let (specs, fs) = (specs.clone(), fs.clone());
+        interruptible(py, move || {
+            specs
+                .iter()
+                .map(|spec| fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        })?
+    };
     let list = PyList::empty(py);
     for (spec, runs) in specs.iter().zip(outs) {
         let per = PyDict::new(py);

@@ -134,10 +134,10 @@ fn slurm_array_of_four_shards_merges_into_the_single_machine_report() {
     std::fs::write(&key, &bytes).unwrap();
     std::fs::set_permissions(&key, std::fs::Permissions::from_mode(0o400)).unwrap();
     let socket = dir.join("munge/munge.sock");
-    let host = Command::new("hostname").arg("-s").output().map_or_else(
-        |_| "localhost".to_string(),
-        |o| String::from_utf8_lossy(&o.stdout).trim().to_string(),
-    );
+    let host = Command::new("hostname")
+        .arg("-s")
+        .output()
+        .map_or_else(|_| "localhost".to_string(), |o| String::from_utf8_lossy(&o.stdout).trim().to_string());
     let conf = dir.join("slurm.conf");
     std::fs::write(&conf, slurm_conf(&dir, &host, &socket)).unwrap();
 
@@ -216,7 +216,8 @@ fn slurm_array_of_four_shards_merges_into_the_single_machine_report() {
         );
     }
     let array_s = t_array.elapsed().as_secs_f64();
-    let o = Command::new(bin).arg("merge").arg(dir.join("shared")).arg("--out").arg(dir.join("merged")).output().unwrap();
+    let o =
+        Command::new(bin).arg("merge").arg(dir.join("shared")).arg("--out").arg(dir.join("merged")).output().unwrap();
     assert!(o.status.success(), "merge: {}", String::from_utf8_lossy(&o.stderr));
     let csvs = assert_same_report(&dir.join("single"), &dir.join("merged"));
     assert_eq!(csvs, 32);
