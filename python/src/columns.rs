@@ -11,6 +11,9 @@ use harness::statics::StaticOutput;
 /// One column of the time-history CSV: its name and how to read it from a row.
 type Getter = fn(&Row) -> f64;
 
+/// How to write a column's value into a row.
+type Setter = fn(&mut Row, f64);
+
 /// Every column a row can have, by its CSV name.
 const COLUMNS: [(&str, Getter); 18] = [
     ("t", |r| r.t),
@@ -93,7 +96,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         hinge_moment: f64::NAN,
     };
     let mut rows = vec![nan; n];
-    let setters: [(&str, fn(&mut Row, f64)); 18] = [
+    let setters: [(&str, Setter); 18] = [
         ("t", |r, x| r.t = x),
         ("tip_x", |r, x| r.tip[0] = x),
         ("tip_y", |r, x| r.tip[1] = x),

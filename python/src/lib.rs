@@ -5,11 +5,11 @@
 //! overrides, then [`harness::scene::run_formulation`] per formulation (in parallel, as
 //! `harness run` runs them) or [`harness::statics::run_static`]. The arrays handed to Python are
 //! the `f64`s of the rows the command line formats into its CSV files, column by column, so a
-//! value printed by the CLI is the Python value rounded by that format ([`to_csv`] re-renders them
-//! with the CLI's own writer).
+//! value printed by the CLI is the Python value rounded by that format (`flexmb.to_csv` re-renders
+//! them with the CLI's own writer).
 //!
-//! A run releases the GIL. It runs on a worker thread while the calling thread waits with the GIL
-//! released and, every [`POLL`], takes it back to let Python handle pending signals: a Ctrl-C
+//! A run releases the GIL. It runs on rayon's pool while the calling thread waits with the GIL
+//! released and, every 20 ms, takes it back to let Python handle pending signals: a Ctrl-C
 //! (`KeyboardInterrupt`) sets the harness's stop flag ([`harness::signal::request_stop`]), which
 //! both time loops read before each step, waits for the run to stop, clears the flag and raises.
 #![warn(missing_docs)]
