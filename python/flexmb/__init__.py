@@ -30,6 +30,7 @@ __all__ = [
     "run",
     "sweep",
     "static",
+    "stability",
     "tip_difference",
     "to_csv",
     "CaseError",
@@ -168,6 +169,29 @@ def static(
     block and :class:`RunError` when a sweep could not start.
     """
     runs = _expand(_core.static_sweep, case, formulation, set, base_dir)
+    shaped = {name: _shape(name, per, formulation, True) for name, per in runs}
+    return next(iter(shaped.values())) if len(shaped) == 1 else shaped
+
+
+def stability(
+    case: CaseLike,
+    formulation: str = "gebf",
+    set: Optional[Mapping[str, Any]] = None,
+    *,
+    base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Dict[str, Any]:
+    """The linearised stability over the case's ``stability.airspeeds`` (``harness stability``:
+    p-method flutter and divergence).
+
+    Returns a dict of arrays keyed by the columns of ``stability_<formulation>.csv`` (one entry per
+    airspeed and tracked mode: ``airspeed``, ``mode``, ``real``, ``imag``, ``frequency_hz``,
+    ``frequency_rad_s``, ``damping_ratio``, ``converged``) plus ``summary``, a dict with
+    ``flutter_speed``, ``flutter_frequency_rad_s``, ``flutter_mode`` and ``divergence_speed`` (None
+    when the sweep finds none); for ``"both"`` one such dict per formulation, and for a case with a
+    ``sweep`` ``{run name: ...}``. Raises :class:`CaseError` when the case has no ``stability``
+    block and :class:`RunError` when the analysis could not start.
+    """
+    runs = _expand(_core.stability, case, formulation, set, base_dir)
     shaped = {name: _shape(name, per, formulation, True) for name, per in runs}
     return next(iter(shaped.values())) if len(shaped) == 1 else shaped
 

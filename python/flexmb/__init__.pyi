@@ -46,6 +46,13 @@ def static(
     *,
     base_dir: Optional[Union[str, os.PathLike[str]]] = ...,
 ) -> Dict[str, Any]: ...
+def stability(
+    case: CaseLike,
+    formulation: str = ...,
+    set: Optional[Mapping[str, Any]] = ...,
+    *,
+    base_dir: Optional[Union[str, os.PathLike[str]]] = ...,
+) -> Dict[str, Any]: ...
 def tip_difference(
     a: Mapping[str, npt.NDArray[np.generic]], b: Mapping[str, npt.NDArray[np.generic]]
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...

@@ -27,6 +27,9 @@ def run(
 def static_sweep(
     case: str, from_path: bool, base_dir: str, formulations: List[str], overrides: List[str]
 ) -> List[Tuple[str, _PerFormulation]]: ...
+def stability(
+    case: str, from_path: bool, base_dir: str, formulations: List[str], overrides: List[str]
+) -> List[Tuple[str, _PerFormulation]]: ...
 def to_csv(columns: Dict[str, npt.NDArray[np.generic]]) -> str: ...
 def tip_difference(
     a: Dict[str, npt.NDArray[np.generic]], b: Dict[str, npt.NDArray[np.generic]]

@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use harness::run::Row;
+use harness::stability::StabilityOutput;
 use harness::statics::StaticOutput;
 
 /// One column of the time-history CSV: its name and how to read it from a row.
@@ -155,5 +156,33 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
     let ok: Vec<bool> = p.iter().map(|p| p.error.is_none()).collect();
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
     debug_assert_eq!(d.len(), harness::static_out::HEADER.split(',').count());
+    Ok(d)
+}
+
+/// A stability sweep as a dict of arrays keyed by the columns of `stability_<f>.csv` (one entry
+/// per airspeed and tracked mode: `airspeed`, `mode`, `real`, `imag`, `frequency_hz`,
+/// `frequency_rad_s`, `damping_ratio`, `converged`) plus `summary`: the flutter and divergence
+/// speeds (None when not found in the sweep).
+pub fn stability_columns<'py>(py: Python<'py>, out: &StabilityOutput) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let rows: Vec<(f64, &harness::stability::Root)> =
+        out.points.iter().flat_map(|p| p.roots.iter().map(move |r| (p.airspeed, r))).collect();
+    let f = |g: fn(&(f64, &harness::stability::Root)) -> f64| PyArray1::from_vec(py, rows.iter().map(g).collect());
+    d.set_item("airspeed", f(|x| x.0))?;
+    let modes: Vec<i64> = rows.iter().map(|x| x.1.mode as i64).collect();
+    d.set_item("mode", PyArray1::from_vec(py, modes))?;
+    d.set_item("real", f(|x| x.1.real))?;
+    d.set_item("imag", f(|x| x.1.imag))?;
+    d.set_item("frequency_hz", f(|x| x.1.frequency_hz()))?;
+    d.set_item("frequency_rad_s", f(|x| x.1.imag))?;
+    d.set_item("damping_ratio", f(|x| x.1.damping_ratio()))?;
+    let ok: Vec<bool> = rows.iter().map(|x| x.1.converged).collect();
+    d.set_item("converged", PyArray1::from_vec(py, ok))?;
+    let summary = PyDict::new(py);
+    summary.set_item("flutter_speed", out.flutter_speed)?;
+    summary.set_item("flutter_frequency_rad_s", out.flutter_frequency_rad_s)?;
+    summary.set_item("flutter_mode", out.flutter_mode)?;
+    summary.set_item("divergence_speed", out.divergence_speed)?;
+    d.set_item("summary", summary)?;
     Ok(d)
 }

@@ -3,7 +3,8 @@
 //! Every function here goes through the harness library exactly as the `harness` command line
 //! does: [`CaseFile::read`]/[`CaseFile::from_bytes`], [`CaseFile::expand`] with the `--set`
 //! overrides, then [`harness::scene::run_formulation`] per formulation (in parallel, as
-//! `harness run` runs them) or [`harness::statics::run_static`]. The arrays handed to Python are
+//! `harness run` runs them), [`harness::statics::run_static`] or
+//! [`harness::stability::run_stability`]. The arrays handed to Python are
 //! the `f64`s of the rows the command line formats into its CSV files, column by column, so a
 //! value printed by the CLI is the Python value rounded by that format (`flexmb.to_csv` re-renders
 //! them with the CLI's own writer).
@@ -185,6 +186,52 @@ fn static_sweep<'py>(
     Ok(list)
 }
 
+/// The linearised stability sweep of a case (`harness stability`): `[(run name, {formulation:
+/// (columns, error or None)})]`, the columns named as in `stability_<f>.csv` plus `summary`.
+#[pyfunction]
+#[pyo3(signature = (case, from_path, base_dir, formulations, overrides))]
+fn stability<'py>(
+    py: Python<'py>,
+    case: &str,
+    from_path: bool,
+    base_dir: &str,
+    formulations: Vec<String>,
+    overrides: Vec<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let fs = self::formulations(&formulations)?;
+    let specs = py.allow_threads(|| load(case, from_path, base_dir, &overrides)).map_err(|e| to_py(py, e))?;
+    if let Some(s) = specs.iter().find(|s| s.ancf.stability.is_none()) {
+        let e = CaseError::new_err(format!(
+            "{}: stability: the case has no `stability` block (airspeeds to analyse)",
+            s.name
+        ));
+        e.value(py).setattr("field", "stability")?;
+        return Err(e);
+    }
+    let specs = std::sync::Arc::new(specs);
+    let outs = {
+        let (specs, fs) = (specs.clone(), fs.clone());
+        interruptible(py, move || {
+            specs
+                .iter()
+                .map(|spec| {
+                    fs.par_iter().map(|&f| harness::stability::run_stability(spec.case(f), f)).collect::<Vec<_>>()
+                })
+                .collect::<Vec<_>>()
+        })?
+    };
+    let list = PyList::empty(py);
+    for (spec, runs) in specs.iter().zip(outs) {
+        let per = PyDict::new(py);
+        for out in runs {
+            let cols = columns::stability_columns(py, &out)?;
+            per.set_item(out.formulation.as_str(), (cols, out.error))?;
+        }
+        list.append((spec.name.as_str(), per))?;
+    }
+    Ok(list)
+}
+
 /// The CSV text the CLI writes for a run with these columns (`harness::csv::to_csv`).
 #[pyfunction]
 fn to_csv(columns: &Bound<'_, PyDict>) -> PyResult<String> {
@@ -233,6 +280,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RunError", py.get_type::<RunError>())?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(static_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(to_csv, m)?)?;
     m.add_function(wrap_pyfunction!(tip_difference, m)?)?;
     m.add_function(wrap_pyfunction!(native_seconds, m)?)?;

@@ -173,3 +173,15 @@ def test_a_failed_run_raises_with_the_rows_so_far():
     assert "t" in e.value.result
     partial = flexmb.run(PENDULUM, "gebf", set=bad, check=False)
     assert np.array_equal(partial["t"], e.value.result["t"])
+
+
+def test_stability_sweep_columns():
+    case = ROOT / "cases" / "goland_flutter.json"
+    r = flexmb.stability(case, "gebf", set={"stability.airspeeds": [140, 190]})
+    cols = "airspeed,mode,real,imag,frequency_hz,frequency_rad_s,damping_ratio,converged".split(",")
+    assert [k for k in r if k != "summary"] == cols
+    assert set(np.unique(r["airspeed"])) <= {140.0, 190.0}
+    assert set(r["summary"]) == {"flutter_speed", "flutter_frequency_rad_s", "flutter_mode", "divergence_speed"}
+    with pytest.raises(flexmb.CaseError) as e:
+        flexmb.stability(PENDULUM)
+    assert e.value.field == "stability"
