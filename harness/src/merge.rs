@@ -181,6 +181,9 @@ struct MetricsRecord {
     f: [u64; 7],
     n: [usize; 5],
     error: Option<String>,
+    /// Each oscillation's window start and end, frequency, growth rate, damping ratio, amplitude.
+    oscillations: Vec<[u64; 6]>,
+    oscillation_signal: String,
 }
 
 impl MetricsRecord {
@@ -198,6 +201,14 @@ impl MetricsRecord {
             ],
             n: [m.n_steps, m.n_newton_iters, m.max_newton_iters, m.n_factorizations, m.n_dof],
             error: m.error.clone(),
+            oscillations: m
+                .oscillations
+                .iter()
+                .map(|o| {
+                    [o.t_start, o.t_end, o.frequency_hz, o.growth_rate, o.damping_ratio, o.amplitude].map(f64::to_bits)
+                })
+                .collect(),
+            oscillation_signal: m.oscillation_signal.to_string(),
         }
     }
 
@@ -218,6 +229,20 @@ impl MetricsRecord {
             max_constraint_residual: f(6),
             error: self.error.clone(),
             aero_wall_s,
+            oscillations: self
+                .oscillations
+                .iter()
+                .map(|o| {
+                    let [t_start, t_end, frequency_hz, growth_rate, damping_ratio, amplitude] = o.map(f64::from_bits);
+                    crate::pencil::Oscillation { t_start, t_end, frequency_hz, growth_rate, damping_ratio, amplitude }
+                })
+                .collect(),
+            // The signals `FormulationMetrics::of` names.
+            oscillation_signal: match self.oscillation_signal.as_str() {
+                "fold" => "fold",
+                "tip_z" => "tip_z",
+                _ => "",
+            },
         }
     }
 }
