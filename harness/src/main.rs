@@ -280,6 +280,8 @@ enum Cmd {
         /// Override a case value (see `all`), e.g. `gust.gradients_m=[30]`.
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<Override>,
+        #[command(flatten)]
+        shard: ShardOpt,
     },
     /// List the runs the case files expand into.
     List {
@@ -397,7 +399,13 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
 
 /// `harness gust`: every run of the case file through its gust sweep; exit 2 without a `gust`
 /// block, 1 when a run failed.
-fn run_gust(case: &std::path::Path, which: Which, out: &std::path::Path, set: &[Override]) -> Result<ExitCode> {
+fn run_gust(
+    case: &std::path::Path,
+    which: Which,
+    out: &std::path::Path,
+    set: &[Override],
+    shard: Option<ShardArg>,
+) -> Result<ExitCode> {
     let runs = CaseFile::read(case)?.expand(set)?;
     let fs: Vec<Formulation> = match which {
         Which::Ancf => vec![Formulation::Ancf],
@@ -411,8 +419,13 @@ fn run_gust(case: &std::path::Path, which: Which, out: &std::path::Path, set: &[
             return Err(harness::Error::Case { file, msg }.into());
         }
     }
+    let plan = harness::shard::plan("gust", shard, || {
+        runs.iter().map(|r| Unit { id: format!("gust:{}", r.name), cost: harness::shard::run_cost(r) }).collect()
+    })?;
+    let mut done = Vec::new();
     let mut failed = false;
-    for spec in &runs {
+    for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("gust:{}", r.name))) {
+        done.push(format!("gust:{}", spec.name));
         let sweep =
             harness::gust::run_sweep(spec, &fs).map_err(|msg| harness::Error::Case { file: file.clone(), msg })?;
         let summary = harness::gust_out::summarise(sweep);
@@ -459,6 +472,9 @@ fn run_gust(case: &std::path::Path, which: Which, out: &std::path::Path, set: &[
             spec.name, summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg, summary.wall_s
         );
         println!("wrote {}", dir.display());
+    }
+    if let Some(p) = &plan {
+        p.write_manifest(out, serde_json::json!({}), &done)?;
     }
     Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
 }
@@ -1033,7 +1049,7 @@ fn real_main() -> Result<ExitCode> {
             }
             Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
         }
-        Cmd::Gust { case, formulation, out, set } => run_gust(&case, formulation, &out, &set),
+        Cmd::Gust { case, formulation, out, set, shard } => run_gust(&case, formulation, &out, &set, shard.shard),
         Cmd::Converge { case, out, set, shard } => {
             let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
             let plan = harness::shard::plan("converge", shard.shard, || {

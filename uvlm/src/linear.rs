@@ -170,7 +170,8 @@ fn unit_wake_ring(
     fil.clear();
     let len = wake.n_rows();
     let up = |jj: usize| if k == 0 { te[jj] } else { wake.node(k - 1, jj) };
-    let dist = |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+    let dist =
+        |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
     let (a0, a1) = (fil.push_node(up(j)), fil.push_node(up(j + 1)));
     let (b0, b1) = (fil.push_node(wake.node(k, j)), fil.push_node(wake.node(k, j + 1)));
     // Local chordwise lengths as the wake builder takes them: of this ring for its upstream edge
@@ -266,9 +267,8 @@ impl Uvlm {
         let u_mid0 = fz.u_mid.clone();
         let v_mid0 = fz.v_mid.clone();
         let nrm = lat.normals();
-        let reference_residual: Vec<f64> = (0..nr)
-            .map(|r| (0..3).map(|q| (fz.v_col[r][q] + u_col0[r][q]) * nrm[r][q]).sum())
-            .collect();
+        let reference_residual: Vec<f64> =
+            (0..nr).map(|r| (0..3).map(|q| (fz.v_col[r][q] + u_col0[r][q]) * nrm[r][q]).sum()).collect();
         compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_mid0, None, &p);
         let mut reference_forces = vec![0.0; 3 * nn];
         stack(&fz.loads, &mut reference_forces);
@@ -409,7 +409,11 @@ impl LinearUvlm {
     /// When `lattice` has other dimensions than the reference.
     pub fn evaluate(&self, lattice: &Lattice) -> Result<(Vec<f64>, Vec<f64>)> {
         if lattice.n_rings() != self.n_rings() || lattice.n_spanwise() != self.lattice.n_spanwise() {
-            return Err(UvlmError::LengthMismatch { what: "lattice rings", expected: self.n_rings(), got: lattice.n_rings() });
+            return Err(UvlmError::LengthMismatch {
+                what: "lattice rings",
+                expected: self.n_rings(),
+                got: lattice.n_rings(),
+            });
         }
         let mut fz = Frozen::default();
         fz.build(lattice, &self.gamma0, &self.wake, self.closure, &self.params);

@@ -46,7 +46,11 @@ fn moved(base: &[SpanStation], al: f64, h: f64, al_dot: f64, h_dot: f64) -> (Vec
         .iter()
         .map(|s| {
             let qc = Vector3::new(0.25, s.origin.y, 0.0);
-            SpanStation { origin: qc + r * (s.origin - qc) + Vector3::new(0.0, 0.0, h), frame: r.matrix() * s.frame, ..*s }
+            SpanStation {
+                origin: qc + r * (s.origin - qc) + Vector3::new(0.0, 0.0, h),
+                frame: r.matrix() * s.frame,
+                ..*s
+            }
         })
         .collect();
     let om = Vector3::new(0.0, al_dot, 0.0);
