@@ -271,10 +271,10 @@ pub fn section_html(name: &str, folder: &str, runs: &[StabilityOutput]) -> Strin
             if let Some(r) = p.roots.iter().filter(|r| r.converged).min_by(|a, b| b.real.total_cmp(&a.real)) {
                 let _ = writeln!(
                     s,
-                    "<tr><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.4}</td><td>{:.3}</td><td>{:+.4}</td></tr>",
+                    "<tr><td>{}</td><td>{:.2}</td><td>{}</td><td>{:.4}</td><td>{:.3}</td><td>{:+.4}</td></tr>",
                     o.formulation.as_str().to_uppercase(),
                     p.airspeed,
-                    p.fold_deg,
+                    if p.fold_deg.is_finite() { format!("{:.2}", p.fold_deg) } else { "–".into() },
                     r.frequency_hz(),
                     100.0 * r.damping_ratio(),
                     r.real
