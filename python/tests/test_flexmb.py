@@ -141,7 +141,9 @@ def test_a_run_releases_the_gil():
 
 def test_ctrl_c_stops_a_long_run_and_the_next_run_works():
     """SIGINT during a 400 s simulated run: KeyboardInterrupt within a second, and the harness's
-    stop flag is cleared so that the next run reaches its end."""
+    stop flag is cleared so that the next run reaches its end. The run takes steps of 0.1 ms so
+    that even a fast machine is still in its first seconds of simulated time when the signal
+    arrives (at the case's 2 ms GEBF stops near t = 7 s, which an idle machine reaches in 0.5 s)."""
     script = f"""
 import os, signal, sys, threading, time
 import flexmb
@@ -149,7 +151,7 @@ case = {str(PENDULUM)!r}
 threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
 t0 = time.perf_counter()
 try:
-    flexmb.run(case, "gebf", set={{"t_end": 400}})
+    flexmb.run(case, "gebf", set={{"t_end": 400, "gebf.dt": 1e-4, "output_dt": 0.01}})
     print("not interrupted")
 except KeyboardInterrupt:
     print(f"interrupted after {{time.perf_counter() - t0:.2f}} s")
