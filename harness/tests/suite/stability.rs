@@ -185,53 +185,59 @@ fn bad_stability_input_is_named() {
     assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
-/// Linear against nonlinear: the HALE wing (wake rows of 0.125 m, 240 of them, closed by legs, in
-/// both analyses) pitched by 0.05° and released into the stream, marched with GEBF (ρ∞ = 1,
-/// dt = row length / U, 4 coupling sub-iterations): over 1–3 s the tip's oscillation near the
-/// flutter root grows or decays at the eigen-analysis's rate, below flutter (34 m/s) and above it
-/// (38 m/s). Measured −1.5 % and +2.2 % (at twice the time step, rows of 0.25 m: −2.3 % and
-/// +0.7 %). The matrix-pencil estimate itself moves by about 2 % with its settings on these
-/// records (samples, model order, singular-value cut), so the check is 3 %: the issue's 2 % holds
-/// at 34 m/s, not at 38 m/s.
+/// Linear against nonlinear: the HALE wing at zero incidence (wake rows of 0.125 m, 240 of them,
+/// closed by legs, in both analyses), disturbed by two cycles of a 0.05 m/s sinusoidal gust at the
+/// frequency of the eigen-analysis's flutter root, marched with GEBF (ρ∞ = 1, dt = row length / U,
+/// 4 coupling sub-iterations): over 1.5–3.5 s, after the gust has passed, the tip's oscillation
+/// grows or decays at the eigen-analysis's rate within 2 %, below flutter (34 m/s) and above it
+/// (38 m/s). The wing starts in its equilibrium (undeformed, no load), so the record carries no
+/// static deflection creeping in along the slow real root (−0.15 1/s at 34 m/s), which biased the
+/// estimate of a release from a pitched start by 1.5–2 %. Measured +0.26 % at 34 m/s and +0.80 %
+/// at 38 m/s, frequencies within 0.06 %. Other windows (starting at 0.8–2 s) and model orders of
+/// the pencil, on the tip's height or the root bending moment, give +0.1 … +0.5 % at 34 m/s and
+/// mostly −1.5 … +0.9 % at 38 m/s (two of 25 estimates reach ±3.4 %).
 #[test]
 fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
     let check = |u: f64| {
         let dt = 0.125 / u;
-        let set: Vec<String> = vec![
+        let common: Vec<String> = vec![
             "stability.wake.row_length=0.125".into(),
             "stability.wake.rows=240".into(),
             format!("stability.airspeeds=[{u}]"),
             format!("aero.airspeed={u}"),
-            "pitch_deg=0.05".into(),
+        ];
+        let refs: Vec<&str> = common.iter().map(String::as_str).collect();
+        let lin = run_stability(&case("hale_flutter.json", &refs).gebf, Formulation::Gebf);
+        // The flutter root: the least stable oscillatory root that the air acts on (at zero
+        // incidence the in-plane bending mode, 31.7 rad/s, has no aerodynamic term and stays on
+        // the imaginary axis; the tip's height does not see it).
+        let root = *lin.points[0]
+            .roots
+            .iter()
+            .filter(|r| r.converged && r.imag > 1.0 && r.real.abs() > 1e-6)
+            .max_by(|a, b| a.real.total_cmp(&b.real))
+            .unwrap();
+        let f_hz = root.imag / (2.0 * std::f64::consts::PI);
+        let mut set = common.clone();
+        set.extend([
             format!("gebf.dt={dt}"),
             format!("ancf.dt={dt}"),
             format!("output_dt={dt}"),
             "gebf.rho_inf=1".into(),
             "aero.n_wake_rows=240".into(),
             "aero.wake_closure=true".into(),
-            "t_end=3".into(),
+            "t_end=3.5".into(),
             "aero.coupling.max_sub_iterations=4".into(),
             "aero.coupling.tolerance=1e-6".into(),
-        ];
+            format!(r#"aero.gust={{"kind":"sinusoidal","velocity":0.05,"frequency_hz":{f_hz},"cycles":2}}"#),
+        ]);
         let set: Vec<&str> = set.iter().map(String::as_str).collect();
         let spec = case("hale_flutter.json", &set);
-        // The linear analysis about the undeformed wing at pitch 0 (0.05° changes nothing at
-        // first order).
-        let mut lin_case = spec.gebf.clone();
-        lin_case.pitch_deg = 0.0;
-        let lin = run_stability(&lin_case, Formulation::Gebf);
         let run = harness::scene::run_formulation(&spec.gebf, Formulation::Gebf);
         assert!(run.error.is_none(), "{u} m/s: {:?}", run.error);
-        let samples: Vec<(f64, f64)> = run.rows.iter().filter(|r| r.t >= 1.0 - 1e-9).map(|r| (r.t, r.tip[2])).collect();
+        let samples: Vec<(f64, f64)> = run.rows.iter().filter(|r| r.t >= 1.5 - 1e-9).map(|r| (r.t, r.tip[2])).collect();
         let osc = harness::pencil::windows(&samples, 2.0, 1.0);
         let o = *osc.first().expect("an oscillation");
-        let w = 2.0 * std::f64::consts::PI * o.frequency_hz;
-        let root = *lin.points[0]
-            .roots
-            .iter()
-            .filter(|r| r.converged)
-            .min_by(|a, b| (a.imag - w).abs().total_cmp(&(b.imag - w).abs()))
-            .unwrap();
         (u, o, root)
     };
     let (a, b) = rayon::join(|| check(34.0), || check(38.0));
@@ -244,6 +250,7 @@ fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
             root.real,
             100.0 * (o.growth_rate / root.real - 1.0)
         );
-        assert!(rel(o.growth_rate, root.real) < 0.03, "{u} m/s: {o:?} vs {root:?}");
+        assert!(rel(o.growth_rate, root.real) < 0.02, "{u} m/s: {o:?} vs {root:?}");
+        assert!(rel(2.0 * std::f64::consts::PI * o.frequency_hz, root.imag) < 0.005, "{u} m/s: {o:?} vs {root:?}");
     }
 }
