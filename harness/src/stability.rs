@@ -507,21 +507,16 @@ fn held_load_stiffness<S: StaticStructure>(
 }
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
-/// lattice's own lumping, [`uvlm::Loads::column_loads_inplace`]).
+/// lattice's own lumping, [`uvlm::lump_columns`]).
 fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f64]) -> Vec<SectionLoad> {
-    let nc = origins.len();
-    let mut out: Vec<SectionLoad> = map
-        .iter()
-        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
-        .collect();
-    for (k, x) in positions.iter().enumerate() {
-        let j = k % nc;
-        let fk = Vector3::new(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
-        let r = Vector3::from(*x) - Vector3::from(origins[j]);
-        out[j].force += fk;
-        out[j].moment += r.cross(&fk);
-    }
-    out
+    let nodal: Vec<[f64; 3]> = f.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let mut force = vec![[0.0; 3]; origins.len()];
+    let mut moment = vec![[0.0; 3]; origins.len()];
+    uvlm::lump_columns(positions, &nodal, origins, &mut force, &mut moment);
+    map.iter()
+        .zip(force.iter().zip(&moment))
+        .map(|(m, (f, mo))| SectionLoad { body: m.body, s: m.s, force: Vector3::from(*f), moment: Vector3::from(*mo) })
+        .collect()
 }
 
 /// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of

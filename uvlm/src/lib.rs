@@ -114,7 +114,7 @@ pub use images::ImagePlane;
 pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
 pub use linear::{LinearUvlm, LinearWake, with_wake};
-pub use loads::{Loads, lift_drag_of};
+pub use loads::{Loads, lift_drag_of, lump_columns};
 pub use params::{PARALLEL_MIN_PAIRS, Parallel, UvlmParams, WakeConvection};
 pub use solver::Uvlm;
 pub use station::{SpanStation, StationVelocity};

@@ -70,22 +70,39 @@ impl Loads {
     /// # Panics
     /// If the slices do not have one entry per grid column.
     pub fn column_loads_inplace(&self, origins: &[[f64; 3]], force: &mut [[f64; 3]], moment: &mut [[f64; 3]]) {
-        let nc = origins.len();
-        assert!(force.len() == nc && moment.len() == nc, "column_loads_inplace: length mismatch");
-        assert_eq!(self.nodal.len() % nc, 0, "column_loads_inplace: origins do not match the lattice");
-        force.fill([0.0; 3]);
-        moment.fill([0.0; 3]);
-        for (k, (x, f)) in self.positions.iter().zip(&self.nodal).enumerate() {
-            let j = k % nc;
-            let o = origins[j];
-            let r = [x[0] - o[0], x[1] - o[1], x[2] - o[2]];
-            for q in 0..3 {
-                force[j][q] += f[q];
-            }
-            moment[j][0] += r[1] * f[2] - r[2] * f[1];
-            moment[j][1] += r[2] * f[0] - r[0] * f[2];
-            moment[j][2] += r[0] * f[1] - r[1] * f[0];
+        lump_columns(&self.positions, &self.nodal, origins, force, moment);
+    }
+}
+
+/// Lump nodal forces `nodal[k]` at `positions[k]` (grid node `k`, column `k mod origins.len()`)
+/// to the point `origins[j]` of every grid column `j`: force and moment about that point (the
+/// rigid-arm, virtual-work consistent transfer). Does not allocate. [`Loads::column_loads_inplace`]
+/// applies it to a solution's loads; the linearised analysis to its unit-response forces.
+///
+/// # Panics
+/// If the slices do not have one entry per grid column, or the nodes do not fill whole rows.
+pub fn lump_columns(
+    positions: &[[f64; 3]],
+    nodal: &[[f64; 3]],
+    origins: &[[f64; 3]],
+    force: &mut [[f64; 3]],
+    moment: &mut [[f64; 3]],
+) {
+    let nc = origins.len();
+    assert!(force.len() == nc && moment.len() == nc, "lump_columns: length mismatch");
+    assert!(nodal.len() == positions.len() && nodal.len() % nc == 0, "lump_columns: origins do not match the lattice");
+    force.fill([0.0; 3]);
+    moment.fill([0.0; 3]);
+    for (k, (x, f)) in positions.iter().zip(nodal).enumerate() {
+        let j = k % nc;
+        let o = origins[j];
+        let r = [x[0] - o[0], x[1] - o[1], x[2] - o[2]];
+        for q in 0..3 {
+            force[j][q] += f[q];
         }
+        moment[j][0] += r[1] * f[2] - r[2] * f[1];
+        moment[j][1] += r[2] * f[0] - r[0] * f[2];
+        moment[j][2] += r[0] * f[1] - r[1] * f[0];
     }
 }
 
