@@ -90,7 +90,10 @@ pub fn lump_columns(
 ) {
     let nc = origins.len();
     assert!(force.len() == nc && moment.len() == nc, "lump_columns: length mismatch");
-    assert!(nodal.len() == positions.len() && nodal.len() % nc == 0, "lump_columns: origins do not match the lattice");
+    assert!(
+        nodal.len() == positions.len() && nodal.len().is_multiple_of(nc),
+        "lump_columns: origins do not match the lattice"
+    );
     force.fill([0.0; 3]);
     moment.fill([0.0; 3]);
     for (k, (x, f)) in positions.iter().zip(nodal).enumerate() {
