@@ -397,6 +397,59 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
     failed
 }
 
+/// The gust sweep of one run specification with the formulations `fs`, written to
+/// `<out>/<case>/` and printed; true when a run of the sweep failed.
+fn gust_case(spec: &harness::case::RunSpec, fs: &[Formulation], out: &std::path::Path, file: &str) -> Result<bool> {
+    let mut failed = false;
+    let sweep =
+        harness::gust::run_sweep(spec, fs).map_err(|msg| harness::Error::Case { file: file.to_string(), msg })?;
+    let summary = harness::gust_out::summarise(sweep);
+    let dir = out.join(&spec.name);
+    harness::gust_out::write(&dir, &summary)?;
+    for r in &summary.runs {
+        match &r.error {
+            Some(e) => {
+                failed = true;
+                eprintln!(
+                    "gust {} {} {} H = {} m: FAILED: {e}",
+                    spec.name,
+                    r.formulation,
+                    r.hinge.label(),
+                    r.gradient_m
+                );
+            }
+            None => println!(
+                "gust {} {} {:<6} H = {:>8.3} m ({:.3} Hz, {:.3} m/s): peak dM_root {:>11.5} N m at {:.2} s, peak dfold {:>8.3} deg, {:.2} s CPU",
+                spec.name,
+                r.formulation,
+                r.hinge.label(),
+                r.gradient_m,
+                r.frequency_hz,
+                r.gust_velocity,
+                r.peak_delta_root_bending_moment.0,
+                r.peak_delta_root_bending_moment.1,
+                r.peak_delta_fold_deg.0,
+                r.cpu_s
+            ),
+        }
+    }
+    for a in &summary.alleviation {
+        println!(
+            "  {} {} H = {:.3} m: alleviation {:.1} %",
+            a.formulation,
+            a.hinge.label(),
+            a.gradient_m,
+            a.root_bending_moment_percent
+        );
+    }
+    println!(
+        "gust {}: ANCF-GEBF peak dM_root within {:.3} %, peak fold within {:.3} deg; sweep {:.1} s wall",
+        spec.name, summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg, summary.wall_s
+    );
+    println!("wrote {}", dir.display());
+    Ok(failed)
+}
+
 /// `harness gust`: every run of the case file through its gust sweep; exit 2 without a `gust`
 /// block, 1 when a run failed.
 fn run_gust(
@@ -426,52 +479,7 @@ fn run_gust(
     let mut failed = false;
     for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("gust:{}", r.name))) {
         done.push(format!("gust:{}", spec.name));
-        let sweep =
-            harness::gust::run_sweep(spec, &fs).map_err(|msg| harness::Error::Case { file: file.clone(), msg })?;
-        let summary = harness::gust_out::summarise(sweep);
-        let dir = out.join(&spec.name);
-        harness::gust_out::write(&dir, &summary)?;
-        for r in &summary.runs {
-            match &r.error {
-                Some(e) => {
-                    failed = true;
-                    eprintln!(
-                        "gust {} {} {} H = {} m: FAILED: {e}",
-                        spec.name,
-                        r.formulation,
-                        r.hinge.label(),
-                        r.gradient_m
-                    );
-                }
-                None => println!(
-                    "gust {} {} {:<6} H = {:>8.3} m ({:.3} Hz, {:.3} m/s): peak dM_root {:>11.5} N m at {:.2} s, peak dfold {:>8.3} deg, {:.2} s CPU",
-                    spec.name,
-                    r.formulation,
-                    r.hinge.label(),
-                    r.gradient_m,
-                    r.frequency_hz,
-                    r.gust_velocity,
-                    r.peak_delta_root_bending_moment.0,
-                    r.peak_delta_root_bending_moment.1,
-                    r.peak_delta_fold_deg.0,
-                    r.cpu_s
-                ),
-            }
-        }
-        for a in &summary.alleviation {
-            println!(
-                "  {} {} H = {:.3} m: alleviation {:.1} %",
-                a.formulation,
-                a.hinge.label(),
-                a.gradient_m,
-                a.root_bending_moment_percent
-            );
-        }
-        println!(
-            "gust {}: ANCF-GEBF peak dM_root within {:.3} %, peak fold within {:.3} deg; sweep {:.1} s wall",
-            spec.name, summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg, summary.wall_s
-        );
-        println!("wrote {}", dir.display());
+        failed |= gust_case(spec, &fs, out, &file)?;
     }
     if let Some(p) = &plan {
         p.write_manifest(out, serde_json::json!({}), &done)?;
@@ -868,6 +876,18 @@ fn real_main() -> Result<ExitCode> {
                 stability_failed += usize::from(report_stability(&spec.name, &outs));
                 println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
             }
+            // The gust sweeps (several minutes of CPU): not with --quick, and on a cluster as
+            // their own array (`harness gust --shard`).
+            let mut gust_failed = 0;
+            if !quick && plan.is_none() {
+                for spec in runs.iter().filter(|r| r.ancf.gust.is_some() && !interrupted) {
+                    progress.phase(&format!("gust sweep of {}", spec.name));
+                    let t = std::time::Instant::now();
+                    let file = spec.dir.join(format!("{}.json", spec.name)).display().to_string();
+                    gust_failed += usize::from(gust_case(spec, &Formulation::ALL, &out, &file)?);
+                    println!("gust {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+                }
+            }
             match &plan {
                 Some(p) => {
                     progress.phase("shard: the exact runs and the manifest for `harness merge`");
@@ -903,11 +923,17 @@ fn real_main() -> Result<ExitCode> {
             if stability_failed > 0 {
                 eprintln!("stability: {stability_failed} sweep(s) have airspeeds that could not be analysed");
             }
+            if gust_failed > 0 {
+                eprintln!("gust: {gust_failed} sweep(s) have runs that failed");
+            }
             if interrupted {
                 eprintln!("interrupted: the rows computed so far are written; studies skipped");
                 return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
             }
-            Ok(exit_code(&errors, failed == 0 && gate_failed == 0 && static_failed == 0 && stability_failed == 0))
+            Ok(exit_code(
+                &errors,
+                failed == 0 && gate_failed == 0 && static_failed == 0 && stability_failed == 0 && gust_failed == 0,
+            ))
         }
         Cmd::Run { case, formulation, out, set, vtk, vtk_stride, max_steps } => {
             let fs: Vec<Formulation> = match formulation {
