@@ -252,6 +252,26 @@ impl GustSpec {
         g
     }
 
+    /// Distance of the front upstream of the wing at the start, m.
+    pub fn x0(&self) -> f64 {
+        match self {
+            GustSpec::OneMinusCosine { x0, .. }
+            | GustSpec::SharpEdged { x0, .. }
+            | GustSpec::Sinusoidal { x0, .. }
+            | GustSpec::VonKarman { x0, .. } => *x0,
+        }
+    }
+
+    /// Direction of the gust velocity, as given (any non-zero length).
+    pub fn direction(&self) -> [f64; 3] {
+        match self {
+            GustSpec::OneMinusCosine { direction, .. }
+            | GustSpec::SharpEdged { direction, .. }
+            | GustSpec::Sinusoidal { direction, .. }
+            | GustSpec::VonKarman { direction, .. } => *direction,
+        }
+    }
+
     /// The gradient of a 1-cos gust, m (NaN for other kinds).
     pub fn gradient(&self) -> f64 {
         match self {
@@ -259,6 +279,23 @@ impl GustSpec {
             _ => f64::NAN,
         }
     }
+}
+
+/// The point the front of `spec` passes at the start of a run on a lattice whose stations are
+/// `stations`: `x0` upstream (along the free stream) of the most upstream leading-edge point.
+pub fn gust_front(spec: &GustSpec, aero: &AeroSettings, stations: &[uvlm::SpanStation]) -> Result<[f64; 3], String> {
+    let v_inf = aero.free_stream();
+    let u = (v_inf[0] * v_inf[0] + v_inf[1] * v_inf[1] + v_inf[2] * v_inf[2]).sqrt();
+    if !(u.is_finite() && u > 0.0) {
+        return Err("the free stream is zero".into());
+    }
+    let dir = nalgebra::Vector3::from(v_inf) / u;
+    let lead = stations
+        .iter()
+        .map(|st| st.origin + st.frame.column(1) * st.le_offset)
+        .min_by(|a, b| dir.dot(a).total_cmp(&dir.dot(b)))
+        .ok_or("no lattice stations")?;
+    Ok((lead - dir * spec.x0()).into())
 }
 
 /// The disturbance field of `spec` for a lattice whose stations are `stations` at time `t0`
@@ -275,21 +312,10 @@ pub fn disturbance(
     if !(u.is_finite() && u > 0.0) {
         return Err("the free stream is zero".into());
     }
-    let dir = nalgebra::Vector3::from(v_inf) / u;
-    let lead = stations
-        .iter()
-        .map(|st| st.origin + st.frame.column(1) * st.le_offset)
-        .min_by(|a, b| dir.dot(a).total_cmp(&dir.dot(b)))
-        .ok_or("no lattice stations")?;
-    let x0 = match spec {
-        GustSpec::OneMinusCosine { x0, .. }
-        | GustSpec::SharpEdged { x0, .. }
-        | GustSpec::Sinusoidal { x0, .. }
-        | GustSpec::VonKarman { x0, .. } => *x0,
-    };
-    let front = lead - dir * x0;
+    let x0 = spec.x0();
+    let front = gust_front(spec, aero, stations)?;
     let e = |e: uvlm::UvlmError| e.to_string();
-    let conv = uvlm::Convection::new(v_inf, front.into(), t0).map_err(e)?;
+    let conv = uvlm::Convection::new(v_inf, front, t0).map_err(e)?;
     Ok(match spec {
         GustSpec::OneMinusCosine { gradient_m, direction, .. } => {
             Box::new(uvlm::OneMinusCosine::new(conv, *gradient_m, spec.velocity(aero), *direction).map_err(e)?)

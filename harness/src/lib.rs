@@ -21,6 +21,7 @@ pub mod energy;
 pub mod fuzz;
 pub mod gate;
 pub mod gust;
+pub mod gust_linear;
 pub mod gust_out;
 pub mod loads;
 pub mod merge;

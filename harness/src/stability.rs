@@ -272,6 +272,8 @@ pub struct Reduced {
     pub n_rings: usize,
     /// Wake rings.
     pub n_wake_rings: usize,
+    /// The modal basis `Φ` (tangent unknowns × basis modes).
+    pub(crate) phi: DMatrix<f64>,
 }
 
 impl Reduced {
@@ -303,6 +305,14 @@ impl Reduced {
             + (&self.c + &self.gv * r).map(|x| s * x)
             + (&self.k + &self.gx * (r * r)).map(C64::from)
             - t * x
+    }
+
+    /// The part of `D(s)` at fixed circulations: `M s² + (C + G_ẋ) s + K + G_x` (UVLM models).
+    pub(crate) fn structural(&self, s: C64) -> DMatrix<C64> {
+        let r = self.ratio;
+        self.m.map(|x| s * s * x)
+            + (&self.c + &self.gv * r).map(|x| s * x)
+            + (&self.k + &self.gx * (r * r)).map(C64::from)
     }
 
     /// Basis size.
@@ -452,7 +462,12 @@ impl Strips {
 }
 
 /// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`.
-fn load_part<S: StaticStructure>(model: &mut S, q: &[f64], loads: &[SectionLoad], zero: &[SectionLoad]) -> Vec<f64> {
+pub(crate) fn load_part<S: StaticStructure>(
+    model: &mut S,
+    q: &[f64],
+    loads: &[SectionLoad],
+    zero: &[SectionLoad],
+) -> Vec<f64> {
     let n = model.n_dof();
     let z = vec![0.0; n];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
@@ -508,7 +523,7 @@ fn held_load_stiffness<S: StaticStructure>(
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
 /// lattice's own lumping, [`uvlm::lump_columns`]).
-fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f64]) -> Vec<SectionLoad> {
+pub(crate) fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f64]) -> Vec<SectionLoad> {
     let nodal: Vec<[f64; 3]> = f.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mut force = vec![[0.0; 3]; origins.len()];
     let mut moment = vec![[0.0; 3]; origins.len()];
@@ -656,6 +671,7 @@ pub fn reduce<S: StaticStructure>(
             omega: modes.omega.clone(),
             n_rings: 0,
             n_wake_rings: 0,
+            phi,
         });
     }
     let spec = crate::aero::lattice_spec(map, aero);
@@ -769,6 +785,7 @@ pub fn reduce<S: StaticStructure>(
         omega: modes.omega.clone(),
         n_rings: nr,
         n_wake_rings: wake.row_lengths.len() * la.te_rings.len(),
+        phi,
     })
 }
 

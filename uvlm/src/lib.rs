@@ -113,7 +113,7 @@ pub use gust::{Convection, OneMinusCosine, SharpEdged, Sinusoidal, VonKarman, Vo
 pub use images::ImagePlane;
 pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
-pub use linear::{LinearUvlm, LinearWake, with_wake};
+pub use linear::{LinearGust, LinearUvlm, LinearWake, WakeNodeDerivatives, with_wake};
 pub use loads::{Loads, lift_drag_of, lump_columns};
 pub use params::{PARALLEL_MIN_PAIRS, Parallel, UvlmParams, WakeConvection};
 pub use solver::Uvlm;

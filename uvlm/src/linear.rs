@@ -472,3 +472,208 @@ impl LinearUvlm {
         with_wake(&base, &self.force_row, &self.row_delays, &self.te_rings, s)
     }
 }
+
+/// The input of a frozen gust to the linear model (see [`LinearUvlm::gust`]): a gust velocity
+/// `w(t) d` at the front's reference point reaches a point `x` of the lattice `τ_x = V̂∞·(x −
+/// x_f)/U` later, so at Laplace variable `s` it enters the non-penetration condition as
+/// `Σ_c e^{−s τ_c} (d·n_c) ŵ(s)` and the nodal forces as `Σ_m e^{−s τ_m} F_m ŵ(s)` (the
+/// Joukowski force of the gust velocity at segment midpoint `m` on the reference circulations).
+#[derive(Debug, Clone)]
+pub struct LinearGust {
+    /// `d·n_c`: normal velocity at each collocation point per unit gust velocity (residual sign,
+    /// as [`LinearUvlm::evaluate`]).
+    pub normalwash: Vec<f64>,
+    /// Delay of each collocation point behind the front's reference point, s.
+    pub collocation_delays: Vec<f64>,
+    /// Nodal forces per unit gust velocity at each load segment's midpoint (3·n_nodes × n_mid).
+    pub force: DMatrix<f64>,
+    /// Delay of each load segment midpoint, s.
+    pub midpoint_delays: Vec<f64>,
+}
+
+impl LinearGust {
+    /// Residual (n_rings) per unit `ŵ(s)`.
+    pub fn normalwash_at(&self, s: Complex<f64>) -> Vec<Complex<f64>> {
+        self.normalwash.iter().zip(&self.collocation_delays).map(|(w, tau)| (-s * tau).exp() * w).collect()
+    }
+
+    /// Stacked nodal forces (3·n_nodes) per unit `ŵ(s)`, at fixed circulations.
+    pub fn force_at(&self, s: Complex<f64>) -> Vec<Complex<f64>> {
+        let e: Vec<Complex<f64>> = self.midpoint_delays.iter().map(|tau| (-s * tau).exp()).collect();
+        (0..self.force.nrows()).map(|i| (0..self.force.ncols()).map(|m| e[m] * self.force[(i, m)]).sum()).collect()
+    }
+}
+
+impl LinearUvlm {
+    /// The input of a frozen gust along `direction` (any non-zero length), convected with the
+    /// free stream, whose front passes `front` at time 0 (the convention of
+    /// [`crate::gust::Convection`]: a point `x` sees the gust velocity of the front's reference
+    /// point `V̂∞·(x − front)/U` later). The collocation points and the load segments' midpoints
+    /// are those of the reference lattice; the forces are exact central differences of the load
+    /// routine with a unit step (they are linear in the external velocity).
+    ///
+    /// # Errors
+    /// A zero or non-finite direction.
+    pub fn gust(&self, direction: [f64; 3], front: [f64; 3]) -> Result<LinearGust> {
+        let dn = (direction[0].powi(2) + direction[1].powi(2) + direction[2].powi(2)).sqrt();
+        if !(dn.is_finite() && dn > 0.0) {
+            return Err(UvlmError::InvalidParameter { field: "gust.direction", value: dn });
+        }
+        let d = direction.map(|x| x / dn);
+        let v = self.params.v_inf;
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let vh = v.map(|x| x / speed);
+        let delay = |x: [f64; 3]| (0..3).map(|q| vh[q] * (x[q] - front[q])).sum::<f64>() / speed;
+        let lat = &self.lattice;
+        let normalwash = lat.normals().iter().map(|n| (0..3).map(|q| d[q] * n[q]).sum()).collect();
+        let collocation_delays = lat.collocation().iter().map(|c| delay(*c)).collect();
+        let mut fz = Frozen::default();
+        fz.build(lat, &self.gamma0, &self.wake, self.closure, &self.params);
+        let bsf = std::mem::take(&mut fz.bs.fil);
+        let known = std::mem::take(&mut fz.known);
+        fz.induce(&[&bsf, &known]);
+        fz.bs.fil = bsf;
+        let flow = Flow::new(v);
+        fz.v_mid.resize(fz.mid.len(), [0.0; 3]);
+        flow.velocity_inplace(&fz.mid, 0.0, &mut fz.v_mid);
+        let n_mid = fz.mid.len();
+        let midpoint_delays = (0..n_mid).map(|k| delay([fz.mid.x[k], fz.mid.y[k], fz.mid.z[k]])).collect();
+        let nf = self.n_force();
+        let mut force = DMatrix::zeros(nf, n_mid);
+        let (mut plus, mut minus) = (vec![0.0; nf], vec![0.0; nf]);
+        let v_mid0 = fz.v_mid.clone();
+        let mut v_pm = v_mid0.clone();
+        for m in 0..n_mid {
+            for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                v_pm[m] = [v_mid0[m][0] + sgn * d[0], v_mid0[m][1] + sgn * d[1], v_mid0[m][2] + sgn * d[2]];
+                compute_loads(&mut fz.loads, lat, &fz.bs, &v_pm, &fz.u_mid, None, &self.params);
+                stack(&fz.loads, buf);
+            }
+            v_pm[m] = v_mid0[m];
+            for i in 0..nf {
+                force[(i, m)] = 0.5 * (plus[i] - minus[i]);
+            }
+        }
+        Ok(LinearGust { normalwash, collocation_delays, force, midpoint_delays })
+    }
+}
+
+/// How the residual and the nodal forces change when the frozen wake's nodes move (see
+/// [`LinearUvlm::wake_node_derivatives`]).
+#[derive(Debug, Clone)]
+pub struct WakeNodeDerivatives {
+    /// Per wake row `k`: the residual (n_rings) per unit displacement of each downstream node
+    /// `(k, j)` along each global axis, columns `3j + axis` (n_rings × 3·(n_spanwise + 1)).
+    pub residual: Vec<DMatrix<f64>>,
+    /// Per wake row `k`: the stacked nodal forces per unit displacement of the same nodes
+    /// (3·n_nodes × 3·(n_spanwise + 1)).
+    pub force: Vec<DMatrix<f64>>,
+}
+
+impl LinearUvlm {
+    /// Derivatives of the residual and of the nodal forces with respect to the positions of the
+    /// frozen wake's nodes, the circulations held (bound rings `Γ₀`, every wake ring `Γ_TE,0`).
+    /// Node `(k, j)` is the downstream corner of wake ring row `k`; in the time-marching scheme
+    /// it is where trailing-edge node `j` was `τ_k` ago, convected with the external flow since,
+    /// so it moves with the trailing edge's past motion and drifts with a gust. The steady wake
+    /// carries the trailing-edge circulation, so these terms are first order wherever `Γ₀`
+    /// varies along the span (its trailing vortices).
+    ///
+    /// Central differences (a step of 1e-5 of the row's length) of the velocity induced by the
+    /// (up to four) wake rings with a corner at the node; the forces are then exact in that
+    /// velocity (the load routine is linear in it).
+    pub fn wake_node_derivatives(&self) -> WakeNodeDerivatives {
+        let p = &self.params;
+        let lat = &self.lattice;
+        let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
+        let (nr, nf) = (self.n_rings(), self.n_force());
+        let te: Vec<[f64; 3]> = lat.ring_nodes()[m * (n + 1)..].to_vec();
+        let g_te: Vec<f64> = self.te_rings.iter().map(|&r| self.gamma0[r]).collect();
+        let mut fz = Frozen::default();
+        fz.build(lat, &self.gamma0, &self.wake, self.closure, p);
+        let bsf = std::mem::take(&mut fz.bs.fil);
+        let known = std::mem::take(&mut fz.known);
+        fz.induce(&[&bsf, &known]);
+        fz.bs.fil = bsf;
+        let u_mid0 = fz.u_mid.clone();
+        let flow = Flow::new(p.v_inf);
+        let mut v_mid0 = vec![[0.0; 3]; fz.mid.len()];
+        flow.velocity_inplace(&fz.mid, 0.0, &mut v_mid0);
+        let nrm = lat.normals().to_vec();
+        let rows = self.wake.n_rows();
+        let mut wake = self.wake.clone();
+        let mut fil = Filaments::default();
+        let (mut du_col, mut du_mid) = (vec![[0.0; 3]; fz.col.len()], vec![[0.0; 3]; fz.mid.len()]);
+        let mut u_pm = u_mid0.clone();
+        let (mut plus, mut minus) = (vec![0.0; nf], vec![0.0; nf]);
+        let mut out = WakeNodeDerivatives { residual: Vec::with_capacity(rows), force: Vec::with_capacity(rows) };
+        for k in 0..rows {
+            let (mut zr, mut zf) = (DMatrix::zeros(nr, 3 * (n + 1)), DMatrix::zeros(nf, 3 * (n + 1)));
+            let len = {
+                let a = if k == 0 { te[0] } else { self.wake.node(k - 1, 0) };
+                let b = self.wake.node(k, 0);
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            };
+            let h = 1e-5 * len.max(1e-9);
+            for j in 0..=n {
+                // Rings with a corner at (k, j): row k (downstream corner), row k + 1 (upstream).
+                let mut rings = Vec::with_capacity(4);
+                for kk in [k, k + 1] {
+                    if kk < rows {
+                        for jj in [j.wrapping_sub(1), j] {
+                            if jj < n {
+                                rings.push((kk, jj));
+                            }
+                        }
+                    }
+                }
+                for axis in 0..3 {
+                    du_col.iter_mut().for_each(|x| *x = [0.0; 3]);
+                    du_mid.iter_mut().for_each(|x| *x = [0.0; 3]);
+                    for sgn in [1.0, -1.0] {
+                        let mut d = [0.0; 3];
+                        d[axis] = sgn * h;
+                        wake.displace(k, j, d);
+                        for &(kk, jj) in &rings {
+                            unit_wake_ring(&mut fil, &te, &wake, kk, jj, self.closure, p);
+                            fz.induce(&[&fil]);
+                            let w = sgn * g_te[jj] / (2.0 * h);
+                            for (a, b) in du_col.iter_mut().zip(&fz.u_col) {
+                                for q in 0..3 {
+                                    a[q] += w * b[q];
+                                }
+                            }
+                            for (a, b) in du_mid.iter_mut().zip(&fz.u_mid) {
+                                for q in 0..3 {
+                                    a[q] += w * b[q];
+                                }
+                            }
+                        }
+                        d[axis] = -d[axis];
+                        wake.displace(k, j, d);
+                    }
+                    let c = 3 * j + axis;
+                    for r in 0..nr {
+                        zr[(r, c)] = (0..3).map(|q| du_col[r][q] * nrm[r][q]).sum();
+                    }
+                    fz.bs.set_strengths(&self.gamma0);
+                    for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                        for (s, u) in u_pm.iter_mut().enumerate() {
+                            for q in 0..3 {
+                                u[q] = u_mid0[s][q] + sgn * du_mid[s][q];
+                            }
+                        }
+                        compute_loads(&mut fz.loads, lat, &fz.bs, &v_mid0, &u_pm, None, p);
+                        stack(&fz.loads, buf);
+                    }
+                    for i in 0..nf {
+                        zf[(i, c)] = 0.5 * (plus[i] - minus[i]);
+                    }
+                }
+            }
+            out.residual.push(zr);
+            out.force.push(zf);
+        }
+        out
+    }
+}

@@ -1,0 +1,462 @@
+//! The linearised gust response (docs/gust.md §7): the flutter equation of the stability
+//! analysis ([`crate::stability`], docs/stability.md) driven by a frozen gust, solved in the
+//! frequency domain and brought back to time.
+//!
+//! About the static aeroelastic equilibrium of the case's hinge state, in the modal coordinates
+//! `η` of the stability analysis,
+//!
+//! $$ D_w(s)\,\eta = -H\,\big[g(s) - F(s)\,N(s)^{-1} r_g(s)\big]\,\hat w(s) ,$$
+//!
+//! `N(s)` and `F(s)` the linear UVLM's normalwash and force operators, `r_g(s)` and `g(s)` the
+//! gust's normalwash at the collocation points and its Joukowski force at the segment midpoints,
+//! each point delayed by its distance behind the gust's front ([`uvlm::LinearUvlm::gust`]), `H`
+//! the generalised load of a unit nodal force and `ŵ(s)` the Laplace transform of the gust
+//! velocity at the front's reference point.
+//!
+//! **The wake's motion.** `D_w(s)` is the stability analysis's `D(s)` plus, optionally
+//! (`wake_motion`), the terms of the wake nodes' motion, as the time march moves them: node
+//! `(k, j)` is where trailing-edge node `j` was `τ_k` ago, `δx_{k,j}(s) = e^{−sτ_k} δx_TE,j(s)`,
+//! and it has drifted with the gust since, by `τ_k` times the gust velocity the trailing edge saw
+//! then (the gust is frozen in the air that carries the node). Both act through the steady
+//! wake's trailing vortices ([`uvlm::LinearUvlm::wake_node_derivatives`]). Without them (the
+//! stability analysis's frozen wake, whose first row alone follows the trailing edge) the paper's
+//! wing misses its peak fold by 10 % (docs/gust.md §7).
+//!
+//! The outputs are the time march's ([`crate::gust::gust_history`]): the free-body root bending
+//! moment, root torque and hinge moment of [`crate::loads::LoadModel`], the fold angle and the
+//! lift, each linearised about the equilibrium (central differences of the same routines along
+//! each mode, its velocity and its acceleration, and exact derivatives in the station loads).
+//!
+//! Back to time: the response is sampled on the time march's steps over a period `T` of twice
+//! the run, and inverted along `Re s = σ` (an exponential window: `y(t) = e^{σt} ·
+//! DFT⁻¹[Y(σ + iω_k) ŵ(σ + iω_k)]`), so that what the periodic inverse folds back from later
+//! periods is weighted by `e^{−σT}` (1e-8) and a lightly damped mode needs no long padding. The
+//! transfer is exact for complex `s`, so the shift costs nothing in accuracy.
+
+use nalgebra::{Complex, DMatrix, DVector, Vector3};
+
+use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
+use crate::case::{Case, Formulation, StaticSettings};
+use crate::stability::{linear_wake, load_part, lump, reduce};
+use crate::statics::StaticStructure;
+
+type C64 = Complex<f64>;
+
+/// A linearised gust response: the increments of the time march's outputs at its output times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearGustHistory {
+    /// Time, s.
+    pub t: Vec<f64>,
+    /// Root bending moment increment, N·m.
+    pub delta_root_bending_moment: Vec<f64>,
+    /// Root torque increment, N·m.
+    pub delta_root_torque: Vec<f64>,
+    /// Hinge moment increment, N·m (NaN without a flared hinge).
+    pub delta_hinge_moment: Vec<f64>,
+    /// Fold angle increment, degrees (NaN without a fold hinge).
+    pub delta_fold_deg: Vec<f64>,
+    /// Lift increment, N.
+    pub delta_lift: Vec<f64>,
+    /// Structural modes in the basis.
+    pub n_basis: usize,
+    /// Frequencies at which the transfer was evaluated.
+    pub n_frequencies: usize,
+    /// Rows of the frozen wake (of length `U·dt` unless the case's `stability.wake` says otherwise).
+    pub n_wake_rows: usize,
+}
+
+/// Outputs, in the order of [`LinearGustHistory`]'s series.
+const N_OUT: usize = 5;
+
+/// The linearised response of `case` (its `aero.gust`, the hinge state already applied) with
+/// formulation `f`, about its static equilibrium at the case's airspeed, over `[0, t_end]` at
+/// the case's output times; `basis_modes` structural modes (default: `stability.basis_modes`,
+/// else 30, at most the free motions). The frozen wake is the stability analysis's
+/// ([`linear_wake`]): by default the time march's, `aero.n_wake_rows` rows of `U·dt`;
+/// `wake_motion` adds the motion of its nodes with the trailing edge's past and the gust (see the
+/// module docs; `false` is the stability analysis's model).
+///
+/// # Errors
+/// A case without `aero` or `aero.gust`, a failed equilibrium, or a failed reduction.
+pub fn linear_gust_history(
+    case: &Case,
+    f: Formulation,
+    basis_modes: Option<usize>,
+    wake_motion: bool,
+) -> Result<LinearGustHistory, String> {
+    match f {
+        Formulation::Ancf => run(case, f, crate::scene::build_ancf, basis_modes, wake_motion),
+        Formulation::Gebf => run(case, f, crate::scene::build_gebf, basis_modes, wake_motion),
+    }
+}
+
+fn run<S: StaticStructure>(
+    case: &Case,
+    f: Formulation,
+    build: fn(&Case) -> Result<S, crate::Error>,
+    basis_modes: Option<usize>,
+    wake_motion: bool,
+) -> Result<LinearGustHistory, String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let spec = aero.gust.as_ref().ok_or("the case has no `aero.gust`")?;
+    let map = station_map(case, aero)?;
+    let v_inf = aero.free_stream();
+    let u = Vector3::from(v_inf).norm();
+    // The equilibrium with its multipliers (the same static solve as the time march's start).
+    let mut c = case.clone();
+    c.statics = Some(StaticSettings {
+        airspeeds: vec![u],
+        references: Vec::new(),
+        point_loads: Vec::new(),
+        load_factors: Vec::new(),
+    });
+    let so = crate::statics::run_static(&c, f);
+    if let Some(e) = so.error {
+        return Err(format!("static equilibrium: {e}"));
+    }
+    let p = so.points.into_iter().next().ok_or("static equilibrium: no point")?;
+    let (q, lam, mu) = match (p.error, p.state) {
+        (None, Some(s)) => s,
+        (e, _) => return Err(format!("static equilibrium: {}", e.unwrap_or_else(|| "no state".into()))),
+    };
+    let settings = crate::scene::settings(case, f);
+    let dt = settings.params.dt;
+    let wake = linear_wake(case, f, u);
+    let nb_req = basis_modes.or(case.stability.as_ref().and_then(|s| s.basis_modes)).unwrap_or(30);
+    let red = reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, &map, aero, &wake, nb_req, None, None)?;
+    let phi = red.phi.clone();
+    let nb = phi.ncols();
+    let mut model = build(case).map_err(|e| e.to_string())?;
+    let zero_loads: Vec<SectionLoad> = map
+        .iter()
+        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+        .collect();
+    model.set_section_loads(&zero_loads);
+
+    // The linear UVLM on the equilibrium's lattice and the gust's input to it.
+    let n_dof = model.n_dof();
+    let zeros = vec![0.0; n_dof];
+    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let (mut stations, mut vel) = (Vec::new(), Vec::new());
+    stations_at(&model, &q, &zeros, &map, aero, &mut scratch, &mut stations, &mut vel);
+    let lattice = uvlm::Lattice::from_stations(lattice_spec(&map, aero), &stations)
+        .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(v_inf)).map_err(|e| format!("UVLM: {e}"))?;
+    let la = uv.linearise(&wake).map_err(|e| format!("linear UVLM: {e}"))?;
+    let front = crate::gust::gust_front(spec, aero, &stations)?;
+    let gust_dir = Vector3::from(spec.direction()).normalize();
+    let lg = la.gust(gust_dir.into(), front).map_err(|e| format!("linear gust: {e}"))?;
+    let steady = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
+    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
+    let f0: Vec<f64> = steady.nodal.iter().flatten().copied().collect();
+    let l0 = lump(&map, &steady.positions, &origins, &f0);
+    let (nr, nf, ns) = (la.n_rings(), la.n_force(), map.len());
+
+    // Lumping `C_l` (6·stations × nodal forces) and `H = Φᵀ P C_l`.
+    let ref_pos = la.lattice().ring_nodes().to_vec();
+    let flat = |l: &[SectionLoad]| -> Vec<f64> {
+        l.iter().flat_map(|x| [x.force.x, x.force.y, x.force.z, x.moment.x, x.moment.y, x.moment.z]).collect()
+    };
+    let mut cl = DMatrix::zeros(6 * ns, nf);
+    let mut unit = vec![0.0; nf];
+    for a in 0..nf {
+        unit.fill(0.0);
+        unit[a] = 1.0;
+        cl.set_column(a, &DVector::from_vec(flat(&lump(&map, &ref_pos, &origins, &unit))));
+    }
+    let mut p = DMatrix::zeros(n_dof, 6 * ns);
+    for j in 0..6 * ns {
+        let mut l = zero_loads.clone();
+        let comp = j % 6;
+        if comp < 3 {
+            l[j / 6].force[comp] = 1.0;
+        } else {
+            l[j / 6].moment[comp - 3] = 1.0;
+        }
+        p.set_column(j, &DVector::from_vec(load_part(&mut model, &q, &l, &zero_loads)));
+    }
+    let h = phi.transpose() * &p * &cl;
+
+    // Geometric terms along each mode: residual, station loads and nodal forces of the moved
+    // lattice with the reference circulations held (as the stability reduction's).
+    let mut lat = la.lattice().clone();
+    let te_start = {
+        let l = la.lattice();
+        l.n_chordwise() * (l.n_spanwise() + 1)
+    };
+    type Eval = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+    let mut eval = |model: &S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<Eval, String> {
+        let (mut st, mut ve) = (Vec::new(), Vec::new());
+        stations_at(model, qq, vv, &map, aero, &mut scratch, &mut st, &mut ve);
+        lat.update_stations(&st, if with_vel { Some(&ve) } else { None })
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let (r, fz) = la.evaluate(&lat).map_err(|e| e.to_string())?;
+        let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
+        let te: Vec<f64> = lat.ring_nodes()[te_start..].iter().flatten().copied().collect();
+        Ok((r, flat(&lump(&map, lat.ring_nodes(), &org, &fz)), fz, te))
+    };
+    let (mut rx, mut rv) = (DMatrix::zeros(nr, nb), DMatrix::zeros(nr, nb));
+    let (mut lx, mut lv) = (DMatrix::zeros(6 * ns, nb), DMatrix::zeros(6 * ns, nb));
+    let (mut fx, mut fv) = (DMatrix::zeros(nf, nb), DMatrix::zeros(nf, nb));
+    let n_te = la.te_rings.len() + 1;
+    let mut xte = DMatrix::zeros(3 * n_te, nb);
+    // Outputs along each mode (position, velocity, acceleration) and per unit station load.
+    let (mut yx, mut yv, mut ya) = (DMatrix::zeros(N_OUT, nb), DMatrix::zeros(N_OUT, nb), DMatrix::zeros(N_OUT, nb));
+    let mut yl = DMatrix::zeros(N_OUT, 6 * ns);
+    let lm = settings.loads.as_ref();
+    let fold = settings.fold_joint;
+    let mut ls = crate::loads::LoadScratch::default();
+    let mut outputs = |model: &S, qq: &[f64], motion: (&[f64], &[f64]), loads: &[SectionLoad]| -> [f64; N_OUT] {
+        let w = lm.map(|lm| lm.evaluate(model, qq, Some(motion), loads, &mut ls));
+        let fold_deg = fold.map_or(f64::NAN, |j| model.fold(qq, j).to_degrees());
+        match w {
+            Some(w) => [w.root_bending_moment, w.root_torque, w.hinge_moment, fold_deg, 0.0],
+            None => [f64::NAN, f64::NAN, f64::NAN, fold_deg, 0.0],
+        }
+    };
+    let span = aero.chord.max(1e-3);
+    let (mut qp, mut qm) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+    for i in 0..nb {
+        let col: Vec<f64> = phi.column(i).iter().copied().collect();
+        let neg: Vec<f64> = col.iter().map(|x| -x).collect();
+        let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+        let eps = 1e-6 * span / big;
+        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
+        model.retract_inplace(&q, &dq, &mut qp);
+        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
+        model.retract_inplace(&q, &dq, &mut qm);
+        let (r1, l1, f1, te1) = eval(&model, &qp, &zeros, false)?;
+        let (r2, l2, f2, te2) = eval(&model, &qm, &zeros, false)?;
+        let d =
+            |a: &[f64], b: &[f64], k: f64| DVector::from_iterator(a.len(), a.iter().zip(b).map(|(x, y)| (x - y) * k));
+        rx.set_column(i, &d(&r1, &r2, 0.5 / eps));
+        lx.set_column(i, &d(&l1, &l2, 0.5 / eps));
+        fx.set_column(i, &d(&f1, &f2, 0.5 / eps));
+        xte.set_column(i, &d(&te1, &te2, 0.5 / eps));
+        let (r1, l1, f1, _) = eval(&model, &q, &col, true)?;
+        let (r2, l2, f2, _) = eval(&model, &q, &neg, true)?;
+        rv.set_column(i, &d(&r1, &r2, 0.5));
+        lv.set_column(i, &d(&l1, &l2, 0.5));
+        fv.set_column(i, &d(&f1, &f2, 0.5));
+        let (y1, y2) = (outputs(&model, &qp, (&zeros, &zeros), &l0), outputs(&model, &qm, (&zeros, &zeros), &l0));
+        yx.set_column(i, &d(&y1, &y2, 0.5 / eps));
+        let (y1, y2) = (outputs(&model, &q, (&col, &zeros), &l0), outputs(&model, &q, (&neg, &zeros), &l0));
+        yv.set_column(i, &d(&y1, &y2, 0.5));
+        let (y1, y2) = (outputs(&model, &q, (&zeros, &col), &l0), outputs(&model, &q, (&zeros, &neg), &l0));
+        ya.set_column(i, &d(&y1, &y2, 0.5));
+    }
+    for j in 0..6 * ns {
+        let (mut lp, mut lmn) = (l0.clone(), l0.clone());
+        let comp = j % 6;
+        for (l, sg) in [(&mut lp, 1.0), (&mut lmn, -1.0)] {
+            if comp < 3 {
+                l[j / 6].force[comp] += sg;
+            } else {
+                l[j / 6].moment[comp - 3] += sg;
+            }
+        }
+        let (y1, y2) = (outputs(&model, &q, (&zeros, &zeros), &lp), outputs(&model, &q, (&zeros, &zeros), &lmn));
+        for o in 0..N_OUT {
+            yl[(o, j)] = 0.5 * (y1[o] - y2[o]);
+        }
+    }
+    // The wake's nodes: where the trailing edge was (structure), drifted by the gust.
+    let mut parts = Parts {
+        rx,
+        rv,
+        fx,
+        fv,
+        lx,
+        lv,
+        yx,
+        yv,
+        ya,
+        yl,
+        h: h.map(C64::from),
+        cl: cl.map(C64::from),
+        lift: DMatrix::zeros(1, nf),
+        row_delays: la.row_delays.clone(),
+        rw: Vec::new(),
+        fw: Vec::new(),
+        drift_delays: Vec::new(),
+        drift_r: DMatrix::zeros(nr, 0),
+        drift_f: DMatrix::zeros(nf, 0),
+    };
+    if wake_motion {
+        let wd = la.wake_node_derivatives();
+        let te_nodes = &la.lattice().ring_nodes()[te_start..];
+        let vh = Vector3::from(v_inf) / u;
+        let te_delay: Vec<f64> =
+            te_nodes.iter().map(|x| vh.dot(&(Vector3::from(*x) - Vector3::from(front))) / u).collect();
+        let n_rows = wd.residual.len();
+        let (mut dr, mut df) = (DMatrix::zeros(nr, n_rows * n_te), DMatrix::zeros(nf, n_rows * n_te));
+        for k in 0..n_rows {
+            parts.rw.push(&wd.residual[k] * &xte);
+            parts.fw.push(&wd.force[k] * &xte);
+            let tau = la.row_delays[k];
+            for (j, &te_tau) in te_delay.iter().enumerate() {
+                let c = k * n_te + j;
+                for a in 0..3 {
+                    let g = tau * gust_dir[a];
+                    for r in 0..nr {
+                        dr[(r, c)] += g * wd.residual[k][(r, 3 * j + a)];
+                    }
+                    for r in 0..nf {
+                        df[(r, c)] += g * wd.force[k][(r, 3 * j + a)];
+                    }
+                }
+                parts.drift_delays.push(tau + te_tau);
+            }
+        }
+        parts.drift_r = dr;
+        parts.drift_f = df;
+    }
+    // Lift: the total nodal force along the lift direction (uvlm::lift_drag_of, linear).
+    let n_nodes = nf / 3;
+    let mut lift_row = DMatrix::zeros(1, nf);
+    for k in 0..n_nodes {
+        for c in 0..3 {
+            let mut e = [0.0; 3];
+            e[c] = 1.0;
+            lift_row[(0, 3 * k + c)] = uvlm::lift_drag_of(e, v_inf, [1.0, 0.0, 0.0]).0;
+        }
+    }
+
+    // The gust at the front's reference point, sampled on the time march's steps over T = 2 t_end.
+    let field = crate::gust::disturbance(spec, aero, &stations, 2.0 * settings.t_end, 0.0)?;
+    let n_run = (settings.t_end / dt).round().max(1.0) as usize;
+    let n = 2 * n_run.max(8);
+    let period = n as f64 * dt;
+    let sigma = 18.4 / period;
+    let gust: Vec<f64> = (0..n).map(|k| Vector3::from(field.velocity(front, k as f64 * dt)).dot(&gust_dir)).collect();
+    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let out_steps: Vec<usize> = (0..=n_run).filter(|k| k % every == 0 || *k == n_run).collect();
+    let mut acc = vec![[0.0; N_OUT]; out_steps.len()];
+    parts.lift = lift_row.map(C64::from);
+    for k in 0..=n / 2 {
+        let omega = 2.0 * std::f64::consts::PI * k as f64 / period;
+        let s = C64::new(sigma, omega);
+        // ŵ on the shifted contour (the DFT of the windowed samples; dt cancels in the inverse).
+        let w_hat: C64 = gust
+            .iter()
+            .enumerate()
+            .map(|(m, g)| {
+                let t = m as f64 * dt;
+                C64::from(g * (-sigma * t).exp()) * C64::new(0.0, -omega * t).exp()
+            })
+            .sum();
+        if w_hat.norm() == 0.0 {
+            continue;
+        }
+        let y = transfer(s, &red, &la, &lg, &parts)?;
+        let weight = if k == 0 || 2 * k == n { 1.0 } else { 2.0 };
+        for (row, &step) in acc.iter_mut().zip(&out_steps) {
+            let t = step as f64 * dt;
+            let e = C64::new(0.0, omega * t).exp() * w_hat;
+            for o in 0..N_OUT {
+                row[o] += weight * (y[o] * e).re;
+            }
+        }
+    }
+    let scale: Vec<f64> = out_steps.iter().map(|&k| (sigma * k as f64 * dt).exp() / n as f64).collect();
+    let series = |o: usize| acc.iter().zip(&scale).map(|(r, sc)| r[o] * sc).collect::<Vec<f64>>();
+    Ok(LinearGustHistory {
+        t: out_steps.iter().map(|&k| k as f64 * dt).collect(),
+        delta_root_bending_moment: series(0),
+        delta_root_torque: series(1),
+        delta_hinge_moment: series(2),
+        delta_fold_deg: series(3),
+        delta_lift: series(4),
+        n_basis: nb,
+        n_frequencies: n / 2 + 1,
+        n_wake_rows: wake.row_lengths.len(),
+    })
+}
+
+/// The pieces of the reduced model besides `D(s)` and the linear UVLM.
+struct Parts {
+    /// Residual, nodal forces and station loads along each mode's position and velocity.
+    rx: DMatrix<f64>,
+    rv: DMatrix<f64>,
+    fx: DMatrix<f64>,
+    fv: DMatrix<f64>,
+    lx: DMatrix<f64>,
+    lv: DMatrix<f64>,
+    /// Outputs along each mode's position, velocity, acceleration, and per unit station load.
+    yx: DMatrix<f64>,
+    yv: DMatrix<f64>,
+    ya: DMatrix<f64>,
+    yl: DMatrix<f64>,
+    /// `H = Φᵀ P C_l`, the lumping `C_l`, and the lift per unit nodal force.
+    h: DMatrix<C64>,
+    cl: DMatrix<C64>,
+    lift: DMatrix<C64>,
+    /// Wake rows following the trailing edge's past motion: delays and, per row, residual and
+    /// nodal forces per mode (empty without the wake's motion).
+    row_delays: Vec<f64>,
+    rw: Vec<DMatrix<f64>>,
+    fw: Vec<DMatrix<f64>>,
+    /// The gust's drift of the wake nodes: per node, its delay, residual and nodal forces per
+    /// unit gust velocity.
+    drift_delays: Vec<f64>,
+    drift_r: DMatrix<f64>,
+    drift_f: DMatrix<f64>,
+}
+
+/// `Σ_k e^{−s τ_k} M_k`.
+fn delayed_sum(s: C64, delays: &[f64], m: &[DMatrix<f64>], rows: usize, cols: usize) -> DMatrix<C64> {
+    let mut out = DMatrix::zeros(rows, cols);
+    for (mk, &tau) in m.iter().zip(delays) {
+        let e = (-s * tau).exp();
+        out.zip_apply(mk, |a, b| *a += e * b);
+    }
+    out
+}
+
+/// `Σ_c e^{−s τ_c} m[:, c]`.
+fn delayed_columns(s: C64, delays: &[f64], m: &DMatrix<f64>) -> DVector<C64> {
+    let e: DVector<C64> = DVector::from_iterator(delays.len(), delays.iter().map(|tau| (-s * tau).exp()));
+    m.map(C64::from) * e
+}
+
+/// The outputs per unit `ŵ(s)` at `s`.
+fn transfer(
+    s: C64,
+    red: &crate::stability::Reduced,
+    la: &uvlm::LinearUvlm,
+    lg: &uvlm::LinearGust,
+    p: &Parts,
+) -> Result<[C64; N_OUT], String> {
+    let nb = p.rx.ncols();
+    let (nr, nf) = (p.rx.nrows(), p.fx.nrows());
+    let lu = la.normalwash_matrix(s).lu();
+    // Wake nodes following the trailing edge: extra residual and forces per mode.
+    let r_w = delayed_sum(s, &p.row_delays, &p.rw, nr, nb);
+    let f_w = delayed_sum(s, &p.row_delays, &p.fw, nf, nb);
+    let mut rhs = DMatrix::zeros(nr, nb + 1);
+    rhs.view_mut((0, 0), (nr, nb)).copy_from(&(p.rx.map(C64::from) + p.rv.map(|x| s * x) + &r_w));
+    let mut r_g = DVector::from_vec(lg.normalwash_at(s));
+    let mut f_g = DVector::from_vec(lg.force_at(s));
+    if !p.drift_delays.is_empty() {
+        r_g += delayed_columns(s, &p.drift_delays, &p.drift_r);
+        f_g += delayed_columns(s, &p.drift_delays, &p.drift_f);
+    }
+    rhs.set_column(nb, &r_g);
+    let x = lu.solve(&rhs).ok_or("the linear UVLM's normalwash matrix is singular")?;
+    // Nodal forces of the circulations (δΓ = −N⁻¹ r) per η and per ŵ.
+    let fgam = -(la.force_matrix(s) * x);
+    let f_eta_circ = fgam.columns(0, nb).into_owned();
+    let f_wg = fgam.column(nb) + f_g;
+    // D(s): the stability analysis's, −T N⁻¹ (R_x + s R_ẋ) being H times the circulations'
+    // forces, plus the wake's motion (its residual in `f_eta_circ`, its forces `f_w`).
+    let d = red.structural(s) + &p.h * (&f_eta_circ + &f_w);
+    let eta = d.lu().solve(&(-(&p.h * &f_wg))).ok_or("the flutter matrix is singular")?;
+    let f_eta_geo = p.fx.map(C64::from) + p.fv.map(|x| s * x) + &f_w;
+    let nodal = &f_eta_circ * &eta + &f_wg + &f_eta_geo * &eta;
+    let station =
+        &p.cl * (&f_eta_circ * &eta + &f_wg + &f_w * &eta) + (p.lx.map(C64::from) + p.lv.map(|x| s * x)) * &eta;
+    let y =
+        (p.yx.map(C64::from) + p.yv.map(|x| s * x) + p.ya.map(|x| s * s * x)) * &eta + p.yl.map(C64::from) * station;
+    let l = (&p.lift * nodal)[0];
+    Ok([y[0], y[1], y[2], y[3], l])
+}
