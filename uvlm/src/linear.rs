@@ -27,6 +27,12 @@
 //! how the caller moves the lattice (a structure's modes), so the caller differentiates
 //! [`LinearUvlm::evaluate`], which returns the residual and the nodal forces of a moved lattice
 //! with the reference circulations held.
+//!
+//! Two further inputs (docs/gust.md §7): [`LinearUvlm::gust`], a frozen gust's normalwash at the
+//! collocation points and its Joukowski force at the segment midpoints, each point delayed by its
+//! distance behind the gust's front; and [`LinearUvlm::wake_node_derivatives`], the residual and
+//! forces per displacement of the frozen wake's nodes (which in the time-marching scheme follow
+//! the trailing edge's past motion and drift with a gust).
 
 use nalgebra::{Complex, DMatrix};
 

@@ -6,6 +6,7 @@ mod flow;
 mod gust;
 mod hinge;
 mod linear;
+mod linear_gust;
 mod properties;
 mod steady;
 mod theodorsen;
