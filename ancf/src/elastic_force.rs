@@ -126,7 +126,7 @@ fn symmetric_times<const L: usize>(
 /// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a < b`;
 ///    diagonal blocks `a = b` on and above their diagonal only) at a time with fixed-size loops.
 #[inline(always)]
-fn add_group_tangent<const M: usize, const NB: usize>(
+fn add_group_tangent<const M: usize, const NB: usize, const NEWTON: bool>(
     plan: &StrainPlan,
     group: &StrainGroup,
     x: &[[f64; 3]; N_BLOCKS],
@@ -157,7 +157,11 @@ fn add_group_tangent<const M: usize, const NB: usize>(
             value += 0.5 * (xt[0][i] * um[0] + xt[1][i] * um[1] + xt[2][i] * um[2]);
         }
         let w = c * s.stiffness;
-        let wd = w * (value - s.reference);
+        let mut d = value - s.reference;
+        if NEWTON && newton_drops_geometric(s.kind, d) {
+            d = 0.0;
+        }
+        let wd = w * d;
         for &(a, b, h) in &s.pairs[..s.n_pairs] {
             geometric[a][b] += wd * h;
         }
@@ -189,6 +193,18 @@ fn add_group_tangent<const M: usize, const NB: usize>(
                 *k += ac;
             }
         }
+    }
+}
+
+/// Whether [`Element::add_newton_tangent_upper`] leaves out the geometric term of a strain of
+/// this kind at `s − s⁰ = d`: a section stretch penalty under compression, and the section shear
+/// penalty (`r_y·r_z`, whose geometric term is indefinite) always.
+#[inline(always)]
+fn newton_drops_geometric(kind: StrainKind, d: f64) -> bool {
+    match kind {
+        StrainKind::SectionYY | StrainKind::SectionZZ => d < 0.0,
+        StrainKind::SectionYZ => true,
+        _ => false,
     }
 }
 
@@ -314,24 +330,41 @@ impl Element {
     ///
     /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.add_tangent_upper::<false>(e, c, k)
+    }
+
+    /// [`Self::add_elastic_tangent_upper`] for Newton's iteration matrix of a time step
+    /// (`c > 0`): the cross-section penalties (docs/ancf.md §3.4) contribute only the positive
+    /// semidefinite part of their tangent. The geometric term `c C (s − s⁰) a` of a section
+    /// stretch (`ε_yy`, `ε_zz`) is left out where the section is compressed (`s < s⁰`, where it
+    /// is negative definite on the slope), and that of the section shear `γ_yz` (indefinite)
+    /// always: on the light section slopes such terms can outweigh the inertia in the iteration
+    /// matrix and make it near-singular. Every other term is the exact tangent's; the residual is
+    /// unchanged, so Newton converges to the same solution.
+    pub fn add_newton_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.add_tangent_upper::<true>(e, c, k)
+    }
+
+    #[inline]
+    fn add_tangent_upper<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { self.tangent_avx2(e, c, k) };
+            unsafe { self.tangent_avx2::<NEWTON>(e, c, k) };
             return;
         }
-        self.tangent_generic(e, c, k)
+        self.tangent_generic::<NEWTON>(e, c, k)
     }
 
     /// [`Self::add_elastic_tangent_upper`] compiled with AVX2 (see the module documentation).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn tangent_avx2(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        self.tangent_generic(e, c, k)
+    fn tangent_avx2<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.tangent_generic::<NEWTON>(e, c, k)
     }
 
     #[inline(always)]
-    fn tangent_generic(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+    fn tangent_generic<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
         let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
@@ -340,10 +373,10 @@ impl Element {
             macro_rules! members {
                 ($nb:literal) => {
                     match group.n_members {
-                        1 => add_group_tangent::<1, $nb>(plan, group, &x, c, g, cols),
-                        2 => add_group_tangent::<2, $nb>(plan, group, &x, c, g, cols),
-                        3 => add_group_tangent::<3, $nb>(plan, group, &x, c, g, cols),
-                        _ => add_group_tangent::<MAX_GROUP, $nb>(plan, group, &x, c, g, cols),
+                        1 => add_group_tangent::<1, $nb, NEWTON>(plan, group, &x, c, g, cols),
+                        2 => add_group_tangent::<2, $nb, NEWTON>(plan, group, &x, c, g, cols),
+                        3 => add_group_tangent::<3, $nb, NEWTON>(plan, group, &x, c, g, cols),
+                        _ => add_group_tangent::<MAX_GROUP, $nb, NEWTON>(plan, group, &x, c, g, cols),
                     }
                 };
             }
@@ -570,7 +603,11 @@ mod tests {
             assert_eq!(f, f_base, "{c:?}");
             let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
             el.add_elastic_tangent_upper(&es[1], 0.7, &mut k);
-            el.tangent_generic(&es[1], 0.7, &mut k_base);
+            el.tangent_generic::<false>(&es[1], 0.7, &mut k_base);
+            assert_eq!(k, k_base, "{c:?}");
+            let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+            el.add_newton_tangent_upper(&es[1], 0.7, &mut k);
+            el.tangent_generic::<true>(&es[1], 0.7, &mut k_base);
             assert_eq!(k, k_base, "{c:?}");
         }
     }
@@ -584,6 +621,47 @@ mod tests {
             let mut k = ElementMatrix::zeros();
             el.add_elastic_tangent(&e, 1.0, &mut k);
             assert!((k - k.transpose()).amax() < 1e-12 * k.amax());
+        }
+    }
+
+    /// Newton's tangent leaves out only geometric terms of the section penalties: it differs
+    /// from the exact tangent on the `r_y`, `r_z` blocks of a node only, by the section shear's
+    /// coupling of `r_y` and `r_z` component by component, and, on compressed sections only, by
+    /// a non-negative diagonal.
+    #[test]
+    fn newton_tangent_drops_only_section_penalty_geometric_terms() {
+        let l = 0.1;
+        for curvature in ALL_CURVATURES {
+            let el = Element::new(l, &section(), curvature, 1.0);
+            for (scale, compressed) in [(1.01, false), (0.99, true)] {
+                let mut e = deformed(l, &[0.3, -0.7, 0.2, 0.5, -0.1], 1e-3);
+                for node in 0..2 {
+                    for x in &mut e[12 * node + 6..12 * node + 12] {
+                        *x *= scale; // r_y, r_z
+                    }
+                }
+                let (mut exact, mut newton) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+                el.add_elastic_tangent_upper(&e, 0.7, &mut exact);
+                el.add_newton_tangent_upper(&e, 0.7, &mut newton);
+                let d = newton - exact;
+                let (mut diagonal, mut shear) = (0.0_f64, 0.0_f64);
+                for j in 0..ELEMENT_DOF {
+                    for i in 0..=j {
+                        let x = d[(i, j)];
+                        let section = i / 12 == j / 12 && i % 12 >= 6 && j % 12 >= 6;
+                        if section && i == j {
+                            assert!(x >= 0.0, "{curvature:?} ({i}, {j}): {x}");
+                            diagonal = diagonal.max(x);
+                        } else if section && j - i == 3 {
+                            shear = shear.max(x.abs());
+                        } else {
+                            assert_eq!(x, 0.0, "{curvature:?} ({i}, {j})");
+                        }
+                    }
+                }
+                assert!(shear > 0.0, "{curvature:?}: the section shear term must be left out");
+                assert_eq!(diagonal > 0.0, compressed, "{curvature:?}: stretch terms left out iff compressed");
+            }
         }
     }
 

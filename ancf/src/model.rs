@@ -748,6 +748,11 @@ impl Model {
     /// zero; only the dampers read them), written through the chosen form.
     #[allow(clippy::too_many_arguments)] // the state and the three generalized-α weights
     fn add_iteration_matrix(&self, q: &[f64], v: Option<&[f64]>, c_m: f64, c_c: f64, c_k: f64, k: &mut MatView<'_>) {
+        // With both c_m and c_k it is Newton's matrix of a time step: the section penalties and
+        // ties then keep only the positive semidefinite part of their geometric terms
+        // (docs/ancf.md §3.4). The analyses ask for M and K_t apart (c_m = 0 or c_k = 0) and get
+        // the exact tangent.
+        let newton = c_m != 0.0 && c_k != 0.0;
         let mut ke = ElementMatrix::zeros();
         let mut e_index = 0;
         for b in &self.bodies {
@@ -760,8 +765,11 @@ impl Model {
                         ke[(3 * a + i, 3 * bb + i)] = c_m * m;
                     }
                 }
-                if c_k != 0.0 {
-                    b.element.add_elastic_tangent_upper(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
+                let e = &q[first..first + ELEMENT_DOF];
+                if newton {
+                    b.element.add_newton_tangent_upper(e, c_k, &mut ke);
+                } else if c_k != 0.0 {
+                    b.element.add_elastic_tangent_upper(e, c_k, &mut ke);
                 }
                 self.scatter_element(first, e_index, &mut ke, k);
                 e_index += 1;
@@ -784,7 +792,7 @@ impl Model {
         }
         if c_k != 0.0 {
             for tie in &self.ties {
-                self.scatter_tie(tie.first, &tie.tangent(q, c_k), k);
+                self.scatter_tie(tie.first, &tie.tangent(q, c_k, newton), k);
             }
         }
         for spring in &self.springs {
@@ -914,7 +922,7 @@ impl Model {
             k.add_block(p.first, p.first, &ke);
         }
         for tie in &self.ties {
-            let t = tie.tangent(q, c_k);
+            let t = tie.tangent(q, c_k, false);
             for b in 0..9 {
                 for a in 0..9 {
                     k.add(tie.first + a, tie.first + b, t[(a, b)]);

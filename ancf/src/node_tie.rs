@@ -71,8 +71,13 @@ impl NodeTie {
         }
     }
 
-    /// `c · ∂²U/∂q²` on the node's nine slope coordinates (symmetric).
-    pub(crate) fn tangent(&self, q: &[f64], c: f64) -> TieMatrix {
+    /// `c · ∂²U/∂q²` on the node's nine slope coordinates (symmetric). With `newton` (Newton's
+    /// iteration matrix of a time step, `c > 0`) only the positive semidefinite part is kept:
+    /// the geometric term `c k_s s ∂²s` of a compressed stretch (`s = ½(|r_a|² − 1) < 0`,
+    /// negative definite on that slope) and of every angle `r_a·r_b` (indefinite) is left out.
+    /// At the tie's stiffness such terms can outweigh the light slopes' inertia and make the
+    /// iteration matrix near-singular (docs/ancf.md §3.5). The residual is unchanged.
+    pub(crate) fn tangent(&self, q: &[f64], c: f64, newton: bool) -> TieMatrix {
         let (x, s) = self.strains(q);
         let mut t = TieMatrix::zeros();
         for (((a, b), s), k) in PAIRS.iter().zip(&s).zip(&self.k) {
@@ -93,7 +98,7 @@ impl NodeTie {
                     t[(i, j)] += ck * g[i] * g[j];
                 }
             }
-            let h = c * k * s;
+            let h = if newton && (a != b || *s < 0.0) { 0.0 } else { c * k * s };
             for i in 0..3 {
                 if a == b {
                     t[(3 * a + i, 3 * a + i)] += h;
@@ -138,7 +143,7 @@ mod tests {
             let q = state(seed);
             let mut f = vec![0.0; 12];
             t.add_force(&q, &mut f);
-            let k = t.tangent(&q, 1.0);
+            let k = t.tangent(&q, 1.0, false);
             let h = 1e-6;
             let fmax = f.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             for j in 0..9 {
@@ -158,6 +163,37 @@ mod tests {
             assert_eq!(k, k.transpose());
             assert!(f[..2].iter().chain(&f[11..]).all(|&x| x == 0.0), "only the triad is loaded");
         }
+    }
+
+    /// Newton's tangent differs from the exact one by the term `k s I` of the compressed slope
+    /// (`r_x` here; `r_y`, `r_z` are stretched) and the angles' terms `k s (e_a e_bᵀ + e_b e_aᵀ)`.
+    #[test]
+    fn newton_tangent_drops_the_compressed_stretch_and_angle_terms() {
+        let t = tie();
+        let mut q = vec![0.0; 12];
+        let x = [[0.9, 0.05, 0.0], [0.0, 1.1, 0.02], [0.01, 0.0, 1.05]];
+        for (a, xa) in x.iter().enumerate() {
+            q[2 + 3 * a..5 + 3 * a].copy_from_slice(xa);
+        }
+        let (exact, newton) = (t.tangent(&q, 0.7, false), t.tangent(&q, 0.7, true));
+        assert_eq!(newton, newton.transpose());
+        let s = t.strains(&q).1;
+        let d = newton - exact;
+        for j in 0..9 {
+            for i in 0..9 {
+                let (a, b) = (i / 3, j / 3);
+                let expected = if i % 3 != j % 3 {
+                    0.0
+                } else if a == b {
+                    if s[a] < 0.0 { -0.7 * t.k[a] * s[a] } else { 0.0 }
+                } else {
+                    let p = PAIRS.iter().position(|&pair| pair == (a.min(b), a.max(b))).unwrap();
+                    -0.7 * t.k[p] * s[p]
+                };
+                assert!((d[(i, j)] - expected).abs() < 1e-12 * exact.amax(), "({i}, {j}): {} vs {expected}", d[(i, j)]);
+            }
+        }
+        assert!(s[0] < 0.0 && s[1] > 0.0 && s[2] > 0.0, "r_x compressed, r_y and r_z stretched: {s:?}");
     }
 
     /// An orthonormal triad in any orientation stores no energy and feels no force.
