@@ -235,7 +235,7 @@ fn damper_energy_balance_on_the_paper_pendulum() {
 /// matrix through the skyline LU's unsymmetric storage) follows the ODE path to solver
 /// tolerance (rho_inf = 0.8, 2 s), and so does the DAE path with the integrator's default
 /// solver (the bordered band LU on the declared structure, where the flared hinge's spring
-/// merges the two bodies' blocks). Measured: 2.6e-10 m, 2.6e-10 m. (The springs are at rest at t = 0. A spring preloaded at t = 0, θ₀ ≠ 0, is a step
+/// merges the two bodies' blocks). Measured: 9.6e-12 m, 9.6e-12 m. (The springs are at rest at t = 0. A spring preloaded at t = 0, θ₀ ≠ 0, is a step
 /// moment on the hinge nodes' slopes: Newton then needs step halvings at the start, 13 for
 /// 0.6 N·m here, and the two paths halve at different steps and differ by 2e-5 m.)
 #[test]
