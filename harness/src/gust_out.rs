@@ -393,7 +393,7 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
         let _ = writeln!(
             h,
             "<tr><td>{}</td><td>{:.3}</td><td>{:.3}</td><td>{:.3}</td><td>{:.5}</td><td>{:.5}</td><td>{:.3}</td>\
-             <td>{:.3}</td><td>{:.3}</td><td>{:.1}</td><td>{:.1}</td></tr>",
+             <td>{:.3}</td><td>{:.3}</td><td>{}</td><td>{}</td></tr>",
             esc(&hinge_name(&a.hinge)),
             a.gradient_m,
             a.frequency_hz,
@@ -403,8 +403,8 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
             d.map_or(f64::NAN, |d| d.peak_rbm_percent),
             a.peak_delta_fold_deg.0,
             g.map_or(f64::NAN, |g| g.peak_delta_fold_deg.0),
-            al(Formulation::Ancf),
-            al(Formulation::Gebf),
+            percent_cell(al(Formulation::Ancf)),
+            percent_cell(al(Formulation::Gebf)),
         );
     }
     h.push_str("</table>\n");
@@ -459,4 +459,9 @@ pub fn sections_html(out: &Path) -> String {
         }
     }
     s
+}
+
+/// A percentage to one decimal, or a dash where there is none (the locked hinge's alleviation).
+fn percent_cell(x: f64) -> String {
+    if x.is_finite() { format!("{x:.1}") } else { "–".into() }
 }
