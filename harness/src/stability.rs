@@ -264,6 +264,11 @@ pub struct Reduced {
     t_gamma: DMatrix<f64>,
     t_gamma_dot: DMatrix<f64>,
     t_rows: Vec<DMatrix<f64>>,
+    /// The frozen wake's nodes following the trailing edge's past motion (docs/stability.md
+    /// §2.4): per wake row `k`, the residual (n_rings × n_b) and the generalised load (n_b × n_b)
+    /// per modal coordinate of the trailing edge `τ_k` earlier. Empty without steady loading.
+    wake_r: Vec<DMatrix<f64>>,
+    wake_g: Vec<DMatrix<f64>>,
     /// Theodorsen strips instead of the lattice.
     strip: Option<Strips>,
     /// Structural natural frequencies, rad/s (all free motions).
@@ -279,7 +284,8 @@ pub struct Reduced {
 impl Reduced {
     /// The same model at `ratio` times the airspeed it was built at, the geometry (and the wake's
     /// row lengths) held: with the circulations `Γ₀ ∝ U`, `R_x`, `T_Γ`, `T_k` and `G_ẋ` scale with
-    /// the ratio, `G_x` with its square, the delays with its inverse, and `R_ẋ`, `T_Γ̇` not at all.
+    /// the ratio, `G_x` with its square, the delays with its inverse, and `R_ẋ`, `T_Γ̇` not at all;
+    /// the wake nodes' terms scale as `R_x` (residual) and `G_x` (loads).
     pub fn at_speed_ratio(&mut self, ratio: f64) {
         self.ratio = ratio;
     }
@@ -296,7 +302,13 @@ impl Reduced {
         let t0 = self.t_gamma.map(|x| C64::from(r * x)) + self.t_gamma_dot.map(|x| s * x);
         let mut t = uvlm::with_wake(&t0.map(|x| x / r), &self.t_rows, &delays, &self.te_rings, s);
         t *= C64::from(r);
-        let rhs = self.rx.map(|x| C64::from(r * x)) + self.rv.map(|x| s * x);
+        let mut rhs = self.rx.map(|x| C64::from(r * x)) + self.rv.map(|x| s * x);
+        let mut wake_g = DMatrix::<C64>::zeros(self.m.nrows(), self.m.ncols());
+        for ((wr, wg), tau) in self.wake_r.iter().zip(&self.wake_g).zip(&delays) {
+            let e = (-s * tau).exp();
+            rhs.zip_apply(wr, |a, b| *a += e * (r * b));
+            wake_g.zip_apply(wg, |a, b| *a += e * (r * r * b));
+        }
         let x = n
             .lu()
             .solve(&rhs)
@@ -304,7 +316,21 @@ impl Reduced {
         self.m.map(|x| s * s * x)
             + (&self.c + &self.gv * r).map(|x| s * x)
             + (&self.k + &self.gx * (r * r)).map(C64::from)
+            + wake_g
             - t * x
+    }
+
+    /// Leave out the motion of the frozen wake's nodes (every node but the trailing edge's stays
+    /// put): the flutter equation of a wake frozen in space, for comparison.
+    pub fn without_wake_motion(&mut self) {
+        self.wake_r.clear();
+        self.wake_g.clear();
+    }
+
+    /// Rows of the frozen wake whose nodes follow the trailing edge's past (0 without steady
+    /// loading or after [`Reduced::without_wake_motion`]).
+    pub fn n_moving_wake_rows(&self) -> usize {
+        self.wake_r.len()
     }
 
     /// The part of `D(s)` at fixed circulations: `M s² + (C + G_ẋ) s + K + G_x` (UVLM models).
@@ -667,6 +693,8 @@ pub fn reduce<S: StaticStructure>(
             t_gamma: DMatrix::zeros(nb, 0),
             t_gamma_dot: DMatrix::zeros(nb, 0),
             t_rows: Vec::new(),
+            wake_r: Vec::new(),
+            wake_g: Vec::new(),
             strip: Some(strips),
             omega: modes.omega.clone(),
             n_rings: 0,
@@ -727,7 +755,11 @@ pub fn reduce<S: StaticStructure>(
     let mut gx = DMatrix::zeros(nb, nb);
     let mut gv = DMatrix::zeros(nb, nb);
     let mut lat = la.lattice().clone();
-    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<(Vec<f64>, Vec<f64>), String> {
+    let te_start = lat.n_chordwise() * (lat.n_spanwise() + 1);
+    let n_te = 3 * (lat.n_spanwise() + 1);
+    let mut xte = DMatrix::zeros(n_te, nb);
+    type Eval = (Vec<f64>, Vec<f64>, Vec<f64>);
+    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<Eval, String> {
         let (mut st, mut ve) = (Vec::new(), Vec::new());
         stations_at(&*model, qq, vv, map, aero, &mut scratch, &mut st, &mut ve);
         lat.update_stations(&st, if with_vel { Some(&ve) } else { None })
@@ -736,7 +768,8 @@ pub fn reduce<S: StaticStructure>(
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
         let loads = lump(map, lat.ring_nodes(), &org, &f);
         let g = load_part(model, qq, &loads, &zero_loads);
-        Ok((r, g))
+        let te = lat.ring_nodes()[te_start..].iter().flatten().copied().collect();
+        Ok((r, g, te))
     };
     for i in 0..nb {
         let col: Vec<f64> = phi.column(i).iter().copied().collect();
@@ -748,22 +781,36 @@ pub fn reduce<S: StaticStructure>(
         model.retract_inplace(q, &dq, &mut qp);
         let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
         model.retract_inplace(q, &dq, &mut qm);
-        let (r1, g1) = eval(&mut model, &qp, &zeros, false)?;
-        let (r2, g2) = eval(&mut model, &qm, &zeros, false)?;
+        let (r1, g1, te1) = eval(&mut model, &qp, &zeros, false)?;
+        let (r2, g2, te2) = eval(&mut model, &qm, &zeros, false)?;
         for a in 0..nr {
             rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
+        }
+        for a in 0..n_te {
+            xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
         }
         let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
         gx.set_column(i, &gp);
         // Velocity along the mode: the residual and the loads are linear in it.
-        let (r1, g1) = eval(&mut model, q, &col, true)?;
+        let (r1, g1, _) = eval(&mut model, q, &col, true)?;
         let neg: Vec<f64> = col.iter().map(|x| -x).collect();
-        let (r2, g2) = eval(&mut model, q, &neg, true)?;
+        let (r2, g2, _) = eval(&mut model, q, &neg, true)?;
         for a in 0..nr {
             rv[(a, i)] = 0.5 * (r1[a] - r2[a]);
         }
         let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) * 0.5;
         gv.set_column(i, &gp);
+    }
+    // The wake's nodes follow the trailing edge's past motion, as the time march sheds them:
+    // node (k, j) is where trailing-edge node j was τ_k ago. They matter only where the steady
+    // wake carries circulation (its trailing vortices), so an unloaded lattice skips them.
+    let (mut wake_r, mut wake_g) = (Vec::new(), Vec::new());
+    if la.te_rings.iter().any(|&r| la.gamma0()[r] != 0.0) {
+        let wd = la.wake_node_derivatives();
+        for (zr, zf) in wd.residual.iter().zip(&wd.force) {
+            wake_r.push(zr * &xte);
+            wake_g.push(&h * (zf * &xte));
+        }
     }
     Ok(Reduced {
         m,
@@ -781,6 +828,8 @@ pub fn reduce<S: StaticStructure>(
         t_gamma: &h * &la.force_gamma,
         t_gamma_dot: &h * &la.force_gamma_dot,
         t_rows: la.force_row.iter().map(|f| &h * f).collect(),
+        wake_r,
+        wake_g,
         strip: None,
         omega: modes.omega.clone(),
         n_rings: nr,

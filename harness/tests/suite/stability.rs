@@ -256,3 +256,42 @@ fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
         assert!(rel(2.0 * std::f64::consts::PI * o.frequency_hz, root.imag) < 0.005, "{u} m/s: {o:?} vs {root:?}");
     }
 }
+
+/// The paper's wing at AoA 10°, 25 m/s, as the case runs it (GEBF, dt 0.01 s, 40 wake rows of
+/// U·dt): the least-damped oscillation of its 20 s time history (matrix pencil on the fold, its
+/// mean removed, over 15–20 s) decays at the rate of the eigen-analysis's root within 3 %. This
+/// needs the frozen wake's nodes to follow the trailing edge's past motion in the flutter
+/// equation, as the time march sheds them: without that term the root decays at −0.278 1/s,
+/// 7.7 % faster than the history. Measured: eigen 1.0374 Hz, −0.2592 1/s; history 1.0448 Hz,
+/// −0.2581 1/s (+0.45 %).
+#[test]
+fn a_loaded_wing_decays_at_the_eigen_rate() {
+    let spec = case("wing_aoa10.json", &[]);
+    let (lin, run) = rayon::join(
+        || run_stability(&spec.gebf, Formulation::Gebf),
+        || harness::scene::run_formulation(&spec.gebf, Formulation::Gebf),
+    );
+    assert!(run.error.is_none(), "{:?}", run.error);
+    let fold: Vec<(f64, f64)> =
+        run.rows.iter().filter(|r| r.t >= 15.0 - 1e-9).map(|r| (r.t, r.fold.to_degrees())).collect();
+    let mean = fold.iter().map(|s| s.1).sum::<f64>() / fold.len() as f64;
+    let samples: Vec<(f64, f64)> = fold.iter().map(|&(t, y)| (t, y - mean)).collect();
+    let span = samples.last().expect("samples").0 - samples[0].0;
+    let o = *harness::pencil::windows(&samples, span, 0.4).first().expect("an oscillation");
+    let root = *lin.points[0]
+        .roots
+        .iter()
+        .filter(|r| r.converged && r.imag > 0.0)
+        .min_by(|a, b| (a.frequency_hz() - o.frequency_hz).abs().total_cmp(&(b.frequency_hz() - o.frequency_hz).abs()))
+        .expect("roots");
+    println!(
+        "AoA 10: time history {:.4} Hz {:+.4} 1/s; eigen {:.4} Hz {:+.4} 1/s ({:+.2} %)",
+        o.frequency_hz,
+        o.growth_rate,
+        root.frequency_hz(),
+        root.real,
+        100.0 * (root.real / o.growth_rate - 1.0)
+    );
+    assert!(rel(root.frequency_hz(), o.frequency_hz) < 0.01, "{o:?} vs {root:?}");
+    assert!(rel(root.real, o.growth_rate) < 0.03, "{o:?} vs {root:?}");
+}
