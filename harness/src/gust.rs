@@ -503,21 +503,31 @@ pub struct Equilibrium {
     pub lift: f64,
 }
 
-/// One gust run: the incremental loads over their equilibrium values, at the output times.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct GustHistory {
+/// The increments of a gust run's outputs over their equilibrium values at the output times: the
+/// time march's ([`GustHistory`]) and the linearised model's
+/// ([`crate::gust_linear::LinearGustHistory`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Increments {
     /// Times, s (0 at the equilibrium; the gust's front starts `x0` upstream of the wing).
     pub t: Vec<f64>,
     /// Root bending moment minus its equilibrium value, N·m.
     pub delta_root_bending_moment: Vec<f64>,
     /// Root torque minus its equilibrium value, N·m.
     pub delta_root_torque: Vec<f64>,
-    /// Hinge moment minus its equilibrium value, N·m.
+    /// Hinge moment minus its equilibrium value, N·m (NaN without a flared hinge).
     pub delta_hinge_moment: Vec<f64>,
-    /// Fold angle minus its equilibrium value, degrees.
+    /// Fold angle minus its equilibrium value, degrees (NaN without a fold hinge).
     pub delta_fold_deg: Vec<f64>,
     /// Lift minus its equilibrium value, N.
     pub delta_lift: Vec<f64>,
+}
+
+/// One gust run: the incremental loads over their equilibrium values, at the output times.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GustHistory {
+    /// The increments.
+    #[serde(flatten)]
+    pub increments: Increments,
     /// The equilibrium.
     pub equilibrium: Equilibrium,
     /// CPU time of the time march, s (thread CPU time; wall time off Linux).
@@ -600,12 +610,14 @@ pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result
     };
     let col = |g: &dyn Fn(&crate::run::Row) -> f64, v0: f64| out.rows.iter().map(|r| g(r) - v0).collect::<Vec<f64>>();
     Ok(GustHistory {
-        t: out.rows.iter().map(|r| r.t).collect(),
-        delta_root_bending_moment: col(&|r| r.root_bending_moment, eq.root_bending_moment),
-        delta_root_torque: col(&|r| r.root_torque, eq.root_torque),
-        delta_hinge_moment: col(&|r| r.hinge_moment, eq.hinge_moment),
-        delta_fold_deg: col(&|r| r.fold.to_degrees(), eq.fold_deg),
-        delta_lift: col(&|r| r.lift, eq.lift),
+        increments: Increments {
+            t: out.rows.iter().map(|r| r.t).collect(),
+            delta_root_bending_moment: col(&|r| r.root_bending_moment, eq.root_bending_moment),
+            delta_root_torque: col(&|r| r.root_torque, eq.root_torque),
+            delta_hinge_moment: col(&|r| r.hinge_moment, eq.hinge_moment),
+            delta_fold_deg: col(&|r| r.fold.to_degrees(), eq.fold_deg),
+            delta_lift: col(&|r| r.lift, eq.lift),
+        },
         equilibrium: eq,
         cpu_s,
         static_cpu_s,
@@ -752,11 +764,12 @@ pub fn run_sweep(spec: &crate::case::RunSpec, fs: &[Formulation]) -> Result<Gust
             }
             match gust_history(&c, f, Some(q)) {
                 Ok(hist) => {
-                    run.peak_delta_root_bending_moment = peak(&hist.t, &hist.delta_root_bending_moment);
-                    run.peak_delta_root_torque = peak(&hist.t, &hist.delta_root_torque);
-                    run.peak_delta_hinge_moment = peak(&hist.t, &hist.delta_hinge_moment);
-                    run.peak_delta_fold_deg = peak(&hist.t, &hist.delta_fold_deg);
-                    run.peak_delta_lift = peak(&hist.t, &hist.delta_lift);
+                    let inc = &hist.increments;
+                    run.peak_delta_root_bending_moment = peak(&inc.t, &inc.delta_root_bending_moment);
+                    run.peak_delta_root_torque = peak(&inc.t, &inc.delta_root_torque);
+                    run.peak_delta_hinge_moment = peak(&inc.t, &inc.delta_hinge_moment);
+                    run.peak_delta_fold_deg = peak(&inc.t, &inc.delta_fold_deg);
+                    run.peak_delta_lift = peak(&inc.t, &inc.delta_lift);
                     run.equilibrium = Some(hist.equilibrium);
                     run.cpu_s = hist.cpu_s;
                     run.error = hist.error.clone();

@@ -37,6 +37,7 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
 use crate::case::{Case, Formulation, StaticSettings};
+use crate::gust::Increments;
 use crate::stability::{linear_wake, load_part, lump, reduce};
 use crate::statics::StaticStructure;
 
@@ -45,18 +46,8 @@ type C64 = Complex<f64>;
 /// A linearised gust response: the increments of the time march's outputs at its output times.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearGustHistory {
-    /// Time, s.
-    pub t: Vec<f64>,
-    /// Root bending moment increment, N·m.
-    pub delta_root_bending_moment: Vec<f64>,
-    /// Root torque increment, N·m.
-    pub delta_root_torque: Vec<f64>,
-    /// Hinge moment increment, N·m (NaN without a flared hinge).
-    pub delta_hinge_moment: Vec<f64>,
-    /// Fold angle increment, degrees (NaN without a fold hinge).
-    pub delta_fold_deg: Vec<f64>,
-    /// Lift increment, N.
-    pub delta_lift: Vec<f64>,
+    /// The increments (as the time march's [`crate::gust::GustHistory`]).
+    pub increments: Increments,
     /// Structural modes in the basis.
     pub n_basis: usize,
     /// Frequencies at which the transfer was evaluated.
@@ -65,7 +56,7 @@ pub struct LinearGustHistory {
     pub n_wake_rows: usize,
 }
 
-/// Outputs, in the order of [`LinearGustHistory`]'s series.
+/// Outputs, in the order of [`Increments`]' series.
 const N_OUT: usize = 5;
 
 /// The linearised response of `case` (its `aero.gust`, the hinge state already applied) with
@@ -361,12 +352,14 @@ fn run<S: StaticStructure>(
     let scale: Vec<f64> = out_steps.iter().map(|&k| (sigma * k as f64 * dt).exp() / n as f64).collect();
     let series = |o: usize| acc.iter().zip(&scale).map(|(r, sc)| r[o] * sc).collect::<Vec<f64>>();
     Ok(LinearGustHistory {
-        t: out_steps.iter().map(|&k| k as f64 * dt).collect(),
-        delta_root_bending_moment: series(0),
-        delta_root_torque: series(1),
-        delta_hinge_moment: series(2),
-        delta_fold_deg: series(3),
-        delta_lift: series(4),
+        increments: Increments {
+            t: out_steps.iter().map(|&k| k as f64 * dt).collect(),
+            delta_root_bending_moment: series(0),
+            delta_root_torque: series(1),
+            delta_hinge_moment: series(2),
+            delta_fold_deg: series(3),
+            delta_lift: series(4),
+        },
         n_basis: nb,
         n_frequencies: n / 2 + 1,
         n_wake_rows: wake.row_lengths.len(),

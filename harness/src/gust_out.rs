@@ -183,7 +183,7 @@ pub fn history_csv(s: &GustSummary, f: Formulation) -> String {
     let mut t = String::from(HISTORY_HEADER);
     t.push('\n');
     for r in s.runs.iter().filter(|r| r.formulation == f) {
-        let Some(h) = &r.history else { continue };
+        let Some(h) = r.history.as_ref().map(|h| &h.increments) else { continue };
         for i in 0..h.t.len() {
             let _ = writeln!(
                 t,
@@ -280,13 +280,14 @@ fn critical_gradient(s: &GustSummary) -> Option<f64> {
         .map(|r| r.gradient_m)
 }
 
-fn histories(s: &GustSummary, h_crit: f64, value: impl Fn(&crate::gust::GustHistory) -> &Vec<f64>) -> Curves {
+fn histories(s: &GustSummary, h_crit: f64, value: impl Fn(&crate::gust::Increments) -> &Vec<f64>) -> Curves {
     let hinges = hinges_of(s);
     let mut curves = Curves::new();
     for f in Formulation::ALL {
         for r in s.runs.iter().filter(|r| r.formulation == f && r.gradient_m == h_crit) {
             let Some(hist) = &r.history else { continue };
-            let pts = hist.t.iter().copied().zip(value(hist).iter().copied()).collect();
+            let inc = &hist.increments;
+            let pts = inc.t.iter().copied().zip(value(inc).iter().copied()).collect();
             curves.push((
                 format!("{} {}", f.as_str().to_uppercase(), hinge_name(&r.hinge)),
                 hinge_color(&hinges, &r.hinge),

@@ -35,13 +35,14 @@ fn no_gust_stays_at_equilibrium() {
             c.aero.as_mut().unwrap().gust = None;
             let hist = gust_history(&c, f, None).unwrap();
             assert!(hist.error.is_none(), "{f} {}: {:?}", h.label(), hist.error);
-            let (m, th) = (max_abs(&hist.delta_root_bending_moment), max_abs(&hist.delta_fold_deg));
+            let (m, th) =
+                (max_abs(&hist.increments.delta_root_bending_moment), max_abs(&hist.increments.delta_fold_deg));
             println!(
                 "{f} {}: equilibrium RBM {:.3} N m, fold {:.3} deg; without a gust over 2 s: |dRBM| <= {m:.2e} N m, |dfold| <= {th:.2e} deg, |dlift| <= {:.2e} N",
                 h.label(),
                 hist.equilibrium.root_bending_moment,
                 hist.equilibrium.fold_deg,
-                max_abs(&hist.delta_lift)
+                max_abs(&hist.increments.delta_lift)
             );
             assert!(m < 1e-3, "{f} {}: the root bending moment drifts by {m} N m", h.label());
             assert!(th < 1e-6, "{f} {}: the fold drifts by {th} deg", h.label());
@@ -74,14 +75,14 @@ fn wing_gust_ancf_and_gebf_agree() {
     for r in &s.runs {
         let h = r.history.as_ref().unwrap();
         // The peak is the largest magnitude of the recorded series.
-        assert_eq!(peak(&h.t, &h.delta_root_bending_moment), r.peak_delta_root_bending_moment);
+        assert_eq!(peak(&h.increments.t, &h.increments.delta_root_bending_moment), r.peak_delta_root_bending_moment);
         println!(
             "{} {} H = {} m: {:.2} s CPU for {} s simulated",
             r.formulation,
             r.hinge.label(),
             r.gradient_m,
             r.cpu_s,
-            h.t.last().unwrap()
+            h.increments.t.last().unwrap()
         );
     }
 }
@@ -187,19 +188,24 @@ fn small_gust_matches_the_linearised_model() {
                 println!(
                     "{f} {} frozen wake: peak dRBM {:?} dfold {:?} dlift {:?}",
                     h.label(),
-                    peak(&l0.t, &l0.delta_root_bending_moment),
-                    peak(&l0.t, &l0.delta_fold_deg),
-                    peak(&l0.t, &l0.delta_lift)
+                    peak(&l0.increments.t, &l0.increments.delta_root_bending_moment),
+                    peak(&l0.increments.t, &l0.increments.delta_fold_deg),
+                    peak(&l0.increments.t, &l0.increments.delta_lift)
                 );
             }
             let hist = gust_history(&c, f, None).unwrap();
             assert!(hist.error.is_none(), "{f} {}: {:?}", h.label(), hist.error);
-            assert_eq!(lin.t.len(), hist.t.len());
-            assert!(lin.t.iter().zip(&hist.t).all(|(a, b)| (a - b).abs() < 1e-9));
+            assert_eq!(lin.increments.t.len(), hist.increments.t.len());
+            assert!(lin.increments.t.iter().zip(&hist.increments.t).all(|(a, b)| (a - b).abs() < 1e-9));
             let diff = |a: (f64, f64), b: (f64, f64)| 100.0 * (a.0 / b.0 - 1.0);
-            let (mn, ml) =
-                (peak(&hist.t, &hist.delta_root_bending_moment), peak(&lin.t, &lin.delta_root_bending_moment));
-            let (ln, ll) = (peak(&hist.t, &hist.delta_lift), peak(&lin.t, &lin.delta_lift));
+            let (mn, ml) = (
+                peak(&hist.increments.t, &hist.increments.delta_root_bending_moment),
+                peak(&lin.increments.t, &lin.increments.delta_root_bending_moment),
+            );
+            let (ln, ll) = (
+                peak(&hist.increments.t, &hist.increments.delta_lift),
+                peak(&lin.increments.t, &lin.increments.delta_lift),
+            );
             println!(
                 "{f} {}: peak dRBM {:.5} N m at {:.2} s (time march), {:.5} N m at {:.2} s (linear): {:+.3} %; peak dlift {:.5} / {:.5} N: {:+.3} %",
                 h.label(),
@@ -214,7 +220,10 @@ fn small_gust_matches_the_linearised_model() {
             );
             assert!(diff(ml, mn).abs() < 2.0, "{f} {}: peak dRBM {ml:?} against {mn:?}", h.label());
             if h == HingeState::Free {
-                let (fnl, fl) = (peak(&hist.t, &hist.delta_fold_deg), peak(&lin.t, &lin.delta_fold_deg));
+                let (fnl, fl) = (
+                    peak(&hist.increments.t, &hist.increments.delta_fold_deg),
+                    peak(&lin.increments.t, &lin.increments.delta_fold_deg),
+                );
                 println!(
                     "{f} free: peak dfold {:.6} deg at {:.2} s (time march), {:.6} deg at {:.2} s (linear): {:+.3} %",
                     fnl.0,
@@ -228,9 +237,10 @@ fn small_gust_matches_the_linearised_model() {
             // The whole history, not only its peak: largest difference over the run.
             let scale = mn.0.abs();
             let worst = hist
+                .increments
                 .delta_root_bending_moment
                 .iter()
-                .zip(&lin.delta_root_bending_moment)
+                .zip(&lin.increments.delta_root_bending_moment)
                 .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
             println!(
                 "{f} {}: largest |dRBM difference| over the run {:.3} % of the peak",
