@@ -128,6 +128,9 @@ fn bad_static_input_exits_2_naming_the_field() {
         ("static.airspeeds=[12,\"NaN\"]", "static.airspeeds[1]"),
         ("pitch_deg=95", "pitch_deg"),
         ("aero.airspeed=-1", "aero.airspeed"),
+        (r#"static.wake={"row_length":0.25,"rows":0}"#, "static.wake.rows"),
+        (r#"static.wake={"row_length":-1,"rows":40}"#, "static.wake.row_length"),
+        (r#"static.wake={"row_length":"NaN","rows":40}"#, "static.wake.row_length"),
     ] {
         let o = harness(&["static", c, "--set", set, "--out", std::env::temp_dir().to_str().unwrap()]);
         let err = String::from_utf8_lossy(&o.stderr);
