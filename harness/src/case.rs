@@ -126,6 +126,40 @@ pub struct StaticSettings {
     /// (m/s) and fold angle (degrees), relative to the case file's folder.
     #[serde(default)]
     pub references: Vec<StaticReference>,
+    /// The steady wake of the static solution: `rows` straight rows of `row_length` (m) along
+    /// the free stream behind the trailing edge, without closure a finite frozen wake (each
+    /// strip's wake one ring of length `rows·row_length` carrying its trailing-edge circulation,
+    /// the steady state of a time march with `aero.n_wake_rows` rows of `airspeed·dt`), with
+    /// `closure` the semi-infinite legs. Default (absent): semi-infinite legs along the free
+    /// stream. Needs `aero`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wake: Option<crate::stability::WakeSettings>,
+}
+
+impl crate::stability::WakeSettings {
+    /// Every impossible value, naming its field under `prefix` (e.g. `static.wake`).
+    ///
+    /// # Errors
+    /// A message naming the field.
+    pub fn validate(&self, prefix: &str) -> Result<(), String> {
+        if !(self.row_length.is_finite() && self.row_length > 0.0 && self.row_length <= 1e6) {
+            return Err(format!("{prefix}.row_length: {} is not in (0, 1e6] m", self.row_length));
+        }
+        if self.rows == 0 || self.rows > 4000 {
+            return Err(format!("{prefix}.rows: {} is not in 1..=4000", self.rows));
+        }
+        Ok(())
+    }
+
+    /// The steady UVLM wake of these settings: the rows' total length without closure, the
+    /// semi-infinite legs with it.
+    pub fn steady_wake(&self) -> uvlm::SteadyWake {
+        if self.closure {
+            uvlm::SteadyWake::SemiInfinite
+        } else {
+            uvlm::SteadyWake::Finite { length: self.rows as f64 * self.row_length }
+        }
+    }
 }
 
 /// A dead point load of a structural static case (`static.point_loads`).
@@ -1458,6 +1492,9 @@ impl Case {
             if !st.references.is_empty() {
                 return Err("static.references: coast-angle curves need `aero`".into());
             }
+            if st.wake.is_some() {
+                return Err("static.wake: the steady wake needs `aero`".into());
+            }
         } else if let Some(st) = &self.statics {
             if !st.point_loads.is_empty() || !st.load_factors.is_empty() {
                 return Err("static.point_loads: point loads are for a structural static case (without `aero`)".into());
@@ -1475,6 +1512,9 @@ impl Case {
                 if r.label.is_empty() {
                     return Err(format!("static.references[{k}].label: empty"));
                 }
+            }
+            if let Some(w) = &st.wake {
+                w.validate("static.wake")?;
             }
         }
         if let Some(st) = &self.stability {

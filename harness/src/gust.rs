@@ -560,6 +560,7 @@ pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
         references: Vec::new(),
         point_loads: Vec::new(),
         load_factors: Vec::new(),
+        wake: None,
     });
     let out = crate::statics::run_static(&c, f);
     if let Some(e) = out.error {

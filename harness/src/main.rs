@@ -622,6 +622,24 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             c.static_fold_deg,
             c.fold_difference_deg
         );
+        match &c.run_wake_error {
+            Some(e) => println!(
+                "static {} {}: static with the run's wake ({}) failed: {e}",
+                s.name,
+                c.formulation,
+                harness::static_out::wake_label(&c.run_wake)
+            ),
+            None => println!(
+                "static {} {}: static with the run's wake ({}): {:.4} m ({:+.2} %), {:.3} deg ({:+.3} deg)",
+                s.name,
+                c.formulation,
+                harness::static_out::wake_label(&c.run_wake),
+                c.run_wake_static_tip_z,
+                100.0 * c.run_wake_tip_z_relative_difference,
+                c.run_wake_static_fold_deg,
+                c.run_wake_fold_difference_deg
+            ),
+        }
     }
     if let (true, [a, g]) = (structural, s.runs.as_slice()) {
         let d = a
@@ -860,7 +878,7 @@ fn real_main() -> Result<ExitCode> {
                 let t = std::time::Instant::now();
                 let mut summary = run_static_case(spec, &Formulation::ALL);
                 if let Some(r) = results.iter().find(|r| r.name == spec.name) {
-                    harness::static_out::compare_with_history(&mut summary, &spec.ancf, &r.runs);
+                    harness::static_out::compare_with_history(&mut summary, spec, &r.runs);
                 }
                 harness::static_out::write(&out.join(&spec.name), &summary)?;
                 static_failed += usize::from(report_static(&summary));

@@ -89,7 +89,8 @@ pub enum AeroModel {
     Strip,
 }
 
-/// The frozen wake of the linear aerodynamics.
+/// A frozen wake of straight rows along the free stream: the linear aerodynamics'
+/// (`stability.wake`) or the static solution's (`static.wake`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WakeSettings {
@@ -927,6 +928,7 @@ fn sweep<S: StaticStructure>(
                 references: Vec::new(),
                 point_loads: Vec::new(),
                 load_factors: Vec::new(),
+                wake: None,
             });
             let so = crate::statics::run_static(&c, f);
             if let Some(e) = so.error {

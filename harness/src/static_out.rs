@@ -8,8 +8,9 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use crate::Error;
-use crate::case::{Case, Formulation};
+use crate::case::{Case, Formulation, RunSpec};
 use crate::csv::write_file;
+use crate::stability::WakeSettings;
 use crate::statics::StaticOutput;
 
 /// Column header of `static_<f>.csv`.
@@ -134,19 +135,36 @@ pub struct HistoryComparison {
     pub tip_z_relative_difference: f64,
     /// static − mean of the fold, degrees.
     pub fold_difference_deg: f64,
+    /// The run's own wake (`aero.n_wake_rows` rows of airspeed × the formulation's `dt`, closed
+    /// when `aero.wake_closure`), the steady wake of the like-for-like static solution below.
+    pub run_wake: WakeSettings,
+    /// Static tip height with the run's wake, m (NaN when that solve failed).
+    pub run_wake_static_tip_z: f64,
+    /// Static fold angle with the run's wake, degrees.
+    pub run_wake_static_fold_deg: f64,
+    /// (static with the run's wake − mean) / |mean| of the tip height.
+    pub run_wake_tip_z_relative_difference: f64,
+    /// static with the run's wake − mean of the fold, degrees.
+    pub run_wake_fold_difference_deg: f64,
+    /// Why the static solution with the run's wake failed, if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run_wake_error: Option<String>,
 }
 
 /// Compare the static points of `summary` with the time histories `runs` of the same case (at
-/// the case's airspeed), averaged over the second half of each run.
-pub fn compare_with_history(summary: &mut StaticSummary, case: &Case, runs: &[crate::run::RunOutput]) {
-    let Some(aero) = &case.aero else { return };
-    let v = aero.free_stream();
-    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+/// the case's airspeed), averaged over the second half of each run; and the static solution at
+/// that airspeed with the run's own wake ([`static_with_run_wake`]) with the same means.
+pub fn compare_with_history(summary: &mut StaticSummary, spec: &RunSpec, runs: &[crate::run::RunOutput]) {
     for run in runs.iter().filter(|r| r.error.is_none() && !r.rows.is_empty()) {
+        let case = spec.case(run.formulation);
+        let Some(aero) = &case.aero else { continue };
+        let v = aero.free_stream();
+        let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         let Some(st) = summary.runs.iter().find(|o| o.formulation == run.formulation) else { continue };
         let Some(p) = st.points.iter().find(|p| (p.airspeed - airspeed).abs() < 1e-9 && p.error.is_none()) else {
             continue;
         };
+        let (tip_z, fold) = (p.tip[2], p.fold_deg);
         let t_end = run.rows.last().map_or(0.0, |r| r.t);
         let window = (0.5 * t_end, t_end);
         let w: Vec<&crate::run::Row> = run.rows.iter().filter(|r| r.t >= window.0 - 1e-9).collect();
@@ -155,6 +173,13 @@ pub fn compare_with_history(summary: &mut StaticSummary, case: &Case, runs: &[cr
         let fo: Vec<f64> = w.iter().map(|r| r.fold.to_degrees()).collect();
         let range = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
         let (tz_mean, fo_mean) = (tz.iter().sum::<f64>() / n, fo.iter().sum::<f64>() / n);
+        let run_wake = run_wake_of(case, run.formulation);
+        // A closed wake is the steady one: the point above, bit for bit.
+        let like = if run_wake.closure { Ok((tip_z, fold)) } else { static_with_run_wake(case, run.formulation) };
+        let (rw_tip, rw_fold, rw_err) = match like {
+            Ok((t, f)) => (t, f, None),
+            Err(e) => (f64::NAN, f64::NAN, Some(e)),
+        };
         summary.history.push(HistoryComparison {
             formulation: run.formulation,
             airspeed,
@@ -163,11 +188,65 @@ pub fn compare_with_history(summary: &mut StaticSummary, case: &Case, runs: &[cr
             tip_z_range: range(&tz),
             fold_mean_deg: fo_mean,
             fold_range_deg: range(&fo),
-            static_tip_z: p.tip[2],
-            static_fold_deg: p.fold_deg,
-            tip_z_relative_difference: (p.tip[2] - tz_mean) / tz_mean.abs(),
-            fold_difference_deg: p.fold_deg - fo_mean,
+            static_tip_z: tip_z,
+            static_fold_deg: fold,
+            tip_z_relative_difference: (tip_z - tz_mean) / tz_mean.abs(),
+            fold_difference_deg: fold - fo_mean,
+            run_wake,
+            run_wake_static_tip_z: rw_tip,
+            run_wake_static_fold_deg: rw_fold,
+            run_wake_tip_z_relative_difference: (rw_tip - tz_mean) / tz_mean.abs(),
+            run_wake_fold_difference_deg: rw_fold - fo_mean,
+            run_wake_error: rw_err,
         });
+    }
+}
+
+/// A wake in words: `40 rows of 0.25 m, unclosed`.
+pub fn wake_label(w: &WakeSettings) -> String {
+    format!("{} rows of {} m, {}", w.rows, w.row_length, if w.closure { "closed" } else { "unclosed" })
+}
+
+/// The wake a time march of `case` with formulation `f` sheds: `aero.n_wake_rows` rows of
+/// airspeed × the formulation's `dt`, closed when `aero.wake_closure` (default rows for a case
+/// without `aero`).
+pub fn run_wake_of(case: &Case, f: Formulation) -> WakeSettings {
+    let dt = match f {
+        Formulation::Ancf => case.ancf.dt,
+        Formulation::Gebf => case.gebf.dt,
+    };
+    let (airspeed, rows, closure) = case.aero.as_ref().map_or((0.0, 0, false), |a| {
+        let v = a.free_stream();
+        ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt(), a.n_wake_rows, a.wake_closure)
+    });
+    WakeSettings { row_length: airspeed * dt, rows, closure }
+}
+
+/// The static equilibrium of `case` at its airspeed with the wake of its own time march
+/// ([`run_wake_of`]) as the steady wake: tip height (m) and fold angle (degrees).
+///
+/// # Errors
+/// A case without `aero`, or no equilibrium.
+pub fn static_with_run_wake(case: &Case, f: Formulation) -> Result<(f64, f64), String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let v = aero.free_stream();
+    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let mut c = case.clone();
+    c.statics = Some(crate::case::StaticSettings {
+        airspeeds: vec![airspeed],
+        references: Vec::new(),
+        point_loads: Vec::new(),
+        load_factors: Vec::new(),
+        wake: Some(run_wake_of(case, f)),
+    });
+    let out = crate::statics::run_static(&c, f);
+    if let Some(e) = out.error {
+        return Err(e);
+    }
+    let p = out.points.first().ok_or("no point")?;
+    match &p.error {
+        Some(e) => Err(e.clone()),
+        None => Ok((p.tip[2], p.fold_deg)),
     }
 }
 
@@ -618,7 +697,8 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
         let _ = writeln!(
             h,
             "<li>{} time history at {} m/s, mean over {:.0}–{:.0} s: tip height {:.4} m (range {:.4} to {:.4}), fold {:.3}° \
-             (range {:.2} to {:.2}); static: tip height {:.4} m ({:+.2} %), fold {:.3}° ({:+.3}°)</li>",
+             (range {:.2} to {:.2}); static (semi-infinite wake): tip height {:.4} m ({:+.2} %), fold {:.3}° \
+             ({:+.3}°); static with the run's wake ({}): {}</li>",
             c.formulation.as_str().to_uppercase(),
             c.airspeed,
             c.window.0,
@@ -632,7 +712,18 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
             c.static_tip_z,
             100.0 * c.tip_z_relative_difference,
             c.static_fold_deg,
-            c.fold_difference_deg
+            c.fold_difference_deg,
+            html_escape(&wake_label(&c.run_wake)),
+            match &c.run_wake_error {
+                Some(e) => format!("failed: {}", html_escape(e)),
+                None => format!(
+                    "tip height {:.4} m ({:+.2} %), fold {:.3}° ({:+.3}°)",
+                    c.run_wake_static_tip_z,
+                    100.0 * c.run_wake_tip_z_relative_difference,
+                    c.run_wake_static_fold_deg,
+                    c.run_wake_fold_difference_deg
+                ),
+            }
         );
     }
     h.push_str("</ul>\n");

@@ -3,8 +3,9 @@
 //! continuation in airspeed (docs/statics.md).
 //!
 //! The coupled system is the structure's `ConstrainedSystem` with the station loads of a steady
-//! UVLM solve (semi-infinite wake legs along the free stream, [`uvlm::Uvlm::solve_steady`]) at the
-//! current coordinates added to its residual ([`AeroStatic`]). Its tangent is the structure's
+//! UVLM solve (semi-infinite wake legs along the free stream, [`uvlm::Uvlm::solve_steady`], or the
+//! finite frozen wake of `static.wake`) at the current coordinates added to its residual
+//! ([`AeroStatic`]). Its tangent is the structure's
 //! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, a forward difference of the
 //! generalised aerodynamic force, one steady solve per tangent coordinate. That costs one
 //! lattice solve per unknown, so the aerodynamic part is kept between iterations and between
@@ -64,13 +65,15 @@ struct SteadyAero {
 }
 
 impl SteadyAero {
-    /// A steady UVLM on the lattice of `model` at `q`, with free stream `v_inf`.
+    /// A steady UVLM on the lattice of `model` at `q`, with free stream `v_inf` and the steady
+    /// wake `wake`.
     fn new<S: AeroStructure>(
         model: &S,
         q: &[f64],
         map: &[StationMap],
         aero: &AeroSettings,
         v_inf: [f64; 3],
+        wake: uvlm::SteadyWake,
     ) -> Result<Self, String> {
         let mut s = Self {
             uv: placeholder_uvlm()?,
@@ -85,7 +88,8 @@ impl SteadyAero {
         };
         stations_at(model, q, &s.zeros, map, aero, &mut s.scratch, &mut s.stations, &mut s.vel);
         let spec = crate::aero::lattice_spec(map, aero);
-        let params = aero.uvlm_params(v_inf);
+        let mut params = aero.uvlm_params(v_inf);
+        params.steady_wake = wake;
         s.uv = uvlm::Lattice::from_stations(spec, &s.stations)
             .and_then(|l| uvlm::Uvlm::new(l, params))
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
@@ -159,6 +163,8 @@ pub struct AeroStatic<'a, S: StaticStructure> {
     error: RefCell<Option<String>>,
     map: &'a [StationMap],
     aero: AeroSettings,
+    /// The steady wake (a fixed length: the V² scaling of the kept stiffness stays exact).
+    wake: uvlm::SteadyWake,
     speed2: f64,
     /// Forward-difference step of the aerodynamic stiffness, in the increment weights' units.
     fd_step: f64,
@@ -166,10 +172,17 @@ pub struct AeroStatic<'a, S: StaticStructure> {
 
 impl<'a, S: StaticStructure> AeroStatic<'a, S> {
     /// The coupled system of `model` with the aerodynamics `aero` (its free stream as given) on
-    /// the stations `map`; the lattice is built at `q`.
-    pub fn new(model: S, q: &[f64], map: &'a [StationMap], aero: &AeroSettings, span: f64) -> Result<Self, String> {
+    /// the stations `map`, with the steady wake `wake`; the lattice is built at `q`.
+    pub fn new(
+        model: S,
+        q: &[f64],
+        map: &'a [StationMap],
+        aero: &AeroSettings,
+        wake: uvlm::SteadyWake,
+        span: f64,
+    ) -> Result<Self, String> {
         let v = aero.free_stream();
-        let st = SteadyAero::new(&model, q, map, aero, v)?;
+        let st = SteadyAero::new(&model, q, map, aero, v, wake)?;
         let n = model.n_dof();
         let loads: Vec<SectionLoad> = map
             .iter()
@@ -196,6 +209,7 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
             error: RefCell::new(None),
             map,
             aero: aero.clone(),
+            wake,
             speed2: v.iter().map(|x| x * x).sum(),
             fd_step: 1e-7 * span.max(1e-3),
         })
@@ -207,7 +221,7 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
         self.aero.airspeed = Some(airspeed);
         let v = self.aero.free_stream();
         let solves = self.aero_state.borrow().n_solves;
-        let mut st = SteadyAero::new(&*self.model.borrow(), q, self.map, &self.aero, v)?;
+        let mut st = SteadyAero::new(&*self.model.borrow(), q, self.map, &self.aero, v, self.wake)?;
         st.n_solves = solves;
         *self.aero_state.borrow_mut() = st;
         self.speed2 = v.iter().map(|x| x * x).sum();
@@ -664,7 +678,8 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
     let top = st.airspeeds[order[0]];
     let mut a0 = aero.clone();
     a0.airspeed = Some(top);
-    let mut sys = match AeroStatic::new(model, &q_ref, &map, &a0, case.span()) {
+    let wake = st.wake.as_ref().map_or(uvlm::SteadyWake::SemiInfinite, |w| w.steady_wake());
+    let mut sys = match AeroStatic::new(model, &q_ref, &map, &a0, wake, case.span()) {
         Ok(s) => s,
         Err(e) => return failed_output(case, f, e),
     };

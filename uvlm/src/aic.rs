@@ -6,7 +6,10 @@
 //! is shed into a new wake row, so the whole wake is known and the trailing-edge edge of the rings
 //! is a bound filament of net strength Γ_w0 − Γ_TE (which carries the circulation shed during the
 //! step). Steady solves close the rings with semi-infinite legs from the trailing-edge nodes along
-//! the free stream (the trailing-edge edge then cancels). Edge net strengths
+//! the free stream (the trailing-edge edge then cancels), or with a finite frozen wake: legs of a
+//! given length along the free stream and a spanwise segment joining their far ends, each strip's
+//! wake one ring carrying its trailing-edge circulation (the steady state of an unclosed wake of
+//! straight rows). Edge net strengths
 //! (segment directions along increasing indices):
 //! spanwise `(i, j)→(i, j+1)`: `Γ(i, j) − Γ(i−1, j)`; chordwise `(i, j)→(i+1, j)`:
 //! `Γ(i, j−1) − Γ(i, j)`. The AIC row of collocation point `c_p` is
@@ -39,6 +42,15 @@ pub(crate) enum TrailingEdge {
     /// Steady: semi-infinite legs along the unit vector carry the trailing-edge circulations
     /// (the trailing-edge spanwise edge cancels).
     Steady([f64; 3]),
+    /// Steady with a finite frozen wake: legs of length `length` (m) along the unit vector `dir`
+    /// from the trailing-edge nodes, and spanwise segments joining their far ends, which close
+    /// each strip's wake ring (net strength −Γ_TE of the strip).
+    SteadyFinite {
+        /// Unit direction of the wake.
+        dir: [f64; 3],
+        /// Wake length, m.
+        length: f64,
+    },
 }
 
 /// Unit-strength bound filaments with incidences.
@@ -122,6 +134,30 @@ impl BoundSystem {
                     let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
                     let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
                     self.inc.push([right, left]);
+                }
+            }
+            TrailingEdge::SteadyFinite { dir, length } => {
+                // Far ends of the legs: node (m, j) + length·dir, after the lattice's nodes.
+                let far0 = fil.n_nodes() as u32;
+                for j in 0..nc {
+                    let p = nodes[node(m, j) as usize];
+                    fil.push_node([p[0] + length * dir[0], p[1] + length * dir[1], p[2] + length * dir[2]]);
+                }
+                let far = |j: usize| far0 + j as u32;
+                // Legs (m, j) → far(j), with the incidences and core of the semi-infinite legs
+                // (sized by the trailing-edge panel's chordwise length).
+                for j in 0..nc {
+                    let len = dist(node(m - 1, j), node(m, j));
+                    fil.push_segment_scaled(node(m, j), far(j), 1.0, core, len);
+                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
+                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
+                    self.inc.push([right, left]);
+                }
+                // Closing spanwise segments far(j) → far(j+1): the downstream edge of strip j's
+                // wake ring, −Γ_TE(j).
+                for j in 0..n {
+                    fil.push_segment_scaled(far(j), far(j + 1), 1.0, core, chord_scale(m, j));
+                    self.inc.push([(te_ring(j), -1.0), (NONE, 0.0)]);
                 }
             }
         }

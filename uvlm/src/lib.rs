@@ -75,7 +75,8 @@
 //! * Parameters ([`UvlmParams`], serde, unknown fields rejected): `rho`, `v_inf`, `n_wake_rows`,
 //!   `wake_convection` (prescribed / free), `wake_closure`, `bound_core` / `wake_core`
 //!   ([`CoreModel`]: SHARPy cut-off or Scully core sized from the local panel), `images`
-//!   ([`ImagePlane`]: symmetry and/or ground), `te_segment_force`, `unsteady_term`, `parallel`.
+//!   ([`ImagePlane`]: symmetry and/or ground), `te_segment_force`, `unsteady_term`, `parallel`,
+//!   `steady_wake` ([`SteadyWake`]: semi-infinite legs, or a finite frozen wake of a given length).
 //!
 //! ## Performance
 //! Filaments are stored once per shared edge in structure-of-arrays form; the kernels evaluate
@@ -115,7 +116,7 @@ pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
 pub use linear::{LinearGust, LinearUvlm, LinearWake, WakeNodeDerivatives, with_wake};
 pub use loads::{Loads, lift_drag_of, lump_columns};
-pub use params::{PARALLEL_MIN_PAIRS, Parallel, UvlmParams, WakeConvection};
+pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeConvection};
 pub use solver::Uvlm;
 pub use station::{SpanStation, StationVelocity};
 pub use stats::Stats;

@@ -17,6 +17,25 @@ pub enum WakeConvection {
     Free,
 }
 
+/// The wake of a steady solve ([`crate::Uvlm::solve_steady`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SteadyWake {
+    /// Semi-infinite trailing legs from the trailing-edge nodes along the free stream (a ring
+    /// VLM; the steady limit of a wake of any length closed by `wake_closure`).
+    #[default]
+    SemiInfinite,
+    /// A frozen wake of straight rows of total length `length` along the free stream, without
+    /// closure: every strip's wake is one ring carrying the trailing-edge circulation, two
+    /// finite trailing legs from the trailing-edge nodes and a spanwise segment joining their far
+    /// ends. The steady state of a time march with `n_wake_rows` rows of `|V∞|·dt` and no
+    /// closure has `length = n_wake_rows·|V∞|·dt`.
+    Finite {
+        /// Wake length along the free stream, m (> 0, finite).
+        length: f64,
+    },
+}
+
 /// Threading policy of the Biot–Savart evaluations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -73,6 +92,9 @@ pub struct UvlmParams {
     /// Threading of the Biot–Savart kernels. Default auto.
     #[serde(default)]
     pub parallel: Parallel,
+    /// The wake of a steady solve. Default semi-infinite legs (unsteady steps ignore it).
+    #[serde(default)]
+    pub steady_wake: SteadyWake,
 }
 
 fn default_wake_rows() -> usize {
@@ -97,6 +119,7 @@ impl UvlmParams {
             te_segment_force: false,
             unsteady_term: true,
             parallel: Parallel::Auto,
+            steady_wake: SteadyWake::SemiInfinite,
         }
     }
 
@@ -117,6 +140,11 @@ impl UvlmParams {
                 return Err(UvlmError::InvalidParameter { field, value: p });
             }
         }
+        if let SteadyWake::Finite { length } = self.steady_wake
+            && !(length.is_finite() && length > 0.0)
+        {
+            return Err(UvlmError::InvalidParameter { field: "steady_wake.length", value: length });
+        }
         validate_planes(&self.images)
     }
 }
@@ -133,6 +161,14 @@ mod tests {
         assert_eq!(p.wake_core, CoreModel::Scully { fraction: 0.05 });
         assert!(p.validate().is_ok());
         assert!(serde_json::from_str::<UvlmParams>(r#"{"rho": 1, "v_inf": [1,0,0], "wake_rows": 3}"#).is_err());
+        assert_eq!(p.steady_wake, SteadyWake::SemiInfinite);
+        let finite: UvlmParams =
+            serde_json::from_str(r#"{"rho": 1, "v_inf": [1,0,0], "steady_wake": {"finite": {"length": 10}}}"#).unwrap();
+        assert_eq!(finite.steady_wake, SteadyWake::Finite { length: 10.0 });
+        for length in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let bad = UvlmParams { steady_wake: SteadyWake::Finite { length }, ..p.clone() };
+            assert!(matches!(bad.validate(), Err(UvlmError::InvalidParameter { field: "steady_wake.length", .. })));
+        }
         let bad = UvlmParams { rho: -1.0, ..p };
         assert!(matches!(bad.validate(), Err(UvlmError::InvalidParameter { field: "rho", .. })));
     }

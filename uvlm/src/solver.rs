@@ -8,7 +8,7 @@ use crate::flow::{Flow, FlowField};
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
-use crate::params::{UvlmParams, WakeConvection};
+use crate::params::{SteadyWake, UvlmParams, WakeConvection};
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
 use crate::wake::Wake;
@@ -254,7 +254,10 @@ impl Uvlm {
             return Ok(());
         }
         let te = match mode {
-            Mode::Steady => TrailingEdge::Steady(self.stream_dir()?),
+            Mode::Steady => match self.params.steady_wake {
+                SteadyWake::SemiInfinite => TrailingEdge::Steady(self.stream_dir()?),
+                SteadyWake::Finite { length } => TrailingEdge::SteadyFinite { dir: self.stream_dir()?, length },
+            },
             Mode::Unsteady => TrailingEdge::Unsteady,
         };
         self.bound.build(&self.lattice, te, &self.params.bound_core, &self.params.images);
@@ -346,8 +349,9 @@ impl Uvlm {
         compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.v_mid, &self.u_mid, gd, &self.params);
     }
 
-    /// Steady solution with semi-infinite trailing legs along the free stream (a ring VLM), in the
-    /// external flow at [`Uvlm::time`] (the legs follow `V∞`, not the disturbance).
+    /// Steady solution with the wake of [`UvlmParams::steady_wake`] along the free stream:
+    /// semi-infinite trailing legs (a ring VLM, the default) or a finite frozen wake. In the
+    /// external flow at [`Uvlm::time`] (the wake follows `V∞`, not the disturbance).
     /// Does not touch the wake or the unsteady history.
     pub fn solve_steady(&mut self) -> Result<&Loads> {
         if self.pending_dt.is_some() {

@@ -9,5 +9,6 @@ mod linear;
 mod linear_gust;
 mod properties;
 mod steady;
+mod steady_finite_wake;
 mod theodorsen;
 mod unsteady;
