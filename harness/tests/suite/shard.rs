@@ -1,4 +1,4 @@
-//! `--shard k/N` and `harness merge` (issue #24): every unit of a sweep runs in exactly one shard,
+//! `--shard k/N` and `harness merge`: every unit of a sweep runs in exactly one shard,
 //! the shards are balanced by estimated cost, and the merged folder equals one machine's.
 
 use std::collections::BTreeMap;

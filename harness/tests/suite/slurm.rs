@@ -1,4 +1,4 @@
-//! The job-array template on a real SLURM (issue #24): a one-node cluster on localhost (munged,
+//! The job-array template on a real SLURM: a one-node cluster on localhost (munged,
 //! slurmctld and slurmd of Debian's `munge` and `slurm-wlm`, which `tools/ci-deps.sh` installs)
 //! runs `cluster/flexmb-array.sbatch` as a 4-task array over a 16-run sweep; the merged report
 //! must equal a single-machine run of the same sweep (CSV files byte for byte, summaries apart

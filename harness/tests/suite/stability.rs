@@ -96,7 +96,8 @@ fn hale_flutter_strip_theory_and_lattice() {
 /// 173.7 / 171.2 m/s); the first-order extrapolation from 8 and 16 panels lies within 3 % of the
 /// about 165 m/s and 70 rad/s of SHARPy's linear-UVLM test (measured 168.7 m/s, 68.7 rad/s).
 /// This is the chordwise limit at 16 spanwise panels only: spanwise refinement raises the speed
-/// by about 2 % (docs/stability.md §7), which this test does not cover.
+/// by about 2 % (to 171.0–171.3 m/s converged, docs/stability.md §7), which this test does not
+/// cover.
 #[test]
 fn goland_flutter_converges_to_the_vortex_lattice_value() {
     let run = |nc: usize| {

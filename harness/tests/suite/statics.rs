@@ -181,7 +181,7 @@ fn pitch_rotates_the_scene_nose_up() {
 /// the static solution meets the mean of the 20 s GEBF run at AoA 5° over its second half within
 /// 0.2 % in tip height and 0.1° in fold (the whole run: about 6 s release on one core).
 #[test]
-fn static_with_the_runs_wake_meets_the_time_history_mean_issue_20() {
+fn static_with_the_runs_wake_meets_the_time_history_mean() {
     let spec = case("wing_aoa5.json", &[]);
     let f = Formulation::Gebf;
     let run = run_formulation(spec.case(f), f);

@@ -1,4 +1,4 @@
-//! The finite frozen steady wake (`UvlmParams::steady_wake`, issue 20): it tends to the
+//! The finite frozen steady wake (`UvlmParams::steady_wake`): it tends to the
 //! semi-infinite legs as it grows, it is the converged state of a time march with the same
 //! unclosed wake rows, and mirror planes treat it as any other filament.
 
