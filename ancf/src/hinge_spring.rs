@@ -264,14 +264,17 @@ impl HingeSpring {
 
     /// `c_k ∂r/∂q + c_c ∂r/∂v` of the spring's residual `(k(θ−θ₀) + c θ̇) θ_q` over its local
     /// coordinates: `c_k [k θ_q θ_qᵀ + (k(θ−θ₀) + cθ̇) θ_qq + c θ_q (θ_qq v)ᵀ] + c_c c θ_q θ_qᵀ`
-    /// (`v` the full velocities, `None` for zero).
-    pub(crate) fn tangent(&self, kin: &Kinematics, v: Option<&[f64]>, c_c: f64, c_k: f64) -> Hessian {
+    /// (`v` the full velocities, `None` for zero). With `newton` (Newton's matrix of a time step)
+    /// the damper's `c θ_q (θ_qq v)ᵀ`, the only unsymmetric term, is left out, so that the matrix
+    /// stays symmetric (docs/ancf.md §11); the residual, and so every converged step, is unchanged.
+    pub(crate) fn tangent(&self, kin: &Kinematics, v: Option<&[f64]>, c_c: f64, c_k: f64, newton: bool) -> Hessian {
         let (k, c) = (self.stiffness, self.damping);
         let g = &kin.grad;
         let rate = v.map_or(0.0, |v| Self::rate(kin, v));
         let mut t = g * g.transpose() * (c_k * k + c_c * c) + kin.hess * (c_k * self.moment(kin, rate));
         if let Some(v) = v
             && c != 0.0
+            && !newton
         {
             let mut hv = Gradient::zeros();
             for a in 0..kin.n {

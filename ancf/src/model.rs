@@ -109,12 +109,13 @@ pub struct Model {
     reduced_block: RefCell<Vec<f64>>,
     work: RefCell<Workspace>,
     sensor: RefCell<(Vec<f64>, Vec<f64>)>,
-    /// Whether the iteration matrix is symmetric (no follower moments, no hinge dampers),
-    /// shared with the [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
+    /// Whether the iteration matrix is symmetric (no follower moments; a hinge damper's
+    /// unsymmetric term is left out of Newton's matrix and vanishes at rest), shared with the
+    /// [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
     symmetric: Arc<AtomicBool>,
     /// Hinge springs and dampers (docs/ancf.md §11).
     springs: Vec<HingeSpring>,
-    /// Whether a spring has damping: its tangent `c θ_q (θ_qq v)ᵀ` is not symmetric.
+    /// Whether a spring has damping (the residual then reads the velocities).
     damped: bool,
     /// Point masses (docs/ancf.md §12.2), each on its element.
     point_inertia: Vec<PointInertia>,
@@ -275,7 +276,7 @@ impl Model {
                 rate: vec![0.0; if damped { n_full } else { 0 }],
             }),
             sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
-            symmetric: Arc::new(AtomicBool::new(!damped)),
+            symmetric: Arc::new(AtomicBool::new(true)),
             springs,
             damped,
             point_inertia,
@@ -669,8 +670,9 @@ impl Model {
                 self.moments.push((st, p.moment));
             }
         }
-        // a follower moment's tangent is not symmetric, nor is a damper's
-        self.symmetric.store(self.moments.is_empty() && !self.damped, Ordering::Relaxed);
+        // a follower moment's tangent is not symmetric; a damper's unsymmetric term vanishes at
+        // rest (statics, linearisation) and Newton's matrix of a time step leaves it out
+        self.symmetric.store(self.moments.is_empty(), Ordering::Relaxed);
         Ok(())
     }
 
@@ -797,7 +799,7 @@ impl Model {
         }
         for spring in &self.springs {
             let kin = spring.kinematics(q, true);
-            let t = spring.tangent(&kin, v, c_c, c_k);
+            let t = spring.tangent(&kin, v, c_c, c_k, newton);
             self.scatter_spring(&kin, &t, k);
         }
     }
@@ -931,7 +933,7 @@ impl Model {
         }
         for spring in &self.springs {
             let kin = spring.kinematics(q, true);
-            let t = spring.tangent(&kin, None, 0.0, c_k);
+            let t = spring.tangent(&kin, None, 0.0, c_k, false);
             for b in 0..kin.n {
                 for a in 0..kin.n {
                     k.add(kin.idx[a], kin.idx[b], t[(a, b)]);
