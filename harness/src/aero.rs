@@ -365,7 +365,14 @@ pub fn simulate_aero_from<S: AeroStructure>(
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
     let spec = lattice_spec(map, aero);
-    let params = aero.uvlm_params(aero.free_stream());
+    let mut params = aero.uvlm_params(aero.free_stream());
+    if equilibrium.is_some() && !aero.wake_closure {
+        // The equilibrium's steady solution with the march's own unclosed wake (its rows
+        // prefilled below), so that without a disturbance the run stays there.
+        let v = aero.free_stream();
+        let u = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * u * dt };
+    }
     let mut uv = match uvlm::Lattice::from_stations(spec, &stations).and_then(|l| uvlm::Uvlm::new(l, params)) {
         Ok(u) => u,
         Err(e) => return fail(out, format!("aerodynamic lattice: {e}")),

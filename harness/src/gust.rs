@@ -555,12 +555,13 @@ pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
     let v = aero.free_stream();
     let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let mut c = case.clone();
+    // The steady state of the march's own wake, so that without a gust the run stays there.
     c.statics = Some(StaticSettings {
         airspeeds: vec![airspeed],
         references: Vec::new(),
         point_loads: Vec::new(),
         load_factors: Vec::new(),
-        wake: None,
+        wake: Some(crate::stability::march_wake(case, f, airspeed)),
     });
     let out = crate::statics::run_static(&c, f);
     if let Some(e) = out.error {

@@ -100,7 +100,7 @@ fn run<S: StaticStructure>(
         references: Vec::new(),
         point_loads: Vec::new(),
         load_factors: Vec::new(),
-        wake: None,
+        wake: Some(crate::stability::wake_settings(case, f, u)),
     });
     let so = crate::statics::run_static(&c, f);
     if let Some(e) = so.error {

@@ -841,17 +841,27 @@ pub fn reduce<S: StaticStructure>(
 
 /// The linear wake of `case` at `airspeed`: the stability block's, or the time-marching one.
 pub fn linear_wake(case: &Case, f: Formulation, airspeed: f64) -> uvlm::LinearWake {
-    let aero = case.aero.as_ref().expect("validated: stability needs aero");
-    match case.stability.as_ref().and_then(|s| s.wake) {
-        Some(w) => uvlm::LinearWake::uniform(w.rows, w.row_length, w.closure),
-        None => {
-            let dt = match f {
-                Formulation::Ancf => case.ancf.dt,
-                Formulation::Gebf => case.gebf.dt,
-            };
-            uvlm::LinearWake::uniform(aero.n_wake_rows, airspeed * dt, aero.wake_closure)
-        }
-    }
+    let w = wake_settings(case, f, airspeed);
+    uvlm::LinearWake::uniform(w.rows, w.row_length, w.closure)
+}
+
+/// The time march's wake at `airspeed` with formulation `f`: `aero.n_wake_rows` rows of
+/// `airspeed·dt`, closed when `aero.wake_closure`.
+pub fn march_wake(case: &Case, f: Formulation, airspeed: f64) -> WakeSettings {
+    let aero = case.aero.as_ref().expect("validated: needs aero");
+    let dt = match f {
+        Formulation::Ancf => case.ancf.dt,
+        Formulation::Gebf => case.gebf.dt,
+    };
+    WakeSettings { rows: aero.n_wake_rows, row_length: airspeed * dt, closure: aero.wake_closure }
+}
+
+/// The frozen wake of [`linear_wake`] as wake settings: the stability block's, or the time
+/// march's (`aero.n_wake_rows` rows of `airspeed·dt`, closed when `aero.wake_closure`). The
+/// equilibrium the analysis linearises about is that wake's steady state, as the time march's
+/// equilibrium is (`static.wake`, docs/statics.md §1).
+pub fn wake_settings(case: &Case, f: Formulation, airspeed: f64) -> WakeSettings {
+    case.stability.as_ref().and_then(|s| s.wake).unwrap_or_else(|| march_wake(case, f, airspeed))
 }
 
 /// An equilibrium: coordinates, holonomic and velocity multipliers, fold angle (degrees).
@@ -922,25 +932,35 @@ fn sweep<S: StaticStructure>(
             st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
         }
         About::Equilibrium => {
-            let mut c = case.clone();
-            c.statics = Some(crate::case::StaticSettings {
-                airspeeds: st.airspeeds.clone(),
-                references: Vec::new(),
-                point_loads: Vec::new(),
-                load_factors: Vec::new(),
-                wake: None,
-            });
-            let so = crate::statics::run_static(&c, f);
-            if let Some(e) = so.error {
-                return empty_output(f, Some(e));
-            }
-            so.points
-                .into_iter()
-                .map(|p| match (p.state, p.error) {
+            // Each equilibrium is the steady state of the frozen wake linearised about it. The
+            // time march's default wake has rows of U·dt, so without closure its length changes
+            // with the airspeed: one static solve per airspeed then.
+            let wakes: Vec<WakeSettings> = st.airspeeds.iter().map(|&u| wake_settings(case, f, u)).collect();
+            let groups: Vec<(Vec<f64>, WakeSettings)> = if wakes.iter().all(|w| w.closure || *w == wakes[0]) {
+                vec![(st.airspeeds.clone(), wakes[0])]
+            } else {
+                st.airspeeds.iter().zip(&wakes).map(|(&u, &w)| (vec![u], w)).collect()
+            };
+            let mut states = Vec::with_capacity(st.airspeeds.len());
+            for (airspeeds, wake) in groups {
+                let mut c = case.clone();
+                c.statics = Some(crate::case::StaticSettings {
+                    airspeeds,
+                    references: Vec::new(),
+                    point_loads: Vec::new(),
+                    load_factors: Vec::new(),
+                    wake: Some(wake),
+                });
+                let so = crate::statics::run_static(&c, f);
+                if let Some(e) = so.error {
+                    return empty_output(f, Some(e));
+                }
+                states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
                     (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
                     (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
-                })
-                .collect()
+                }));
+            }
+            states
         }
     };
     let mut out = empty_output(f, None);

@@ -1,7 +1,8 @@
 //! The UVLM linearised about a steady solution, in the Laplace domain (docs/uvlm.md §13).
 //!
 //! About a steady solution `Γ₀` on a lattice at rest, with a frozen wake of straight rows along
-//! the free stream, a small motion of the lattice (grid node displacements `δx` and velocities
+//! the free stream (`Γ₀` the steady state of that wake: finite without closure,
+//! [`crate::SteadyWake`]), a small motion of the lattice (grid node displacements `δx` and velocities
 //! `δẋ`) and small circulations `δΓ` obey
 //!
 //! $$ A\,\delta\Gamma + \sum_k W_k\,\delta\Gamma_{w,k} + R_x\,\delta x + R_{\dot x}\,\delta\dot x = 0 ,$$
@@ -44,7 +45,7 @@ use crate::images::append_images;
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
-use crate::params::UvlmParams;
+use crate::params::{SteadyWake, UvlmParams};
 use crate::solver::Uvlm;
 use crate::wake::Wake;
 
@@ -221,7 +222,18 @@ impl Uvlm {
         if self.lattice().grid_velocities().iter().flatten().any(|v| *v != 0.0) {
             return Err(UvlmError::InvalidParameter { field: "lattice velocity", value: 1.0 });
         }
-        self.solve_steady()?;
+        // The reference state is the steady state of this frozen wake: its rows' total length
+        // without closure, the semi-infinite legs with it (the time march's steady state).
+        let total: f64 = wake.row_lengths.iter().sum();
+        let own = self.params().steady_wake;
+        self.set_steady_wake(if wake.closure {
+            SteadyWake::SemiInfinite
+        } else {
+            SteadyWake::Finite { length: total }
+        })?;
+        let solved = self.solve_steady().map(|_| ());
+        self.set_steady_wake(own)?;
+        solved?;
         let p = self.params().clone();
         let lat = self.lattice().clone();
         let gamma0 = self.gamma().to_vec();

@@ -159,6 +159,21 @@ impl Uvlm {
         &self.flow
     }
 
+    /// Set the wake of the steady solves ([`UvlmParams::steady_wake`]); the next
+    /// [`Uvlm::solve_steady`] rebuilds its influence matrix.
+    ///
+    /// # Errors
+    /// A finite wake whose length is not positive and finite.
+    pub fn set_steady_wake(&mut self, wake: SteadyWake) -> Result<()> {
+        let p = UvlmParams { steady_wake: wake, ..self.params.clone() };
+        p.validate()?;
+        if self.params.steady_wake != wake {
+            self.params.steady_wake = wake;
+            self.aic_key = None;
+        }
+        Ok(())
+    }
+
     /// Attach a disturbance field (gust, turbulence) to the free stream, or remove it (`None`).
     /// It applies from the next evaluation on: the next wake convection and solve. See
     /// [`crate::flow`] for where it is evaluated and how to write one.

@@ -262,9 +262,9 @@ fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
 /// U·dt): the least-damped oscillation of its 20 s time history (matrix pencil on the fold, its
 /// mean removed, over 15–20 s) decays at the rate of the eigen-analysis's root within 3 %. This
 /// needs the frozen wake's nodes to follow the trailing edge's past motion in the flutter
-/// equation, as the time march sheds them: without that term the root decays at −0.278 1/s,
-/// 7.7 % faster than the history. Measured: eigen 1.0374 Hz, −0.2592 1/s; history 1.0448 Hz,
-/// −0.2581 1/s (+0.45 %).
+/// equation, as the time march sheds them: without that term the root decays at −0.2759 1/s,
+/// 6.9 % faster than the history. Measured: eigen 1.0453 Hz, −0.2582 1/s; history 1.0448 Hz,
+/// −0.2581 1/s (+0.04 %), the equilibrium being the steady state of the same 40-row wake.
 #[test]
 fn a_loaded_wing_decays_at_the_eigen_rate() {
     let spec = case("wing_aoa10.json", &[]);
