@@ -111,6 +111,12 @@ impl AeroSettings {
             (None, None) => [0.0; 3],
         }
     }
+
+    /// The free stream's speed, m/s.
+    pub fn speed(&self) -> f64 {
+        let v = self.free_stream();
+        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    }
 }
 
 /// Aero-structure coupling per step.
@@ -369,9 +375,7 @@ pub fn simulate_aero_from<S: AeroStructure>(
     if equilibrium.is_some() && !aero.wake_closure {
         // The equilibrium's steady solution with the march's own unclosed wake (its rows
         // prefilled below), so that without a disturbance the run stays there.
-        let v = aero.free_stream();
-        let u = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * u * dt };
+        params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * aero.speed() * dt };
     }
     let mut uv = match uvlm::Lattice::from_stations(spec, &stations).and_then(|l| uvlm::Uvlm::new(l, params)) {
         Ok(u) => u,

@@ -136,6 +136,14 @@ pub struct StaticSettings {
     pub wake: Option<crate::stability::WakeSettings>,
 }
 
+impl StaticSettings {
+    /// An aeroelastic sweep over `airspeeds` with the steady wake `wake` (semi-infinite legs
+    /// when `None`), no references.
+    pub fn at(airspeeds: Vec<f64>, wake: Option<crate::stability::WakeSettings>) -> Self {
+        Self { airspeeds, references: Vec::new(), point_loads: Vec::new(), load_factors: Vec::new(), wake }
+    }
+}
+
 impl crate::stability::WakeSettings {
     /// Every impossible value, naming its field under `prefix` (e.g. `static.wake`).
     ///

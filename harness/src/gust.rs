@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use uvlm::FlowField;
 
 use crate::aero::{AeroSettings, AeroStructure, simulate_aero_from, station_map};
-use crate::case::{Case, Formulation, Joint, Spring, StaticSettings};
+use crate::case::{Case, Formulation, Joint, Spring};
 
 /// Sea-level density of the standard atmosphere, kg/m³ (equivalent to true airspeed).
 pub const RHO_SEA_LEVEL: f64 = 1.225;
@@ -552,27 +552,10 @@ fn cpu_since(t: (Instant, Option<f64>)) -> f64 {
 /// The static aeroelastic equilibrium of `case` at its airspeed: its coordinates.
 pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
-    let v = aero.free_stream();
-    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let mut c = case.clone();
     // The steady state of the march's own wake, so that without a gust the run stays there.
-    c.statics = Some(StaticSettings {
-        airspeeds: vec![airspeed],
-        references: Vec::new(),
-        point_loads: Vec::new(),
-        load_factors: Vec::new(),
-        wake: Some(crate::stability::march_wake(case, f, airspeed)),
-    });
-    let out = crate::statics::run_static(&c, f);
-    if let Some(e) = out.error {
-        return Err(format!("static equilibrium: {e}"));
-    }
-    let p = out.points.into_iter().next().ok_or("static equilibrium: no point")?;
-    match (p.error, p.state) {
-        (Some(e), _) => Err(format!("static equilibrium: {e}")),
-        (None, Some((q, _, _))) => Ok(q),
-        (None, None) => Err("static equilibrium: no state".into()),
-    }
+    let wake = crate::stability::march_wake(case, f, aero.speed());
+    let p = crate::statics::equilibrium_at(case, f, wake).map_err(|e| format!("static equilibrium: {e}"))?;
+    p.state.map(|s| s.0).ok_or_else(|| "static equilibrium: no state".into())
 }
 
 /// Run `case` (with its `aero.gust`, its hinge state applied) with formulation `f` from the

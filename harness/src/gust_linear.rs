@@ -36,7 +36,7 @@
 use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
-use crate::case::{Case, Formulation, StaticSettings};
+use crate::case::{Case, Formulation};
 use crate::gust::Increments;
 use crate::stability::{linear_wake, load_part, lump, reduce};
 use crate::statics::StaticStructure;
@@ -93,24 +93,10 @@ fn run<S: StaticStructure>(
     let map = station_map(case, aero)?;
     let v_inf = aero.free_stream();
     let u = Vector3::from(v_inf).norm();
-    // The equilibrium with its multipliers (the same static solve as the time march's start).
-    let mut c = case.clone();
-    c.statics = Some(StaticSettings {
-        airspeeds: vec![u],
-        references: Vec::new(),
-        point_loads: Vec::new(),
-        load_factors: Vec::new(),
-        wake: Some(crate::stability::wake_settings(case, f, u)),
-    });
-    let so = crate::statics::run_static(&c, f);
-    if let Some(e) = so.error {
-        return Err(format!("static equilibrium: {e}"));
-    }
-    let p = so.points.into_iter().next().ok_or("static equilibrium: no point")?;
-    let (q, lam, mu) = match (p.error, p.state) {
-        (None, Some(s)) => s,
-        (e, _) => return Err(format!("static equilibrium: {}", e.unwrap_or_else(|| "no state".into()))),
-    };
+    // The equilibrium with its multipliers, the steady state of the linearised frozen wake.
+    let p = crate::statics::equilibrium_at(case, f, crate::stability::wake_settings(case, f, u))
+        .map_err(|e| format!("static equilibrium: {e}"))?;
+    let (q, lam, mu) = p.state.ok_or("static equilibrium: no state")?;
     let settings = crate::scene::settings(case, f);
     let dt = settings.params.dt;
     let wake = linear_wake(case, f, u);

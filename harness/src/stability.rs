@@ -321,19 +321,6 @@ impl Reduced {
             - t * x
     }
 
-    /// Leave out the motion of the frozen wake's nodes (every node but the trailing edge's stays
-    /// put): the flutter equation of a wake frozen in space, for comparison.
-    pub fn without_wake_motion(&mut self) {
-        self.wake_r.clear();
-        self.wake_g.clear();
-    }
-
-    /// Rows of the frozen wake whose nodes follow the trailing edge's past (0 without steady
-    /// loading or after [`Reduced::without_wake_motion`]).
-    pub fn n_moving_wake_rows(&self) -> usize {
-        self.wake_r.len()
-    }
-
     /// The part of `D(s)` at fixed circulations: `M s² + (C + G_ẋ) s + K + G_x` (UVLM models).
     pub(crate) fn structural(&self, s: C64) -> DMatrix<C64> {
         let r = self.ratio;
@@ -944,13 +931,7 @@ fn sweep<S: StaticStructure>(
             let mut states = Vec::with_capacity(st.airspeeds.len());
             for (airspeeds, wake) in groups {
                 let mut c = case.clone();
-                c.statics = Some(crate::case::StaticSettings {
-                    airspeeds,
-                    references: Vec::new(),
-                    point_loads: Vec::new(),
-                    load_factors: Vec::new(),
-                    wake: Some(wake),
-                });
+                c.statics = Some(crate::case::StaticSettings::at(airspeeds, Some(wake)));
                 let so = crate::statics::run_static(&c, f);
                 if let Some(e) = so.error {
                     return empty_output(f, Some(e));

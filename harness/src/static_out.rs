@@ -158,8 +158,7 @@ pub fn compare_with_history(summary: &mut StaticSummary, spec: &RunSpec, runs: &
     for run in runs.iter().filter(|r| r.error.is_none() && !r.rows.is_empty()) {
         let case = spec.case(run.formulation);
         let Some(aero) = &case.aero else { continue };
-        let v = aero.free_stream();
-        let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let airspeed = aero.speed();
         let Some(st) = summary.runs.iter().find(|o| o.formulation == run.formulation) else { continue };
         let Some(p) = st.points.iter().find(|p| (p.airspeed - airspeed).abs() < 1e-9 && p.error.is_none()) else {
             continue;
@@ -173,7 +172,7 @@ pub fn compare_with_history(summary: &mut StaticSummary, spec: &RunSpec, runs: &
         let fo: Vec<f64> = w.iter().map(|r| r.fold.to_degrees()).collect();
         let range = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
         let (tz_mean, fo_mean) = (tz.iter().sum::<f64>() / n, fo.iter().sum::<f64>() / n);
-        let run_wake = run_wake_of(case, run.formulation);
+        let run_wake = crate::stability::march_wake(case, run.formulation, airspeed);
         // A closed wake is the steady one: the point above, bit for bit.
         let like = if run_wake.closure { Ok((tip_z, fold)) } else { static_with_run_wake(case, run.formulation) };
         let (rw_tip, rw_fold, rw_err) = match like {
@@ -207,47 +206,15 @@ pub fn wake_label(w: &WakeSettings) -> String {
     format!("{} rows of {} m, {}", w.rows, w.row_length, if w.closure { "closed" } else { "unclosed" })
 }
 
-/// The wake a time march of `case` with formulation `f` sheds: `aero.n_wake_rows` rows of
-/// airspeed × the formulation's `dt`, closed when `aero.wake_closure` (default rows for a case
-/// without `aero`).
-pub fn run_wake_of(case: &Case, f: Formulation) -> WakeSettings {
-    let dt = match f {
-        Formulation::Ancf => case.ancf.dt,
-        Formulation::Gebf => case.gebf.dt,
-    };
-    let (airspeed, rows, closure) = case.aero.as_ref().map_or((0.0, 0, false), |a| {
-        let v = a.free_stream();
-        ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt(), a.n_wake_rows, a.wake_closure)
-    });
-    WakeSettings { row_length: airspeed * dt, rows, closure }
-}
-
 /// The static equilibrium of `case` at its airspeed with the wake of its own time march
-/// ([`run_wake_of`]) as the steady wake: tip height (m) and fold angle (degrees).
+/// ([`crate::stability::march_wake`]) as the steady wake: tip height (m) and fold angle (degrees).
 ///
 /// # Errors
 /// A case without `aero`, or no equilibrium.
 pub fn static_with_run_wake(case: &Case, f: Formulation) -> Result<(f64, f64), String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
-    let v = aero.free_stream();
-    let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let mut c = case.clone();
-    c.statics = Some(crate::case::StaticSettings {
-        airspeeds: vec![airspeed],
-        references: Vec::new(),
-        point_loads: Vec::new(),
-        load_factors: Vec::new(),
-        wake: Some(run_wake_of(case, f)),
-    });
-    let out = crate::statics::run_static(&c, f);
-    if let Some(e) = out.error {
-        return Err(e);
-    }
-    let p = out.points.first().ok_or("no point")?;
-    match &p.error {
-        Some(e) => Err(e.clone()),
-        None => Ok((p.tip[2], p.fold_deg)),
-    }
+    let p = crate::statics::equilibrium_at(case, f, crate::stability::march_wake(case, f, aero.speed()))?;
+    Ok((p.tip[2], p.fold_deg))
 }
 
 /// Linear interpolation of the converged points `(airspeed, value)` (sorted) at `u`; None

@@ -523,6 +523,31 @@ pub struct StaticOutput {
     pub error: Option<String>,
 }
 
+/// The static equilibrium of `case` at its own airspeed with the steady wake `wake`: the point
+/// with its state.
+///
+/// # Errors
+/// A case without `aero`, a failed sweep, or no equilibrium.
+pub fn equilibrium_at(
+    case: &Case,
+    f: Formulation,
+    wake: crate::stability::WakeSettings,
+) -> Result<StaticPoint, String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let mut c = case.clone();
+    c.statics = Some(crate::case::StaticSettings::at(vec![aero.speed()], Some(wake)));
+    let out = run_static(&c, f);
+    if let Some(e) = out.error {
+        return Err(e);
+    }
+    let p = out.points.into_iter().next().ok_or("no point")?;
+    match (&p.error, &p.state) {
+        (Some(e), _) => Err(e.clone()),
+        (None, None) => Err("no state".into()),
+        (None, Some(_)) => Ok(p),
+    }
+}
+
 /// Run the static sweep of `case` (its `static.airspeeds`, or for a structural case its
 /// `static.load_factors`) with formulation `f`.
 pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
