@@ -55,6 +55,13 @@ pub struct AeroSettings {
     /// ≈ −1.3 % lift bias of a 40-row wake); default false (the paper's and SHARPy's set-up).
     #[serde(default)]
     pub wake_closure: bool,
+    /// Apply the Kutta–Joukowski force to the trailing-edge segment, whose net circulation
+    /// Γ_w0 − Γ_TE is what the last step shed (as SHARPy's linear UVLM and Ptera Software do);
+    /// default false (SHARPy's time-marching UVLM and the paper: the segment carries no load).
+    /// Zero in steady flow; a first-order discretisation term otherwise (≈ −ρ·h·Δy·dΓ_TE/dt with
+    /// h the wake row length), which vanishes as the chordwise panels are refined.
+    #[serde(default)]
+    pub te_segment_force: bool,
     /// Mirror planes (at most two, perpendicular): a wind-tunnel wall or floor at a wall-mounted
     /// model's root, an aircraft's plane of symmetry, the ground. Each reflects every bound and
     /// wake vortex (image vortices). Default none.
@@ -85,6 +92,7 @@ impl AeroSettings {
         let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
         params.n_wake_rows = self.n_wake_rows;
         params.wake_closure = self.wake_closure;
+        params.te_segment_force = self.te_segment_force;
         params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();

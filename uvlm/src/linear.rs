@@ -287,7 +287,9 @@ impl Uvlm {
         let nrm = lat.normals();
         let reference_residual: Vec<f64> =
             (0..nr).map(|r| (0..3).map(|q| (fz.v_col[r][q] + u_col0[r][q]) * nrm[r][q]).sum()).collect();
-        compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_mid0, None, &p);
+        // The trailing-edge segment (`te_segment_force`) carries Γ_w0 − Γ_TE: zero in the
+        // reference state, whose newest wake row holds the trailing-edge circulation.
+        compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_mid0, None, Some(&g_te), &p);
         let mut reference_forces = vec![0.0; 3 * nn];
         stack(&fz.loads, &mut reference_forces);
 
@@ -308,25 +310,33 @@ impl Uvlm {
         let mut minus = vec![0.0; 3 * nn];
         let mut u_pm = vec![[0.0; 3]; u_mid0.len()];
         let mut gamma_pm = vec![0.0; nr];
-        let mut load_derivative = |fz: &mut Frozen, dgamma: Option<usize>, du: &[[f64; 3]], out: &mut [f64]| {
-            for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
-                gamma_pm.copy_from_slice(&gamma0);
-                if let Some(r) = dgamma {
-                    gamma_pm[r] += sgn;
-                }
-                fz.bs.set_strengths(&gamma_pm);
-                for (s, u) in u_pm.iter_mut().enumerate() {
-                    for q in 0..3 {
-                        u[q] = u_mid0[s][q] + sgn * du[s][q];
+        let mut shed_pm = g_te.clone();
+        // `dshed`: a unit step of the newest wake ring of that column (its direct load on the
+        // trailing-edge segment, with `te_segment_force`).
+        let mut load_derivative =
+            |fz: &mut Frozen, dgamma: Option<usize>, dshed: Option<usize>, du: &[[f64; 3]], out: &mut [f64]| {
+                for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                    gamma_pm.copy_from_slice(&gamma0);
+                    if let Some(r) = dgamma {
+                        gamma_pm[r] += sgn;
                     }
+                    shed_pm.copy_from_slice(&g_te);
+                    if let Some(j) = dshed {
+                        shed_pm[j] += sgn;
+                    }
+                    fz.bs.set_strengths(&gamma_pm);
+                    for (s, u) in u_pm.iter_mut().enumerate() {
+                        for q in 0..3 {
+                            u[q] = u_mid0[s][q] + sgn * du[s][q];
+                        }
+                    }
+                    compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_pm, None, Some(&shed_pm), &p);
+                    stack(&fz.loads, buf);
                 }
-                compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_pm, None, &p);
-                stack(&fz.loads, buf);
-            }
-            for k in 0..out.len() {
-                out[k] = 0.5 * (plus[k] - minus[k]);
-            }
-        };
+                for k in 0..out.len() {
+                    out[k] = 0.5 * (plus[k] - minus[k]);
+                }
+            };
 
         // Bound rings: F_Γ and F_Γ̇.
         let mut force_gamma = DMatrix::zeros(3 * nn, nr);
@@ -344,10 +354,10 @@ impl Uvlm {
             induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blk);
             fz.mid = mid;
             let du = fz.u_mid.clone();
-            load_derivative(&mut fz, Some(r), &du, &mut col);
+            load_derivative(&mut fz, Some(r), None, &du, &mut col);
             force_gamma.column_mut(r).copy_from_slice(&col);
             fz.bs.set_strengths(&zero_gamma);
-            compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &zeros_mid, Some(&unit), &p);
+            compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &zeros_mid, Some(&unit), None, &p);
             stack(&fz.loads, &mut col);
             force_gamma_dot.column_mut(r).copy_from_slice(&col);
         }
@@ -369,7 +379,7 @@ impl Uvlm {
                     w[(r, j)] = (0..3).map(|q| fz.u_col[r][q] * nrm[r][q]).sum();
                 }
                 let du = fz.u_mid.clone();
-                load_derivative(&mut fz, None, &du, &mut col);
+                load_derivative(&mut fz, None, (k == 0).then_some(j), &du, &mut col);
                 f.column_mut(j).copy_from_slice(&col);
             }
             row_normalwash.push(w);
@@ -396,6 +406,11 @@ impl Uvlm {
 }
 
 impl LinearUvlm {
+    /// Circulation of the frozen wake's newest row, per column (the reference state's shed row).
+    fn reference_shed(&self) -> Vec<f64> {
+        (0..self.wake.n_spanwise()).map(|j| if self.wake.n_rows() > 0 { self.wake.gamma(0, j) } else { 0.0 }).collect()
+    }
+
     /// The reference lattice (its geometry at the steady solution).
     pub fn lattice(&self) -> &Lattice {
         &self.lattice
@@ -448,7 +463,8 @@ impl LinearUvlm {
         let residual = (0..lattice.n_rings())
             .map(|r| (0..3).map(|q| (fz.v_col[r][q] - cv[r][q] + fz.u_col[r][q]) * nrm[r][q]).sum())
             .collect();
-        compute_loads(&mut fz.loads, lattice, &fz.bs, &fz.v_mid, &fz.u_mid, None, &self.params);
+        let shed = self.reference_shed();
+        compute_loads(&mut fz.loads, lattice, &fz.bs, &fz.v_mid, &fz.u_mid, None, Some(&shed), &self.params);
         let mut forces = vec![0.0; self.n_force()];
         stack(&fz.loads, &mut forces);
         Ok((residual, forces))
@@ -546,6 +562,7 @@ impl LinearUvlm {
         let normalwash = lat.normals().iter().map(|n| (0..3).map(|q| d[q] * n[q]).sum()).collect();
         let collocation_delays = lat.collocation().iter().map(|c| delay(*c)).collect();
         let mut fz = Frozen::default();
+        let shed = self.reference_shed();
         fz.build(lat, &self.gamma0, &self.wake, self.closure, &self.params);
         let bsf = std::mem::take(&mut fz.bs.fil);
         let known = std::mem::take(&mut fz.known);
@@ -564,7 +581,7 @@ impl LinearUvlm {
         for m in 0..n_mid {
             for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
                 v_pm[m] = [v_mid0[m][0] + sgn * d[0], v_mid0[m][1] + sgn * d[1], v_mid0[m][2] + sgn * d[2]];
-                compute_loads(&mut fz.loads, lat, &fz.bs, &v_pm, &fz.u_mid, None, &self.params);
+                compute_loads(&mut fz.loads, lat, &fz.bs, &v_pm, &fz.u_mid, None, Some(&shed), &self.params);
                 stack(&fz.loads, buf);
             }
             v_pm[m] = v_mid0[m];
@@ -608,6 +625,7 @@ impl LinearUvlm {
         let te: Vec<[f64; 3]> = lat.ring_nodes()[m * (n + 1)..].to_vec();
         let g_te: Vec<f64> = self.te_rings.iter().map(|&r| self.gamma0[r]).collect();
         let mut fz = Frozen::default();
+        let shed = self.reference_shed();
         fz.build(lat, &self.gamma0, &self.wake, self.closure, p);
         let bsf = std::mem::take(&mut fz.bs.fil);
         let known = std::mem::take(&mut fz.known);
@@ -681,7 +699,7 @@ impl LinearUvlm {
                                 u[q] = u_mid0[s][q] + sgn * du_mid[s][q];
                             }
                         }
-                        compute_loads(&mut fz.loads, lat, &fz.bs, &v_mid0, &u_pm, None, p);
+                        compute_loads(&mut fz.loads, lat, &fz.bs, &v_mid0, &u_pm, None, Some(&shed), p);
                         stack(&fz.loads, buf);
                     }
                     for i in 0..nf {

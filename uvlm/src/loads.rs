@@ -8,7 +8,8 @@
 //! `V_ext = V∞ + u_dist` the external flow at the midpoint (see [`crate::flow`]), `Γ_s` the
 //! segment's net circulation, split ½–½ to its end nodes. The trailing-edge segment
 //! (net strength Γ_w0 − Γ_TE, the circulation shed during the step) is skipped by default, as in
-//! SHARPy, or included, as in Ptera Software (`te_segment_force`). Unsteady part (eq. 16 of
+//! SHARPy's time-marching UVLM, or included, as in Ptera Software and SHARPy's linear UVLM
+//! (`te_segment_force`). Unsteady part (eq. 16 of
 //! Otsuka, Cheng & Palacios 2024; Katz & Plotkin §13.12):
 //!
 //! $$ f_r = \rho\,A_r\,n_r\,\frac{d\Gamma_r}{dt}, $$
@@ -124,7 +125,10 @@ pub fn lift_drag_of(f: [f64; 3], v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f
 
 /// Fill `loads` from the solved bound system. `v_mid[s]` and `u_mid[s]` are the external flow and
 /// the induced velocity at the midpoint of lattice segment `s`; `gamma_dot` the ring circulation
-/// rates (None: steady).
+/// rates (None: steady); `te_shed[j]` the circulation Γ_w0 of the newest wake ring of column `j`,
+/// which the trailing-edge segment carries besides the bound −Γ_TE (used with
+/// `te_segment_force`; None: no shed row).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn compute_loads(
     loads: &mut Loads,
     lat: &Lattice,
@@ -132,6 +136,7 @@ pub(crate) fn compute_loads(
     v_mid: &[[f64; 3]],
     u_mid: &[[f64; 3]],
     gamma_dot: Option<&[f64]>,
+    te_shed: Option<&[f64]>,
     params: &UvlmParams,
 ) {
     let (rho, te_segment_force) = (params.rho, params.te_segment_force);
@@ -147,9 +152,16 @@ pub(crate) fn compute_loads(
     loads.positions.extend_from_slice(nodes);
     let mut tot = [0.0; 3];
     for s in 0..bs.n_lattice_seg {
-        let g = bs.lattice_segment_gamma(s);
         let te_row = s >= m * n + m * nc;
-        if g == 0.0 || (te_row && !te_segment_force) {
+        if te_row && !te_segment_force {
+            continue;
+        }
+        let mut g = bs.lattice_segment_gamma(s);
+        if let (true, Some(w)) = (te_row, te_shed) {
+            // Net strength of the trailing-edge segment: the shed row's +Γ_w0 with the bound −Γ_TE.
+            g += w[(s - (m * n + m * nc)) % n];
+        }
+        if g == 0.0 {
             continue;
         }
         let (a, b) = bs.fil.segment_nodes(s);

@@ -82,8 +82,10 @@ pub struct UvlmParams {
     /// Image planes (symmetry and/or ground), at most two, perpendicular.
     #[serde(default)]
     pub images: Vec<ImagePlane>,
-    /// Apply the Joukowski force to the trailing-edge segment (net strength Γ_w0 − Γ_TE) as
-    /// Ptera Software does; default false (SHARPy: the segment is skipped). Zero at steady state.
+    /// Apply the Joukowski force to the trailing-edge segment (net strength Γ_w0 − Γ_TE, the
+    /// newest wake row's circulation with the bound −Γ_TE) as Ptera Software and SHARPy's linear
+    /// UVLM do; default false (SHARPy's time-marching UVLM: the segment is skipped). Zero at
+    /// steady state; in unsteady flow a first-order term in the wake row length.
     #[serde(default)]
     pub te_segment_force: bool,
     /// Include the unsteady load term ρ·A·n·dΓ/dt. Default true.

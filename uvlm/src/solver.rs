@@ -70,6 +70,8 @@ pub struct Uvlm {
     v_wake: Vec<[f64; 3]>,
     row_buf: Vec<[f64; 3]>,
     gamma_row: Vec<f64>,
+    /// Circulation of the newest wake row, per column (the trailing-edge segment's force).
+    te_shed: Vec<f64>,
     blk: NodeBlock,
     loads: Loads,
     stats: Stats,
@@ -116,6 +118,7 @@ impl Uvlm {
             v_wake: Vec::new(),
             row_buf: vec![[0.0; 3]; n + 1],
             gamma_row: vec![0.0; n],
+            te_shed: vec![0.0; n],
             blk: NodeBlock::default(),
             loads: Loads::default(),
             stats: Stats::default(),
@@ -361,7 +364,14 @@ impl Uvlm {
         self.v_mid.resize(self.mid.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
         let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
-        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.v_mid, &self.u_mid, gd, &self.params);
+        let shed = with_known_wake && self.params.te_segment_force && self.wake.n_rows() > 0;
+        if shed {
+            for j in 0..self.te_shed.len() {
+                self.te_shed[j] = self.wake.gamma(0, j);
+            }
+        }
+        let te_shed = if shed { Some(&self.te_shed[..]) } else { None };
+        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.v_mid, &self.u_mid, gd, te_shed, &self.params);
     }
 
     /// Steady solution with the wake of [`UvlmParams::steady_wake`] along the free stream:

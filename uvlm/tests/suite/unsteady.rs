@@ -44,14 +44,23 @@ fn wagner_function_high_aspect_ratio() {
 }
 
 /// Steady state is a fixed point: after a steady solve, a prefilled straight wake closed by
-/// semi-infinite legs reproduces the steady circulations and loads at every unsteady step.
+/// semi-infinite legs reproduces the steady circulations and loads at every unsteady step, with
+/// and without the trailing-edge segment's force (its net circulation Γ_w0 − Γ_TE is zero in
+/// steady flow).
 #[test]
 fn prefilled_steady_wake_is_fixed_point() {
+    for te_segment_force in [false, true] {
+        prefilled_steady_wake_is_fixed_point_with(te_segment_force);
+    }
+}
+
+fn prefilled_steady_wake_is_fixed_point_with(te_segment_force: bool) {
     let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
     let lat = Lattice::from_stations(wing.spec(), &wing.stations(0.2)).unwrap();
     let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
     p.wake_closure = true;
     p.n_wake_rows = 10;
+    p.te_segment_force = te_segment_force;
     let mut u = Uvlm::new(lat, p).unwrap();
     let f_steady = u.solve_steady().unwrap().total_force();
     let g_steady = u.gamma().to_vec();
