@@ -62,6 +62,11 @@ pub struct AeroSettings {
     /// h the wake row length), which vanishes as the chordwise panels are refined.
     #[serde(default)]
     pub te_segment_force: bool,
+    /// Give the last panel row's trailing-edge corners their quarter of the unsteady load term
+    /// ρ·A·n·dΓ/dt; default true (the whole term acts). False reproduces SHARPy's time-marching
+    /// UVLM, which skips those corners: the last row applies half its unsteady load.
+    #[serde(default = "default_true")]
+    pub unsteady_te_corners: bool,
     /// Mirror planes (at most two, perpendicular): a wind-tunnel wall or floor at a wall-mounted
     /// model's root, an aircraft's plane of symmetry, the ground. Each reflects every bound and
     /// wake vortex (image vortices). Default none.
@@ -93,6 +98,7 @@ impl AeroSettings {
         params.n_wake_rows = self.n_wake_rows;
         params.wake_closure = self.wake_closure;
         params.te_segment_force = self.te_segment_force;
+        params.unsteady_te_corners = self.unsteady_te_corners;
         params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
@@ -103,6 +109,10 @@ impl AeroSettings {
 
 fn default_cutoff() -> f64 {
     1e-6
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl AeroSettings {

@@ -201,20 +201,28 @@ pub(crate) fn compute_loads(
     loads.total_steady = tot;
     let mut tu = [0.0; 3];
     if let Some(gd) = gamma_dot {
+        // Without `unsteady_te_corners` the last row's two trailing-edge corners get nothing (as
+        // SHARPy's time-marching UVLM): that row applies half its load, at its leading corners.
+        let te_nodes = m * nc;
         for i in 0..m {
             for j in 0..n {
                 let r = lat.ring_index(i, j);
                 let c = rho * lat.areas()[r] * gd[r];
                 let nr = lat.normals()[r];
                 let f = [c * nr[0], c * nr[1], c * nr[2]];
+                let mut applied = 0.0;
                 for k in lat.ring_corners(i, j) {
+                    if k >= te_nodes && !params.unsteady_te_corners {
+                        continue;
+                    }
+                    applied += 0.25;
                     for q in 0..3 {
                         loads.nodal[k][q] += 0.25 * f[q];
                     }
                 }
                 for q in 0..3 {
-                    loads.strip[j][q] += f[q];
-                    tu[q] += f[q];
+                    loads.strip[j][q] += applied * f[q];
+                    tu[q] += applied * f[q];
                 }
             }
         }

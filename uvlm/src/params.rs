@@ -91,6 +91,12 @@ pub struct UvlmParams {
     /// Include the unsteady load term ρ·A·n·dΓ/dt. Default true.
     #[serde(default = "default_true")]
     pub unsteady_term: bool,
+    /// Give the last panel row's trailing-edge corners their quarter of the unsteady load term
+    /// (default true: every ring's ρ·A·n·dΓ/dt acts whole, a quarter at each corner). False
+    /// reproduces SHARPy's time-marching UVLM, which skips those corners, so that the last row
+    /// applies half its unsteady load, at its leading corners.
+    #[serde(default = "default_true")]
+    pub unsteady_te_corners: bool,
     /// Threading of the Biot–Savart kernels. Default auto.
     #[serde(default)]
     pub parallel: Parallel,
@@ -120,6 +126,7 @@ impl UvlmParams {
             images: Vec::new(),
             te_segment_force: false,
             unsteady_term: true,
+            unsteady_te_corners: true,
             parallel: Parallel::Auto,
             steady_wake: SteadyWake::SemiInfinite,
         }
