@@ -446,7 +446,7 @@ pub fn simulate_aero_from<S: AeroStructure>(
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s);
-    // Wing loads from the free body of each output state (docs/outputs.md §6).
+    // Wing loads from the free body of each output state (docs/statics.md §4).
     let load_model = settings.loads.as_ref();
     let mut load_scratch = crate::loads::LoadScratch::default();
     let mut with_loads = |model: &S, r: &mut crate::run::Row, s: &genalpha::State, loads: &[SectionLoad]| {

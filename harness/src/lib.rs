@@ -36,6 +36,7 @@ pub mod shard;
 pub mod signal;
 pub mod stability;
 pub mod stability_out;
+pub mod static_hold;
 pub mod static_out;
 pub mod statics;
 pub mod stress;

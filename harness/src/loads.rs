@@ -1,6 +1,6 @@
 //! Wing loads from a free body: the root wrench at a clamp and the hinge moment of a flared
 //! hinge, from the aerodynamic station loads, gravity and (in time histories) the inertia of the
-//! distributed mass and the point masses (docs/outputs.md §6).
+//! distributed mass and the point masses (docs/statics.md §4).
 //!
 //! Both formulations are measured by the same rule, written once against [`AeroStructure`]: the
 //! free body is the set of bodies outboard of the cut, and its loads are integrated along the

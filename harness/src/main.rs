@@ -557,7 +557,9 @@ fn run_stress(
 fn run_static_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> harness::static_out::StaticSummary {
     use rayon::prelude::*;
     let outs: Vec<_> = fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect();
-    harness::static_out::summarise(&spec.ancf, &spec.dir, outs)
+    let mut summary = harness::static_out::summarise(&spec.ancf, &spec.dir, outs);
+    harness::static_hold::hold_references(spec, &mut summary);
+    summary
 }
 
 /// Print a sweep's outcome; true when a point failed.
@@ -606,6 +608,24 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
     for r in &s.references {
         for (f, rms) in &r.rms_deg {
             println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label);
+        }
+    }
+    for h in &s.held {
+        match &h.error {
+            Some(e) => eprintln!(
+                "static {} {}: held at {} deg at {} m/s: FAILED: {e}",
+                s.name, h.formulation, h.coast_deg, h.airspeed
+            ),
+            None => println!(
+                "static {} {}: held at the measured {:.2} deg at {} m/s: hinge moment {:+.5} N m ({:+.3e} m^3 x q), equivalent pitch {:+.2} deg",
+                s.name,
+                h.formulation,
+                h.coast_deg,
+                h.airspeed,
+                h.hinge_moment,
+                h.per_dynamic_pressure,
+                h.equivalent_pitch_deg
+            ),
         }
     }
     for c in &s.history {

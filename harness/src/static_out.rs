@@ -1,4 +1,4 @@
-//! Outputs of a static aeroelastic sweep (docs/outputs.md §6): `static_<f>.csv`,
+//! Outputs of a static aeroelastic sweep (docs/statics.md §5, §7): `static_<f>.csv`,
 //! `static_lift_<f>.csv`, `static_summary.json`, three SVG plots, and the report's section.
 
 use std::fmt::Write as _;
@@ -108,6 +108,9 @@ pub struct StaticSummary {
     /// The case's own time history (when it was run alongside): its mean over the second half
     /// of the run against the static solution at the same airspeed.
     pub history: Vec<HistoryComparison>,
+    /// The model held at the experiment's coast angles ([`crate::static_hold`]; filled by
+    /// [`crate::static_hold::hold_references`]).
+    pub held: Vec<crate::static_hold::HeldPoint>,
 }
 
 /// A time history's mean over a window against the static equilibrium at its airspeed.
@@ -298,6 +301,7 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
         max_rbm_relative_difference: drbm,
         n_failed,
         history: Vec::new(),
+        held: Vec::new(),
     }
 }
 
@@ -694,6 +698,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
         );
     }
     h.push_str("</ul>\n");
+    h.push_str(&held_html(&s.held));
     for (file, alt) in [
         ("static_coast.svg", "coast angle against airspeed"),
         ("static_rbm.svg", "root bending moment against airspeed"),
@@ -701,6 +706,43 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     ] {
         let _ = writeln!(h, "<p><img src=\"{}/{file}\" alt=\"{alt}\" width=\"900\"></p>", html_escape(folder));
     }
+    h
+}
+
+/// The table of the model held at the experiment's coast angles (empty without such points).
+fn held_html(held: &[crate::static_hold::HeldPoint]) -> String {
+    if held.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from(
+        "<p>The model held at the experiment's coast angles (docs/statics.md §7): the moment about the hinge axis \
+         that the model's tip has there and the experiment's tip did not (fold-up positive), over the dynamic \
+         pressure (constant where the difference is aerodynamic), and the root pitch change that cancels it.</p>\n\
+         <table><tr><th>formulation</th><th>airspeed [m/s]</th><th>measured coast [°]</th><th>hinge moment [N·m]</th>\
+         <th>per dynamic pressure [m³]</th><th>equivalent pitch [°]</th></tr>\n",
+    );
+    for p in held {
+        let f = p.formulation.as_str().to_uppercase();
+        match &p.error {
+            Some(e) => {
+                let _ = writeln!(
+                    h,
+                    "<tr><td>{f}</td><td>{}</td><td>{:.2}</td><td colspan=3>failed: {}</td></tr>",
+                    p.airspeed,
+                    p.coast_deg,
+                    html_escape(e)
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    h,
+                    "<tr><td>{f}</td><td>{}</td><td>{:.2}</td><td>{:+.5}</td><td>{:+.3e}</td><td>{:+.2}</td></tr>",
+                    p.airspeed, p.coast_deg, p.hinge_moment, p.per_dynamic_pressure, p.equivalent_pitch_deg
+                );
+            }
+        }
+    }
+    h.push_str("</table>\n");
     h
 }
 

@@ -203,3 +203,28 @@ fn static_with_the_runs_wake_meets_the_time_history_mean() {
     // The steady-wake solution stays where it was, further from the mean.
     assert!(c.tip_z_relative_difference.abs() > 2.0 * c.run_wake_tip_z_relative_difference.abs());
 }
+
+/// The model held at a measured coast angle (docs/statics.md §7) reads a known difference back.
+/// The "measurement" is the flare 10° case's own equilibrium at 27 m/s with the root pitched
+/// 2° lower: held there, the 5° model's tip has a fold-up moment that a root pitch change of
+/// −2° cancels (within 0.05°: the secant's error); held at its own equilibrium, none (below
+/// 1e-5 N·m, its spring's 1e-4 N·m/rad included). Both formulations.
+#[test]
+fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
+    let spec = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[27]"]);
+    let lower = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[27]", "pitch_deg=3"]);
+    for f in Formulation::ALL {
+        let own = run_static(spec.case(f), f).points[0].fold_deg;
+        let measured = run_static(lower.case(f), f).points[0].fold_deg;
+        assert!(own - measured > 5.0, "{f}: {own} vs {measured}");
+        let at_own = harness::static_hold::hold(spec.case(f), f, 27.0, own);
+        assert!(at_own.error.is_none(), "{:?}", at_own.error);
+        assert!(at_own.hinge_moment.abs() < 1e-5, "{f}: {at_own:?}");
+        let held = harness::static_hold::hold(spec.case(f), f, 27.0, measured);
+        println!("{held:?}");
+        assert!(held.error.is_none(), "{:?}", held.error);
+        assert!((held.fold_deg - measured).abs() < 1e-3, "{f}: held at {} for {measured}", held.fold_deg);
+        assert!(held.hinge_moment > 0.0 && held.pitch_sensitivity > 0.0, "{f}: {held:?}");
+        assert!((held.equivalent_pitch_deg + 2.0).abs() < 0.05, "{f}: {held:?}");
+    }
+}
