@@ -228,3 +228,37 @@ fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
         assert!((held.equivalent_pitch_deg + 2.0).abs() < 0.05, "{f}: {held:?}");
     }
 }
+
+/// `harness static` holds the model at the experiment's coast angles inside the sweep's range:
+/// `held` in `static_summary.json` (one entry per experiment airspeed from 24 to 33 m/s) and
+/// its table in the report section.
+#[test]
+fn harness_static_reports_the_model_held_at_the_experiment() {
+    let dir = std::env::temp_dir().join(format!("flexmb-held-{}", std::process::id()));
+    let o = harness(&[
+        "static",
+        "cases/healy_ffwt_flare30_aoa10.json",
+        "--formulation",
+        "gebf",
+        "--set",
+        "static.airspeeds=[24,33]",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = dir.join("healy_ffwt_flare30_aoa10");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("static_summary.json")).unwrap()).unwrap();
+    let held = v["held"].as_array().unwrap();
+    let speeds: Vec<f64> = held.iter().map(|h| h["airspeed"].as_f64().unwrap()).collect();
+    assert_eq!(speeds, [24.0, 27.0, 30.0, 33.0]);
+    for h in held {
+        assert!(h.get("error").is_none(), "{h}");
+        let (coast, fold) = (h["coast_deg"].as_f64().unwrap(), h["fold_deg"].as_f64().unwrap());
+        assert!((coast - fold).abs() < 1e-3, "{h}");
+        assert!(h["equivalent_pitch_deg"].as_f64().unwrap().is_finite(), "{h}");
+    }
+    let section = std::fs::read_to_string(run.join("static_section.html")).unwrap();
+    assert!(section.contains("equivalent pitch"), "{section}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
