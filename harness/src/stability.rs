@@ -375,6 +375,47 @@ impl Reduced {
         ev.iter().filter(|x| x.im.abs() <= 1e-9 * scale).map(|x| x.re).fold(f64::INFINITY, f64::min)
     }
 
+    /// Mode `m`'s root at the speed ratio `target` that `taken` does not claim: continued from its
+    /// structural start at an eighth of the ratio in eight equal steps (Newton at each). Where the
+    /// path ends on a claimed root (the mode's complex pair has split into two over-damped real
+    /// roots, which a complex path cannot follow, and it was carried onto a neighbour's branch),
+    /// Newton at `target` from the real parts of the path's points, last first. The model is left
+    /// at `target`. None when neither gives a root. The fallback for a start that lands on another
+    /// mode's root.
+    pub fn continued(
+        &mut self,
+        m: usize,
+        target: f64,
+        count: &mut usize,
+        taken: impl Fn(C64) -> bool,
+    ) -> Option<(C64, DVector<C64>)> {
+        const STEPS: usize = 8;
+        let mut path: Vec<(C64, DVector<C64>)> = Vec::with_capacity(STEPS);
+        for k in 1..=STEPS {
+            self.at_speed_ratio(target * k as f64 / STEPS as f64);
+            let start = match path.last() {
+                Some(x) => Some(x.clone()),
+                None => self.starts(m + 1).pop(),
+            };
+            let Some((s0, e0)) = start else { break };
+            match self.newton(s0, e0, count) {
+                (s, e, true) => path.push((C64::new(s.re, s.im.abs()), e)),
+                _ => break,
+            }
+        }
+        self.at_speed_ratio(target);
+        if path.len() == STEPS {
+            let (s, e) = path.last().expect("STEPS points").clone();
+            if !taken(s) {
+                return Some((s, e));
+            }
+        }
+        path.iter().rev().find_map(|(s, e)| match self.newton(C64::new(s.re, 0.0), e.clone(), count) {
+            (r, e, true) if !taken(C64::new(r.re, r.im.abs())) => Some((C64::new(r.re, r.im.abs()), e)),
+            _ => None,
+        })
+    }
+
     /// Newton's method on `D(s) η = 0`, `cᴴ η = 1` from `(s, η)`; returns the root and its vector.
     /// `dD/ds` is a central difference, kept between iterations while they contract (a chord
     /// method: one evaluation of `D` per iteration) and refreshed when they do not.
@@ -1014,7 +1055,6 @@ fn sweep<S: StaticStructure>(
             None
         };
         red.at_speed_ratio(target);
-        let red: &Reduced = red;
         out.n_free = red.omega.len();
         out.n_basis = red.n_basis();
         out.n_rings = red.n_rings;
@@ -1037,15 +1077,37 @@ fn sweep<S: StaticStructure>(
             (Some(t), _) if t.len() == nmodes => t.clone(),
             _ => red.starts(nmodes),
         };
+        let mut found: Vec<(C64, DVector<C64>, bool)> = starts
+            .into_iter()
+            .map(|(s0, e0)| match red.newton(s0, e0.clone(), &mut out.n_evaluations) {
+                (s, e, true) => (C64::new(s.re, s.im.abs()), e, true),
+                _ => (s0, e0, false),
+            })
+            .collect();
+        let same = |a: C64, b: C64| (a - b).norm() <= 1e-6 * (1.0 + a.norm());
+        // Starts that do not converge, or that land on one root (a strongly damped mode can jump
+        // to a neighbour's root): follow each of those modes up from low speed instead, where it
+        // is near its structural root.
+        let suspects: Vec<usize> = (0..found.len())
+            .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same(found[j].0, found[m].0)))
+            .collect();
+        for m in suspects {
+            let claimed = |s: C64| found.iter().enumerate().any(|(j, f)| j != m && f.2 && same(f.0, s));
+            match red.continued(m, target, &mut out.n_evaluations, claimed) {
+                Some((s, e)) => found[m] = (s, e, true),
+                None => found[m].2 = false,
+            }
+        }
+        // Starts that still share a root: the later one is not a root of its own.
+        for m in 0..found.len() {
+            if found[m].2 && (0..m).any(|j| found[j].2 && same(found[j].0, found[m].0)) {
+                found[m].2 = false;
+            }
+        }
         let mut roots = Vec::with_capacity(nmodes);
         let mut next = Vec::with_capacity(nmodes);
-        for (m, (s0, e0)) in starts.into_iter().enumerate() {
-            let (s, e, ok) = red.newton(s0, e0.clone(), &mut out.n_evaluations);
-            let (s, e) = if ok { (s, e) } else { (s0, e0) };
-            let s = C64::new(s.re, s.im.abs());
-            // Two starts that land on one root: the later one is not a root of its own.
-            let dup = roots.iter().any(|r: &Root| (C64::new(r.real, r.imag) - s).norm() <= 1e-6 * (1.0 + s.norm()));
-            roots.push(Root { mode: m, real: s.re, imag: s.im, converged: ok && !dup });
+        for (m, (s, e, ok)) in found.into_iter().enumerate() {
+            roots.push(Root { mode: m, real: s.re, imag: s.im, converged: ok });
             next.push((s, e));
         }
         let smin = red.static_stiffness_min();
