@@ -624,6 +624,11 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     for r in &s.references {
         let _ = write!(h, "<th>{}</th>", html_escape(&r.label));
     }
+    for r in s.references.iter().filter(|r| r.experiment) {
+        for (f, _) in &r.errors {
+            let _ = write!(h, "<th>{} − {} [°]</th>", f.as_str().to_uppercase(), html_escape(&r.label));
+        }
+    }
     h.push_str("</tr>\n");
     if let Some(first) = s.runs.first() {
         for (i, p) in first.points.iter().enumerate() {
@@ -646,6 +651,16 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
                         let _ = write!(h, "<td>{:.2}</td>", x.1);
                     }
                     None => h.push_str("<td></td>"),
+                }
+            }
+            for r in s.references.iter().filter(|r| r.experiment) {
+                for (_, errors) in &r.errors {
+                    match errors.iter().find(|e| (e.0 - p.airspeed).abs() < 1e-9) {
+                        Some(e) => {
+                            let _ = write!(h, "<td>{:+.2}</td>", e.3);
+                        }
+                        None => h.push_str("<td></td>"),
+                    }
                 }
             }
             h.push_str("</tr>\n");
