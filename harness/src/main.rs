@@ -562,7 +562,7 @@ fn run_static_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> harness
     summary
 }
 
-/// Print a sweep's outcome; true when a point failed.
+/// Print a sweep's outcome; true when a point (or a point of the model held at the experiment) failed.
 fn report_static(s: &harness::static_out::StaticSummary) -> bool {
     let structural = s.runs.iter().flat_map(|r| &r.points).any(|p| p.load_factor.is_some());
     for r in &s.runs {
@@ -610,7 +610,9 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label);
         }
     }
+    let mut held_failed = false;
     for h in &s.held {
+        held_failed |= h.error.is_some();
         match &h.error {
             Some(e) => eprintln!(
                 "static {} {}: held at {} deg at {} m/s: FAILED: {e}",
@@ -678,7 +680,7 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             100.0 * s.max_rbm_relative_difference
         );
     }
-    s.n_failed > 0 || s.runs.iter().any(|r| r.error.is_some())
+    s.n_failed > 0 || held_failed || s.runs.iter().any(|r| r.error.is_some())
 }
 
 /// 2 when any input was bad (whatever else happened), else 1 when a run or a gate failed.

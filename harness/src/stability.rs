@@ -282,6 +282,20 @@ pub struct Reduced {
     pub(crate) phi: DMatrix<f64>,
 }
 
+/// Steps of [`Reduced::continuation_path`].
+const CONTINUATION_STEPS: usize = 8;
+
+/// The root of the conjugate pair in the upper half plane, with its vector (`D(s̄) = conj D(s)`:
+/// the conjugate root's vector is the conjugate vector).
+fn upper(s: C64, e: DVector<C64>) -> (C64, DVector<C64>) {
+    if s.im < 0.0 { (s.conj(), e.map(|x| x.conj())) } else { (s, e) }
+}
+
+/// Largest distance between consecutive roots of a continuation path.
+fn largest_step(path: &[(C64, DVector<C64>)]) -> f64 {
+    path.windows(2).map(|w| (w[1].0 - w[0].0).norm()).fold(0.0, f64::max)
+}
+
 impl Reduced {
     /// The same model at `ratio` times the airspeed it was built at, the geometry (and the wake's
     /// row lengths) held: with the circulations `Γ₀ ∝ U`, `R_x`, `T_Γ`, `T_k` and `G_ẋ` scale with
@@ -375,43 +389,43 @@ impl Reduced {
         ev.iter().filter(|x| x.im.abs() <= 1e-9 * scale).map(|x| x.re).fold(f64::INFINITY, f64::min)
     }
 
-    /// Mode `m`'s root at the speed ratio `target` that `taken` does not claim: continued from its
-    /// structural start at an eighth of the ratio in eight equal steps (Newton at each). Where the
-    /// path ends on a claimed root (the mode's complex pair has split into two over-damped real
-    /// roots, which a complex path cannot follow, and it was carried onto a neighbour's branch),
-    /// Newton at `target` from the real parts of the path's points, last first. The model is left
-    /// at `target`. None when neither gives a root. The fallback for a start that lands on another
-    /// mode's root.
-    pub fn continued(
-        &mut self,
-        m: usize,
-        target: f64,
-        count: &mut usize,
-        taken: impl Fn(C64) -> bool,
-    ) -> Option<(C64, DVector<C64>)> {
-        const STEPS: usize = 8;
-        let mut path: Vec<(C64, DVector<C64>)> = Vec::with_capacity(STEPS);
-        for k in 1..=STEPS {
-            self.at_speed_ratio(target * k as f64 / STEPS as f64);
+    /// Mode `m` followed up from low speed: from its structural start at an eighth of the speed
+    /// ratio `target` to `target` in eight equal steps, Newton at each; the roots (upper half
+    /// plane) of the steps that converged, in order, ending at `target` when all did. The model
+    /// is left at `target`. The fallback for a start that lands on another mode's root.
+    pub fn continuation_path(&mut self, m: usize, target: f64, count: &mut usize) -> Vec<(C64, DVector<C64>)> {
+        let mut path: Vec<(C64, DVector<C64>)> = Vec::with_capacity(CONTINUATION_STEPS);
+        for k in 1..=CONTINUATION_STEPS {
+            self.at_speed_ratio(target * k as f64 / CONTINUATION_STEPS as f64);
             let start = match path.last() {
                 Some(x) => Some(x.clone()),
                 None => self.starts(m + 1).pop(),
             };
             let Some((s0, e0)) = start else { break };
             match self.newton(s0, e0, count) {
-                (s, e, true) => path.push((C64::new(s.re, s.im.abs()), e)),
+                (s, e, true) => path.push(upper(s, e)),
                 _ => break,
             }
         }
         self.at_speed_ratio(target);
-        if path.len() == STEPS {
-            let (s, e) = path.last().expect("STEPS points").clone();
-            if !taken(s) {
-                return Some((s, e));
-            }
-        }
-        path.iter().rev().find_map(|(s, e)| match self.newton(C64::new(s.re, 0.0), e.clone(), count) {
-            (r, e, true) if !taken(C64::new(r.re, r.im.abs())) => Some((C64::new(r.re, r.im.abs()), e)),
+        path
+    }
+
+    /// A root at the current speed ratio that `taken` does not claim, from the points of a
+    /// continuation path that did not end on a root of its own: Newton from the last point as
+    /// it is (a path cut short), then from the real parts of its points, last first (the mode's
+    /// complex pair has split into two over-damped real roots, which a complex path cannot
+    /// follow).
+    pub fn restart_from_path(
+        &self,
+        path: &[(C64, DVector<C64>)],
+        count: &mut usize,
+        taken: impl Fn(C64) -> bool,
+    ) -> Option<(C64, DVector<C64>)> {
+        let last = path.last().map(|(s, e)| (*s, e.clone()));
+        let reals = path.iter().rev().map(|(s, e)| (C64::new(s.re, 0.0), e.clone()));
+        last.into_iter().chain(reals).find_map(|(s0, e0)| match self.newton(s0, e0, count) {
+            (s, e, true) if !taken(upper(s, e.clone()).0) => Some(upper(s, e)),
             _ => None,
         })
     }
@@ -1080,22 +1094,55 @@ fn sweep<S: StaticStructure>(
         let mut found: Vec<(C64, DVector<C64>, bool)> = starts
             .into_iter()
             .map(|(s0, e0)| match red.newton(s0, e0.clone(), &mut out.n_evaluations) {
-                (s, e, true) => (C64::new(s.re, s.im.abs()), e, true),
+                (s, e, true) => {
+                    let (s, e) = upper(s, e);
+                    (s, e, true)
+                }
                 _ => (s0, e0, false),
             })
             .collect();
         let same = |a: C64, b: C64| (a - b).norm() <= 1e-6 * (1.0 + a.norm());
         // Starts that do not converge, or that land on one root (a strongly damped mode can jump
         // to a neighbour's root): follow each of those modes up from low speed instead, where it
-        // is near its structural root.
+        // is near its structural root. A path's end is the mode's root unless a mode that was
+        // not in doubt holds it, or another path ends there too with smaller steps (the
+        // smoother path keeps the root: the other jumped branches); those restart from their
+        // paths.
         let suspects: Vec<usize> = (0..found.len())
             .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same(found[j].0, found[m].0)))
             .collect();
-        for m in suspects {
-            let claimed = |s: C64| found.iter().enumerate().any(|(j, f)| j != m && f.2 && same(f.0, s));
-            match red.continued(m, target, &mut out.n_evaluations, claimed) {
-                Some((s, e)) => found[m] = (s, e, true),
-                None => found[m].2 = false,
+        if !suspects.is_empty() {
+            for &m in &suspects {
+                found[m].2 = false;
+            }
+            let paths: Vec<Vec<(C64, DVector<C64>)>> =
+                suspects.iter().map(|&m| red.continuation_path(m, target, &mut out.n_evaluations)).collect();
+            let complete = |i: usize| paths[i].len() == CONTINUATION_STEPS;
+            let mut pending = Vec::new();
+            for (i, &m) in suspects.iter().enumerate() {
+                let end = complete(i).then(|| paths[i].last().expect("complete path").0);
+                let keeps = end.is_some_and(|r| {
+                    !found.iter().any(|f| f.2 && same(f.0, r))
+                        && !suspects.iter().enumerate().any(|(k, _)| {
+                            k != i
+                                && complete(k)
+                                && same(paths[k].last().expect("complete path").0, r)
+                                && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
+                        })
+                });
+                if keeps {
+                    let (s, e) = paths[i].last().expect("complete path").clone();
+                    found[m] = (s, e, true);
+                } else {
+                    pending.push(i);
+                }
+            }
+            for i in pending {
+                let m = suspects[i];
+                let claimed = |s: C64| found.iter().any(|f| f.2 && same(f.0, s));
+                if let Some((s, e)) = red.restart_from_path(&paths[i], &mut out.n_evaluations, claimed) {
+                    found[m] = (s, e, true);
+                }
             }
         }
         // Starts that still share a root: the later one is not a root of its own.

@@ -80,7 +80,8 @@ fn held_moment(
     coast_deg: f64,
     dpitch_deg: f64,
 ) -> Result<(f64, f64), String> {
-    let (c, (k, rest)) = held_case(case, airspeed, coast_deg, dpitch_deg).ok_or("the case has no free fold hinge")?;
+    let (c, (k, rest)) = held_case(case, airspeed, coast_deg, dpitch_deg)
+        .ok_or("the case has no free fold hinge or no `static` block")?;
     let out = crate::statics::run_static(&c, f);
     if let Some(e) = out.error {
         return Err(e);

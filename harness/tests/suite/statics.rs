@@ -208,7 +208,8 @@ fn static_with_the_runs_wake_meets_the_time_history_mean() {
 /// The "measurement" is the flare 10° case's own equilibrium at 27 m/s with the root pitched
 /// 2° lower: held there, the 5° model's tip has a fold-up moment that a root pitch change of
 /// −2° cancels (within 0.05°: the secant's error); held at its own equilibrium, none (below
-/// 1e-5 N·m, its spring's 1e-4 N·m/rad included). Both formulations.
+/// 1e-5 N·m, its spring's 1e-4 N·m/rad included), nor with a 0.05 N·m/rad spring. Both
+/// formulations.
 #[test]
 fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
     let spec = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[27]"]);
@@ -226,6 +227,16 @@ fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
         assert!((held.fold_deg - measured).abs() < 1e-3, "{f}: held at {} for {measured}", held.fold_deg);
         assert!(held.hinge_moment > 0.0 && held.pitch_sensitivity > 0.0, "{f}: {held:?}");
         assert!((held.equivalent_pitch_deg + 2.0).abs() < 0.05, "{f}: {held:?}");
+    }
+    // A sprung hinge (its spring carries 0.011 N·m here): held at its own equilibrium, still none.
+    let sprung = case(
+        "healy_ffwt_flare10_aoa5.json",
+        &["static.airspeeds=[27]", "joints.1.spring.stiffness=0.05", "joints.1.spring.rest_deg=3"],
+    );
+    for f in Formulation::ALL {
+        let own = run_static(sprung.case(f), f).points[0].fold_deg;
+        let at_own = harness::static_hold::hold(sprung.case(f), f, 27.0, own);
+        assert!(at_own.hinge_moment.abs() < 1e-5, "{f}: {own} {at_own:?}");
     }
 }
 
