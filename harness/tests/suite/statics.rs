@@ -67,6 +67,12 @@ fn a_damped_time_march_settles_on_the_static_equilibrium() {
         let fold = last.fold.to_degrees();
         assert!((fold - p.fold_deg).abs() < 0.1, "{f}: march {fold}°, static {}°", p.fold_deg);
         let rbm = p.loads.root_bending_moment;
+        println!(
+            "{f}: fold march {fold:.4}° static {:.4}°; RBM march {:.6} static {rbm:.6} N·m ({:+.4} %)",
+            p.fold_deg,
+            last.root_bending_moment,
+            100.0 * (last.root_bending_moment - rbm) / rbm.abs()
+        );
         assert!(
             (last.root_bending_moment - rbm).abs() < 2e-3 * rbm.abs(),
             "{f}: march {} N·m, static {rbm} N·m",
