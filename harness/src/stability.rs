@@ -425,7 +425,7 @@ impl Reduced {
         let last = path.last().map(|(s, e)| (*s, e.clone()));
         let reals = path.iter().rev().map(|(s, e)| (C64::new(s.re, 0.0), e.clone()));
         last.into_iter().chain(reals).find_map(|(s0, e0)| match self.newton(s0, e0, count) {
-            (s, e, true) if !taken(upper(s, e.clone()).0) => Some(upper(s, e)),
+            (s, e, true) if !taken(C64::new(s.re, s.im.abs())) => Some(upper(s, e)),
             _ => None,
         })
     }
@@ -1117,24 +1117,22 @@ fn sweep<S: StaticStructure>(
             }
             let paths: Vec<Vec<(C64, DVector<C64>)>> =
                 suspects.iter().map(|&m| red.continuation_path(m, target, &mut out.n_evaluations)).collect();
-            let complete = |i: usize| paths[i].len() == CONTINUATION_STEPS;
+            // Each path's end at the full speed ratio (None for a path cut short).
+            let ends: Vec<Option<C64>> =
+                paths.iter().map(|p| p.last().filter(|_| p.len() == CONTINUATION_STEPS).map(|x| x.0)).collect();
             let mut pending = Vec::new();
             for (i, &m) in suspects.iter().enumerate() {
-                let end = complete(i).then(|| paths[i].last().expect("complete path").0);
-                let keeps = end.is_some_and(|r| {
+                let keeps = ends[i].is_some_and(|r| {
                     !found.iter().any(|f| f.2 && same(f.0, r))
-                        && !suspects.iter().enumerate().any(|(k, _)| {
+                        && !(0..suspects.len()).any(|k| {
                             k != i
-                                && complete(k)
-                                && same(paths[k].last().expect("complete path").0, r)
+                                && ends[k].is_some_and(|rk| same(rk, r))
                                 && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
                         })
                 });
-                if keeps {
-                    let (s, e) = paths[i].last().expect("complete path").clone();
-                    found[m] = (s, e, true);
-                } else {
-                    pending.push(i);
+                match paths[i].last() {
+                    Some((s, e)) if keeps => found[m] = (*s, e.clone(), true),
+                    _ => pending.push(i),
                 }
             }
             for i in pending {
