@@ -403,6 +403,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         log_x: true,
         log_y: true,
         series: wp_series,
+        ..Default::default()
     };
     panels_svg(&dir.join("work_precision.svg"), &[wp], 1, (1000, 480))?;
     let t = Panel {
@@ -412,6 +413,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         log_x: true,
         log_y: true,
         series: series(&|g| g.dt, &[Ladder::Time]),
+        ..Default::default()
     };
     let s = Panel {
         title: format!("{} — error against elements", r.name),
@@ -420,6 +422,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
         log_x: true,
         log_y: true,
         series: series(&|g| g.elements.for_body(0) as f64, &[Ladder::Space]),
+        ..Default::default()
     };
     panels_svg(&dir.join("convergence.svg"), &[t, s], 2, (700, 420))
 }

@@ -114,6 +114,9 @@ pub struct Panel {
     pub log_x: bool,
     /// Logarithmic y axis (non-positive values are clipped to the smallest positive one).
     pub log_y: bool,
+    /// Widen a linear x axis by 5 % each side, as the y axis is (scattered points, a root locus),
+    /// instead of ending it at the data (time histories, sweeps).
+    pub pad_x: bool,
     /// Curves.
     pub series: Vec<Series>,
 }
@@ -273,8 +276,17 @@ where
     let label_style = ("sans-serif", 14);
     match (p.log_x, p.log_y) {
         (false, false) => {
-            let (x0, x1) =
-                finite_range(xs).map(|(a, b)| if b > a { (a, b) } else { (a, a + 1.0) }).unwrap_or((0.0, 1.0));
+            let (x0, x1) = finite_range(xs)
+                .map(|(a, b)| {
+                    if p.pad_x {
+                        pad(a, b)
+                    } else if b > a {
+                        (a, b)
+                    } else {
+                        (a, a + 1.0)
+                    }
+                })
+                .unwrap_or((0.0, 1.0));
             let (lo, hi) = finite_range(ys).map(|(a, b)| pad(a, b)).unwrap_or((-1.0, 1.0));
             let mut c = chart.build_cartesian_2d(x0..x1, lo..hi).map_err(|e| e.to_string())?;
             c.configure_mesh()

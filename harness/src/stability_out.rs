@@ -158,6 +158,7 @@ fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {
         title: "Root locus over the sweep".into(),
         x_label: "Re s (1/s)".into(),
         y_label: "Im s (rad/s)".into(),
+        pad_x: true,
         ..Default::default()
     };
     for out in runs {
