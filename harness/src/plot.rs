@@ -415,6 +415,7 @@ mod tests {
             y_label: "Z [m]".into(),
             log_x,
             log_y,
+            pad_x: false,
             series: (0..3)
                 .map(|k| {
                     Series::new(
