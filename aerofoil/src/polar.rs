@@ -69,6 +69,12 @@ pub struct Coefficients {
     pub dcd: f64,
     /// `dcm/dα`, 1/rad.
     pub dcm: f64,
+    /// `∂cl/∂Re` (zero for a single table, and outside the Reynolds range when clamped).
+    pub dcl_dre: f64,
+    /// `∂cd/∂Re`.
+    pub dcd_dre: f64,
+    /// `∂cm/∂Re`.
+    pub dcm_dre: f64,
 }
 
 /// A validated table with its interpolants.
@@ -95,7 +101,7 @@ impl Fitted {
         let (cd, dcd) = self.curves[1].eval(&t.alpha, &t.cd, a);
         let (cm, dcm) = self.curves[2].eval(&t.alpha, &t.cm, a);
         let k = if inside { 1.0 } else { 0.0 };
-        Ok(Coefficients { cl, cd, cm, dcl: k * dcl, dcd: k * dcd, dcm: k * dcm })
+        Ok(Coefficients { cl, cd, cm, dcl: k * dcl, dcd: k * dcd, dcm: k * dcm, ..Coefficients::default() })
     }
 }
 
@@ -191,12 +197,15 @@ impl Polar {
     ///
     /// Between two tables `Re_k ≤ re ≤ Re_{k+1}` the result is `(1 − w)·c_k(α) + w·c_{k+1}(α)`
     /// with `w = ln(re/Re_k) / ln(Re_{k+1}/Re_k)`; the incidence must lie in both tables' ranges.
+    /// The Reynolds derivatives are those of this blend (one-sided at a table's own Re, where
+    /// the blend has a kink).
     pub fn coefficients(&self, alpha: f64, re: f64) -> Result<Coefficients> {
         let rule = self.bounds.alpha;
         let Some((re_min, re_max)) = self.re_range() else {
             return self.tables[0].eval(alpha, rule);
         };
-        if (!(re_min..=re_max).contains(&re) && self.bounds.re == OutOfRange::Error) || re.is_nan() {
+        let inside = (re_min..=re_max).contains(&re);
+        if (!inside && self.bounds.re == OutOfRange::Error) || re.is_nan() {
             return Err(AerofoilError::ReynoldsOutOfRange { re, min: re_min, max: re_max });
         }
         let re = re.clamp(re_min, re_max);
@@ -207,7 +216,12 @@ impl Polar {
         let w = (re / ra).ln() / (rb / ra).ln();
         let (ca, cb) = (a.eval(alpha, rule)?, b.eval(alpha, rule)?);
         let mix = |x: f64, y: f64| (1.0 - w) * x + w * y;
+        // dw/dRe; zero where the Reynolds number is clamped (the derivative of a constant).
+        let dw = if inside { 1.0 / (re * (rb / ra).ln()) } else { 0.0 };
         Ok(Coefficients {
+            dcl_dre: dw * (cb.cl - ca.cl),
+            dcd_dre: dw * (cb.cd - ca.cd),
+            dcm_dre: dw * (cb.cm - ca.cm),
             cl: mix(ca.cl, cb.cl),
             cd: mix(ca.cd, cb.cd),
             cm: mix(ca.cm, cb.cm),
@@ -302,6 +316,9 @@ mod tests {
         assert_relative_eq!(c.cl, 5.5 * (0.05 + 0.02), max_relative = 1e-12);
         assert_relative_eq!(c.dcl, 5.5, max_relative = 1e-9);
         assert_relative_eq!(c.cd, 0.015 + 0.05 * 0.05, max_relative = 1e-3);
+        let (h, re) = (1.0, 2e5);
+        let fd = (p.coefficients(0.05, re + h).unwrap().cl - p.coefficients(0.05, re - h).unwrap().cl) / (2.0 * h);
+        assert_relative_eq!(c.dcl_dre, fd, max_relative = 1e-6);
         // At a table's own Re, that table alone.
         assert_relative_eq!(p.coefficients(0.05, 4e5).unwrap().cl, 6.0 * 0.07, max_relative = 1e-12);
         assert_relative_eq!(p.zero_lift_alpha(2e5).unwrap(), -0.02, epsilon = 1e-10);

@@ -49,5 +49,7 @@ fn reynolds_outside_the_file_is_refused_unless_clamped() {
     let p = polar();
     assert!(p.coefficients(0.05, 2.5e5).is_err());
     let clamped = p.with_bounds(Bounds { re: OutOfRange::Clamp, ..Bounds::default() });
-    assert_eq!(clamped.coefficients(0.05, 2.5e5).unwrap(), clamped.coefficients(0.05, 2.0e5).unwrap());
+    let (out, end) = (clamped.coefficients(0.05, 2.5e5).unwrap(), clamped.coefficients(0.05, 2.0e5).unwrap());
+    assert_eq!((out.cl, out.cd, out.cm, out.dcl), (end.cl, end.cd, end.cm, end.dcl));
+    assert_eq!(out.dcl_dre, 0.0, "clamped in Re: no Reynolds slope");
 }
