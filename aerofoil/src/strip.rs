@@ -140,6 +140,12 @@ pub struct Correction {
     /// `dM/dα_e` at fixed flow when the lattice's lift acts at the quarter chord (steady thin
     /// plate): `r × dF/dα + cm' qS c x̂`, N·m/rad.
     pub d_moment_d_alpha: Vector3<f64>,
+    /// `∂F/∂u` at fixed lattice loads, N·s/m: how the corrected force follows the strip's flow
+    /// vector through `d̂`, `l̂`, `q`, `α_e` (via `cl_inv = F_inv·l̂/(qS)`) and `Re`. The full
+    /// tangent adds `force_jacobian() · ∂F_inv/∂u` of the lattice.
+    pub d_force_d_flow: Matrix3<f64>,
+    /// `∂M/∂u` at fixed lattice loads, N·s.
+    pub d_moment_d_flow: Matrix3<f64>,
 }
 
 impl Correction {
@@ -198,6 +204,8 @@ pub fn correct_strip(
     };
     let d_force_d_lift = (c.dcl / a - 1.0) * lift_dir + (c.dcd / a) * drag_dir;
     let d_force_d_alpha = q_area * (c.dcl * lift_dir + c.dcd * drag_dir);
+    let frame = StripState { speed, drag_dir, lift_dir, q_area, reynolds, cl_inviscid, lift_slope: a };
+    let (d_force_d_flow, d_moment_d_flow) = flow_jacobians(&frame, &c, strip, inviscid);
     Ok(Correction {
         loads,
         alpha,
@@ -212,7 +220,50 @@ pub fn correct_strip(
         d_moment_d_lift: r.cross(&d_force_d_lift) + (c.dcm * strip.chord / a) * span,
         d_force_d_alpha,
         d_moment_d_alpha: r.cross(&d_force_d_alpha) + c.dcm * q_area * strip.chord * span,
+        d_force_d_flow,
+        d_moment_d_flow,
     })
+}
+
+/// The section-plane quantities of one evaluation.
+struct StripState {
+    speed: f64,
+    drag_dir: Vector3<f64>,
+    lift_dir: Vector3<f64>,
+    q_area: f64,
+    reynolds: f64,
+    cl_inviscid: f64,
+    lift_slope: f64,
+}
+
+/// `∂F/∂u` and `∂M/∂u` at fixed lattice loads. With `P = diag(0, 1, 1)` (the section plane):
+///
+/// $$ \partial\hat d = (I - \hat d\hat d^T)P/V, \quad \partial\hat l = -[\hat x]_\times\partial\hat d,
+///    \quad \partial Q = 2Q/V\,\hat d^T, \quad \partial Re = Re/V\,\hat d^T, $$
+/// $$ \partial\alpha_e = \big(F_{inv}^T\partial\hat l/Q - cl_{inv}\,\partial Q/Q\big)/a_{lat}, \quad
+///    \partial c = c'\,\partial\alpha_e + c_{Re}\,\partial Re, $$
+/// and the product rule on `ΔF = (cl Q − L) l̂ + cd Q d̂`, `ΔM = r × ΔF + cm Q c x̂`.
+fn flow_jacobians(
+    s: &StripState,
+    c: &Coefficients,
+    strip: &Strip,
+    inviscid: &StripLoads,
+) -> (Matrix3<f64>, Matrix3<f64>) {
+    let (d, l, q) = (s.drag_dir, s.lift_dir, s.q_area);
+    let plane = Matrix3::from_diagonal(&Vector3::new(0.0, 1.0, 1.0));
+    let dd = (Matrix3::identity() - d * d.transpose()) * plane / s.speed;
+    let dl = -Vector3::<f64>::x().cross_matrix() * dd;
+    let dq = (2.0 * q / s.speed) * d.transpose();
+    let dre = (s.reynolds / s.speed) * d.transpose();
+    let dlift = inviscid.force.transpose() * dl;
+    let dalpha = (dlift / q - s.cl_inviscid * dq / q) / s.lift_slope;
+    let dcl = c.dcl * dalpha + c.dcl_dre * dre;
+    let dcd = c.dcd * dalpha + c.dcd_dre * dre;
+    let dcm = c.dcm * dalpha + c.dcm_dre * dre;
+    let lift_excess = c.cl * q - s.cl_inviscid * q;
+    let df = l * (q * dcl + c.cl * dq - dlift) + lift_excess * dl + d * (q * dcd + c.cd * dq) + (c.cd * q) * dd;
+    let dm = strip.quarter_chord.cross_matrix() * df + (strip.chord * Vector3::x()) * (q * dcm + c.cm * dq);
+    (df, dm)
 }
 
 #[cfg(test)]

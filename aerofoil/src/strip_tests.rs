@@ -214,3 +214,32 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    /// `d_force_d_flow` and `d_moment_d_flow` against central differences in every component of
+    /// the flow vector, at fixed lattice loads, between two Reynolds tables.
+    #[test]
+    fn jacobian_in_the_flow_matches_finite_differences(
+        alpha_deg in -15.0f64..15.0, spanwise in -0.3f64..0.3, v in 21.0f64..55.0, cl in -1.0f64..1.0,
+    ) {
+        let polar = stall_polar();
+        let lat = LatticeSection { lift_slope: 6.0, zero_lift_alpha: -0.01 };
+        let base = strip(alpha_deg.to_radians(), spanwise);
+        let s = Strip { flow: base.flow * (v / 20.0), ..base };
+        let inv = inviscid(&s, cl, Vector3::new(0.01, -0.02, 0.0));
+        let Ok(c) = correct_strip(&polar, &lat, &s, &inv) else { return Ok(()) };
+        let h = 1e-6 * s.flow.norm();
+        for k in 0..3 {
+            let mut e = Vector3::zeros();
+            e[k] = h;
+            let at = |du: Vector3<f64>| correct_strip(&polar, &lat, &Strip { flow: s.flow + du, ..s }, &inv);
+            let (Ok(p), Ok(m)) = (at(e), at(-e)) else { return Ok(()) };
+            let fd_f = (p.loads.force - m.loads.force) / (2.0 * h);
+            let fd_m = (p.loads.moment - m.loads.moment) / (2.0 * h);
+            let scale = c.q_area / s.flow.norm();
+            let (jf, jm) = (c.d_force_d_flow.column(k), c.d_moment_d_flow.column(k));
+            prop_assert!((fd_f - jf).norm() <= 1e-6 * scale, "column {k}: {fd_f} vs {jf}");
+            prop_assert!((fd_m - jm).norm() <= 1e-7 * scale, "column {k}: {fd_m} vs {jm}");
+        }
+    }
+}
