@@ -1,12 +1,15 @@
 //! `harness`: run both formulations on the case files, compare, report, gate.
+//!
+//! One function per subcommand (`cmd_*`), each over the argument structs the subcommands share
+//! (`CaseSource`, `OutOpt`, `SetOpt`, `ShardOpt`, `AnalysisArgs`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use harness::case::{CaseFile, Formulation, Override, json_schema};
+use harness::case::{CaseFile, Formulation, Override, RunSpec, json_schema};
 use harness::driver::{
     any_interrupted, claim_outputs, discover, expand_all, finish_case, limit_steps, run_all, run_into, variant_name,
     write_index,
@@ -43,6 +46,31 @@ struct ShardOpt {
     shard: Option<ShardArg>,
 }
 
+/// `--set` of every command that reads case files.
+#[derive(Args, Clone)]
+struct SetOpt {
+    /// Override a case value: `[ancf:|gebf:]path=value`, e.g. `t_end=0.5`,
+    /// `gebf:joints.1.flare_deg=40`, `pitch_deg=5` or `gust.gradients_m=[30]`.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<Override>,
+}
+
+/// `--out` of the commands that write a report (default `reports`).
+#[derive(Args, Clone)]
+struct OutOpt {
+    /// Output folder.
+    #[arg(long, default_value = "reports")]
+    out: PathBuf,
+}
+
+/// `--cases` of the commands that discover case files.
+#[derive(Args, Clone)]
+struct CaseSource {
+    /// Folder of case files.
+    #[arg(long, default_value = "cases")]
+    cases: PathBuf,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum Which {
     Ancf,
@@ -50,90 +78,205 @@ enum Which {
     Both,
 }
 
+impl Which {
+    /// The formulations this choice runs.
+    fn formulations(self) -> Vec<Formulation> {
+        match self {
+            Which::Ancf => vec![Formulation::Ancf],
+            Which::Gebf => vec![Formulation::Gebf],
+            Which::Both => Formulation::ALL.to_vec(),
+        }
+    }
+}
+
+/// The arguments of the analyses (`static`, `stability`, `gust`).
+#[derive(Args, Clone)]
+struct AnalysisArgs {
+    /// Case file (with the analysis' block: `static`, `stability` or `gust`).
+    case: PathBuf,
+    /// Formulation(s) to run.
+    #[arg(long, value_enum, default_value = "both")]
+    formulation: Which,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+    #[command(flatten)]
+    shard: ShardOpt,
+}
+
+/// `harness all`.
+#[derive(Args)]
+struct AllArgs {
+    #[command(flatten)]
+    cases: CaseSource,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+    /// Skip the refinement ladders, the stress matrix and the speed benchmark (cases only).
+    #[arg(long)]
+    quick: bool,
+    #[command(flatten)]
+    shard: ShardOpt,
+}
+
+/// `harness run`.
+#[derive(Args)]
+struct RunArgs {
+    /// Case file.
+    case: PathBuf,
+    /// Formulation(s) to run.
+    #[arg(long, value_enum, default_value = "both")]
+    formulation: Which,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+    /// Also write ParaView files (beams with section frames, chord ribbon, vortex lattice, wake;
+    /// .vtp plus a .pvd time series per family) to `<out>/<case>/vtk/<formulation>/`; a case
+    /// with a `vtk` block writes them without the flag.
+    #[arg(long)]
+    vtk: bool,
+    /// With --vtk, write every N-th output step (default: the case's `vtk.stride`, else about
+    /// 100 frames per run, max(1, output rows / 100)).
+    #[arg(long, value_name = "N", requires = "vtk")]
+    vtk_stride: Option<usize>,
+    /// Stop each run after N steps (a smoke test; the folder name says so).
+    #[arg(long, value_name = "N")]
+    max_steps: Option<usize>,
+}
+
+/// `harness fuzz`.
+#[derive(Args)]
+struct FuzzArgs {
+    /// Folder of seed case files (with their `reference/`).
+    #[arg(long, default_value = "cases")]
+    cases: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "reports/fuzz")]
+    out: PathBuf,
+    /// Number of inputs.
+    #[arg(long, default_value_t = 100_000)]
+    inputs: usize,
+    /// Index of the first input (to continue a campaign with the same seed).
+    #[arg(long, default_value_t = 0)]
+    first: usize,
+    /// Seed of the mutations.
+    #[arg(long, default_value_t = 19)]
+    seed: u64,
+    /// Inputs run at once.
+    #[arg(long, default_value_t = 2)]
+    jobs: usize,
+    /// Time limit of one input, s of CPU time (and 6 × this of wall time).
+    #[arg(long, default_value_t = 20)]
+    timeout: u64,
+    /// Address-space limit of one input, GB.
+    #[arg(long, default_value_t = 4)]
+    address_space_gb: u64,
+    /// Steps each run of an input takes at most.
+    #[arg(long, default_value_t = 3)]
+    max_steps: usize,
+    /// Children run `harness run` (every output file written) instead of `harness check`.
+    #[arg(long)]
+    run: bool,
+    /// A new process per input (`harness check`) instead of long-lived worker processes
+    /// (each still under the limits, restarted after any crash or hang).
+    #[arg(long)]
+    exec_each: bool,
+}
+
+/// `harness check`.
+#[derive(Args)]
+struct CheckArgs {
+    /// Case file.
+    case: PathBuf,
+    /// Steps each run takes at most.
+    #[arg(long, default_value_t = 3)]
+    max_steps: usize,
+}
+
+/// `harness gate` and `harness bench`: explicit case files, else the ones discovered.
+#[derive(Args)]
+struct FilesArgs {
+    /// Case files (default: the cases in --cases the command applies to).
+    files: Vec<PathBuf>,
+    #[command(flatten)]
+    cases: CaseSource,
+    #[command(flatten)]
+    set: SetOpt,
+}
+
+/// `harness converge` and `harness stress`: one case file, sharded.
+#[derive(Args)]
+struct StudyArgs {
+    /// Case file.
+    case: PathBuf,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+    #[command(flatten)]
+    shard: ShardOpt,
+}
+
+/// `harness stress`: as [`StudyArgs`], with the paper's pendulum as the default base case.
+#[derive(Args)]
+struct StressArgs {
+    /// Base case file.
+    #[arg(default_value = "cases/double_pendulum_c1_beta45.json")]
+    case: PathBuf,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+    #[command(flatten)]
+    shard: ShardOpt,
+}
+
+/// `harness energy`.
+#[derive(Args)]
+struct EnergyArgs {
+    #[command(flatten)]
+    cases: CaseSource,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+}
+
+/// `harness bench`.
+#[derive(Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    files: FilesArgs,
+    /// Timed runs per configuration.
+    #[arg(long, default_value_t = 7)]
+    repeats: usize,
+    #[command(flatten)]
+    out: OutOpt,
+}
+
+/// `harness merge`.
+#[derive(Args)]
+struct MergeArgs {
+    /// The shards' output folders (each holds `shards/*.json`; shards may share one).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    #[command(flatten)]
+    out: OutOpt,
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// Run every case with both formulations; write reports/ (CSV, summary.json, SVG, index.html, summary.md).
-    All {
-        /// Folder of case files.
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value: `[ancf:|gebf:]path=value`, e.g. `t_end=0.5` or `gebf:joints.1.flare_deg=40`.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        /// Skip the refinement ladders, the stress matrix and the speed benchmark (cases only).
-        #[arg(long)]
-        quick: bool,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
+    All(AllArgs),
     /// Run one case file.
-    Run {
-        /// Case file.
-        case: PathBuf,
-        /// Formulation(s) to run.
-        #[arg(long, value_enum, default_value = "both")]
-        formulation: Which,
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        /// Also write ParaView files (beams with section frames, chord ribbon, vortex lattice, wake;
-        /// .vtp plus a .pvd time series per family) to `<out>/<case>/vtk/<formulation>/`; a case
-        /// with a `vtk` block writes them without the flag.
-        #[arg(long)]
-        vtk: bool,
-        /// With --vtk, write every N-th output step (default: the case's `vtk.stride`, else about
-        /// 100 frames per run, max(1, output rows / 100)).
-        #[arg(long, value_name = "N", requires = "vtk")]
-        vtk_stride: Option<usize>,
-        /// Stop each run after N steps (a smoke test; the folder name says so).
-        #[arg(long, value_name = "N")]
-        max_steps: Option<usize>,
-    },
+    Run(RunArgs),
     /// Fuzz campaign: mutants of the case files, each run in its own process (`run --max-steps`)
     /// under a time and an address-space limit, classified by outcome; writes `<out>/fuzz.json`,
     /// `fuzz.md` and every crashing input under `crashes/`.
-    Fuzz {
-        /// Folder of seed case files (with their `reference/`).
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Output folder.
-        #[arg(long, default_value = "reports/fuzz")]
-        out: PathBuf,
-        /// Number of inputs.
-        #[arg(long, default_value_t = 100_000)]
-        inputs: usize,
-        /// Index of the first input (to continue a campaign with the same seed).
-        #[arg(long, default_value_t = 0)]
-        first: usize,
-        /// Seed of the mutations.
-        #[arg(long, default_value_t = 19)]
-        seed: u64,
-        /// Inputs run at once.
-        #[arg(long, default_value_t = 2)]
-        jobs: usize,
-        /// Time limit of one input, s of CPU time (and 6 × this of wall time).
-        #[arg(long, default_value_t = 20)]
-        timeout: u64,
-        /// Address-space limit of one input, GB.
-        #[arg(long, default_value_t = 4)]
-        address_space_gb: u64,
-        /// Steps each run of an input takes at most.
-        #[arg(long, default_value_t = 3)]
-        max_steps: usize,
-        /// Children run `harness run` (every output file written) instead of `harness check`.
-        #[arg(long)]
-        run: bool,
-        /// A new process per input (`harness check`) instead of long-lived worker processes
-        /// (each still under the limits, restarted after any crash or hang).
-        #[arg(long)]
-        exec_each: bool,
-    },
+    Fuzz(FuzzArgs),
     /// The worker of `harness fuzz`: reads input paths from stdin, answers one line each.
     #[command(hide = true)]
     FuzzWorker {
@@ -143,159 +286,45 @@ enum Cmd {
     },
     /// Check a case file: parse, validate, build both formulations and run each at most
     /// `--max-steps` steps, writing nothing; exit 0 (runs), 1 (a run failed), 2 (bad input).
-    Check {
-        /// Case file.
-        case: PathBuf,
-        /// Steps each run takes at most.
-        #[arg(long, default_value_t = 3)]
-        max_steps: usize,
-    },
+    Check(CheckArgs),
     /// Run the gated cases and check their tolerances; exit 1 when any case fails.
-    Gate {
-        /// Case files (default: every case in --cases that declares a gate).
-        files: Vec<PathBuf>,
-        /// Folder of case files.
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-    },
-    /// Refinement ladders (time, space, both) for each formulation: error against wall time.
-    Converge {
-        /// Case file.
-        case: PathBuf,
-        /// Output folder (writes `<out>/converge/<case>/`).
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
-    /// The stress matrix (c × β × dt × rho_inf) on a base case, for both formulations.
-    Stress {
-        /// Base case file.
-        #[arg(default_value = "cases/double_pendulum_c1_beta45.json")]
-        case: PathBuf,
-        /// Output folder (writes `<out>/stress/`).
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a base-case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
+    Gate(FilesArgs),
+    /// Refinement ladders (time, space, both) for each formulation: error against wall time;
+    /// writes `<out>/converge/<case>/`.
+    Converge(StudyArgs),
+    /// The stress matrix (c × β × dt × rho_inf) on a base case, for both formulations; writes
+    /// `<out>/stress/`.
+    Stress(StressArgs),
     /// Energy at rho_inf = 1 of the c = 1 pendulums, each formulation in both generalized-α forms
     /// (Arnold–Brüls, Chung–Hulbert), at dt and dt/2; writes `<out>/energy/` (energy.md, energy.csv,
     /// energy.svg).
-    Energy {
-        /// Folder of case files.
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Output folder (writes `<out>/energy/`).
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-    },
+    Energy(EnergyArgs),
     /// Time each formulation on each case (median thread CPU time of repeated serial runs, ANCF on
     /// both paths) with the work per step; writes `<out>/bench/` (bench.md, bench.json, bench.svg).
-    Bench {
-        /// Case files (default: every case in --cases without aerodynamics).
-        files: Vec<PathBuf>,
-        /// Folder of case files.
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Timed runs per configuration.
-        #[arg(long, default_value_t = 7)]
-        repeats: usize,
-        /// Output folder (writes `<out>/bench/`).
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-    },
+    Bench(BenchArgs),
     /// Static aeroelastic equilibria over the case's `static.airspeeds` (or, for a case without
     /// `aero`, the equilibria under its `static.point_loads` at `static.load_factors`); writes
     /// `<out>/<case>/static_{ancf,gebf}.csv`, `static_lift_*.csv`, `static_summary.json` and plots.
-    Static {
-        /// Case file (with `aero` and `static` blocks).
-        case: PathBuf,
-        /// Formulation(s) to run.
-        #[arg(long, value_enum, default_value = "both")]
-        formulation: Which,
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`), e.g. `pitch_deg=5` or `joints.1.locked=true`.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
+    Static(AnalysisArgs),
     /// Merge the outputs of the shards of a sweep (`--shard`) into one report and summary; exits 1
     /// naming the runs no shard finished.
-    Merge {
-        /// The shards' output folders (each holds `shards/*.json`; shards may share one).
-        #[arg(required = true)]
-        dirs: Vec<PathBuf>,
-        /// Output folder of the merged report.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-    },
+    Merge(MergeArgs),
     /// Linearised stability over the case's `stability.airspeeds` (flutter, divergence, modes);
     /// writes `<out>/<case>/stability_{ancf,gebf}.csv`, `.json`, plots and a report fragment.
-    Stability {
-        /// Case file (with `aero` and `stability` blocks).
-        case: PathBuf,
-        /// Formulation(s) to run.
-        #[arg(long, value_enum, default_value = "both")]
-        formulation: Which,
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
+    Stability(AnalysisArgs),
     /// Gust sweep over the case's `gust` block (gradients x hinge states) from the static
     /// equilibrium; writes `<out>/<case>/gust_{ancf,gebf}.csv`, `gust_history_*.csv`,
     /// `gust_summary.json` and plots (docs/gust.md).
-    Gust {
-        /// Case file (with `aero.gust` and a `gust` block).
-        case: PathBuf,
-        /// Formulation(s) to run.
-        #[arg(long, value_enum, default_value = "both")]
-        formulation: Which,
-        /// Output folder.
-        #[arg(long, default_value = "reports")]
-        out: PathBuf,
-        /// Override a case value (see `all`), e.g. `gust.gradients_m=[30]`.
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        set: Vec<Override>,
-        #[command(flatten)]
-        shard: ShardOpt,
-    },
+    Gust(AnalysisArgs),
     /// List the runs the case files expand into.
-    List {
-        /// Folder of case files.
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-    },
+    List(CaseSource),
     /// Print the JSON Schema of case files.
     Schema,
 }
 
 /// Run the benchmark on `runs` and write `dir` (`<out>/bench/`); the targets apply to the cases without
 /// aerodynamics (the issues' figures are for the paper's pendulums).
-fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, dir: &std::path::Path) -> Result<Vec<bench::BenchRow>> {
+fn run_bench(runs: &[RunSpec], repeats: usize, dir: &Path) -> Result<Vec<bench::BenchRow>> {
     let t = std::time::Instant::now();
     let rows = bench::run(runs, repeats, true);
     let pendulums: Vec<&str> = runs.iter().filter(|r| r.ancf.aero.is_none()).map(|r| r.name.as_str()).collect();
@@ -306,7 +335,7 @@ fn run_bench(runs: &[harness::case::RunSpec], repeats: usize, dir: &std::path::P
 
 /// Run the energy study on the c = 1 pendulums among `runs`, write `dir` (`<out>/energy/`) and print the
 /// drifts; returns whether every run reached its end (true when there is nothing to study).
-fn run_energy(runs: &[harness::case::RunSpec], dir: &std::path::Path) -> Result<bool> {
+fn run_energy(runs: &[RunSpec], dir: &Path) -> Result<bool> {
     let t = std::time::Instant::now();
     let specs = energy::select(runs);
     if specs.is_empty() {
@@ -336,7 +365,7 @@ fn run_energy(runs: &[harness::case::RunSpec], dir: &std::path::Path) -> Result<
 }
 
 /// The extra hard runs of the stress study: a 20 s pendulum and the wing at AoA 15°.
-fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String, harness::case::RunSpec)>> {
+fn stress_extras(dir: &Path, set: &[Override]) -> Result<Vec<(String, RunSpec)>> {
     let mut v = Vec::new();
     let pend = dir.join("double_pendulum_c1_beta45.json");
     if pend.exists() {
@@ -355,7 +384,7 @@ fn stress_extras(dir: &std::path::Path, set: &[Override]) -> Result<Vec<(String,
 }
 
 /// The stability sweeps of `spec` with the formulations `fs`, in parallel.
-fn run_stability_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> Vec<harness::stability::StabilityOutput> {
+fn run_stability_case(spec: &RunSpec, fs: &[Formulation]) -> Vec<harness::stability::StabilityOutput> {
     use rayon::prelude::*;
     fs.par_iter().map(|&f| harness::stability::run_stability(spec.case(f), f)).collect()
 }
@@ -399,7 +428,7 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
 
 /// The gust sweep of one run specification with the formulations `fs`, written to
 /// `<out>/<case>/` and printed; true when a run of the sweep failed.
-fn gust_case(spec: &harness::case::RunSpec, fs: &[Formulation], out: &std::path::Path, file: &str) -> Result<bool> {
+fn gust_case(spec: &RunSpec, fs: &[Formulation], out: &Path, file: &str) -> Result<bool> {
     let mut failed = false;
     let sweep =
         harness::gust::run_sweep(spec, fs).map_err(|msg| harness::Error::Case { file: file.to_string(), msg })?;
@@ -450,43 +479,6 @@ fn gust_case(spec: &harness::case::RunSpec, fs: &[Formulation], out: &std::path:
     Ok(failed)
 }
 
-/// `harness gust`: every run of the case file through its gust sweep; exit 2 without a `gust`
-/// block, 1 when a run failed.
-fn run_gust(
-    case: &std::path::Path,
-    which: Which,
-    out: &std::path::Path,
-    set: &[Override],
-    shard: Option<ShardArg>,
-) -> Result<ExitCode> {
-    let runs = CaseFile::read(case)?.expand(set)?;
-    let fs: Vec<Formulation> = match which {
-        Which::Ancf => vec![Formulation::Ancf],
-        Which::Gebf => vec![Formulation::Gebf],
-        Which::Both => Formulation::ALL.to_vec(),
-    };
-    let file = case.display().to_string();
-    for spec in &runs {
-        if spec.ancf.gust.is_none() {
-            let msg = "gust: the case has no `gust` block (gradients and hinge states to sweep)".into();
-            return Err(harness::Error::Case { file, msg }.into());
-        }
-    }
-    let plan = harness::shard::plan("gust", shard, || {
-        runs.iter().map(|r| Unit { id: format!("gust:{}", r.name), cost: harness::shard::run_cost(r) }).collect()
-    })?;
-    let mut done = Vec::new();
-    let mut failed = false;
-    for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("gust:{}", r.name))) {
-        done.push(format!("gust:{}", spec.name));
-        failed |= gust_case(spec, &fs, out, &file)?;
-    }
-    if let Some(p) = &plan {
-        p.write_manifest(out, serde_json::json!({}), &done)?;
-    }
-    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
-}
-
 /// Rough multiples of one run's estimated cost for the studies of `harness all` (only the ratios
 /// between units matter to [`harness::shard::assign`]): a refinement ladder set, the energy study
 /// (both forms at dt and dt/2) and the benchmark (7 serial repeats, ANCF on two paths).
@@ -497,11 +489,11 @@ const BENCH_COST: f64 = 10.0;
 /// Every unit of work of `harness all`: each case run (with its static sweep), and unless
 /// `quick` each refinement ladder, stress cell and extra run, the energy study and the benchmark.
 fn all_units(
-    runs: &[harness::case::RunSpec],
+    runs: &[RunSpec],
     quick: bool,
-    stress_base: Option<&harness::case::RunSpec>,
+    stress_base: Option<&RunSpec>,
     axes: &stress::Axes,
-    extras: &[(String, harness::case::RunSpec)],
+    extras: &[(String, RunSpec)],
 ) -> Vec<Unit> {
     use harness::shard::run_cost;
     let mut u: Vec<Unit> = runs.iter().map(|r| Unit { id: run_unit(&r.name), cost: run_cost(r) }).collect();
@@ -522,11 +514,7 @@ fn all_units(
 }
 
 /// The units of the stress study: every cell of the matrix, then each extra run.
-fn stress_units(
-    base: &harness::case::RunSpec,
-    axes: &stress::Axes,
-    extras: &[(String, harness::case::RunSpec)],
-) -> Vec<Unit> {
+fn stress_units(base: &RunSpec, axes: &stress::Axes, extras: &[(String, RunSpec)]) -> Vec<Unit> {
     let mut u: Vec<Unit> =
         stress::jobs(axes).iter().map(|j| Unit { id: stress::job_id(j), cost: stress::job_cost(base, j) }).collect();
     u.extend(extras.iter().map(|(l, r)| Unit { id: harness::merge::extra_unit(l), cost: harness::shard::run_cost(r) }));
@@ -536,9 +524,9 @@ fn stress_units(
 /// Run this shard's cells and extra runs of the stress study (all of them without a plan),
 /// adding their units to `done`.
 fn run_stress(
-    base: &harness::case::RunSpec,
+    base: &RunSpec,
     axes: &stress::Axes,
-    extras: &[(String, harness::case::RunSpec)],
+    extras: &[(String, RunSpec)],
     plan: Option<&Plan>,
     done: &mut Vec<String>,
 ) -> (Vec<stress::Cell>, Vec<stress::Extra>) {
@@ -554,7 +542,7 @@ fn run_stress(
 }
 
 /// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
-fn run_static_case(spec: &harness::case::RunSpec, fs: &[Formulation]) -> harness::static_out::StaticSummary {
+fn run_static_case(spec: &RunSpec, fs: &[Formulation]) -> harness::static_out::StaticSummary {
     use rayon::prelude::*;
     let outs: Vec<_> = fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect();
     let mut summary = harness::static_out::summarise(&spec.ancf, &spec.dir, outs);
@@ -707,11 +695,11 @@ fn main() -> ExitCode {
 /// Claim the runs' output folders, run them streaming their CSVs, write their files; returns the
 /// results and whether a signal stopped them.
 fn run_and_write(
-    runs: &[harness::case::RunSpec],
+    runs: &[RunSpec],
     fs: &[Formulation],
-    out: &std::path::Path,
+    out: &Path,
     progress: &Progress,
-    observer: &(dyn Fn(&harness::case::RunSpec, Formulation) -> Box<dyn harness::run::Observer> + Sync),
+    observer: &(dyn Fn(&RunSpec, Formulation) -> Box<dyn harness::run::Observer> + Sync),
 ) -> Result<(Vec<harness::report::CaseResult>, bool)> {
     let (_locks, dirs) = claim_outputs(out, runs)?;
     let results = run_into(runs, fs, Some(&dirs), progress, observer);
@@ -723,12 +711,7 @@ fn run_and_write(
 }
 
 /// The runs renamed after their variant (`--set`, one formulation, `--max-steps`).
-fn variants(
-    mut runs: Vec<harness::case::RunSpec>,
-    set: &[Override],
-    fs: &[Formulation],
-    max_steps: Option<usize>,
-) -> Vec<harness::case::RunSpec> {
+fn variants(mut runs: Vec<RunSpec>, set: &[Override], fs: &[Formulation], max_steps: Option<usize>) -> Vec<RunSpec> {
     for r in &mut runs {
         r.name = variant_name(&r.name, set, fs);
         if let Some(n) = max_steps {
@@ -739,532 +722,627 @@ fn variants(
     runs
 }
 
+/// The runs of an analysis's case file (`kind`: `static`, `stability` or `gust`), each checked
+/// for the analysis' block (`has_block`, else exit 2 with `missing`), and the shard plan over them.
+fn analysis_runs(
+    a: &AnalysisArgs,
+    kind: &str,
+    has_block: impl Fn(&RunSpec) -> bool,
+    missing: &str,
+) -> Result<(Vec<RunSpec>, Option<Plan>)> {
+    let runs = CaseFile::read(&a.case)?.expand(&a.set.set)?;
+    if !runs.iter().all(has_block) {
+        let file = a.case.display().to_string();
+        return Err(harness::Error::Case { file, msg: format!("{kind}: {missing}") }.into());
+    }
+    let plan = harness::shard::plan(kind, a.shard.shard, || {
+        runs.iter().map(|r| Unit { id: format!("{kind}:{}", r.name), cost: harness::shard::run_cost(r) }).collect()
+    })?;
+    Ok((runs, plan))
+}
+
+/// Run `each` on the runs of this shard (`<kind>:<name>` units), then write the shard's manifest;
+/// exit 1 when `each` reports a failure for any run.
+fn analysis_loop(
+    kind: &str,
+    runs: &[RunSpec],
+    plan: Option<&Plan>,
+    out: &Path,
+    mut each: impl FnMut(&RunSpec) -> Result<bool>,
+) -> Result<ExitCode> {
+    let mut failed = false;
+    let mut done = Vec::new();
+    for spec in runs.iter().filter(|r| runs_here(plan, &format!("{kind}:{}", r.name))) {
+        failed |= each(spec)?;
+        done.push(format!("{kind}:{}", spec.name));
+    }
+    if let Some(p) = plan {
+        p.write_manifest(out, serde_json::json!({}), &done)?;
+    }
+    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// `harness static`: every run of the case file through its static sweep; exit 2 without a
+/// `static` block, 1 when a point failed.
+fn cmd_static(a: &AnalysisArgs) -> Result<ExitCode> {
+    let missing = "the case has no `static` block (airspeeds to sweep)";
+    let (runs, plan) = analysis_runs(a, "static", |r| r.ancf.statics.is_some(), missing)?;
+    let fs = a.formulation.formulations();
+    let out = &a.out.out;
+    analysis_loop("static", &runs, plan.as_ref(), out, |spec| {
+        let summary = run_static_case(spec, &fs);
+        let dir = out.join(&spec.name);
+        harness::static_out::write(&dir, &summary)?;
+        let failed = report_static(&summary);
+        println!("wrote {}", dir.display());
+        Ok(failed)
+    })
+}
+
+/// `harness stability`: every run of the case file through its stability sweep; exit 2 without a
+/// `stability` block, 1 when a point could not be analysed.
+fn cmd_stability(a: &AnalysisArgs) -> Result<ExitCode> {
+    let missing = "the case has no `stability` block (airspeeds to analyse)";
+    let (runs, plan) = analysis_runs(a, "stability", |r| r.ancf.stability.is_some(), missing)?;
+    let fs = a.formulation.formulations();
+    let out = &a.out.out;
+    analysis_loop("stability", &runs, plan.as_ref(), out, |spec| {
+        let outs = run_stability_case(spec, &fs);
+        let dir = out.join(&spec.name);
+        harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
+        let failed = report_stability(&spec.name, &outs);
+        println!("wrote {}", dir.display());
+        Ok(failed)
+    })
+}
+
+/// `harness gust`: every run of the case file through its gust sweep; exit 2 without a `gust`
+/// block, 1 when a run failed.
+fn cmd_gust(a: &AnalysisArgs) -> Result<ExitCode> {
+    let missing = "the case has no `gust` block (gradients and hinge states to sweep)";
+    let (runs, plan) = analysis_runs(a, "gust", |r| r.ancf.gust.is_some(), missing)?;
+    let fs = a.formulation.formulations();
+    let file = a.case.display().to_string();
+    analysis_loop("gust", &runs, plan.as_ref(), &a.out.out, |spec| gust_case(spec, &fs, &a.out.out, &file))
+}
+
+/// `harness check`: exit 0 (runs), 1 (a run failed), 101 (a panic), 2 (bad input).
+fn cmd_check(a: &CheckArgs) -> Result<ExitCode> {
+    use harness::fuzz::Class;
+    let (class, msg) = harness::fuzz::check_file(&a.case, a.max_steps, &harness::budget::limits());
+    Ok(match class {
+        Class::Ok => {
+            println!("{}: ok", a.case.display());
+            ExitCode::SUCCESS
+        }
+        Class::RunFailed => {
+            eprintln!("{}: a run failed: {msg}", a.case.display());
+            ExitCode::FAILURE
+        }
+        Class::Panic => {
+            eprintln!("{}: panicked: {msg}", a.case.display());
+            ExitCode::from(101)
+        }
+        _ => {
+            eprintln!("error: {msg}");
+            ExitCode::from(2)
+        }
+    })
+}
+
+/// `harness fuzz`: exit 1 when an input crashed (panic, abort, hang, escape).
+fn cmd_fuzz(a: &FuzzArgs) -> Result<ExitCode> {
+    let c = harness::fuzz::Campaign {
+        cases: a.cases.clone(),
+        out: a.out.clone(),
+        inputs: a.inputs,
+        first: a.first,
+        seed: a.seed,
+        jobs: a.jobs,
+        timeout: std::time::Duration::from_secs(a.timeout),
+        address_space: a.address_space_gb << 30,
+        max_steps: a.max_steps,
+        run: a.run,
+        exec_each: a.exec_each,
+    };
+    let r = harness::fuzz::campaign(&c)?;
+    println!("fuzz: {} inputs in {:.0} s, slowest {:.1} s", r.inputs, r.wall_s, r.slowest_s);
+    for (k, n) in &r.classes {
+        println!("  {k:?}: {n}");
+    }
+    println!("wrote {}", a.out.join("fuzz.md").display());
+    let crashed = r.classes.iter().any(|(k, n)| k.is_crash() && *n > 0);
+    Ok(if crashed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// `harness schema`.
+fn cmd_schema() -> Result<ExitCode> {
+    use std::io::Write as _;
+    // A closed pipe (`| head`) is not an error worth a panic.
+    let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json_schema())?);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `harness list`: exit 2 when a case file does not load.
+fn cmd_list(a: &CaseSource) -> Result<ExitCode> {
+    let (runs, errors) = expand_all(&discover(&a.cases)?, &[]);
+    for r in &runs {
+        println!(
+            "{:<48} ancf: {} el/body dt {}  gebf: {} el/body dt {}  t_end {}  gate: {}",
+            r.name,
+            r.ancf.ancf.elements_per_body,
+            r.ancf.ancf.dt,
+            r.gebf.gebf.elements_per_body,
+            r.gebf.gebf.dt,
+            r.ancf.t_end,
+            if r.ancf.gate.is_some() { "yes" } else { "no" }
+        );
+    }
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+/// The shared state of the phases of `harness all`.
+struct AllPlan {
+    /// Every run of the cases (this shard's and the others').
+    all_runs: Vec<RunSpec>,
+    /// This shard's runs.
+    runs: Vec<RunSpec>,
+    /// The stress study's base run (not with --quick).
+    stress_base: Option<RunSpec>,
+    axes: stress::Axes,
+    extras: Vec<(String, RunSpec)>,
+    plan: Option<Plan>,
+}
+
+impl AllPlan {
+    fn here(&self, id: &str) -> bool {
+        runs_here(self.plan.as_ref(), id)
+    }
+}
+
+/// `harness all`: the cases, then (unless `--quick` or interrupted) the studies, the analyses and
+/// the reports; exit 2 when a case file was bad, 1 when a run, a gate or an analysis failed, 130
+/// when interrupted.
+fn cmd_all(a: &AllArgs) -> Result<ExitCode> {
+    let (cases, out, set) = (&a.cases.cases, &a.out.out, &a.set.set);
+    let files = discover(cases)?;
+    let progress = Progress::new(true);
+    progress.phase(&format!("reading {} case files in {}", files.len(), cases.display()));
+    let (runs, errors) = expand_all(&files, set);
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    let all_runs = variants(runs, set, &Formulation::ALL, None);
+    // The stress matrix's base case and extra runs (read here: a shard plans every unit).
+    let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
+    let axes = stress::Axes::default();
+    let stress_base = match base {
+        Some(b) if !a.quick => Some(CaseFile::read(b).and_then(|c| c.expand(set))?.remove(0)),
+        _ => None,
+    };
+    let extras = if stress_base.is_some() { stress_extras(cases, set)? } else { Vec::new() };
+    let plan = harness::shard::plan("all", a.shard.shard, || {
+        all_units(&all_runs, a.quick, stress_base.as_ref(), &axes, &extras)
+    })?;
+    let runs: Vec<_> = all_runs.iter().filter(|r| runs_here(plan.as_ref(), &run_unit(&r.name))).cloned().collect();
+    let p = AllPlan { all_runs, runs, stress_base, axes, extras, plan };
+    let mut done: Vec<String> = Vec::new();
+    let t0 = std::time::Instant::now();
+    progress.phase(&format!("cases: {} runs x 2 formulations", p.runs.len()));
+    // Each run also records its 3-D view for the report (and writes VTK where the case asks).
+    let (results, interrupted) = run_and_write(&p.runs, &Formulation::ALL, out, &progress, &|spec, f| {
+        harness::view3d::report_observer(out, spec, f)
+    })?;
+    let wall = t0.elapsed().as_secs_f64();
+    if !interrupted {
+        done.extend(p.runs.iter().map(|r| run_unit(&r.name)));
+    }
+    if !a.quick && !interrupted {
+        all_studies(a, &p, &progress, &mut done)?;
+    }
+    let failures = if interrupted { AnalysisFailures::default() } else { all_analyses(a, &p, &results, &progress)? };
+    match &p.plan {
+        Some(plan) => {
+            progress.phase("shard: the exact runs and the manifest for `harness merge`");
+            for (spec, r) in p.runs.iter().zip(&results) {
+                harness::merge::save_case(&plan.data_dir(out), spec, r)?;
+            }
+            let stress_dir = variant_name("stress", set, &Formulation::ALL);
+            let args = serde_json::json!({ "report": true, "stress_dir": stress_dir, "axes": p.axes });
+            plan.write_manifest(out, args, &done)?;
+        }
+        None => {
+            progress.phase("reports: index.html, summary.md");
+            write_index(out, &results).context("writing reports")?;
+        }
+    }
+    all_verdict(out, &results, wall, &failures, &errors, interrupted)
+}
+
+/// The phases of `harness all` after the case runs (not with --quick): the refinement ladders,
+/// the stress matrix, the energy study and the benchmark, each where this shard runs it.
+fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress, done: &mut Vec<String>) -> Result<()> {
+    let (out, set) = (&a.out.out, &a.set.set);
+    // Studies of a run with overrides go to folders that say so too.
+    let study = |name: &str| out.join(variant_name(name, set, &Formulation::ALL));
+    for spec in p.all_runs.iter().filter(|r| r.ancf.converge && p.here(&format!("converge:{}", r.name))) {
+        progress.phase(&format!("refinement ladders of {}", spec.name));
+        let t = std::time::Instant::now();
+        let r = converge::converge(spec, true)?;
+        converge::write(&study("converge").join(&spec.name), &r)?;
+        println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+        done.push(format!("converge:{}", spec.name));
+    }
+    if let Some(spec) = &p.stress_base {
+        progress.phase("stress matrix (c x beta x dt x rho_inf, both formulations), then its two long runs");
+        let t = std::time::Instant::now();
+        let (cells, ex) = run_stress(spec, &p.axes, &p.extras, p.plan.as_ref(), done);
+        match &p.plan {
+            Some(plan) => harness::merge::save_stress(&plan.data_dir(out), &cells, &ex)?,
+            None => {
+                stress::write(&study("stress"), &p.axes, &cells)?;
+                stress::write_extras(&study("stress"), &ex)?;
+            }
+        }
+        for f in Formulation::ALL {
+            let (ok, rec, n) = stress::survival(&cells, f);
+            println!("stress {f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
+        }
+        println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
+    }
+    if p.here("energy") {
+        progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
+        run_energy(&p.all_runs, &study("energy"))?;
+        done.push("energy".into());
+    }
+    if p.here("bench") {
+        progress.phase("speed benchmark (serial repeated runs)");
+        let pendulums: Vec<_> = p.all_runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
+        run_bench(&pendulums, 7, &study("bench"))?;
+        done.push("bench".into());
+    }
+    Ok(())
+}
+
+/// How many sweeps of each analysis failed in `harness all`.
+#[derive(Default)]
+struct AnalysisFailures {
+    static_failed: usize,
+    stability_failed: usize,
+    gust_failed: usize,
+}
+
+/// The analyses of `harness all` on this shard's runs: the static and stability sweeps (beside
+/// the runs' histories), and without --quick or a shard the gust sweeps.
+fn all_analyses(
+    a: &AllArgs,
+    p: &AllPlan,
+    results: &[harness::report::CaseResult],
+    progress: &Progress,
+) -> Result<AnalysisFailures> {
+    let out = &a.out.out;
+    let mut n = AnalysisFailures::default();
+    for spec in p.runs.iter().filter(|r| r.ancf.statics.is_some()) {
+        progress.phase(&format!("static sweep of {}", spec.name));
+        let t = std::time::Instant::now();
+        let mut summary = run_static_case(spec, &Formulation::ALL);
+        if let Some(r) = results.iter().find(|r| r.name == spec.name) {
+            harness::static_out::compare_with_history(&mut summary, spec, &r.runs);
+        }
+        harness::static_out::write(&out.join(&spec.name), &summary)?;
+        n.static_failed += usize::from(report_static(&summary));
+        println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+    }
+    for spec in p.runs.iter().filter(|r| r.ancf.stability.is_some()) {
+        progress.phase(&format!("stability sweep of {}", spec.name));
+        let t = std::time::Instant::now();
+        let outs = run_stability_case(spec, &Formulation::ALL);
+        let history = results.iter().find(|r| r.name == spec.name).map(|r| r.metrics.clone());
+        harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, &outs, history.as_ref())?;
+        n.stability_failed += usize::from(report_stability(&spec.name, &outs));
+        println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+    }
+    // The gust sweeps (several minutes of CPU): not with --quick, and on a cluster as their own
+    // array (`harness gust --shard`).
+    if !a.quick && p.plan.is_none() {
+        for spec in p.runs.iter().filter(|r| r.ancf.gust.is_some()) {
+            progress.phase(&format!("gust sweep of {}", spec.name));
+            let t = std::time::Instant::now();
+            let file = spec.dir.join(format!("{}.json", spec.name)).display().to_string();
+            n.gust_failed += usize::from(gust_case(spec, &Formulation::ALL, out, &file)?);
+            println!("gust {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+        }
+    }
+    Ok(n)
+}
+
+/// The gate table, the totals and the exit code of `harness all`.
+fn all_verdict(
+    out: &Path,
+    results: &[harness::report::CaseResult],
+    wall: f64,
+    n: &AnalysisFailures,
+    errors: &[harness::Error],
+    interrupted: bool,
+) -> Result<ExitCode> {
+    print!("{}", gate::table(results));
+    let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
+    println!(
+        "{} runs ({} cases x 2 formulations) in {:.2} s wall; {} failed; reports in {}",
+        2 * results.len(),
+        results.len(),
+        wall,
+        failed,
+        out.join("index.html").display()
+    );
+    let gate_failed = results.iter().filter(|r| r.status() == "FAIL").count();
+    if gate_failed > 0 {
+        eprintln!("gate: {gate_failed} case(s) fail their tolerances (see the table)");
+    }
+    if n.static_failed > 0 {
+        eprintln!("static: {} sweep(s) have airspeeds without an equilibrium", n.static_failed);
+    }
+    if n.stability_failed > 0 {
+        eprintln!("stability: {} sweep(s) have airspeeds that could not be analysed", n.stability_failed);
+    }
+    if n.gust_failed > 0 {
+        eprintln!("gust: {} sweep(s) have runs that failed", n.gust_failed);
+    }
+    if interrupted {
+        eprintln!("interrupted: the rows computed so far are written; studies skipped");
+        return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
+    }
+    let analyses_ok = n.static_failed == 0 && n.stability_failed == 0 && n.gust_failed == 0;
+    Ok(exit_code(errors, failed == 0 && gate_failed == 0 && analyses_ok))
+}
+
+/// `harness run`: exit 1 when a run failed, 130 when interrupted.
+fn cmd_run(a: &RunArgs) -> Result<ExitCode> {
+    let (out, set) = (&a.out.out, &a.set.set);
+    let fs = a.formulation.formulations();
+    let limits = harness::budget::limits();
+    let file = CaseFile::read(&a.case)?;
+    let runs = variants(file.expand_within(set, &limits, a.max_steps)?, set, &fs, a.max_steps);
+    let progress = Progress::new(true);
+    // VTK when --vtk asks for it or the case's `vtk` block does.
+    let cli = a.vtk.then_some(a.vtk_stride);
+    let vtk_out = out.clone();
+    let observer = move |spec: &RunSpec, f: Formulation| -> Box<dyn harness::run::Observer> {
+        match harness::vtk::writer_for(&vtk_out, spec, f, cli) {
+            Some(w) => Box::new(w),
+            None => Box::new(harness::run::NoObserver),
+        }
+    };
+    let (results, interrupted) = run_and_write(&runs, &fs, out, &progress, &observer)?;
+    let mut failed = false;
+    for r in &results {
+        failed |= print_run(out, r);
+    }
+    if interrupted {
+        eprintln!("interrupted: the rows computed so far are written; summary.json says \"interrupted\"");
+        return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
+    }
+    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// Print one case's runs (metrics or failure), the ANCF-GEBF difference and its gate; true when
+/// a run failed.
+fn print_run(out: &Path, r: &harness::report::CaseResult) -> bool {
+    let mut failed = false;
+    let dir = out.join(&r.name);
+    for run in &r.runs {
+        let m = &r.metrics[&run.formulation];
+        match &run.error {
+            Some(e) => {
+                failed = true;
+                eprintln!("{} {}: FAILED: {e}", r.name, run.formulation);
+            }
+            None => println!(
+                "{} {}: {} steps in {:.1} ms, {:.2} Newton/step, energy drift {:.2e}, max constraint {:.1e} -> {}",
+                r.name,
+                run.formulation,
+                m.n_steps,
+                1e3 * m.wall_s,
+                m.newton_per_step,
+                m.energy_drift,
+                m.max_constraint_residual,
+                dir.join(format!("{}.csv", run.formulation)).display()
+            ),
+        }
+    }
+    if let Some(p) = &r.pair {
+        println!("{}: max tip difference ANCF-GEBF {:.3} mm", r.name, 1e3 * p.all.max);
+    }
+    // The case's gate, for information (`harness gate` is the command that enforces it).
+    if let Some(g) = &r.gate_outcome {
+        let lines = g.failed_lines();
+        println!(
+            "{}: gate {} ({} failed check(s); `harness gate` enforces it)",
+            r.name,
+            if g.pass() { "pass" } else { "FAIL" },
+            lines.len()
+        );
+        for l in lines {
+            eprintln!("{}: gate: {l}", r.name);
+        }
+    }
+    failed
+}
+
+/// `harness converge`: the refinement ladders of every run of the case file.
+fn cmd_converge(a: &StudyArgs) -> Result<ExitCode> {
+    let out = &a.out.out;
+    let runs = CaseFile::read(&a.case).and_then(|c| c.expand(&a.set.set))?;
+    let plan = harness::shard::plan("converge", a.shard.shard, || {
+        runs.iter()
+            .map(|r| Unit { id: format!("converge:{}", r.name), cost: LADDER_COST * harness::shard::run_cost(r) })
+            .collect()
+    })?;
+    let mut done = Vec::new();
+    for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("converge:{}", r.name))) {
+        let r = converge::converge(spec, true)?;
+        let dir = out.join("converge").join(&spec.name);
+        converge::write(&dir, &r)?;
+        for o in &r.orders {
+            let ord: Vec<String> = o.orders.iter().map(|x| format!("{x:.2}")).collect();
+            println!(
+                "{} {} {:<8} observed orders [{}], truth error estimate {:.2e} m",
+                spec.name,
+                o.formulation,
+                format!("{:?}", o.ladder).to_lowercase(),
+                ord.join(", "),
+                o.truth_error_estimate_m
+            );
+        }
+        println!("wrote {}", dir.display());
+        done.push(format!("converge:{}", spec.name));
+    }
+    if let Some(p) = &plan {
+        p.write_manifest(out, serde_json::json!({}), &done)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `harness merge`: exit 1 naming the runs no shard finished.
+fn cmd_merge(a: &MergeArgs) -> Result<ExitCode> {
+    let out = &a.out.out;
+    let m = harness::merge::merge(&a.dirs, out)?;
+    let shards: Vec<String> = m.shards.iter().map(|(c, k)| format!("{c} {k}")).collect();
+    println!(
+        "merge: {} shard(s) ({}); {} case run(s), {} stress cell(s); wrote {}",
+        m.shards.len(),
+        shards.join(", "),
+        m.results.len(),
+        m.stress_cells,
+        out.display()
+    );
+    if !m.results.is_empty() {
+        print!("{}", gate::table(&m.results));
+    }
+    if m.missing.is_empty() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    eprintln!("merge: {} run(s) missing (no shard finished them):", m.missing.len());
+    for (cmd, unit, k) in &m.missing {
+        eprintln!("  {cmd} {unit} (shard {k})");
+    }
+    Ok(ExitCode::FAILURE)
+}
+
+/// `harness stress`: the stress matrix and its extra runs on the base case.
+fn cmd_stress(a: &StressArgs) -> Result<ExitCode> {
+    let (out, set) = (&a.out.out, &a.set.set);
+    let runs = CaseFile::read(&a.case).and_then(|c| c.expand(set))?;
+    let base = runs.first().context("the base case expands into no run")?;
+    let axes = stress::Axes::default();
+    let extras = stress_extras(&a.case.with_file_name(""), set)?;
+    let plan = harness::shard::plan("stress", a.shard.shard, || stress_units(base, &axes, &extras))?;
+    let t0 = std::time::Instant::now();
+    let mut done = Vec::new();
+    let (cells, ex) = run_stress(base, &axes, &extras, plan.as_ref(), &mut done);
+    let dir = out.join("stress");
+    for f in Formulation::ALL {
+        let (ok, rec, n) = stress::survival(&cells, f);
+        println!("{f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
+    }
+    match &plan {
+        Some(p) => {
+            harness::merge::save_stress(&p.data_dir(out), &cells, &ex)?;
+            let args = serde_json::json!({ "report": false, "stress_dir": "stress", "axes": axes });
+            p.write_manifest(out, args, &done)?;
+        }
+        None => {
+            stress::write(&dir, &axes, &cells)?;
+            stress::write_extras(&dir, &ex)?;
+        }
+    }
+    let line = |error: &Option<String>, newton: f64, drift: f64| {
+        error.clone().unwrap_or_else(|| format!("ok, {newton:.2} Newton/step, drift {drift:.2e}"))
+    };
+    for e in &ex {
+        let m = &e.metrics;
+        println!("{} {}: {}", e.label, e.formulation, line(&m.error, m.newton_per_step, m.energy_drift));
+        if let Some(r) = &e.recovery {
+            println!("  with step control: {}", line(&r.error, r.newton_per_step, r.energy_drift));
+        }
+    }
+    println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `harness energy`: exit 2 when a case file was bad, 1 when a run failed.
+fn cmd_energy(a: &EnergyArgs) -> Result<ExitCode> {
+    let (runs, errors) = expand_all(&discover(&a.cases.cases)?, &a.set.set);
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    let ok = run_energy(&runs, &a.out.out.join("energy"))?;
+    Ok(exit_code(&errors, ok))
+}
+
+/// The case files of `harness gate` and `harness bench` (explicit, else discovered), expanded;
+/// the bad ones printed and returned apart. The flag says whether the files were explicit.
+fn files_runs(a: &FilesArgs) -> Result<(Vec<RunSpec>, Vec<harness::Error>, bool)> {
+    let explicit = !a.files.is_empty();
+    let files = if explicit { a.files.clone() } else { discover(&a.cases.cases)? };
+    let (runs, errors) = expand_all(&files, &a.set.set);
+    for e in &errors {
+        eprintln!("error: {e}");
+    }
+    Ok((runs, errors, explicit))
+}
+
+/// `harness bench`: exit 2 when a case file was bad, 1 when a timed run failed.
+fn cmd_bench(a: &BenchArgs) -> Result<ExitCode> {
+    let (runs, errors, explicit) = files_runs(&a.files)?;
+    let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
+    let rows = run_bench(&runs, a.repeats, &a.out.out.join("bench"))?;
+    let failed = rows.iter().filter(|r| r.error.is_some()).count();
+    Ok(exit_code(&errors, failed == 0))
+}
+
+/// `harness gate`: exit 2 when a case file was bad, 1 when a gated case fails.
+fn cmd_gate(a: &FilesArgs) -> Result<ExitCode> {
+    let (runs, errors, _) = files_runs(a)?;
+    let gated: Vec<_> = runs.into_iter().filter(|r| r.ancf.gate.is_some()).collect();
+    let results = run_all(&gated, &Formulation::ALL, true);
+    print!("{}", gate::table(&results));
+    let failing: Vec<_> = results.iter().filter(|r| r.status() != "pass").collect();
+    for r in &failing {
+        for l in r.gate_outcome.as_ref().map(|g| g.failed_lines()).unwrap_or_default() {
+            eprintln!("gate FAILED: {}: {l}", r.name);
+        }
+    }
+    println!("gate: {} of {} cases pass", results.len() - failing.len(), results.len());
+    Ok(exit_code(&errors, failing.is_empty()))
+}
+
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
     harness::budget::set_limits(cli.max_memory, cli.max_hours);
     harness::signal::install();
-    match cli.cmd {
-        Cmd::Check { case, max_steps } => {
-            use harness::fuzz::Class;
-            let (class, msg) = harness::fuzz::check_file(&case, max_steps, &harness::budget::limits());
-            match class {
-                Class::Ok => {
-                    println!("{}: ok", case.display());
-                    Ok(ExitCode::SUCCESS)
-                }
-                Class::RunFailed => {
-                    eprintln!("{}: a run failed: {msg}", case.display());
-                    Ok(ExitCode::FAILURE)
-                }
-                Class::Panic => {
-                    eprintln!("{}: panicked: {msg}", case.display());
-                    Ok(ExitCode::from(101))
-                }
-                _ => {
-                    eprintln!("error: {msg}");
-                    Ok(ExitCode::from(2))
-                }
-            }
-        }
+    match &cli.cmd {
+        Cmd::All(a) => cmd_all(a),
+        Cmd::Run(a) => cmd_run(a),
+        Cmd::Fuzz(a) => cmd_fuzz(a),
         Cmd::FuzzWorker { max_steps } => {
-            harness::fuzz::worker_main(max_steps)?;
+            harness::fuzz::worker_main(*max_steps)?;
             Ok(ExitCode::SUCCESS)
         }
-        Cmd::Fuzz { cases, out, inputs, first, seed, jobs, timeout, address_space_gb, max_steps, run, exec_each } => {
-            let c = harness::fuzz::Campaign {
-                cases,
-                out: out.clone(),
-                inputs,
-                first,
-                seed,
-                jobs,
-                timeout: std::time::Duration::from_secs(timeout),
-                address_space: address_space_gb << 30,
-                max_steps,
-                run,
-                exec_each,
-            };
-            let r = harness::fuzz::campaign(&c)?;
-            println!("fuzz: {} inputs in {:.0} s, slowest {:.1} s", r.inputs, r.wall_s, r.slowest_s);
-            for (k, n) in &r.classes {
-                println!("  {k:?}: {n}");
-            }
-            println!("wrote {}", out.join("fuzz.md").display());
-            let crashed = r.classes.iter().any(|(k, n)| k.is_crash() && *n > 0);
-            Ok(if crashed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
-        }
-        Cmd::Schema => {
-            use std::io::Write as _;
-            // A closed pipe (`| head`) is not an error worth a panic.
-            let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json_schema())?);
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::List { cases } => {
-            let (runs, errors) = expand_all(&discover(&cases)?, &[]);
-            for r in &runs {
-                println!(
-                    "{:<48} ancf: {} el/body dt {}  gebf: {} el/body dt {}  t_end {}  gate: {}",
-                    r.name,
-                    r.ancf.ancf.elements_per_body,
-                    r.ancf.ancf.dt,
-                    r.gebf.gebf.elements_per_body,
-                    r.gebf.gebf.dt,
-                    r.ancf.t_end,
-                    if r.ancf.gate.is_some() { "yes" } else { "no" }
-                );
-            }
-            for e in &errors {
-                eprintln!("error: {e}");
-            }
-            Ok(if errors.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
-        }
-        Cmd::All { cases, out, set, quick, shard } => {
-            let files = discover(&cases)?;
-            let progress = Progress::new(true);
-            progress.phase(&format!("reading {} case files in {}", files.len(), cases.display()));
-            let (runs, errors) = expand_all(&files, &set);
-            for e in &errors {
-                eprintln!("error: {e}");
-            }
-            let all_runs = variants(runs, &set, &Formulation::ALL, None);
-            // Studies of a run with overrides go to folders that say so too.
-            let study = |name: &str| out.join(variant_name(name, &set, &Formulation::ALL));
-            // The stress matrix's base case and extra runs (read here: a shard plans every unit).
-            let base = files.iter().find(|f| f.ends_with("double_pendulum_c1_beta45.json"));
-            let axes = stress::Axes::default();
-            let stress_base = match base {
-                Some(b) if !quick => Some(CaseFile::read(b).and_then(|c| c.expand(&set))?.remove(0)),
-                _ => None,
-            };
-            let extras = if stress_base.is_some() { stress_extras(&cases, &set)? } else { Vec::new() };
-            let plan = harness::shard::plan("all", shard.shard, || {
-                all_units(&all_runs, quick, stress_base.as_ref(), &axes, &extras)
-            })?;
-            let here = |id: &str| runs_here(plan.as_ref(), id);
-            let mut done: Vec<String> = Vec::new();
-            let runs: Vec<_> = all_runs.iter().filter(|r| here(&run_unit(&r.name))).cloned().collect();
-            let t0 = std::time::Instant::now();
-            progress.phase(&format!("cases: {} runs x 2 formulations", runs.len()));
-            // Each run also records its 3-D view for the report (and writes VTK where the case asks).
-            let (results, interrupted) = run_and_write(&runs, &Formulation::ALL, &out, &progress, &|spec, f| {
-                harness::view3d::report_observer(&out, spec, f)
-            })?;
-            let wall = t0.elapsed().as_secs_f64();
-            if !interrupted {
-                done.extend(runs.iter().map(|r| run_unit(&r.name)));
-            }
-            if !quick && !interrupted {
-                for spec in all_runs.iter().filter(|r| r.ancf.converge && here(&format!("converge:{}", r.name))) {
-                    progress.phase(&format!("refinement ladders of {}", spec.name));
-                    let t = std::time::Instant::now();
-                    let r = converge::converge(spec, true)?;
-                    converge::write(&study("converge").join(&spec.name), &r)?;
-                    println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-                    done.push(format!("converge:{}", spec.name));
-                }
-                if let Some(spec) = &stress_base {
-                    progress
-                        .phase("stress matrix (c x beta x dt x rho_inf, both formulations), then its two long runs");
-                    let t = std::time::Instant::now();
-                    let (cells, ex) = run_stress(spec, &axes, &extras, plan.as_ref(), &mut done);
-                    match &plan {
-                        Some(p) => harness::merge::save_stress(&p.data_dir(&out), &cells, &ex)?,
-                        None => {
-                            stress::write(&study("stress"), &axes, &cells)?;
-                            stress::write_extras(&study("stress"), &ex)?;
-                        }
-                    }
-                    for f in Formulation::ALL {
-                        let (ok, rec, n) = stress::survival(&cells, f);
-                        println!(
-                            "stress {f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control"
-                        );
-                    }
-                    println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
-                }
-                if here("energy") {
-                    progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
-                    run_energy(&all_runs, &study("energy"))?;
-                    done.push("energy".into());
-                }
-                if here("bench") {
-                    progress.phase("speed benchmark (serial repeated runs)");
-                    let pendulums: Vec<_> = all_runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
-                    run_bench(&pendulums, 7, &study("bench"))?;
-                    done.push("bench".into());
-                }
-            }
-            let mut static_failed = 0;
-            for spec in runs.iter().filter(|r| r.ancf.statics.is_some() && !interrupted) {
-                progress.phase(&format!("static sweep of {}", spec.name));
-                let t = std::time::Instant::now();
-                let mut summary = run_static_case(spec, &Formulation::ALL);
-                if let Some(r) = results.iter().find(|r| r.name == spec.name) {
-                    harness::static_out::compare_with_history(&mut summary, spec, &r.runs);
-                }
-                harness::static_out::write(&out.join(&spec.name), &summary)?;
-                static_failed += usize::from(report_static(&summary));
-                println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-            }
-            let mut stability_failed = 0;
-            for spec in runs.iter().filter(|r| r.ancf.stability.is_some() && !interrupted) {
-                progress.phase(&format!("stability sweep of {}", spec.name));
-                let t = std::time::Instant::now();
-                let outs = run_stability_case(spec, &Formulation::ALL);
-                let history = results.iter().find(|r| r.name == spec.name).map(|r| r.metrics.clone());
-                harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, &outs, history.as_ref())?;
-                stability_failed += usize::from(report_stability(&spec.name, &outs));
-                println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-            }
-            // The gust sweeps (several minutes of CPU): not with --quick, and on a cluster as
-            // their own array (`harness gust --shard`).
-            let mut gust_failed = 0;
-            if !quick && plan.is_none() {
-                for spec in runs.iter().filter(|r| r.ancf.gust.is_some() && !interrupted) {
-                    progress.phase(&format!("gust sweep of {}", spec.name));
-                    let t = std::time::Instant::now();
-                    let file = spec.dir.join(format!("{}.json", spec.name)).display().to_string();
-                    gust_failed += usize::from(gust_case(spec, &Formulation::ALL, &out, &file)?);
-                    println!("gust {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-                }
-            }
-            match &plan {
-                Some(p) => {
-                    progress.phase("shard: the exact runs and the manifest for `harness merge`");
-                    for (spec, r) in runs.iter().zip(&results) {
-                        harness::merge::save_case(&p.data_dir(&out), spec, r)?;
-                    }
-                    let stress_dir = variant_name("stress", &set, &Formulation::ALL);
-                    let args = serde_json::json!({ "report": true, "stress_dir": stress_dir, "axes": axes });
-                    p.write_manifest(&out, args, &done)?;
-                }
-                None => {
-                    progress.phase("reports: index.html, summary.md");
-                    write_index(&out, &results).context("writing reports")?;
-                }
-            }
-            print!("{}", gate::table(&results));
-            let failed = results.iter().flat_map(|r| &r.runs).filter(|r| r.error.is_some()).count();
-            println!(
-                "{} runs ({} cases x 2 formulations) in {:.2} s wall; {} failed; reports in {}",
-                2 * results.len(),
-                results.len(),
-                wall,
-                failed,
-                out.join("index.html").display()
-            );
-            let gate_failed = results.iter().filter(|r| r.status() == "FAIL").count();
-            if gate_failed > 0 {
-                eprintln!("gate: {gate_failed} case(s) fail their tolerances (see the table)");
-            }
-            if static_failed > 0 {
-                eprintln!("static: {static_failed} sweep(s) have airspeeds without an equilibrium");
-            }
-            if stability_failed > 0 {
-                eprintln!("stability: {stability_failed} sweep(s) have airspeeds that could not be analysed");
-            }
-            if gust_failed > 0 {
-                eprintln!("gust: {gust_failed} sweep(s) have runs that failed");
-            }
-            if interrupted {
-                eprintln!("interrupted: the rows computed so far are written; studies skipped");
-                return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
-            }
-            Ok(exit_code(
-                &errors,
-                failed == 0 && gate_failed == 0 && static_failed == 0 && stability_failed == 0 && gust_failed == 0,
-            ))
-        }
-        Cmd::Run { case, formulation, out, set, vtk, vtk_stride, max_steps } => {
-            let fs: Vec<Formulation> = match formulation {
-                Which::Ancf => vec![Formulation::Ancf],
-                Which::Gebf => vec![Formulation::Gebf],
-                Which::Both => Formulation::ALL.to_vec(),
-            };
-            let limits = harness::budget::limits();
-            let file = CaseFile::read(&case)?;
-            let runs = variants(file.expand_within(&set, &limits, max_steps)?, &set, &fs, max_steps);
-            let progress = Progress::new(true);
-            // VTK when --vtk asks for it or the case's `vtk` block does.
-            let cli = vtk.then_some(vtk_stride);
-            let vtk_out = out.clone();
-            let observer = move |spec: &harness::case::RunSpec, f: Formulation| -> Box<dyn harness::run::Observer> {
-                match harness::vtk::writer_for(&vtk_out, spec, f, cli) {
-                    Some(w) => Box::new(w),
-                    None => Box::new(harness::run::NoObserver),
-                }
-            };
-            let (results, interrupted) = run_and_write(&runs, &fs, &out, &progress, &observer)?;
-            let mut failed = false;
-            for r in &results {
-                let dir = out.join(&r.name);
-                for run in &r.runs {
-                    let m = &r.metrics[&run.formulation];
-                    match &run.error {
-                        Some(e) => {
-                            failed = true;
-                            eprintln!("{} {}: FAILED: {e}", r.name, run.formulation);
-                        }
-                        None => println!(
-                            "{} {}: {} steps in {:.1} ms, {:.2} Newton/step, energy drift {:.2e}, max constraint {:.1e} -> {}",
-                            r.name,
-                            run.formulation,
-                            m.n_steps,
-                            1e3 * m.wall_s,
-                            m.newton_per_step,
-                            m.energy_drift,
-                            m.max_constraint_residual,
-                            dir.join(format!("{}.csv", run.formulation)).display()
-                        ),
-                    }
-                }
-                if let Some(p) = &r.pair {
-                    println!("{}: max tip difference ANCF-GEBF {:.3} mm", r.name, 1e3 * p.all.max);
-                }
-                // The case's gate, for information (`harness gate` is the command that enforces it).
-                if let Some(g) = &r.gate_outcome {
-                    let lines = g.failed_lines();
-                    println!(
-                        "{}: gate {} ({} failed check(s); `harness gate` enforces it)",
-                        r.name,
-                        if g.pass() { "pass" } else { "FAIL" },
-                        lines.len()
-                    );
-                    for l in lines {
-                        eprintln!("{}: gate: {l}", r.name);
-                    }
-                }
-            }
-            if interrupted {
-                eprintln!("interrupted: the rows computed so far are written; summary.json says \"interrupted\"");
-                return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
-            }
-            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
-        }
-        Cmd::Static { case, formulation, out, set, shard } => {
-            let file = CaseFile::read(&case)?;
-            let runs = file.expand(&set)?;
-            let plan = harness::shard::plan("static", shard.shard, || {
-                runs.iter()
-                    .map(|r| Unit { id: format!("static:{}", r.name), cost: harness::shard::run_cost(r) })
-                    .collect()
-            })?;
-            let fs: Vec<Formulation> = match formulation {
-                Which::Ancf => vec![Formulation::Ancf],
-                Which::Gebf => vec![Formulation::Gebf],
-                Which::Both => Formulation::ALL.to_vec(),
-            };
-            for spec in &runs {
-                if spec.ancf.statics.is_none() {
-                    return Err(harness::Error::Case {
-                        file: case.display().to_string(),
-                        msg: "static: the case has no `static` block (airspeeds to sweep)".into(),
-                    }
-                    .into());
-                }
-            }
-            let mut failed = false;
-            let mut done = Vec::new();
-            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("static:{}", r.name))) {
-                let summary = run_static_case(spec, &fs);
-                let dir = out.join(&spec.name);
-                harness::static_out::write(&dir, &summary)?;
-                failed |= report_static(&summary);
-                println!("wrote {}", dir.display());
-                done.push(format!("static:{}", spec.name));
-            }
-            if let Some(p) = &plan {
-                p.write_manifest(&out, serde_json::json!({}), &done)?;
-            }
-            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
-        }
-        Cmd::Stability { case, formulation, out, set, shard } => {
-            let file = CaseFile::read(&case)?;
-            let runs = file.expand(&set)?;
-            let fs: Vec<Formulation> = match formulation {
-                Which::Ancf => vec![Formulation::Ancf],
-                Which::Gebf => vec![Formulation::Gebf],
-                Which::Both => Formulation::ALL.to_vec(),
-            };
-            for spec in &runs {
-                if spec.ancf.stability.is_none() {
-                    return Err(harness::Error::Case {
-                        file: case.display().to_string(),
-                        msg: "stability: the case has no `stability` block (airspeeds to analyse)".into(),
-                    }
-                    .into());
-                }
-            }
-            let plan = harness::shard::plan("stability", shard.shard, || {
-                runs.iter()
-                    .map(|r| Unit { id: format!("stability:{}", r.name), cost: harness::shard::run_cost(r) })
-                    .collect()
-            })?;
-            let mut failed = false;
-            let mut done = Vec::new();
-            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("stability:{}", r.name))) {
-                let outs = run_stability_case(spec, &fs);
-                let dir = out.join(&spec.name);
-                harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
-                failed |= report_stability(&spec.name, &outs);
-                println!("wrote {}", dir.display());
-                done.push(format!("stability:{}", spec.name));
-            }
-            if let Some(p) = &plan {
-                p.write_manifest(&out, serde_json::json!({}), &done)?;
-            }
-            Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
-        }
-        Cmd::Gust { case, formulation, out, set, shard } => run_gust(&case, formulation, &out, &set, shard.shard),
-        Cmd::Converge { case, out, set, shard } => {
-            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
-            let plan = harness::shard::plan("converge", shard.shard, || {
-                runs.iter()
-                    .map(|r| Unit {
-                        id: format!("converge:{}", r.name),
-                        cost: LADDER_COST * harness::shard::run_cost(r),
-                    })
-                    .collect()
-            })?;
-            let mut done = Vec::new();
-            for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("converge:{}", r.name))) {
-                let r = converge::converge(spec, true)?;
-                let dir = out.join("converge").join(&spec.name);
-                converge::write(&dir, &r)?;
-                for o in &r.orders {
-                    let ord: Vec<String> = o.orders.iter().map(|x| format!("{x:.2}")).collect();
-                    println!(
-                        "{} {} {:<8} observed orders [{}], truth error estimate {:.2e} m",
-                        spec.name,
-                        o.formulation,
-                        format!("{:?}", o.ladder).to_lowercase(),
-                        ord.join(", "),
-                        o.truth_error_estimate_m
-                    );
-                }
-                println!("wrote {}", dir.display());
-                done.push(format!("converge:{}", spec.name));
-            }
-            if let Some(p) = &plan {
-                p.write_manifest(&out, serde_json::json!({}), &done)?;
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::Merge { dirs, out } => {
-            let m = harness::merge::merge(&dirs, &out)?;
-            let shards: Vec<String> = m.shards.iter().map(|(c, k)| format!("{c} {k}")).collect();
-            println!(
-                "merge: {} shard(s) ({}); {} case run(s), {} stress cell(s); wrote {}",
-                m.shards.len(),
-                shards.join(", "),
-                m.results.len(),
-                m.stress_cells,
-                out.display()
-            );
-            if !m.results.is_empty() {
-                print!("{}", gate::table(&m.results));
-            }
-            if m.missing.is_empty() {
-                return Ok(ExitCode::SUCCESS);
-            }
-            eprintln!("merge: {} run(s) missing (no shard finished them):", m.missing.len());
-            for (cmd, unit, k) in &m.missing {
-                eprintln!("  {cmd} {unit} (shard {k})");
-            }
-            Ok(ExitCode::FAILURE)
-        }
-        Cmd::Stress { case, out, set, shard } => {
-            let runs = CaseFile::read(&case).and_then(|c| c.expand(&set))?;
-            let base = runs.first().context("the base case expands into no run")?;
-            let axes = stress::Axes::default();
-            let extras = stress_extras(&case.with_file_name(""), &set)?;
-            let plan = harness::shard::plan("stress", shard.shard, || stress_units(base, &axes, &extras))?;
-            let t0 = std::time::Instant::now();
-            let mut done = Vec::new();
-            let (cells, ex) = run_stress(base, &axes, &extras, plan.as_ref(), &mut done);
-            let dir = out.join("stress");
-            for f in Formulation::ALL {
-                let (ok, rec, n) = stress::survival(&cells, f);
-                println!("{f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
-            }
-            match &plan {
-                Some(p) => {
-                    harness::merge::save_stress(&p.data_dir(&out), &cells, &ex)?;
-                    let args = serde_json::json!({ "report": false, "stress_dir": "stress", "axes": axes });
-                    p.write_manifest(&out, args, &done)?;
-                }
-                None => {
-                    stress::write(&dir, &axes, &cells)?;
-                    stress::write_extras(&dir, &ex)?;
-                }
-            }
-            for e in &ex {
-                let m = &e.metrics;
-                println!(
-                    "{} {}: {}",
-                    e.label,
-                    e.formulation,
-                    m.error.clone().unwrap_or_else(|| format!(
-                        "ok, {:.2} Newton/step, drift {:.2e}",
-                        m.newton_per_step, m.energy_drift
-                    ))
-                );
-                if let Some(r) = &e.recovery {
-                    println!(
-                        "  with step control: {}",
-                        r.error.clone().unwrap_or_else(|| format!(
-                            "ok, {:.2} Newton/step, drift {:.2e}",
-                            r.newton_per_step, r.energy_drift
-                        ))
-                    );
-                }
-            }
-            println!("stress matrix in {:.1} s; wrote {}", t0.elapsed().as_secs_f64(), dir.display());
-            Ok(ExitCode::SUCCESS)
-        }
-        Cmd::Energy { cases, out, set } => {
-            let (runs, errors) = expand_all(&discover(&cases)?, &set);
-            for e in &errors {
-                eprintln!("error: {e}");
-            }
-            let ok = run_energy(&runs, &out.join("energy"))?;
-            Ok(if !errors.is_empty() {
-                ExitCode::from(2)
-            } else if ok {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::FAILURE
-            })
-        }
-        Cmd::Bench { files, cases, repeats, out, set } => {
-            let explicit = !files.is_empty();
-            let files = if explicit { files } else { discover(&cases)? };
-            let (runs, errors) = expand_all(&files, &set);
-            for e in &errors {
-                eprintln!("error: {e}");
-            }
-            let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
-            let rows = run_bench(&runs, repeats, &out.join("bench"))?;
-            let failed = rows.iter().filter(|r| r.error.is_some()).count();
-            Ok(exit_code(&errors, failed == 0))
-        }
-        Cmd::Gate { files, cases, set } => {
-            let files = if files.is_empty() { discover(&cases)? } else { files };
-            let (runs, errors) = expand_all(&files, &set);
-            for e in &errors {
-                eprintln!("error: {e}");
-            }
-            let gated: Vec<_> = runs.into_iter().filter(|r| r.ancf.gate.is_some()).collect();
-            let results = run_all(&gated, &Formulation::ALL, true);
-            print!("{}", gate::table(&results));
-            let failing: Vec<_> = results.iter().filter(|r| r.status() != "pass").collect();
-            for r in &failing {
-                for l in r.gate_outcome.as_ref().map(|g| g.failed_lines()).unwrap_or_default() {
-                    eprintln!("gate FAILED: {}: {l}", r.name);
-                }
-            }
-            println!("gate: {} of {} cases pass", results.len() - failing.len(), results.len());
-            Ok(exit_code(&errors, failing.is_empty()))
-        }
+        Cmd::Check(a) => cmd_check(a),
+        Cmd::Gate(a) => cmd_gate(a),
+        Cmd::Converge(a) => cmd_converge(a),
+        Cmd::Stress(a) => cmd_stress(a),
+        Cmd::Energy(a) => cmd_energy(a),
+        Cmd::Bench(a) => cmd_bench(a),
+        Cmd::Static(a) => cmd_static(a),
+        Cmd::Merge(a) => cmd_merge(a),
+        Cmd::Stability(a) => cmd_stability(a),
+        Cmd::Gust(a) => cmd_gust(a),
+        Cmd::List(a) => cmd_list(a),
+        Cmd::Schema => cmd_schema(),
     }
 }
