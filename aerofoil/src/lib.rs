@@ -36,6 +36,7 @@
 //!     width: 0.02,
 //!     rho: 1.225,
 //!     kinematic_viscosity: 1.5e-5,
+//!     fixed_reynolds: None,
 //!     quarter_chord: Vector3::new(0.0, 0.0195, 0.0), // from the reference point, m
 //! };
 //! let inviscid = StripLoads { force: Vector3::new(0.0, 0.005, 0.2), moment: Vector3::zeros() };
