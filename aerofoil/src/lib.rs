@@ -7,7 +7,8 @@
 //!   more Reynolds numbers, read from a CSV file ([`read_polar`]: `alpha_deg, cl, cd, cm`, plus
 //!   `re`) and validated with errors that name the file, line and column. Interpolation is
 //!   monotone cubic in incidence (C¹, no overshoot; the local slope `dcl/dα` is continuous) and
-//!   linear in `ln Re`; outside the ranges an error or a clamp ([`Bounds`]).
+//!   linear in `ln Re`; outside the ranges an error, a clamp or, in incidence, the
+//!   flat-plate extrapolation to ±90° ([`Bounds`]).
 //! * [`correct_strip`]: the strip correction of a lattice's loads, as SHARPy's polar correction
 //!   does it, with its derivatives in the incidence and in the lattice's force, for Newton
 //!   tangents and the linear stability model. From a strip's inviscid lift `L`, with
@@ -35,6 +36,7 @@
 //!     width: 0.02,
 //!     rho: 1.225,
 //!     kinematic_viscosity: 1.5e-5,
+//!     fixed_reynolds: None,
 //!     quarter_chord: Vector3::new(0.0, 0.0195, 0.0), // from the reference point, m
 //! };
 //! let inviscid = StripLoads { force: Vector3::new(0.0, 0.005, 0.2), moment: Vector3::zeros() };
@@ -45,12 +47,13 @@
 #![warn(missing_docs)]
 
 mod error;
+mod extrapolation;
 mod monotone_cubic;
 mod polar;
 mod polar_file;
 mod strip;
 
 pub use error::{AerofoilError, Result};
-pub use polar::{Bounds, Coefficients, OutOfRange, Polar, Table};
+pub use polar::{AlphaOutOfRange, Bounds, Coefficients, OutOfRange, Polar, Table};
 pub use polar_file::{parse_polar, read_polar};
 pub use strip::{Correction, LatticeSection, Strip, StripLoads, correct_strip};

@@ -11,11 +11,13 @@
 //! Outside the table's incidence range, or its Reynolds range, [`Bounds`] decides: an error
 //! (the default, the rule for bad input) or a clamp to the nearest end, where the
 //! coefficients hold their end values and their incidence slopes are zero (the exact derivative
-//! of the clamped function).
+//! of the clamped function); in incidence also the flat-plate (Viterna–Corrigan) extrapolation.
 
 use crate::error::{AerofoilError, Result};
+use crate::extrapolation::viterna;
 use crate::monotone_cubic::MonotoneCubic;
 use serde::{Deserialize, Serialize};
+use std::f64::consts::FRAC_PI_2;
 
 /// One Reynolds number's table, incidences in radians.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,12 +45,26 @@ pub enum OutOfRange {
     Clamp,
 }
 
+/// What to do with an incidence outside the table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlphaOutOfRange {
+    /// Return [`AerofoilError::IncidenceOutOfRange`].
+    #[default]
+    Error,
+    /// Use the nearest end of the table: coefficients held, incidence slopes zero.
+    Clamp,
+    /// The Viterna–Corrigan flat-plate extrapolation from the table's end row up to ±90°
+    /// (`cd_max = 2`, `cm` held; docs/section_aero.md §3); an error beyond ±90°.
+    FlatPlate,
+}
+
 /// Range rules of a polar, one per axis.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Bounds {
     /// Incidence outside `[α_min, α_max]` of the table in use.
-    pub alpha: OutOfRange,
+    pub alpha: AlphaOutOfRange,
     /// Reynolds number outside `[Re_min, Re_max]` of a multi-Re polar (a polar of one table
     /// without `re` accepts every Reynolds number).
     pub re: OutOfRange,
@@ -85,16 +101,29 @@ struct Fitted {
 }
 
 impl Fitted {
-    fn eval(&self, alpha: f64, rule: OutOfRange) -> Result<Coefficients> {
+    fn eval(&self, alpha: f64, rule: AlphaOutOfRange) -> Result<Coefficients> {
         let t = &self.table;
         let (lo, hi) = (t.alpha[0], *t.alpha.last().expect("validated: ≥ 2 rows"));
         let inside = (lo..=hi).contains(&alpha);
-        if !inside && rule == OutOfRange::Error {
-            return Err(AerofoilError::IncidenceOutOfRange {
+        let out_of_range = |min: f64, max: f64| {
+            Err(AerofoilError::IncidenceOutOfRange {
                 alpha_deg: alpha.to_degrees(),
-                min_deg: lo.to_degrees(),
-                max_deg: hi.to_degrees(),
-            });
+                min_deg: min.to_degrees(),
+                max_deg: max.to_degrees(),
+            })
+        };
+        if (!inside && rule == AlphaOutOfRange::Error) || alpha.is_nan() {
+            return out_of_range(lo, hi);
+        }
+        if !inside && rule == AlphaOutOfRange::FlatPlate {
+            let end = if alpha > hi { t.alpha.len() - 1 } else { 0 };
+            let alpha_s = t.alpha[end];
+            // The extrapolation runs from an end on the same side of zero up to ±90°.
+            if alpha.abs() > FRAC_PI_2 || alpha_s * alpha <= 0.0 {
+                return out_of_range(lo.min(-FRAC_PI_2), hi.max(FRAC_PI_2));
+            }
+            let (cl, cd, dcl, dcd) = viterna(alpha_s, t.cl[end], t.cd[end], alpha);
+            return Ok(Coefficients { cl, cd, cm: t.cm[end], dcl, dcd, ..Coefficients::default() });
         }
         let a = alpha.clamp(lo, hi);
         let (cl, dcl) = self.curves[0].eval(&t.alpha, &t.cl, a);
@@ -207,6 +236,10 @@ impl Polar {
         let inside = (re_min..=re_max).contains(&re);
         if (!inside && self.bounds.re == OutOfRange::Error) || re.is_nan() {
             return Err(AerofoilError::ReynoldsOutOfRange { re, min: re_min, max: re_max });
+        }
+        if self.tables.len() == 1 {
+            // One table at one Reynolds number (a file with `re` and a single value).
+            return self.tables[0].eval(alpha, rule);
         }
         let re = re.clamp(re_min, re_max);
         let upper = self.tables.partition_point(|f| f.table.re.is_some_and(|r| r <= re));
@@ -331,11 +364,27 @@ mod tests {
         assert!(matches!(err, AerofoilError::IncidenceOutOfRange { max_deg, .. } if (max_deg - 10.0).abs() < 1e-9));
         let err = p.coefficients(0.0, 5e5).unwrap_err();
         assert!(matches!(err, AerofoilError::ReynoldsOutOfRange { min, max, .. } if min == 1e5 && max == 4e5));
-        let p = p.with_bounds(Bounds { alpha: OutOfRange::Clamp, re: OutOfRange::Clamp });
+        let p = p.with_bounds(Bounds { alpha: AlphaOutOfRange::Clamp, re: OutOfRange::Clamp });
         let c = p.coefficients(0.2, 5e5).unwrap();
         assert_relative_eq!(c.cl, 6.0 * (10f64.to_radians() + 0.02), max_relative = 1e-12);
         assert_eq!(c.dcl, 0.0, "clamped: the slope of a constant");
         assert_eq!(p.coefficients(0.2, 5e5).unwrap(), p.coefficients(0.3, 1e7).unwrap());
+    }
+
+    #[test]
+    fn flat_plate_extrapolation_continues_the_table_to_ninety_degrees() {
+        let p = Polar::new(vec![table(1e5, 5.0, 0.02)]).unwrap();
+        let p = p.with_bounds(Bounds { alpha: AlphaOutOfRange::FlatPlate, ..Bounds::default() });
+        let (end, eps) = (10f64.to_radians(), 1e-9);
+        let (inner, outer) = (p.coefficients(end - eps, 1e5).unwrap(), p.coefficients(end + eps, 1e5).unwrap());
+        assert_relative_eq!(inner.cl, outer.cl, max_relative = 1e-7);
+        assert_relative_eq!(inner.cd, outer.cd, max_relative = 1e-7);
+        assert_relative_eq!(outer.cm, inner.cm, max_relative = 1e-7);
+        let normal = p.coefficients(PI / 2.0, 1e5).unwrap();
+        assert!(normal.cl.abs() < 1e-12 && (normal.cd - 2.0).abs() < 1e-12);
+        let below = p.coefficients(-PI / 3.0, 1e5).unwrap();
+        assert!(below.cl < 0.0 && below.cd > 1.0, "{below:?}");
+        assert!(matches!(p.coefficients(1.7, 1e5), Err(AerofoilError::IncidenceOutOfRange { .. })));
     }
 
     #[test]

@@ -193,6 +193,18 @@ mod tests {
     }
 
     #[test]
+    fn a_file_with_one_reynolds_number_holds_there_only() {
+        let p = parse("re,alpha_deg,cl,cd,cm\n1e5,-5,-0.5,0.01,0\n1e5,5,0.5,0.01,0\n").unwrap();
+        assert_eq!(p.re_range(), Some((1e5, 1e5)));
+        assert_relative_eq!(
+            p.coefficients(0.05, 1e5).unwrap().cl,
+            0.5 * 0.05 / 5f64.to_radians(),
+            max_relative = 1e-12
+        );
+        assert!(matches!(p.coefficients(0.05, 2e5), Err(AerofoilError::ReynoldsOutOfRange { .. })));
+    }
+
+    #[test]
     fn a_file_without_re_holds_at_every_reynolds_number() {
         let p = parse("alpha_deg,cl,cd,cm\n-5,-0.5,0.01,0\n5,0.5,0.01,0\n").unwrap();
         assert_eq!(p.re_range(), None);

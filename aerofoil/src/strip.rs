@@ -58,6 +58,9 @@ pub struct Strip {
     pub rho: f64,
     /// Kinematic viscosity of the air, m²/s (1.5e-5 for air near 20 °C).
     pub kinematic_viscosity: f64,
+    /// A fixed Reynolds number to read the polar at (e.g. the free stream's, `V∞ c/ν`, per run);
+    /// `None`: the strip's own `V c/ν` on its section-plane speed, at every evaluation.
+    pub fixed_reynolds: Option<f64>,
     /// The quarter-chord point relative to the reference point about which moments are given,
     /// m: where the polar's `cm` refers and where the lift change and the profile drag act.
     pub quarter_chord: Vector3<f64>,
@@ -69,9 +72,10 @@ impl Strip {
         self.flow.yz().norm()
     }
 
-    /// Reynolds number `V c / ν` on the section-plane speed.
+    /// The Reynolds number the polar is read at: `fixed_reynolds`, or `V c / ν` on the
+    /// section-plane speed.
     pub fn reynolds(&self) -> f64 {
-        self.section_speed() * self.chord / self.kinematic_viscosity
+        self.fixed_reynolds.unwrap_or_else(|| self.section_speed() * self.chord / self.kinematic_viscosity)
     }
 
     fn validate(&self) -> Result<()> {
@@ -94,6 +98,9 @@ impl Strip {
         }
         if self.section_speed() <= 0.0 {
             return bad("flow", self.section_speed());
+        }
+        if let Some(re) = self.fixed_reynolds.filter(|re| !(re.is_finite() && *re > 0.0)) {
+            return bad("fixed_reynolds", re);
         }
         Ok(())
     }
@@ -254,7 +261,12 @@ fn flow_jacobians(
     let dd = (Matrix3::identity() - d * d.transpose()) * plane / s.speed;
     let dl = -Vector3::<f64>::x().cross_matrix() * dd;
     let dq = (2.0 * q / s.speed) * d.transpose();
-    let dre = (s.reynolds / s.speed) * d.transpose();
+    // A fixed Reynolds number does not follow the flow.
+    let dre = if strip.fixed_reynolds.is_some() {
+        Vector3::zeros().transpose()
+    } else {
+        (s.reynolds / s.speed) * d.transpose()
+    };
     let dlift = inviscid.force.transpose() * dl;
     let dalpha = (dlift / q - s.cl_inviscid * dq / q) / s.lift_slope;
     let dcl = c.dcl * dalpha + c.dcl_dre * dre;

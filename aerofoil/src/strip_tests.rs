@@ -34,6 +34,7 @@ fn strip(alpha: f64, spanwise: f64) -> Strip {
         width: 0.04,
         rho: 1.225,
         kinematic_viscosity: 1.5e-5,
+        fixed_reynolds: None,
         quarter_chord: Vector3::new(0.003, 0.0195 - 0.02, 0.001),
     }
 }
@@ -154,6 +155,7 @@ fn errors_name_the_field_and_the_incidence() {
         ("width", Strip { width: -1.0, ..s }),
         ("rho", Strip { rho: f64::NAN, ..s }),
         ("kinematic_viscosity", Strip { kinematic_viscosity: 0.0, ..s }),
+        ("fixed_reynolds", Strip { fixed_reynolds: Some(-1.0), ..s }),
         ("flow", Strip { flow: Vector3::new(3.0, 0.0, 0.0), ..s }),
     ] {
         let e = correct_strip(&polar, &lat, &bad, &inv).unwrap_err();
@@ -225,7 +227,8 @@ proptest! {
         let polar = stall_polar();
         let lat = LatticeSection { lift_slope: 6.0, zero_lift_alpha: -0.01 };
         let base = strip(alpha_deg.to_radians(), spanwise);
-        let s = Strip { flow: base.flow * (v / 20.0), ..base };
+        let fixed = (v > 40.0).then_some(1.7e5);
+        let s = Strip { flow: base.flow * (v / 20.0), fixed_reynolds: fixed, ..base };
         let inv = inviscid(&s, cl, Vector3::new(0.01, -0.02, 0.0));
         let Ok(c) = correct_strip(&polar, &lat, &s, &inv) else { return Ok(()) };
         let h = 1e-6 * s.flow.norm();

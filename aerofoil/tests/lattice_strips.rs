@@ -32,6 +32,7 @@ fn mid_span(ar: f64, n_half: usize, alpha: f64) -> (Vector3<f64>, Strip) {
         width: 0.5 * ar / n_half as f64,
         rho: 1.0,
         kinematic_viscosity: 1e-5,
+        fixed_reynolds: None,
         quarter_chord: Vector3::zeros(),
     };
     (to_strip * Vector3::from(f), strip)
