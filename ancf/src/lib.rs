@@ -43,7 +43,7 @@
 //! [`SkylineLu`] solver) or `genalpha::GenAlpha::new` (the model declares its band structure),
 //! read [`Model::tip_position`], [`Model::fold_angle`], [`Model::hinge_angle`],
 //! [`Model::energies`], [`Model::dissipation_power`], [`Model::constraint_residual`]; apply aerodynamic or other loads with
-//! [`Model::set_point_loads`]; statics with [`Model::solve_statics`], linear modes with
+//! [`Model::set_point_loads`]; statics with [`Model::solve_static`], linear modes with
 //! [`Model::linear_modes`]. Reference scenes are in [`samples`].
 //!
 //! Units SI; global frame as in docs/conventions.md §1.
@@ -69,12 +69,14 @@ pub mod skyline;
 mod spec;
 pub mod statics;
 pub mod strain;
+mod structure;
 
 pub use error::Error;
+pub use formulation::Energies;
 pub use joint::ConstraintRow;
 pub use loads::PointLoad;
 pub use modal::{Mode, ModeKind};
-pub use model::{Energies, Model};
+pub use model::Model;
 pub use rigid::RigidPose;
 pub use skyline::SkylineLu;
 pub use spec::{BodySpec, Curvature, ForceElement, JointSpec, Options, PointMass, Scene, Section, SolvePath};

@@ -1,6 +1,7 @@
 //! The assembled multibody model: bodies of two-node elements, linear joints, loads, and its
 //! two presentations to the integrator (index-3 DAE or reduced ODE).
 
+use crate::Energies;
 use crate::elastic_force::{ElementMatrix, mirror_upper_inplace};
 use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
@@ -15,9 +16,9 @@ use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
 use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
-use std::cell::RefCell;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// A body with its place in the global coordinate vector.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,27 +33,6 @@ pub(crate) struct Body {
 impl Body {
     pub(crate) fn n_elements(&self) -> usize {
         self.n_nodes - 1
-    }
-}
-
-/// Energies in J. `potential = −∫ m g·(r − r_ref) ds − Σ m_p g·(r_p − r_p,ref)` (zero in the
-/// reference configuration).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Energies {
-    /// Kinetic energy ½ q̇ᵀ M q̇ (point masses included), J.
-    pub kinetic: f64,
-    /// Elastic energy including the cross-section penalty terms, J.
-    pub elastic: f64,
-    /// Gravitational potential energy relative to the reference configuration, J.
-    pub potential: f64,
-    /// Energy of the hinge springs `Σ ½ k (θ − θ₀)²`, J.
-    pub spring: f64,
-}
-
-impl Energies {
-    /// T + U + V + spring energy, J.
-    pub fn total(&self) -> f64 {
-        self.kinetic + self.elastic + self.potential + self.spring
     }
 }
 
@@ -106,9 +86,11 @@ pub struct Model {
     /// Per element whose `element_z` is `None`: how its matrix reaches the reduced coordinates.
     element_reduced: Vec<Option<ReducedElement>>,
     /// The reduced matrix of an element with dependent coordinates (ODE path), n_z × n_z.
-    reduced_block: RefCell<Vec<f64>>,
-    work: RefCell<Workspace>,
-    sensor: RefCell<(Vec<f64>, Vec<f64>)>,
+    reduced_block: Mutex<Vec<f64>>,
+    /// Full-coordinate buffers of the ODE path's residual and matrix.
+    work: Mutex<Workspace>,
+    /// Full coordinates and velocities of the sensors on the ODE path.
+    sensor: Mutex<(Vec<f64>, Vec<f64>)>,
     /// Whether the iteration matrix is symmetric (no follower moments; a hinge damper's
     /// unsymmetric term is left out of Newton's matrix and vanishes at rest), shared with the
     /// [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
@@ -268,14 +250,14 @@ impl Model {
             weights,
             element_z,
             element_reduced,
-            reduced_block: RefCell::new(vec![0.0; max_reduced * max_reduced]),
-            work: RefCell::new(Workspace {
+            reduced_block: Mutex::new(vec![0.0; max_reduced * max_reduced]),
+            work: Mutex::new(Workspace {
                 q: vec![0.0; n_full],
                 v: vec![0.0; n_full],
                 r: vec![0.0; n_full],
                 rate: vec![0.0; if damped { n_full } else { 0 }],
             }),
-            sensor: RefCell::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
+            sensor: Mutex::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
             symmetric: Arc::new(AtomicBool::new(true)),
             springs,
             damped,
@@ -437,7 +419,7 @@ impl Model {
         match self.options.path {
             SolvePath::Dae => f(q),
             SolvePath::Ode => {
-                let mut s = self.sensor.borrow_mut();
+                let mut s = scratch(&self.sensor);
                 self.reduction.expand_inplace(q, &mut s.0);
                 f(&s.0)
             }
@@ -472,7 +454,7 @@ impl Model {
 
     /// Kinetic, elastic and gravitational potential energy.
     pub fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
-        let mut s = self.sensor.borrow_mut();
+        let mut s = scratch(&self.sensor);
         let (qf, vf) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
@@ -508,7 +490,7 @@ impl Model {
         if !self.damped {
             return 0.0;
         }
-        let mut s = self.sensor.borrow_mut();
+        let mut s = scratch(&self.sensor);
         let (qf, vf) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
@@ -559,7 +541,7 @@ impl Model {
         match options.path {
             SolvePath::Dae => springs.iter_mut().for_each(|s| s.accept(q)),
             SolvePath::Ode => {
-                let qf = &mut work.get_mut().q;
+                let qf = &mut work.get_mut().unwrap_or_else(PoisonError::into_inner).q;
                 reduction.expand_inplace(q, qf);
                 springs.iter_mut().for_each(|s| s.accept(qf));
             }
@@ -616,7 +598,7 @@ impl Model {
     pub fn material_velocity(&self, v: &[f64], body: usize, s: f64, y: f64, z: f64) -> Result<Vector3<f64>, Error> {
         let b = self.check_station(|| "station".to_string(), body, s)?;
         let st = locate(b, s);
-        let mut sens = self.sensor.borrow_mut();
+        let mut sens = scratch(&self.sensor);
         let vf = &mut sens.1[..self.n_full];
         self.full_velocities_inplace(v, vf);
         let w = point_weights(st.xi, st.l, y, z);
@@ -853,7 +835,7 @@ impl Model {
             (SolvePath::Ode, None, Some(red)) => {
                 mirror_upper_inplace(ke);
                 let nz = red.z.len();
-                let mut buffer = self.reduced_block.borrow_mut();
+                let mut buffer = scratch(&self.reduced_block);
                 let block = &mut buffer[..nz * nz];
                 block.fill(0.0);
                 for (bb, rb) in red.rows.iter().enumerate() {
@@ -1002,7 +984,7 @@ impl ConstrainedSystem for Model {
         match self.options.path {
             SolvePath::Dae => self.full_residual_at(q, Some(v), v_dot, r),
             SolvePath::Ode => {
-                let mut w = self.work.borrow_mut();
+                let mut w = scratch(&self.work);
                 let Workspace { q: qf, v: af, r: rf, rate } = &mut *w;
                 self.reduction.expand_inplace(q, qf);
                 self.reduction.expand_rate_inplace(v_dot, af);
@@ -1032,7 +1014,7 @@ impl ConstrainedSystem for Model {
         match self.options.path {
             SolvePath::Dae => self.add_iteration_matrix(q, Some(v), c_m, c_c, c_k, k),
             SolvePath::Ode => {
-                let mut w = self.work.borrow_mut();
+                let mut w = scratch(&self.work);
                 let Workspace { q: qf, rate, .. } = &mut *w;
                 self.reduction.expand_inplace(q, qf);
                 let vf = if self.damped {
@@ -1189,4 +1171,12 @@ fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
         }
     }
     ties
+}
+
+/// Lock a model's scratch buffer. The model's methods take `&self` (the integrator's trait), so
+/// their per-call buffers sit behind a `Mutex`: the model stays `Send + Sync`, and a call never
+/// nests a second lock of the same buffer. A poisoned lock only means a panic elsewhere left the
+/// buffer half written; every user overwrites it first.
+fn scratch<T>(buffer: &Mutex<T>) -> MutexGuard<'_, T> {
+    buffer.lock().unwrap_or_else(PoisonError::into_inner)
 }

@@ -96,7 +96,7 @@ impl Model {
     /// Solve for static equilibrium under gravity and the point loads, starting from the
     /// reference configuration. Works on the full coordinates whatever [`SolvePath`](crate::SolvePath) the model
     /// was built with; the load factor is left at 1.
-    pub fn solve_statics(&mut self, params: StaticsParams) -> Result<StaticSolution, Error> {
+    pub fn solve_static(&mut self, params: StaticsParams) -> Result<StaticSolution, Error> {
         let generic = analysis::StaticParams { max_iter: params.max_iter, tol: params.tol, rel_residual_tol: 0.0 };
         let mut solver = StaticSolver::new(&FullCoordinates(self), generic);
         let mut x = analysis::StaticSolution::guess(&FullCoordinates(self), self.reference_coordinates());
@@ -116,5 +116,11 @@ impl Model {
         }
         self.set_load_factor(1.0);
         Ok(StaticSolution { q: x.q, lambda: x.lambda, n_iterations: x.n_iterations })
+    }
+
+    /// The former name of [`solve_static`](Self::solve_static) (GEBF's spelling is the one kept).
+    #[deprecated(note = "renamed to `solve_static`, as in gebf")]
+    pub fn solve_statics(&mut self, params: StaticsParams) -> Result<StaticSolution, Error> {
+        self.solve_static(params)
     }
 }

@@ -8,7 +8,7 @@ pub enum Error {
     Scene(#[from] scene::Error),
     /// A number that must be finite is not.
     #[error("{field}: {value} is not finite")]
-    NotFinite {
+    NonFinite {
         /// Path of the offending input field, e.g. `bodies[0].start`.
         field: String,
         /// The value.

@@ -93,13 +93,15 @@ mod section;
 pub mod simulate;
 mod statics;
 mod stiffness;
+mod structure;
 
 pub use body::BodySpec;
 pub use error::Error;
+pub use formulation::Energies;
 pub use joint::JointSpec;
 pub use loads::NodalLoad;
 pub use modal::Modes;
-pub use model::{Energies, Model};
+pub use model::Model;
 pub use options::Options;
 pub use rigid::RigidPose;
 pub use scene::{ForceElement, PointMass, Scene};

@@ -1,6 +1,7 @@
 //! The multibody GEBF model: bodies with floating frames, joints, gravity, nodal loads; the
 //! [`genalpha::ConstrainedSystem`] implementation and the sensors of the harness API.
 
+use crate::Energies;
 use crate::body::Body;
 use crate::clamp::Clamp;
 use crate::crv::{M3, V3, rotation_matrix};
@@ -18,27 +19,6 @@ use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::Vector3;
 
-/// Energies in J. potential = −∫ m g·(r − r_ref) ds − Σ m_p g·(r_p − r_p,ref) (zero in the
-/// reference configuration).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Energies {
-    /// Kinetic energy, J.
-    pub kinetic: f64,
-    /// Elastic strain energy, J.
-    pub elastic: f64,
-    /// Gravitational potential energy, J.
-    pub potential: f64,
-    /// Energy of the hinge springs `Σ ½ k (θ − θ₀)²`, J.
-    pub spring: f64,
-}
-
-impl Energies {
-    /// kinetic + elastic + potential + spring, J.
-    pub fn total(&self) -> f64 {
-        self.kinetic + self.elastic + self.potential + self.spring
-    }
-}
-
 /// The GEBF multibody model. Implements [`genalpha::ConstrainedSystem`].
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -54,7 +34,7 @@ pub struct Model {
     n_coords: usize,
     n_rows: usize,
     /// Nodal loads per body and node.
-    loads: Vec<Vec<NodalLoad>>,
+    pub(crate) loads: Vec<Vec<NodalLoad>>,
     n_loaded: usize,
     /// Factor on gravity and nodal loads (load stepping in statics).
     pub(crate) load_scale: f64,
@@ -301,7 +281,7 @@ impl Model {
         self.check_node(body, node)?;
         for (k, x) in load.force.iter().chain(load.moment.iter()).enumerate() {
             if !x.is_finite() {
-                return Err(Error::NotFinite { field: format!("load[{k}]"), value: *x });
+                return Err(Error::NonFinite { field: format!("load[{k}]"), value: *x });
             }
         }
         self.loads[body][node] = load;

@@ -40,13 +40,13 @@ impl RigidPose {
         for (name, x) in vectors.into_iter().chain([("velocity", &self.velocity)]) {
             for (k, v) in x.iter().enumerate() {
                 if !v.is_finite() {
-                    return Err(Error::NotFinite { field: format!("poses[{i}].{name}[{k}]"), value: *v });
+                    return Err(Error::NonFinite { field: format!("poses[{i}].{name}[{k}]"), value: *v });
                 }
             }
         }
         for (k, v) in self.rotation.iter().enumerate() {
             if !v.is_finite() {
-                return Err(Error::NotFinite {
+                return Err(Error::NonFinite {
                     field: format!("poses[{i}].rotation[{}][{}]", k % 3, k / 3),
                     value: *v,
                 });

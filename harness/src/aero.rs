@@ -1,6 +1,6 @@
 //! Aero-structure coupling: the UVLM driven by either structural formulation.
 //!
-//! Written once against [`AeroStructure`]: the section pose (axis point and section frame) of a
+//! Written once against [`Structure`]: the section pose (axis point and section frame) of a
 //! body at an arclength, and a way to apply point forces and moments there. Station velocities
 //! are the derivative of the pose along the model's own retraction `q ∘ exp(ε v)` (central
 //! difference), so they are consistent with each formulation's kinematics without a second code
@@ -21,7 +21,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::case::{Case, Joint};
-use crate::run::Structure;
+use formulation::Structure;
 
 /// Aerodynamic settings of a case.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -155,26 +155,7 @@ impl Default for Coupling {
     }
 }
 
-/// A force and moment on a section (global components).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SectionLoad {
-    /// Body index.
-    pub body: usize,
-    /// Arclength, m.
-    pub s: f64,
-    /// Force, N.
-    pub force: Vector3<f64>,
-    /// Moment, N·m.
-    pub moment: Vector3<f64>,
-}
-
-/// What the aerodynamics needs from a structure.
-pub trait AeroStructure: Structure {
-    /// Axis point (m) and section frame (columns x, y, z, orthonormal) of `body` at arclength `s`.
-    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>);
-    /// Replace all external section loads.
-    fn set_section_loads(&mut self, loads: &[SectionLoad]);
-}
+pub use formulation::SectionLoad;
 
 /// One span station of the lattice: which body section drives it, and its column slant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -269,7 +250,7 @@ pub fn lattice_spec(map: &[StationMap], aero: &AeroSettings) -> uvlm::LatticeSpe
 }
 
 /// Pose and velocity of a section by central differences along the retraction.
-pub fn section_state<S: AeroStructure + ?Sized>(
+pub fn section_state<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
     v: &[f64],
@@ -300,7 +281,7 @@ pub fn section_state<S: AeroStructure + ?Sized>(
 
 /// Build the lattice stations (and their velocities) of the current structural state.
 #[allow(clippy::too_many_arguments)] // model, state, map, settings and three reused buffers
-pub(crate) fn stations_at<S: AeroStructure + ?Sized>(
+pub(crate) fn stations_at<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
     v: &[f64],
@@ -332,7 +313,7 @@ fn power(loads: &[SectionLoad], vel: &[uvlm::StationVelocity]) -> f64 {
 
 /// Integrate an aeroelastic case (see the module docs for the scheme), from the model's initial
 /// state with an empty wake (an impulsive start).
-pub fn simulate_aero<S: AeroStructure>(
+pub fn simulate_aero<S: Structure>(
     formulation: crate::case::Formulation,
     model: &mut S,
     settings: &crate::run::RunSettings,
@@ -349,7 +330,7 @@ pub fn simulate_aero<S: AeroStructure>(
 /// initial accelerations, so that without a disturbance the run stays at the equilibrium
 /// (docs/gust.md §3). A gust (`aero.gust`) is attached in both cases, its front placed relative to
 /// the initial lattice's most upstream leading-edge point.
-pub fn simulate_aero_from<S: AeroStructure>(
+pub fn simulate_aero_from<S: Structure>(
     formulation: crate::case::Formulation,
     model: &mut S,
     settings: &crate::run::RunSettings,
@@ -430,7 +411,9 @@ pub fn simulate_aero_from<S: AeroStructure>(
         if let Err(e) = uv.prefill_wake(dt) {
             return fail(out, format!("steady wake at the equilibrium: {e}"));
         }
-        model.set_section_loads(&loads);
+        if let Err(e) = model.set_section_loads(&loads) {
+            return fail(out, format!("loads at the equilibrium: {e}"));
+        }
     }
     if let Some(g) = &aero.gust {
         match crate::gust::disturbance(g, aero, &stations, settings.t_end, s.t) {
@@ -511,7 +494,9 @@ pub fn simulate_aero_from<S: AeroStructure>(
         }
         // 3. Structural step with these loads.
         let s_n: State = s.clone();
-        model.set_section_loads(&loads);
+        if let Err(e) = model.set_section_loads(&loads) {
+            return fail(out, format!("step {k} (t = {t1:.4} s): {e}"));
+        }
         let mut st = match ga.step(model, &mut s) {
             Ok(st) => st,
             Err(e) => return fail(out, format!("step {k}: {e}")),
@@ -535,7 +520,9 @@ pub fn simulate_aero_from<S: AeroStructure>(
                 break;
             }
             s = s_n.clone();
-            model.set_section_loads(&loads);
+            if let Err(e) = model.set_section_loads(&loads) {
+                return fail(out, format!("step {k} (t = {t1:.4} s, sub-iteration): {e}"));
+            }
             st = match ga.step(model, &mut s) {
                 Ok(st) => st,
                 Err(e) => return fail(out, format!("step {k} (sub-iteration): {e}")),

@@ -13,8 +13,11 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use uvlm::FlowField;
 
-use crate::aero::{AeroSettings, AeroStructure, simulate_aero_from, station_map};
+use formulation::Structure;
+
+use crate::aero::{AeroSettings, simulate_aero_from, station_map};
 use crate::case::{Case, Formulation, Joint, Spring};
+use crate::scene::{CaseModel, ForModel, dispatch};
 
 /// Sea-level density of the standard atmosphere, kg/m³ (equivalent to true airspeed).
 pub const RHO_SEA_LEVEL: f64 = 1.225;
@@ -574,16 +577,15 @@ pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result
     };
     let static_cpu_s = cpu_since(t0);
     let t1 = cpu_now();
-    let out = match f {
-        Formulation::Ancf => {
-            let mut m = crate::scene::build_ancf(case).map_err(|e| e.to_string())?;
-            march(case, f, &mut m, q)?
+    struct March<'a>(&'a Case, Formulation, &'a [f64]);
+    impl ForModel for March<'_> {
+        type Output = Result<crate::run::RunOutput, String>;
+        fn run<M: CaseModel>(self) -> Self::Output {
+            let mut m = M::build(self.0).map_err(|e| e.to_string())?;
+            march(self.0, self.1, &mut m, self.2)
         }
-        Formulation::Gebf => {
-            let mut m = crate::scene::build_gebf(case).map_err(|e| e.to_string())?;
-            march(case, f, &mut m, q)?
-        }
-    };
+    }
+    let out = dispatch(f, March(case, f, q))?;
     let cpu_s = cpu_since(t1);
     let r0 = out.rows.first().ok_or_else(|| out.error.clone().unwrap_or_else(|| "no output".into()))?;
     let eq = Equilibrium {
@@ -610,12 +612,7 @@ pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result
     })
 }
 
-fn march<S: AeroStructure>(
-    case: &Case,
-    f: Formulation,
-    model: &mut S,
-    q: &[f64],
-) -> Result<crate::run::RunOutput, String> {
+fn march<S: Structure>(case: &Case, f: Formulation, model: &mut S, q: &[f64]) -> Result<crate::run::RunOutput, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let map = station_map(case, aero)?;
     let settings = crate::scene::settings(case, f);

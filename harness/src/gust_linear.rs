@@ -35,11 +35,13 @@
 
 use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
+use formulation::Structure;
+
 use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
 use crate::case::{Case, Formulation};
 use crate::gust::Increments;
+use crate::scene::{CaseModel, ForModel, dispatch};
 use crate::stability::{linear_wake, load_part, lump, reduce};
-use crate::statics::StaticStructure;
 
 type C64 = Complex<f64>;
 
@@ -75,13 +77,17 @@ pub fn linear_gust_history(
     basis_modes: Option<usize>,
     wake_motion: bool,
 ) -> Result<LinearGustHistory, String> {
-    match f {
-        Formulation::Ancf => run(case, f, crate::scene::build_ancf, basis_modes, wake_motion),
-        Formulation::Gebf => run(case, f, crate::scene::build_gebf, basis_modes, wake_motion),
+    struct Run<'a>(&'a Case, Formulation, Option<usize>, bool);
+    impl ForModel for Run<'_> {
+        type Output = Result<LinearGustHistory, String>;
+        fn run<M: CaseModel>(self) -> Self::Output {
+            run(self.0, self.1, M::build, self.2, self.3)
+        }
     }
+    dispatch(f, Run(case, f, basis_modes, wake_motion))
 }
 
-fn run<S: StaticStructure>(
+fn run<S: Structure>(
     case: &Case,
     f: Formulation,
     build: fn(&Case) -> Result<S, crate::Error>,
@@ -109,7 +115,7 @@ fn run<S: StaticStructure>(
         .iter()
         .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
         .collect();
-    model.set_section_loads(&zero_loads);
+    model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
 
     // The linear UVLM on the equilibrium's lattice and the gust's input to it.
     let n_dof = model.n_dof();
@@ -151,7 +157,7 @@ fn run<S: StaticStructure>(
         } else {
             l[j / 6].moment[comp - 3] = 1.0;
         }
-        p.set_column(j, &DVector::from_vec(load_part(&mut model, &q, &l, &zero_loads)));
+        p.set_column(j, &DVector::from_vec(load_part(&mut model, &q, &l, &zero_loads)?));
     }
     let h = phi.transpose() * &p * &cl;
 

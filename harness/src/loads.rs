@@ -2,7 +2,7 @@
 //! hinge, from the aerodynamic station loads, gravity and (in time histories) the inertia of the
 //! distributed mass and the point masses (docs/statics.md §4).
 //!
-//! Both formulations are measured by the same rule, written once against [`AeroStructure`]: the
+//! Both formulations are measured by the same rule, written once against [`Structure`]: the
 //! free body is the set of bodies outboard of the cut, and its loads are integrated along the
 //! bodies' section poses (3-point Gauss–Legendre on each of the formulation's elements, so the
 //! rule is exact for the polynomial interpolation inside an element). Accelerations come from the
@@ -19,7 +19,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::aero::{AeroStructure, SectionLoad};
+use formulation::Structure;
+
+use crate::aero::SectionLoad;
 use crate::case::{Case, Formulation, Joint};
 
 /// The cut of a free body: its bodies and the point moments are taken about.
@@ -141,7 +143,7 @@ impl LoadModel {
 
     /// The loads at state `(q, v, v̇)` (`None` for the velocities: at rest) with the
     /// aerodynamic station loads `aero`.
-    pub fn evaluate<S: AeroStructure + ?Sized>(
+    pub fn evaluate<S: Structure + ?Sized>(
         &self,
         model: &S,
         q: &[f64],
@@ -175,7 +177,7 @@ impl LoadModel {
     }
 
     /// Resultant force and moment about `about` of every load on the bodies of `cut`.
-    fn wrench<S: AeroStructure + ?Sized>(
+    fn wrench<S: Structure + ?Sized>(
         &self,
         model: &S,
         cut: &Cut,
@@ -256,7 +258,7 @@ pub struct LoadScratch {
 }
 
 impl LoadScratch {
-    fn prepare<S: AeroStructure + ?Sized>(&mut self, model: &S, q: &[f64], motion: Option<(&[f64], &[f64])>) {
+    fn prepare<S: Structure + ?Sized>(&mut self, model: &S, q: &[f64], motion: Option<(&[f64], &[f64])>) {
         self.q[0].clear();
         self.q[0].extend_from_slice(q);
         self.moving = false;
@@ -278,7 +280,7 @@ impl LoadScratch {
         }
     }
 
-    fn kinematics<S: AeroStructure + ?Sized>(&self, model: &S, body: usize, s: f64) -> Kinematics {
+    fn kinematics<S: Structure + ?Sized>(&self, model: &S, body: usize, s: f64) -> Kinematics {
         let (p, r) = model.section_pose(&self.q[0], body, s);
         if !self.moving {
             return Kinematics {

@@ -2,80 +2,12 @@
 
 use std::time::Instant;
 
-use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, LinearSolver, State, Stats};
-use nalgebra::{Matrix3, Vector3};
+use genalpha::{IntegratorParams, State, Stats};
 use serde::Serialize;
 
 use crate::case::Formulation;
 
-/// Energies, J.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct Energies {
-    /// Kinetic energy T.
-    pub kinetic: f64,
-    /// Elastic energy U.
-    pub elastic: f64,
-    /// Gravitational potential V (zero in the reference configuration).
-    pub potential: f64,
-    /// Potential of the hinge springs ½k(θ − θ₀)².
-    pub spring: f64,
-}
-
-/// What the harness needs from a structural model beyond the integrator's trait: its initial
-/// state, the sensors and its geometry. Implemented in [`crate::scene`] directly on both
-/// formulations' models (the integrator sees the model itself, with every optional method of
-/// its trait).
-pub trait Structure: ConstrainedSystem {
-    /// The linear solver the formulation integrates best with.
-    type Solver: LinearSolver;
-    /// A generalized-α integrator with that solver.
-    fn integrator(&self, params: IntegratorParams) -> Result<GenAlpha<Self::Solver>, genalpha::Error>;
-    /// Reference configuration at rest.
-    fn initial_state(&self) -> State;
-    /// Tip position (centroid of the last body's free end), m.
-    fn tip(&self, q: &[f64]) -> [f64; 3];
-    /// Fold angle of flared hinge `joint`, rad (NaN when it is not one).
-    fn fold(&self, q: &[f64], joint: usize) -> f64;
-    /// Energies.
-    fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
-    /// Power dissipated by the force elements' dampers, W (≥ 0).
-    fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64;
-    /// Whether the model has force elements (the spring and dissipated-work columns).
-    fn has_force_elements(&self) -> bool;
-    /// Position-level joint violation (gap in m and axis misalignment in rad, Euclidean norm).
-    fn constraint_residual(&self, q: &[f64]) -> f64;
-    /// Number of bodies.
-    fn n_bodies(&self) -> usize;
-    /// Positions and section frames of body `body`'s nodes, written into `out` (cleared first).
-    fn body_geometry(&self, q: &[f64], body: usize, out: &mut BeamGeometry);
-}
-
-/// One body's nodes in the current configuration.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct BeamGeometry {
-    /// Arclength of each node in the reference configuration, m.
-    pub arc: Vec<f64>,
-    /// Node positions, global, m.
-    pub positions: Vec<Vector3<f64>>,
-    /// Section frames at the nodes: columns x (beam axis), y, z, global.
-    pub frames: Vec<Matrix3<f64>>,
-}
-
-impl BeamGeometry {
-    /// Forget the nodes, keep the storage.
-    pub fn clear(&mut self) {
-        self.arc.clear();
-        self.positions.clear();
-        self.frames.clear();
-    }
-
-    /// Append a node.
-    pub fn push(&mut self, arc: f64, position: Vector3<f64>, frame: Matrix3<f64>) {
-        self.arc.push(arc);
-        self.positions.push(position);
-        self.frames.push(frame);
-    }
-}
+pub use formulation::{BeamGeometry, Energies, Structure};
 
 /// What a run hands its [`Observer`] at every output step: the time, every body's nodes with their
 /// section frames, and the aerodynamic state (lattice, bound circulation, wake) when the case has

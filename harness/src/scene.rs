@@ -1,171 +1,77 @@
-//! Building each formulation's model from a case, and the [`Structure`] impls that expose the
-//! sensors of both through one interface.
+//! Building each formulation's model from a case. Both models implement
+//! [`formulation::Structure`] in their own crates; the time loops and analyses are generic over
+//! it. [`dispatch`] is the one place that picks a formulation's model type.
 
-use nalgebra::{Matrix3, Vector3};
+use formulation::Structure;
+use genalpha::Predictor;
 
 use crate::Error;
-use crate::aero::{AeroStructure, SectionLoad, simulate_aero, station_map};
+use crate::aero::{simulate_aero, station_map};
 use crate::case::{AncfPath, Case, Formulation};
-use crate::run::{BeamGeometry, Energies, NoObserver, Observer, RunOutput, RunSettings, Structure, simulate};
+use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate};
 
-/// `Structure` for a formulation's model: the integrator it runs with and its sensors. The
-/// model itself goes to the integrator, so every optional method of `ConstrainedSystem` it
-/// overrides (GEBF's fused residual-and-matrix pass, its declared matrix structure) is used.
-macro_rules! structure {
-    ($t:ty, $solver:ty, $make:expr, $geometry:expr) => {
-        impl Structure for $t {
-            type Solver = $solver;
-            fn integrator(
-                &self,
-                params: genalpha::IntegratorParams,
-            ) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> {
-                let make: fn(&$t, genalpha::IntegratorParams) -> Result<genalpha::GenAlpha<$solver>, genalpha::Error> =
-                    $make;
-                make(self, params)
-            }
-            fn initial_state(&self) -> genalpha::State {
-                <$t>::initial_state(self)
-            }
-            fn tip(&self, q: &[f64]) -> [f64; 3] {
-                self.tip_position(q).into()
-            }
-            fn fold(&self, q: &[f64], joint: usize) -> f64 {
-                self.fold_angle(q, joint).unwrap_or(f64::NAN)
-            }
-            fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
-                let e = <$t>::energies(self, q, v);
-                Energies { kinetic: e.kinetic, elastic: e.elastic, potential: e.potential, spring: e.spring }
-            }
-            fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
-                <$t>::dissipation_power(self, q, v)
-            }
-            fn has_force_elements(&self) -> bool {
-                <$t>::n_force_elements(self) > 0
-            }
-            fn constraint_residual(&self, q: &[f64]) -> f64 {
-                <$t>::constraint_residual(self, q)
-            }
-            fn n_bodies(&self) -> usize {
-                <$t>::n_bodies(self)
-            }
-            fn body_geometry(&self, q: &[f64], body: usize, out: &mut BeamGeometry) {
-                out.clear();
-                let geometry: fn(&$t, &[f64], usize, &mut BeamGeometry) = $geometry;
-                geometry(self, q, body, out)
-            }
-        }
-    };
+/// A formulation's model as a case builds it: [`Structure`] plus its construction and its
+/// Newton predictor. A third formulation implements this and adds one line to [`dispatch`].
+pub trait CaseModel: Structure + Send + Sync + Sized {
+    /// Newton's predictor for this formulation's time steps.
+    const PREDICTOR: Predictor;
+    /// Build the model of `case` (its scene and this formulation's options).
+    fn build(case: &Case) -> Result<Self, Error>;
 }
 
-// ANCF brings its skyline LU (banded, symmetric-structure); GEBF declares a block-banded
-// structure that genalpha's default solver exploits.
-structure!(ancf::Model, ancf::SkylineLu, |m, p| m.integrator(p), |m, q, body, out| {
-    // The nodes of ANCF's two-node elements, equally spaced.
-    let Some(spec) = m.body_spec(body) else { return };
-    for k in 0..=spec.n_elements {
-        let s = spec.length * k as f64 / spec.n_elements as f64;
-        if let Ok((p, r)) = m.section_frame(q, body, s) {
-            out.push(s, p, r);
-        }
-    }
-});
-structure!(gebf::Model, genalpha::DenseLu, |m, p| genalpha::GenAlpha::new(p, m), |m, q, body, out| {
-    // Every node of the three-node elements, middle nodes included.
-    for k in 0..m.n_nodes(body) {
-        if let (Ok(s), Ok(p), Ok(r)) =
-            (m.node_arc_length(body, k), m.node_position(q, body, k), m.node_frame(q, body, k))
-        {
-            out.push(s, p, r);
-        }
-    }
-});
-
-impl AeroStructure for ancf::Model {
-    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
-        // The station list is validated against the case, so (body, s) is always in range.
-        self.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))
-    }
-    fn set_section_loads(&mut self, loads: &[SectionLoad]) {
-        let pl: Vec<ancf::PointLoad> = loads
-            .iter()
-            .map(|l| ancf::PointLoad { body: l.body, s: l.s, y: 0.0, z: 0.0, force: l.force, moment: l.moment })
-            .collect();
-        // Stations come from the validated case: in range by construction.
-        let _ = self.set_point_loads(&pl);
+impl CaseModel for ancf::Model {
+    /// ANCF's inertia is linear: constant accelerations.
+    const PREDICTOR: Predictor = Predictor::ConstantAcceleration;
+    fn build(case: &Case) -> Result<Self, Error> {
+        build_ancf(case)
     }
 }
 
-/// Element of a GEBF body holding arclength `s`: its three node indices and the quadratic
-/// Lagrange weights of `s`.
-fn gebf_element(model: &gebf::Model, body: usize, s: f64) -> Option<([usize; 3], [f64; 3])> {
-    let n = model.n_nodes(body);
-    let arc = |k: usize| model.node_arc_length(body, k).ok();
-    let n_el = (n - 1) / 2;
-    for e in 0..n_el {
-        let (s0, s1, s2) = (arc(2 * e)?, arc(2 * e + 1)?, arc(2 * e + 2)?);
-        if s <= s2 + 1e-12 || e + 1 == n_el {
-            let w = [
-                (s - s1) * (s - s2) / ((s0 - s1) * (s0 - s2)),
-                (s - s0) * (s - s2) / ((s1 - s0) * (s1 - s2)),
-                (s - s0) * (s - s1) / ((s2 - s0) * (s2 - s1)),
-            ];
-            return Some(([2 * e, 2 * e + 1, 2 * e + 2], w));
-        }
+impl CaseModel for gebf::Model {
+    /// GEBF starts Newton from extrapolated accelerations: its residual is quadratic in the
+    /// floating frames' angular velocities (Coriolis and centrifugal terms of the beam in a
+    /// frame spinning at up to 30 rad/s in the c = 0.01 case).
+    const PREDICTOR: Predictor = Predictor::ExtrapolatedAcceleration;
+    fn build(case: &Case) -> Result<Self, Error> {
+        build_gebf(case)
     }
-    None
 }
 
-/// Rotation vector of a rotation matrix. Through the quaternion (Shepperd's method), accurate at
-/// every angle: an `acos` of the trace returns NaN when rounding pushes it past 3 for the tiny
-/// relative rotations of a stiff wing.
-fn log_so3(r: &Matrix3<f64>) -> Vector3<f64> {
-    gebf::crv::from_rotation_matrix(r)
+/// Work generic over a formulation's model type, run by [`dispatch`].
+pub trait ForModel {
+    /// What the work returns.
+    type Output;
+    /// Do the work with model type `M`.
+    fn run<M: CaseModel>(self) -> Self::Output;
 }
 
-impl AeroStructure for gebf::Model {
-    /// Quadratic interpolation of the element's nodal positions, and of the nodal rotations
-    /// relative to the middle node (objective).
-    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
-        let m = self;
-        let Some((nodes, w)) = gebf_element(m, body, s) else {
-            return (Vector3::from_element(f64::NAN), Matrix3::identity());
-        };
-        let pos = |k| m.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
-        let frm = |k| m.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
-        let p = pos(nodes[0]) * w[0] + pos(nodes[1]) * w[1] + pos(nodes[2]) * w[2];
-        let r1 = frm(nodes[1]);
-        let phi = log_so3(&(r1.transpose() * frm(nodes[0]))) * w[0] + log_so3(&(r1.transpose() * frm(nodes[2]))) * w[2];
-        let r = r1 * nalgebra::Rotation3::new(phi).into_inner();
-        (p, r)
+/// The formulation factory: run `work` with the model type of formulation `f`.
+pub fn dispatch<W: ForModel>(f: Formulation, work: W) -> W::Output {
+    match f {
+        Formulation::Ancf => work.run::<ancf::Model>(),
+        Formulation::Gebf => work.run::<gebf::Model>(),
     }
-    /// Consistent nodal loads: the quadratic weights distribute each station's force and moment.
-    fn set_section_loads(&mut self, loads: &[SectionLoad]) {
-        self.clear_nodal_loads();
-        for l in loads {
-            let Some((nodes, w)) = gebf_element(self, l.body, l.s) else { continue };
-            for (k, wk) in nodes.iter().zip(w) {
-                let old = self
-                    .nodal_load(l.body, *k)
-                    .unwrap_or(gebf::NodalLoad { force: Vector3::zeros(), moment: Vector3::zeros() });
-                let new = gebf::NodalLoad { force: old.force + wk * l.force, moment: old.moment + wk * l.moment };
-                let _ = self.set_nodal_load(l.body, *k, new);
-            }
+}
+
+/// The Newton predictor of formulation `f` ([`CaseModel::PREDICTOR`]).
+pub fn predictor(f: Formulation) -> Predictor {
+    struct Of;
+    impl ForModel for Of {
+        type Output = Predictor;
+        fn run<M: CaseModel>(self) -> Predictor {
+            M::PREDICTOR
         }
     }
+    dispatch(f, Of)
 }
 
 /// The integrator parameters, end time and output interval of formulation `f` of a case.
 pub fn settings(case: &Case, f: Formulation) -> RunSettings {
-    use genalpha::Predictor::{ConstantAcceleration, ExtrapolatedAcceleration};
-    // GEBF starts Newton from extrapolated accelerations: its residual is quadratic in the
-    // floating frames' angular velocities (Coriolis and centrifugal terms of the beam in a frame
-    // spinning at up to 30 rad/s in the c = 0.01 case). ANCF's inertia is linear.
-    let (dt, rho, newton, predictor, form) = match f {
-        Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton, ConstantAcceleration, case.ancf.form),
-        Formulation::Gebf => {
-            (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton, ExtrapolatedAcceleration, case.gebf.form)
-        }
+    let (dt, rho, newton, form) = match f {
+        Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton, case.ancf.form),
+        Formulation::Gebf => (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton, case.gebf.form),
     };
+    let predictor = predictor(f);
     let mut params = genalpha::IntegratorParams::new(rho, dt);
     params.newton = newton.to_params(predictor);
     // Both formulations default to the Arnold–Brüls form. GEBF's energy at rho_inf = 1 is better
@@ -208,21 +114,24 @@ pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
 
 /// As [`run_formulation`], handing every output step's geometry to `observer`.
 pub fn run_formulation_observed(case: &Case, f: Formulation, observer: &mut dyn Observer) -> RunOutput {
-    let s = settings(case, f);
-    let built = match (&case.aero, f) {
-        (None, Formulation::Ancf) => build_ancf(case).map(|mut model| simulate(f, &mut model, &s, observer)),
-        (None, Formulation::Gebf) => build_gebf(case).map(|mut model| simulate(f, &mut model, &s, observer)),
-        (Some(aero), _) => match station_map(case, aero) {
-            Err(msg) => Err(Error::Model { formulation: f, msg }),
-            Ok(map) => match f {
-                Formulation::Ancf => {
-                    build_ancf(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
+    struct Run<'a, 'o> {
+        case: &'a Case,
+        f: Formulation,
+        observer: &'o mut dyn Observer,
+    }
+    impl ForModel for Run<'_, '_> {
+        type Output = Result<RunOutput, Error>;
+        fn run<M: CaseModel>(self) -> Self::Output {
+            let Run { case, f, observer } = self;
+            let s = settings(case, f);
+            match &case.aero {
+                None => M::build(case).map(|mut model| simulate(f, &mut model, &s, observer)),
+                Some(aero) => {
+                    let map = station_map(case, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
+                    M::build(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
                 }
-                Formulation::Gebf => {
-                    build_gebf(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
-                }
-            },
-        },
-    };
-    built.unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
+            }
+        }
+    }
+    dispatch(f, Run { case, f, observer }).unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
 }

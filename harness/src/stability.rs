@@ -34,9 +34,11 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use formulation::Structure;
+
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
 use crate::case::{Case, Formulation};
-use crate::statics::StaticStructure;
+use crate::scene::{CaseModel, ForModel, dispatch};
 
 type C64 = Complex<f64>;
 
@@ -530,26 +532,27 @@ impl Strips {
     }
 }
 
-/// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`.
-pub(crate) fn load_part<S: StaticStructure>(
+/// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`; the model's refusal of
+/// a load names its station.
+pub(crate) fn load_part<S: Structure>(
     model: &mut S,
     q: &[f64],
     loads: &[SectionLoad],
     zero: &[SectionLoad],
-) -> Vec<f64> {
+) -> Result<Vec<f64>, String> {
     let n = model.n_dof();
     let z = vec![0.0; n];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-    model.set_section_loads(loads);
+    model.set_section_loads(loads).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut a);
-    model.set_section_loads(zero);
+    model.set_section_loads(zero).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut b);
-    a.iter().zip(&b).map(|(x, y)| x - y).collect()
+    Ok(a.iter().zip(&b).map(|(x, y)| x - y).collect())
 }
 
 /// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
 /// held fixed (central differences along the retraction); `None` when they vanish.
-fn held_load_stiffness<S: StaticStructure>(
+fn held_load_stiffness<S: Structure>(
     model: &mut S,
     q: &[f64],
     map: &[StationMap],
@@ -579,10 +582,10 @@ fn held_load_stiffness<S: StaticStructure>(
         dq.fill(0.0);
         dq[j] = h;
         model.retract_inplace(q, &dq, &mut qq);
-        let gp = load_part(model, &qq, &l0, zero);
+        let gp = load_part(model, &qq, &l0, zero)?;
         dq[j] = -h;
         model.retract_inplace(q, &dq, &mut qq);
-        let gm = load_part(model, &qq, &l0, zero);
+        let gm = load_part(model, &qq, &l0, zero)?;
         for i in 0..n {
             k[(i, j)] = (gp[i] - gm[i]) / (2.0 * h);
         }
@@ -606,7 +609,7 @@ pub(crate) fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 
 /// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
 /// `aero`, with `nb` basis modes.
 #[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
-pub fn reduce<S: StaticStructure>(
+pub fn reduce<S: Structure>(
     mut model: S,
     q: &[f64],
     lambda: &[f64],
@@ -622,7 +625,7 @@ pub fn reduce<S: StaticStructure>(
         .iter()
         .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
         .collect();
-    model.set_section_loads(&zero_loads);
+    model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
     let mut lin =
         genalpha::analysis::linearise(&model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
     // The structural modes are those of the structure under its equilibrium's steady station
@@ -764,7 +767,7 @@ pub fn reduce<S: StaticStructure>(
             } else {
                 l[j].moment[comp - 3] = 1.0;
             }
-            let g = load_part(&mut model, q, &l, &zero_loads);
+            let g = load_part(&mut model, q, &l, &zero_loads)?;
             p.column_mut(6 * j + comp).copy_from_slice(&g);
         }
     }
@@ -810,7 +813,7 @@ pub fn reduce<S: StaticStructure>(
         let (r, f) = la.evaluate(&lat).map_err(|e| e.to_string())?;
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
         let loads = lump(map, lat.ring_nodes(), &org, &f);
-        let g = load_part(model, qq, &loads, &zero_loads);
+        let g = load_part(model, qq, &loads, &zero_loads)?;
         let te = lat.ring_nodes()[te_start..].iter().flatten().copied().collect();
         Ok((r, g, te))
     };
@@ -919,10 +922,14 @@ fn cpu_now() -> f64 {
 /// Run the stability sweep of `case` with formulation `f`.
 pub fn run_stability(case: &Case, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
-    let mut out = match f {
-        Formulation::Ancf => sweep(case, f, crate::scene::build_ancf),
-        Formulation::Gebf => sweep(case, f, crate::scene::build_gebf),
-    };
+    struct Sweep<'a>(&'a Case, Formulation);
+    impl ForModel for Sweep<'_> {
+        type Output = StabilityOutput;
+        fn run<M: CaseModel>(self) -> StabilityOutput {
+            sweep(self.0, self.1, M::build)
+        }
+    }
+    let mut out = dispatch(f, Sweep(case, f));
     out.wall_s = t0.elapsed().as_secs_f64();
     out
 }
@@ -949,11 +956,7 @@ fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
     }
 }
 
-fn sweep<S: StaticStructure>(
-    case: &Case,
-    f: Formulation,
-    build: fn(&Case) -> Result<S, crate::Error>,
-) -> StabilityOutput {
+fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, crate::Error>) -> StabilityOutput {
     let (Some(aero), Some(st)) = (case.aero.as_ref(), case.stability.as_ref()) else {
         return empty_output(f, Some("the case has no `aero` and `stability` blocks".into()));
     };

@@ -18,8 +18,8 @@
 //! a point that fails is retried through intermediate airspeeds (bisection), and if it still
 //! fails it is reported and the sweep goes on from the last equilibrium.
 
-use std::cell::RefCell;
 use std::path::Path;
+use std::sync::{Mutex, MutexGuard, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::Instant;
 
 use genalpha::analysis::{StaticParams, StaticSolution, StaticSolver};
@@ -28,28 +28,12 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::Error;
-use crate::aero::{AeroSettings, AeroStructure, SectionLoad, StationMap, station_map, stations_at};
+use formulation::Structure;
+
+use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
 use crate::case::{Case, Formulation};
 use crate::loads::{LoadModel, LoadScratch, WingLoads};
-
-/// What the static analysis needs beyond the aerodynamic seam: a way to keep stored coordinates
-/// on one branch after every Newton update (GEBF's rotation vectors past π).
-pub trait StaticStructure: AeroStructure {
-    /// Bring stored coordinates back to their canonical branch without changing the
-    /// configuration. Default: nothing.
-    fn normalise(&self, _q: &mut [f64]) {}
-}
-
-impl StaticStructure for ancf::Model {}
-
-impl StaticStructure for gebf::Model {
-    /// Rotation vectors back past π, and the joints' position-level projection: the
-    /// velocity-level hinge rows keep each Newton increment on the joint only to first order.
-    fn normalise(&self, q: &mut [f64]) {
-        self.rescale_rotations(q, None);
-        self.project_joints(q);
-    }
-}
+use crate::scene::{CaseModel, ForModel, dispatch};
 
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
@@ -67,7 +51,7 @@ struct SteadyAero {
 impl SteadyAero {
     /// A steady UVLM on the lattice of `model` at `q`, with free stream `v_inf` and the steady
     /// wake `wake`.
-    fn new<S: AeroStructure>(
+    fn new<S: Structure>(
         model: &S,
         q: &[f64],
         map: &[StationMap],
@@ -97,7 +81,7 @@ impl SteadyAero {
     }
 
     /// Station loads of the steady solution on the lattice of `model` at `q`, into `out`.
-    fn loads_at<S: AeroStructure>(
+    fn loads_at<S: Structure>(
         &mut self,
         model: &S,
         q: &[f64],
@@ -154,13 +138,13 @@ struct AeroTangent {
 
 /// The structure with the steady aerodynamic loads of its own lattice: a [`ConstrainedSystem`]
 /// whose static equilibria are the aeroelastic ones.
-pub struct AeroStatic<'a, S: StaticStructure> {
-    model: RefCell<S>,
-    aero_state: RefCell<SteadyAero>,
-    tangent: RefCell<AeroTangent>,
-    loads: RefCell<Vec<SectionLoad>>,
+pub struct AeroStatic<'a, S: Structure> {
+    model: RwLock<S>,
+    aero_state: Mutex<SteadyAero>,
+    tangent: Mutex<AeroTangent>,
+    loads: Mutex<Vec<SectionLoad>>,
     zero_loads: Vec<SectionLoad>,
-    error: RefCell<Option<String>>,
+    error: Mutex<Option<String>>,
     map: &'a [StationMap],
     aero: AeroSettings,
     /// The steady wake (a fixed length: the V² scaling of the kept stiffness stays exact).
@@ -170,7 +154,7 @@ pub struct AeroStatic<'a, S: StaticStructure> {
     fd_step: f64,
 }
 
-impl<'a, S: StaticStructure> AeroStatic<'a, S> {
+impl<'a, S: Structure> AeroStatic<'a, S> {
     /// The coupled system of `model` with the aerodynamics `aero` (its free stream as given) on
     /// the stations `map`, with the steady wake `wake`; the lattice is built at `q`.
     pub fn new(
@@ -201,12 +185,12 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
             loads: loads.clone(),
         };
         Ok(Self {
-            model: RefCell::new(model),
-            aero_state: RefCell::new(st),
-            tangent: RefCell::new(tangent),
+            model: RwLock::new(model),
+            aero_state: Mutex::new(st),
+            tangent: Mutex::new(tangent),
             zero_loads: loads.clone(),
-            loads: RefCell::new(loads),
-            error: RefCell::new(None),
+            loads: Mutex::new(loads),
+            error: Mutex::new(None),
             map,
             aero: aero.clone(),
             wake,
@@ -220,10 +204,10 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
     pub fn set_airspeed(&mut self, airspeed: f64, q: &[f64]) -> Result<(), String> {
         self.aero.airspeed = Some(airspeed);
         let v = self.aero.free_stream();
-        let solves = self.aero_state.borrow().n_solves;
-        let mut st = SteadyAero::new(&*self.model.borrow(), q, self.map, &self.aero, v, self.wake)?;
+        let solves = lock(&self.aero_state).n_solves;
+        let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake)?;
         st.n_solves = solves;
-        *self.aero_state.borrow_mut() = st;
+        *lock(&self.aero_state) = st;
         self.speed2 = v.iter().map(|x| x * x).sum();
         self.begin_solve(false);
         Ok(())
@@ -231,20 +215,20 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
 
     /// Replace the structural model (same coordinates; e.g. with scaled gravity).
     pub fn set_model(&mut self, model: S) {
-        *self.model.borrow_mut() = model;
+        *write(&self.model) = model;
         self.begin_solve(false);
     }
 
     /// Start a solve: re-evaluate the aerodynamic stiffness at the next assembly when `refresh`
     /// (it is evaluated at the first assembly in any case).
     pub fn begin_solve(&mut self, refresh: bool) {
-        self.tangent.get_mut().refresh = refresh;
-        *self.error.get_mut() = None;
+        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).refresh = refresh;
+        *self.error.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
     }
 
     /// The structural model.
-    pub fn model(&self) -> std::cell::Ref<'_, S> {
-        self.model.borrow()
+    pub fn model(&self) -> RwLockReadGuard<'_, S> {
+        read(&self.model)
     }
 
     /// The airspeed, m/s.
@@ -254,21 +238,21 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
 
     /// Why the last residual could not be evaluated (the lattice folded, the solve failed).
     pub fn error(&self) -> Option<String> {
-        self.error.borrow().clone()
+        lock(&self.error).clone()
     }
 
     /// Steady solves and aerodynamic-stiffness evaluations so far.
     pub fn counters(&self) -> (usize, usize) {
-        (self.aero_state.borrow().n_solves, self.tangent.borrow().n_refresh)
+        (lock(&self.aero_state).n_solves, lock(&self.tangent).n_refresh)
     }
 
     /// Station loads and the UVLM's lattice loads at `q`.
     fn station_loads(&self, q: &[f64], out: &mut [SectionLoad]) -> bool {
-        let model = self.model.borrow();
-        match self.aero_state.borrow_mut().loads_at(&*model, q, self.map, &self.aero, out) {
+        let model = read(&self.model);
+        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, out) {
             Ok(()) => true,
             Err(e) => {
-                *self.error.borrow_mut() = Some(e);
+                *lock(&self.error) = Some(e);
                 false
             }
         }
@@ -276,17 +260,20 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
 
     /// Loads at `q` applied to the model; false when the aerodynamics failed.
     fn apply_loads(&self, q: &[f64]) -> bool {
-        let mut loads = self.loads.borrow_mut();
+        let mut loads = lock(&self.loads);
         if !self.station_loads(q, &mut loads) {
             return false;
         }
-        self.model.borrow_mut().set_section_loads(&loads);
+        if let Err(e) = write(&self.model).set_section_loads(&loads) {
+            *lock(&self.error) = Some(e.to_string());
+            return false;
+        }
         true
     }
 
     /// The station loads of the last residual evaluation.
     pub fn current_loads(&self) -> Vec<SectionLoad> {
-        self.loads.borrow().clone()
+        lock(&self.loads).clone()
     }
 
     /// Recompute the aerodynamics at `q` (e.g. at a converged equilibrium, after the difference
@@ -295,17 +282,23 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
         if !self.apply_loads(q) {
             return Err(self.error().unwrap_or_default());
         }
-        let st = self.aero_state.borrow();
-        Ok((self.loads.borrow().clone(), st.uv.loads().clone(), st.stations.clone()))
+        let st = lock(&self.aero_state);
+        Ok((lock(&self.loads).clone(), st.uv.loads().clone(), st.stations.clone()))
     }
 
     /// Generalised aerodynamic load `r(q, L) − r(q, 0)` (the residual's load part, with the
     /// minus sign of an external force) of the station loads `loads` at `q`, into `out`.
     fn load_part(&self, t: f64, q: &[f64], loads: &[SectionLoad], zeros: &[f64], scratch: &mut [f64], out: &mut [f64]) {
-        let mut m = self.model.borrow_mut();
-        m.set_section_loads(loads);
-        m.residual_inplace(t, q, zeros, zeros, out);
-        m.set_section_loads(&self.zero_loads);
+        let mut m = write(&self.model);
+        let applied = m
+            .set_section_loads(loads)
+            .map(|()| m.residual_inplace(t, q, zeros, zeros, out))
+            .and_then(|()| m.set_section_loads(&self.zero_loads));
+        if let Err(e) = applied {
+            *lock(&self.error) = Some(e.to_string());
+            out.fill(f64::NAN);
+            return;
+        }
         m.residual_inplace(t, q, zeros, zeros, scratch);
         for (o, s) in out.iter_mut().zip(scratch.iter()) {
             *o -= s;
@@ -317,7 +310,7 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
     /// response and the way a formulation applies a station load (ANCF's moments through the
     /// section slopes) are in it. The model's loads are those of `q` on return.
     fn update_tangent(&self, t: f64, q: &[f64]) {
-        let mut tg = self.tangent.borrow_mut();
+        let mut tg = lock(&self.tangent);
         let tg = &mut *tg;
         if tg.valid && !tg.refresh {
             return;
@@ -327,13 +320,13 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
         let n = self.n_dof();
         let zeros = vec![0.0; n];
         let mut scratch = vec![0.0; n];
-        let loads_q = self.loads.borrow().clone();
+        let loads_q = lock(&self.loads).clone();
         self.load_part(t, q, &loads_q, &zeros, &mut scratch, &mut tg.r0);
         for j in 0..n {
-            let h = self.fd_step / self.model.borrow().increment_weight(j).max(1e-12);
+            let h = self.fd_step / read(&self.model).increment_weight(j).max(1e-12);
             tg.dq.iter_mut().for_each(|x| *x = 0.0);
             tg.dq[j] = h;
-            self.model.borrow().retract_inplace(q, &tg.dq, &mut tg.q_tmp);
+            read(&self.model).retract_inplace(q, &tg.dq, &mut tg.q_tmp);
             if !self.station_loads(&tg.q_tmp, &mut tg.loads) {
                 // Keep the structural tangent alone in this column.
                 for i in 0..n {
@@ -348,33 +341,35 @@ impl<'a, S: StaticStructure> AeroStatic<'a, S> {
         }
         tg.speed2 = self.speed2;
         tg.valid = true;
-        // Back to the loads of q.
-        self.model.borrow_mut().set_section_loads(&loads_q);
+        // Back to the loads of q (accepted before).
+        if let Err(e) = write(&self.model).set_section_loads(&loads_q) {
+            *lock(&self.error) = Some(e.to_string());
+        }
     }
 }
 
-impl<S: StaticStructure> ConstrainedSystem for AeroStatic<'_, S> {
+impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
     fn n_coords(&self) -> usize {
-        self.model.borrow().n_coords()
+        read(&self.model).n_coords()
     }
     fn n_dof(&self) -> usize {
-        self.model.borrow().n_dof()
+        read(&self.model).n_dof()
     }
     fn n_holonomic(&self) -> usize {
-        self.model.borrow().n_holonomic()
+        read(&self.model).n_holonomic()
     }
     fn n_velocity_constraints(&self) -> usize {
-        self.model.borrow().n_velocity_constraints()
+        read(&self.model).n_velocity_constraints()
     }
     fn retract_inplace(&self, q: &[f64], dq: &[f64], q_out: &mut [f64]) {
-        self.model.borrow().retract_inplace(q, dq, q_out);
+        read(&self.model).retract_inplace(q, dq, q_out);
     }
     fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
         if !self.apply_loads(q) {
             r.iter_mut().for_each(|x| *x = f64::NAN);
             return;
         }
-        self.model.borrow().residual_inplace(t, q, v, v_dot, r);
+        read(&self.model).residual_inplace(t, q, v, v_dot, r);
     }
     fn iteration_matrix_inplace(
         &self,
@@ -404,18 +399,22 @@ impl<S: StaticStructure> ConstrainedSystem for AeroStatic<'_, S> {
     ) {
         // The structure's matrix without loads (their tangent is in the difference quotients),
         // then the residual with the loads of q.
-        self.model.borrow_mut().set_section_loads(&self.zero_loads);
-        self.model.borrow().residual_and_iteration_matrix_inplace(t, q, v, v_dot, r, c_m, c_c, c_k, k);
+        if let Err(e) = write(&self.model).set_section_loads(&self.zero_loads) {
+            *lock(&self.error) = Some(e.to_string());
+            r.fill(f64::NAN);
+            return;
+        }
+        read(&self.model).residual_and_iteration_matrix_inplace(t, q, v, v_dot, r, c_m, c_c, c_k, k);
         if !self.apply_loads(q) {
             r.iter_mut().for_each(|x| *x = f64::NAN);
             return;
         }
-        self.model.borrow().residual_inplace(t, q, v, v_dot, r);
+        read(&self.model).residual_inplace(t, q, v, v_dot, r);
         if c_k == 0.0 {
             return;
         }
         self.update_tangent(t, q);
-        let tg = self.tangent.borrow();
+        let tg = lock(&self.tangent);
         let n = self.n_dof();
         let scale = c_k * self.speed2 / tg.speed2;
         for i in 0..n {
@@ -428,22 +427,22 @@ impl<S: StaticStructure> ConstrainedSystem for AeroStatic<'_, S> {
         }
     }
     fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
-        self.model.borrow().phi_inplace(t, q, phi);
+        read(&self.model).phi_inplace(t, q, phi);
     }
     fn phi_q_inplace(&self, t: f64, q: &[f64], j: &mut MatView<'_>) {
-        self.model.borrow().phi_q_inplace(t, q, j);
+        read(&self.model).phi_q_inplace(t, q, j);
     }
     fn phi_q_is_constant(&self) -> bool {
-        self.model.borrow().phi_q_is_constant()
+        read(&self.model).phi_q_is_constant()
     }
     fn psi_inplace(&self, t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
-        self.model.borrow().psi_inplace(t, q, v, psi);
+        read(&self.model).psi_inplace(t, q, v, psi);
     }
     fn psi_v_inplace(&self, t: f64, q: &[f64], j: &mut MatView<'_>) {
-        self.model.borrow().psi_v_inplace(t, q, j);
+        read(&self.model).psi_v_inplace(t, q, j);
     }
     fn psi_q_inplace(&self, t: f64, q: &[f64], v: &[f64], j: &mut MatView<'_>) {
-        self.model.borrow().psi_q_inplace(t, q, v, j);
+        read(&self.model).psi_q_inplace(t, q, v, j);
     }
     fn constraint_force_tangent_inplace(
         &self,
@@ -454,10 +453,10 @@ impl<S: StaticStructure> ConstrainedSystem for AeroStatic<'_, S> {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        self.model.borrow().constraint_force_tangent_inplace(t, q, lambda, mu, c_k, k);
+        read(&self.model).constraint_force_tangent_inplace(t, q, lambda, mu, c_k, k);
     }
     fn increment_weight(&self, i: usize) -> f64 {
-        self.model.borrow().increment_weight(i)
+        read(&self.model).increment_weight(i)
     }
 }
 
@@ -552,10 +551,14 @@ pub fn equilibrium_at(
 /// `static.load_factors`) with formulation `f`.
 pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
     let t0 = Instant::now();
-    let mut out = match f {
-        Formulation::Ancf => sweep(case, f, crate::scene::build_ancf),
-        Formulation::Gebf => sweep(case, f, crate::scene::build_gebf),
-    };
+    struct Sweep<'a>(&'a Case, Formulation);
+    impl ForModel for Sweep<'_> {
+        type Output = StaticOutput;
+        fn run<M: CaseModel>(self) -> StaticOutput {
+            sweep(self.0, self.1, M::build)
+        }
+    }
+    let mut out = dispatch(f, Sweep(case, f));
     out.wall_s = t0.elapsed().as_secs_f64();
     out
 }
@@ -613,11 +616,7 @@ const MAX_LOAD_STEP: f64 = 0.05;
 /// `static.load_factors`, each equilibrium reached from the previous one by equal load steps of
 /// at most [`MAX_LOAD_STEP`]. A point that fails ends the sweep (the later ones are reported as
 /// not reached).
-fn structural_sweep<S: StaticStructure>(
-    case: &Case,
-    f: Formulation,
-    build: fn(&Case) -> Result<S, Error>,
-) -> StaticOutput {
+fn structural_sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
     let Some(st) = case.statics.as_ref() else {
         return failed_output(case, f, "the case has no `static` block".into());
     };
@@ -654,7 +653,10 @@ fn structural_sweep<S: StaticStructure>(
                 a.force = l * b.force;
                 a.moment = l * b.moment;
             }
-            model.set_section_loads(&scaled);
+            if let Err(e) = model.set_section_loads(&scaled) {
+                failed = Some(format!("static.point_loads at load factor {l:.6}: {e}"));
+                break;
+            }
             let m = &model;
             if let Err(e) = solver.solve_normalised(m, 0.0, &mut x, |q| m.normalise(q)) {
                 failed = Some(format!("no equilibrium at load factor {l:.6}: {e}"));
@@ -681,7 +683,7 @@ fn structural_sweep<S: StaticStructure>(
     StaticOutput { formulation: f, points, wall_s: 0.0, n_aero_solves: 0, n_tangents: 0, n_dof, error: None }
 }
 
-fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
+fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
     if case.aero.is_none() && case.statics.as_ref().is_some_and(|s| !s.point_loads.is_empty()) {
         return structural_sweep(case, f, build);
     }
@@ -725,7 +727,7 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
                 sys.begin_solve(round > 0);
                 let s: &AeroStatic<'_, S> = sys;
                 // Borrowed only for the call: the system borrows the model mutably to apply its loads.
-                match solver.solve_normalised(s, 0.0, x, |q| s.model.borrow().normalise(q)) {
+                match solver.solve_normalised(s, 0.0, x, |q| read(&s.model).normalise(q)) {
                     // The residual at the converged state is evaluated once more; the lattice
                     // must still be valid there.
                     Ok(()) if !x.residual_norm.is_finite() => {
@@ -843,7 +845,7 @@ fn sweep<S: StaticStructure>(case: &Case, f: Formulation, build: fn(&Case) -> Re
 }
 
 /// The outputs at the equilibrium `q` of `sys`.
-fn point_at<S: StaticStructure>(
+fn point_at<S: Structure>(
     sys: &AeroStatic<'_, S>,
     q: &[f64],
     case: &Case,
@@ -940,4 +942,18 @@ pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
         return Err("no data rows".into());
     }
     Ok(out)
+}
+
+// `AeroStatic` is a `ConstrainedSystem` (methods on `&self`) whose residual sets loads on the
+// model and solves the lattice: its state sits behind locks, so it is `Send + Sync` like the
+// models. The model behind a read-write lock (its reads nest), the rest behind mutexes; a lock
+// is poisoned only by a panic elsewhere, after which the state is rewritten before it is read.
+fn read<T>(l: &RwLock<T>) -> RwLockReadGuard<'_, T> {
+    l.read().unwrap_or_else(PoisonError::into_inner)
+}
+fn write<T>(l: &RwLock<T>) -> RwLockWriteGuard<'_, T> {
+    l.write().unwrap_or_else(PoisonError::into_inner)
+}
+fn lock<T>(l: &Mutex<T>) -> MutexGuard<'_, T> {
+    l.lock().unwrap_or_else(PoisonError::into_inner)
 }

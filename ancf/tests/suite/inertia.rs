@@ -247,7 +247,7 @@ fn tip_mass_at_an_offset_deflects_and_twists_the_cantilever() {
     let (bodies, joints, sec) = cantilever_with_tip_mass(tip, 10);
     let g = Vector3::new(0.0, 0.0, -9.81);
     let mut model = Model::from_scene(&Scene::new(bodies, joints, g), Options::default()).unwrap();
-    let sol = model.solve_statics(StaticsParams::default()).unwrap();
+    let sol = model.solve_static(StaticsParams::default()).unwrap();
     let l: f64 = 1.0;
     let p = 9.81 * tip.mass;
     let deflection = -model.tip_position(&sol.q).z;

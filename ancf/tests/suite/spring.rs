@@ -325,7 +325,7 @@ fn static_equilibrium_balances_spring_and_gravity() {
         )
     };
     let mut model = Model::from_scene(&scene, Options::default()).unwrap();
-    let sol = model.solve_statics(ancf::statics::StaticsParams::default()).unwrap();
+    let sol = model.solve_static(ancf::statics::StaticsParams::default()).unwrap();
     let theta = model.hinge_angle(&sol.q, 0).unwrap();
     // k θ = W cos θ by Newton's method
     let w = body.section.mass * body.length * g * 0.5 * body.length;

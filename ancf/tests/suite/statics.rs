@@ -41,7 +41,7 @@ fn tip_moment_rolls_into_a_full_circle() {
         // −y moment bends the beam toward +z
         m.set_point_loads(&[PointLoad::moment(0, l, Vector3::new(0.0, -moment, 0.0))]).unwrap();
         let sol =
-            m.solve_statics(StaticsParams { n_load_steps: (40.0 * factor) as usize, ..Default::default() }).unwrap();
+            m.solve_static(StaticsParams { n_load_steps: (40.0 * factor) as usize, ..Default::default() }).unwrap();
         let tip = m.tip_position(&sol.q);
         let theta = moment * l;
         let exact = Vector3::new(theta.sin() / moment, 0.0, (1.0 - theta.cos()) / moment);
@@ -71,7 +71,7 @@ fn tip_load_elastica_table() {
     for (p, u_ref, w_ref, rot_ref) in table {
         let mut m = Model::new(&b, &j, Vector3::zeros(), Options::default()).unwrap();
         m.set_point_loads(&[PointLoad::force(0, l, Vector3::new(0.0, 0.0, -p))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: 10, ..Default::default() }).unwrap();
+        let sol = m.solve_static(StaticsParams { n_load_steps: 10, ..Default::default() }).unwrap();
         let tip = m.tip_position(&sol.q);
         let (u, w, rot) = ((l - tip.x) / l, -tip.z / l, -tip_rotation_about_y(&m, &sol.q));
         let errs = [(u / u_ref - 1.0).abs(), (w / w_ref - 1.0).abs(), (rot / rot_ref - 1.0).abs()];
@@ -96,12 +96,12 @@ fn no_shear_locking_in_the_thin_limit() {
             let p = 1e-6;
             let mut m = Model::new(&b, &j, Vector3::zeros(), Options::default()).unwrap();
             m.set_point_loads(&[PointLoad::force(0, l, Vector3::new(0.0, 0.0, p))]).unwrap();
-            let sol = m.solve_statics(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
+            let sol = m.solve_static(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
             let exact = p * l.powi(3) / 3.0 + p * l / ga;
             let rel = m.tip_position(&sol.q).z / exact - 1.0;
             let mut m2 = Model::new(&b, &j, Vector3::zeros(), Options::default()).unwrap();
             m2.set_point_loads(&[PointLoad::moment(0, l, Vector3::new(0.0, -p, 0.0))]).unwrap();
-            let sol2 = m2.solve_statics(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
+            let sol2 = m2.solve_static(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
             let rel2 = m2.tip_position(&sol2.q).z / (p * l * l / 2.0) - 1.0;
             println!("GA {ga:e}, {n} el: tip load {rel:.2e}, tip moment {rel2:.2e}");
             assert!(rel.abs() < 1e-8 && rel2.abs() < 1e-8, "GA {ga}, {n} el: {rel:e}, {rel2:e}");
@@ -123,7 +123,7 @@ fn kirchhoff_curvature_clamp_compliance_grows_with_refinement() {
         let mut m = Model::new(&b, &j, Vector3::zeros(), opts).unwrap();
         let p = 1e-3;
         m.set_point_loads(&[PointLoad::force(0, l, Vector3::new(0.0, 0.0, p))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
+        let sol = m.solve_static(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
         let exact = p * l.powi(3) / (3.0 * sec.ei_yy) + p * l / sec.ga_z;
         m.tip_position(&sol.q).z / exact - 1.0
     };
@@ -159,14 +159,14 @@ fn flared_hinge_transmits_moments_without_mesh_dependent_compliance() {
         let p = 1e-3;
         let mut m = Model::from_scene(&scene, opts).unwrap();
         m.set_point_loads(&[PointLoad::force(1, 0.5, Vector3::new(0.0, p, 0.0))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
+        let sol = m.solve_static(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
         let force = m.tip_position(&sol.q).y / (p / (3.0 * sec.ei_zz) + p / sec.ga_y) - 1.0;
         // tip moment (c, −s, 0)·M ⟂ a = (s, c, 0): torque c M and bending −s M about y along both
         // bodies; the tip rises by s M L² / (2 EI_yy)
         let mm = 1e-3;
         let mut m = Model::from_scene(&scene, opts).unwrap();
         m.set_point_loads(&[PointLoad::moment(1, 0.5, Vector3::new(c * mm, -s * mm, 0.0))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
+        let sol = m.solve_static(StaticsParams { n_load_steps: 1, ..Default::default() }).unwrap();
         let moment = m.tip_position(&sol.q).z / (s * mm / (2.0 * sec.ei_yy)) - 1.0;
         (force, moment)
     };
@@ -251,7 +251,7 @@ fn bathe_bolourchi_bend_matches_simo_vu_quoc() {
     for (p, reference) in published {
         let mut m = Model::from_scene(&scene, Options::default()).unwrap();
         m.set_point_loads(&[PointLoad::force(last, length, Vector3::new(0.0, 0.0, p))]).unwrap();
-        let sol = m.solve_statics(StaticsParams { n_load_steps: 20, ..Default::default() }).unwrap();
+        let sol = m.solve_static(StaticsParams { n_load_steps: 20, ..Default::default() }).unwrap();
         let tip = m.tip_position(&sol.q);
         let err = (tip - reference).norm() / reference.norm();
         println!(

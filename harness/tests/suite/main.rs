@@ -9,8 +9,10 @@ mod fuzz;
 mod gate;
 mod gust;
 mod honest;
+mod loads_lost;
 mod observer;
 mod properties;
+mod send_sync;
 mod shard;
 #[cfg(target_os = "linux")]
 mod slurm;

@@ -1,0 +1,118 @@
+//! [`formulation::Structure`] for the GEBF model: what the analyses need from it, with the
+//! section interpolation of the aerodynamic seam.
+
+use formulation::{BeamGeometry, Energies, LoadError, SectionLoad, Structure};
+use genalpha::{DenseLu, GenAlpha, IntegratorParams, State};
+use nalgebra::{Matrix3, Vector3};
+
+use crate::{Model, NodalLoad};
+
+impl Model {
+    /// Element of body `body` holding arclength `s`: its three node indices and the quadratic
+    /// Lagrange weights of `s` (the first or last element beyond the body's ends).
+    pub fn section_element(&self, body: usize, s: f64) -> Option<([usize; 3], [f64; 3])> {
+        let b = self.bodies.get(body)?;
+        let n = b.n_nodes();
+        let arc = |k: usize| b.node_ref(k).x;
+        let n_el = (n - 1) / 2;
+        for e in 0..n_el {
+            let (s0, s1, s2) = (arc(2 * e), arc(2 * e + 1), arc(2 * e + 2));
+            if s <= s2 + 1e-12 || e + 1 == n_el {
+                let w = [
+                    (s - s1) * (s - s2) / ((s0 - s1) * (s0 - s2)),
+                    (s - s0) * (s - s2) / ((s1 - s0) * (s1 - s2)),
+                    (s - s0) * (s - s1) / ((s2 - s0) * (s2 - s1)),
+                ];
+                return Some(([2 * e, 2 * e + 1, 2 * e + 2], w));
+            }
+        }
+        None
+    }
+}
+
+impl Structure for Model {
+    /// genalpha's default solver, which switches to the bordered node-block LU from GEBF's
+    /// declared block-banded structure.
+    type Solver = DenseLu;
+    fn integrator(&self, params: IntegratorParams) -> Result<GenAlpha<DenseLu>, genalpha::Error> {
+        GenAlpha::new(params, self)
+    }
+    fn initial_state(&self) -> State {
+        Model::initial_state(self)
+    }
+    fn tip(&self, q: &[f64]) -> [f64; 3] {
+        self.tip_position(q).into()
+    }
+    fn fold(&self, q: &[f64], joint: usize) -> f64 {
+        self.fold_angle(q, joint).unwrap_or(f64::NAN)
+    }
+    fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
+        Model::energies(self, q, v)
+    }
+    fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
+        Model::dissipation_power(self, q, v)
+    }
+    fn has_force_elements(&self) -> bool {
+        self.n_force_elements() > 0
+    }
+    fn constraint_residual(&self, q: &[f64]) -> f64 {
+        Model::constraint_residual(self, q)
+    }
+    fn n_bodies(&self) -> usize {
+        Model::n_bodies(self)
+    }
+    fn body_length(&self, body: usize) -> Option<f64> {
+        self.bodies.get(body).map(|b| b.length)
+    }
+    /// Every node of the three-node elements, middle nodes included.
+    fn body_geometry(&self, q: &[f64], body: usize, out: &mut BeamGeometry) {
+        out.clear();
+        if body >= self.bodies.len() {
+            return;
+        }
+        for k in 0..self.n_nodes(body) {
+            if let (Ok(s), Ok(p), Ok(r)) =
+                (self.node_arc_length(body, k), self.node_position(q, body, k), self.node_frame(q, body, k))
+            {
+                out.push(s, p, r);
+            }
+        }
+    }
+    /// Quadratic interpolation of the element's nodal positions, and of the nodal rotations
+    /// relative to the middle node (objective). The relative rotations' vectors come through the
+    /// quaternion ([`crate::crv::from_rotation_matrix`], Shepperd's method), accurate at every
+    /// angle: an `acos` of the trace returns NaN when rounding pushes it past 3 for the tiny
+    /// relative rotations of a stiff wing.
+    fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
+        let Some((nodes, w)) = self.section_element(body, s) else {
+            return (Vector3::from_element(f64::NAN), Matrix3::identity());
+        };
+        let pos = |k| self.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
+        let frm = |k| self.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+        let log = |r: &Matrix3<f64>| crate::crv::from_rotation_matrix(r);
+        let p = pos(nodes[0]) * w[0] + pos(nodes[1]) * w[1] + pos(nodes[2]) * w[2];
+        let r1 = frm(nodes[1]);
+        let phi = log(&(r1.transpose() * frm(nodes[0]))) * w[0] + log(&(r1.transpose() * frm(nodes[2]))) * w[2];
+        let r = r1 * nalgebra::Rotation3::new(phi).into_inner();
+        (p, r)
+    }
+    /// Consistent nodal loads: the quadratic weights distribute each station's force and moment.
+    fn apply_section_loads(&mut self, loads: &[SectionLoad]) -> Result<(), LoadError> {
+        self.clear_nodal_loads();
+        for l in loads {
+            let Some((nodes, w)) = self.section_element(l.body, l.s) else { continue };
+            for (k, wk) in nodes.iter().zip(w) {
+                let old = self.loads[l.body][*k];
+                let new = NodalLoad { force: old.force + wk * l.force, moment: old.moment + wk * l.moment };
+                self.set_nodal_load(l.body, *k, new).map_err(|e| LoadError::Model(e.to_string()))?;
+            }
+        }
+        Ok(())
+    }
+    /// Rotation vectors back past π, and the joints' position-level projection: the
+    /// velocity-level hinge rows keep each Newton increment on the joint only to first order.
+    fn normalise(&self, q: &mut [f64]) {
+        self.rescale_rotations(q, None);
+        self.project_joints(q);
+    }
+}
