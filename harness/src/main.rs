@@ -459,12 +459,12 @@ fn run_gust(
     set: &[Override],
     shard: Option<ShardArg>,
 ) -> Result<ExitCode> {
-    let runs = CaseFile::read(case)?.expand(set)?;
     let fs: Vec<Formulation> = match which {
         Which::Ancf => vec![Formulation::Ancf],
         Which::Gebf => vec![Formulation::Gebf],
         Which::Both => Formulation::ALL.to_vec(),
     };
+    let runs = CaseFile::read(case)?.expand_for(set, &harness::budget::limits(), None, &fs)?;
     let file = case.display().to_string();
     for spec in &runs {
         if spec.ancf.gust.is_none() {
@@ -983,7 +983,7 @@ fn real_main() -> Result<ExitCode> {
             };
             let limits = harness::budget::limits();
             let file = CaseFile::read(&case)?;
-            let runs = variants(file.expand_within(&set, &limits, max_steps)?, &set, &fs, max_steps);
+            let runs = variants(file.expand_for(&set, &limits, max_steps, &fs)?, &set, &fs, max_steps);
             let progress = Progress::new(true);
             // VTK when --vtk asks for it or the case's `vtk` block does.
             let cli = vtk.then_some(vtk_stride);
@@ -1043,17 +1043,17 @@ fn real_main() -> Result<ExitCode> {
         }
         Cmd::Static { case, formulation, out, set, shard } => {
             let file = CaseFile::read(&case)?;
-            let runs = file.expand(&set)?;
-            let plan = harness::shard::plan("static", shard.shard, || {
-                runs.iter()
-                    .map(|r| Unit { id: format!("static:{}", r.name), cost: harness::shard::run_cost(r) })
-                    .collect()
-            })?;
             let fs: Vec<Formulation> = match formulation {
                 Which::Ancf => vec![Formulation::Ancf],
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
+            let runs = file.expand_for(&set, &harness::budget::limits(), None, &fs)?;
+            let plan = harness::shard::plan("static", shard.shard, || {
+                runs.iter()
+                    .map(|r| Unit { id: format!("static:{}", r.name), cost: harness::shard::run_cost(r) })
+                    .collect()
+            })?;
             for spec in &runs {
                 if spec.ancf.statics.is_none() {
                     return Err(harness::Error::Case {
@@ -1080,12 +1080,12 @@ fn real_main() -> Result<ExitCode> {
         }
         Cmd::Stability { case, formulation, out, set, shard } => {
             let file = CaseFile::read(&case)?;
-            let runs = file.expand(&set)?;
             let fs: Vec<Formulation> = match formulation {
                 Which::Ancf => vec![Formulation::Ancf],
                 Which::Gebf => vec![Formulation::Gebf],
                 Which::Both => Formulation::ALL.to_vec(),
             };
+            let runs = file.expand_for(&set, &harness::budget::limits(), None, &fs)?;
             for spec in &runs {
                 if spec.ancf.stability.is_none() {
                     return Err(harness::Error::Case {
