@@ -203,7 +203,17 @@ pub fn check(case: &Case) -> Result<(), String> {
 
 /// As [`check`], against `lim`, for runs of at most `max_steps` steps when given.
 pub fn check_within(case: &Case, lim: &Limits, max_steps: Option<usize>) -> Result<(), String> {
-    for f in Formulation::ALL {
+    check_formulations(case, lim, max_steps, &Formulation::ALL)
+}
+
+/// As [`check_within`] for a run of the formulations `fs` only.
+pub fn check_formulations(
+    case: &Case,
+    lim: &Limits,
+    max_steps: Option<usize>,
+    fs: &[Formulation],
+) -> Result<(), String> {
+    for &f in fs {
         let e = estimate(case, f, max_steps);
         if e.bytes > lim.memory_bytes {
             let field = if e.aero_bytes > e.structure_bytes {

@@ -10,6 +10,8 @@ use serde_json::Value;
 
 use crate::Error;
 
+mod validate;
+
 fn one() -> f64 {
     1.0
 }
@@ -809,6 +811,20 @@ impl CaseFile {
         limits: &crate::budget::Limits,
         max_steps: Option<usize>,
     ) -> Result<Vec<RunSpec>, Error> {
+        self.expand_for(overrides, limits, max_steps, &Formulation::ALL)
+    }
+
+    /// As [`expand_within`](Self::expand_within) for a run of the formulations `fs` only
+    /// (`--formulation`): the case of a formulation outside `fs` is parsed but neither validated
+    /// ([`Case::validate_for`]) nor checked against the limits, so that its settings cannot
+    /// refuse a run that does not use them.
+    pub fn expand_for(
+        &self,
+        overrides: &[Override],
+        limits: &crate::budget::Limits,
+        max_steps: Option<usize>,
+        fs: &[Formulation],
+    ) -> Result<Vec<RunSpec>, Error> {
         let file = self.path.display().to_string();
         let err = |msg: String| Error::Case { file: file.clone(), msg: clip(&msg) };
         // Global overrides first (they may change the sweep itself).
@@ -881,8 +897,12 @@ impl CaseFile {
                 }
                 let mut case = parse_case(&r).map_err(&err)?;
                 case.name.push_str(&suffix);
-                case.validate().map_err(&err)?;
-                crate::budget::check_within(&case, limits, max_steps).map_err(&err)?;
+                if !fs.contains(&f) {
+                    per.push(case);
+                    continue;
+                }
+                case.validate_for(fs).map_err(&err)?;
+                crate::budget::check_formulations(&case, limits, max_steps, fs).map_err(&err)?;
                 for (k, r) in case.references.iter().enumerate() {
                     if checked.contains(&r.file) {
                         continue;
@@ -1206,344 +1226,6 @@ impl Case {
         let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);
         scene::Scene { bodies, joints, forces, gravity }
     }
-
-    /// Check every value; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
-        let pos = |f: &str, v: f64| -> Result<(), String> {
-            if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{f}: {v} is not a positive number")) }
-        };
-        let nonneg = |f: &str, v: f64| -> Result<(), String> {
-            if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{f}: {v} is not a non-negative number")) }
-        };
-        // The name is a folder under the output directory (and a sweep adds `__key=value`).
-        let n = &self.name;
-        let safe = |c: char| c.is_ascii_alphanumeric() || "._-+=,".contains(c);
-        if n.is_empty() || n.len() > 120 || n == "." || n == ".." || !n.chars().all(safe) {
-            return Err(format!(
-                "name: `{n}` is not a safe file name (1 to 120 bytes of ASCII letters, digits and `._-+=,`; \
-                 not `.` or `..`)"
-            ));
-        }
-        if self.bodies.is_empty() {
-            return Err("bodies: at least one body is needed".into());
-        }
-        // Counts that the checks below (and the scene's) visit in pairs.
-        use crate::budget::{MAX_BODIES, MAX_LIST};
-        let counts = [
-            ("bodies", self.bodies.len(), MAX_BODIES),
-            ("joints", self.joints.len(), MAX_BODIES),
-            ("references", self.references.len(), MAX_LIST),
-            ("gate.windows", self.gate.as_ref().map_or(0, |g| g.windows.len()), MAX_LIST),
-        ];
-        for (field, n, cap) in counts {
-            if n > cap {
-                return Err(format!("{field}: {n} entries, more than the limit of {cap}"));
-            }
-        }
-        if let Some(i) = self.bodies.iter().position(|b| b.point_masses.len() > MAX_LIST) {
-            return Err(format!(
-                "bodies[{i}].point_masses: {} entries, more than the limit of {MAX_LIST}",
-                self.bodies[i].point_masses.len()
-            ));
-        }
-        for (i, b) in self.bodies.iter().enumerate() {
-            let f = |s: &str| format!("bodies[{i}].{s}");
-            if b.name.is_empty() {
-                return Err(f("name: empty"));
-            }
-            if self.bodies[..i].iter().any(|o| o.name == b.name) {
-                return Err(f(&format!("name: `{}` is used twice", b.name)));
-            }
-            if !finite3(&b.x_axis) || norm3(&b.x_axis) < 1e-12 {
-                return Err(f("x_axis: not a finite non-zero vector"));
-            }
-            if !finite3(&b.y_axis) || norm3(&b.y_axis) < 1e-12 {
-                return Err(f("y_axis: not a finite non-zero vector"));
-            }
-            let dot: f64 =
-                (0..3).map(|k| b.x_axis[k] * b.y_axis[k]).sum::<f64>() / (norm3(&b.x_axis) * norm3(&b.y_axis));
-            if dot.abs() > 1e-9 {
-                return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
-            }
-        }
-        let body = |field: String, name: &str| -> Result<(), String> {
-            if self.body_index(name).is_some() { Ok(()) } else { Err(format!("{field}: no body named `{name}`")) }
-        };
-        for (i, j) in self.joints.iter().enumerate() {
-            match j {
-                Joint::GroundHinge { body: b, .. } => {
-                    body(format!("joints[{i}].body"), b)?;
-                }
-                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
-                    body(format!("joints[{i}].parent"), parent)?;
-                    body(format!("joints[{i}].child"), child)?;
-                    if !(flare_deg.is_finite() && (-90.0..=90.0).contains(flare_deg)) {
-                        return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
-                    }
-                }
-                Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
-            }
-        }
-        if let Some(n) = &self.fold_joint {
-            match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
-                Some(Joint::FlaredHinge { .. }) => {}
-                Some(_) => return Err(format!("fold_joint: `{n}` is not a flared hinge")),
-                None => return Err(format!("fold_joint: no joint named `{n}`")),
-            }
-        }
-        pos("stiffness_scale", self.stiffness_scale)?;
-        for (f, n) in [("ancf", &self.ancf.elements_per_body), ("gebf", &self.gebf.elements_per_body)] {
-            n.check(&format!("{f}.elements_per_body"), self.bodies.len())?;
-            if let Some(i) = (0..self.bodies.len()).find(|&i| n.for_body(i) > crate::budget::MAX_ELEMENTS_PER_BODY) {
-                return Err(format!(
-                    "{f}.elements_per_body: {} elements on bodies[{i}], more than the limit of {}",
-                    n.for_body(i),
-                    crate::budget::MAX_ELEMENTS_PER_BODY
-                ));
-            }
-        }
-        // Iteration counts and nesting, capped (each multiplies the work of a step).
-        for (f, newton) in [("ancf", &self.ancf.newton), ("gebf", &self.gebf.newton)] {
-            if newton.max_iter > crate::budget::MAX_NEWTON_ITER {
-                return Err(format!(
-                    "{f}.newton.max_iter: {} is more than the limit of {}",
-                    newton.max_iter,
-                    crate::budget::MAX_NEWTON_ITER
-                ));
-            }
-            if newton.max_step_halvings > crate::budget::MAX_STEP_HALVINGS {
-                return Err(format!(
-                    "{f}.newton.max_step_halvings: {} is more than the limit of {}",
-                    newton.max_step_halvings,
-                    crate::budget::MAX_STEP_HALVINGS
-                ));
-            }
-        }
-        if let Some(a) = &self.aero {
-            let caps = [
-                ("aero.n_chordwise", a.n_chordwise, crate::budget::MAX_CHORDWISE),
-                ("aero.n_wake_rows", a.n_wake_rows, crate::budget::MAX_WAKE_ROWS),
-                ("aero.coupling.max_sub_iterations", a.coupling.max_sub_iterations, crate::budget::MAX_SUB_ITERATIONS),
-            ];
-            for (field, v, cap) in caps {
-                if v > cap {
-                    return Err(format!("{field}: {v} is more than the limit of {cap}"));
-                }
-            }
-            if let Some(i) = a.panels_per_body.iter().position(|&p| p > crate::budget::MAX_PANELS_PER_BODY) {
-                return Err(format!(
-                    "aero.panels_per_body[{i}]: {} is more than the limit of {}",
-                    a.panels_per_body[i],
-                    crate::budget::MAX_PANELS_PER_BODY
-                ));
-            }
-        }
-        // Everything else about the structure, as both formulations will check it (in degrees
-        // where the case speaks degrees).
-        self.scene(Formulation::Ancf).validate().map_err(|e| e.to_string())?;
-        pos("t_end", self.t_end)?;
-        if self.vtk.is_some_and(|v| v.stride == Some(0)) {
-            return Err("vtk.stride: must be at least 1".into());
-        }
-        if let Some(t) = self.converge_t_end {
-            pos("converge_t_end", t)?;
-        }
-        if let Some(o) = self.output_dt {
-            pos("output_dt", o)?;
-        }
-        for (f, dt, rho) in [("ancf", self.ancf.dt, self.ancf.rho_inf), ("gebf", self.gebf.dt, self.gebf.rho_inf)] {
-            pos(&format!("{f}.dt"), dt)?;
-            // The time loops take whole steps: a t_end (or output interval) between two steps
-            // would end (or sample) the run somewhere else than the case says.
-            if self.t_end < dt * (1.0 - 1e-9) {
-                return Err(format!("{f}.dt: t_end = {} is shorter than one step of {dt} s", self.t_end));
-            }
-            for (name, t) in [("t_end", Some(self.t_end)), ("output_dt", self.output_dt)] {
-                if let Some(t) = t
-                    && whole_steps(t, dt).is_none()
-                {
-                    return Err(format!("{f}.dt: {name} = {t} is not a whole number of steps of {dt} s"));
-                }
-            }
-            if !(0.0..=1.0).contains(&rho) {
-                return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
-            }
-        }
-        // The integrator's own checks (Newton tolerances, iteration counts), named by case path.
-        for f in Formulation::ALL {
-            if let Err(genalpha::Error::InvalidParameter { field, reason }) =
-                crate::scene::settings(self, f).params.validate()
-            {
-                return Err(format!("{f}.{field}: {reason}"));
-            }
-        }
-        for (k, r) in self.references.iter().enumerate() {
-            if !r.time_shift.is_finite() {
-                return Err(format!("references[{k}].time_shift: not finite"));
-            }
-            if let Some(t) = r.tip_max_m {
-                pos(&format!("references[{k}].tip_max_m"), t)?;
-            }
-        }
-        if let Some(a) = &self.aero {
-            // The coupled step holds the aerodynamic loads of t_{n+1} over the step; evaluated at
-            // the weighted instant t_{n+1-α_f}, they would make the coupling first order.
-            for (f, form) in [("ancf", self.ancf.form), ("gebf", self.gebf.form)] {
-                if form == FormSetting::ChungHulbert {
-                    return Err(format!(
-                        "{f}.form: chung_hulbert is not available with aerodynamics (the loads are those of \
-                         the step's end)"
-                    ));
-                }
-            }
-            pos("aero.rho", a.rho)?;
-            pos("aero.chord", a.chord)?;
-            match (a.v_inf, a.airspeed) {
-                (None, None) => return Err("aero: give the free stream as `v_inf` or `airspeed`".into()),
-                (Some(v), _) if !finite3(&v) || norm3(&v) == 0.0 => {
-                    return Err("aero.v_inf: not a finite non-zero vector".into());
-                }
-                (_, Some(u)) => pos("aero.airspeed", u)?,
-                _ => {}
-            }
-            if !a.le_offset.is_finite() {
-                return Err("aero.le_offset: not finite".into());
-            }
-            if a.n_chordwise == 0 {
-                return Err("aero.n_chordwise: must be at least 1".into());
-            }
-            if a.n_wake_rows == 0 {
-                return Err("aero.n_wake_rows: must be at least 1".into());
-            }
-            nonneg("aero.cutoff_radius", a.cutoff_radius)?;
-            if !(a.coupling.relaxation > 0.0 && a.coupling.relaxation <= 1.0) {
-                return Err(format!("aero.coupling.relaxation: {} is not in (0, 1]", a.coupling.relaxation));
-            }
-            pos("aero.coupling.tolerance", a.coupling.tolerance)?;
-            crate::aero::station_map(self, a)?;
-            // The lattice's own limit on a hinge column's slant, found here rather than at run time.
-            for (i, j) in self.joints.iter().enumerate() {
-                if let Joint::FlaredHinge { flare_deg, .. } = j
-                    && flare_deg.abs() >= uvlm::lattice::MAX_HINGE_FLARE_DEG
-                {
-                    return Err(format!(
-                        "joints[{i}].flare_deg: {flare_deg} is not below the lattice's limit of ±{}° (aero)",
-                        uvlm::lattice::MAX_HINGE_FLARE_DEG
-                    ));
-                }
-            }
-        }
-        if !(self.pitch_deg.is_finite() && (-90.0..=90.0).contains(&self.pitch_deg)) {
-            return Err(format!("pitch_deg: {} is not in [-90, 90]", self.pitch_deg));
-        }
-        if let Some(g) = self.aero.as_ref().and_then(|a| a.gust.as_ref()) {
-            g.validate()?;
-        }
-        if let Some(g) = &self.gust {
-            g.validate(self)?;
-        }
-        if let Some(st) = &self.statics
-            && self.aero.is_none()
-        {
-            // A structural static case: dead point loads at load factors.
-            if st.point_loads.is_empty() {
-                return Err("static: a case without `aero` needs `static.point_loads` (a static aeroelastic sweep needs `aero`)".into());
-            }
-            if !st.airspeeds.is_empty() {
-                return Err("static.airspeeds: a case without `aero` has no airspeeds".into());
-            }
-            if st.point_loads.len() > crate::budget::MAX_LIST {
-                return Err(format!(
-                    "static.point_loads: {} loads, more than {}",
-                    st.point_loads.len(),
-                    crate::budget::MAX_LIST
-                ));
-            }
-            for (k, l) in st.point_loads.iter().enumerate() {
-                let Some(b) = self.bodies.iter().find(|b| b.name == l.body) else {
-                    return Err(format!("static.point_loads[{k}].body: no body named `{}`", clip(&l.body)));
-                };
-                if let Some(at) = l.at
-                    && !(at.is_finite() && (0.0..=b.length).contains(&at))
-                {
-                    return Err(format!(
-                        "static.point_loads[{k}].at: {at} is not in [0, {}] (the body's length)",
-                        b.length
-                    ));
-                }
-                for (what, v) in [("force", l.force), ("moment", l.moment)] {
-                    if let Some(i) = v.iter().position(|x| !(x.is_finite() && x.abs() <= 1e12)) {
-                        return Err(format!(
-                            "static.point_loads[{k}].{what}[{i}]: {} is not a finite value of at most 1e12",
-                            v[i]
-                        ));
-                    }
-                }
-            }
-            if st.load_factors.is_empty() {
-                return Err("static.load_factors: empty list".into());
-            }
-            if st.load_factors.len() > MAX_STATIC_POINTS {
-                return Err(format!(
-                    "static.load_factors: {} points, more than {MAX_STATIC_POINTS}",
-                    st.load_factors.len()
-                ));
-            }
-            for (k, &f) in st.load_factors.iter().enumerate() {
-                if !(f.is_finite() && f > 0.0 && f <= 1e3) {
-                    return Err(format!("static.load_factors[{k}]: {f} is not in (0, 1000]"));
-                }
-                if k > 0 && f <= st.load_factors[k - 1] {
-                    return Err(format!("static.load_factors[{k}]: {f} does not increase"));
-                }
-            }
-            if !st.references.is_empty() {
-                return Err("static.references: coast-angle curves need `aero`".into());
-            }
-            if st.wake.is_some() {
-                return Err("static.wake: the steady wake needs `aero`".into());
-            }
-        } else if let Some(st) = &self.statics {
-            if !st.point_loads.is_empty() || !st.load_factors.is_empty() {
-                return Err("static.point_loads: point loads are for a structural static case (without `aero`)".into());
-            }
-            if st.airspeeds.is_empty() {
-                return Err("static.airspeeds: empty list".into());
-            }
-            if st.airspeeds.len() > MAX_STATIC_POINTS {
-                return Err(format!("static.airspeeds: {} points, more than {MAX_STATIC_POINTS}", st.airspeeds.len()));
-            }
-            for (k, &u) in st.airspeeds.iter().enumerate() {
-                pos(&format!("static.airspeeds[{k}]"), u)?;
-            }
-            for (k, r) in st.references.iter().enumerate() {
-                if r.label.is_empty() {
-                    return Err(format!("static.references[{k}].label: empty"));
-                }
-            }
-            if let Some(w) = &st.wake {
-                w.validate("static.wake")?;
-            }
-        }
-        if let Some(st) = &self.stability {
-            if self.aero.is_none() {
-                return Err("stability: a stability analysis needs `aero`".into());
-            }
-            st.validate()?;
-        }
-        if let Some(g) = &self.gate {
-            pos("gate.energy_drift", g.energy_drift)?;
-            pos("gate.constraint_residual", g.constraint_residual)?;
-            for (k, w) in g.windows.iter().enumerate() {
-                if !(w.t_start.is_finite() && w.t_end.is_finite() && w.t_end > w.t_start) {
-                    return Err(format!("gate.windows[{k}]: t_end must exceed t_start"));
-                }
-                pos(&format!("gate.windows[{k}].tip_max_m"), w.tip_max_m)?;
-                pos(&format!("gate.windows[{k}].tip_rms_m"), w.tip_rms_m)?;
-            }
-        }
-        Ok(())
-    }
 }
 
 /// The JSON Schema of a case file, generated from these types.
@@ -1632,5 +1314,33 @@ mod tests {
         let mut v = raw();
         set_path(&mut v, "bodies.0.section.mass", json!("NaN")).unwrap();
         assert!(parse_case(&v).unwrap_err().contains("bodies[0].section.mass"));
+    }
+
+    /// `run CASE --formulation ancf` refused the case over GEBF's `dt` (issue 33, item 9): a
+    /// run validates only the settings of the formulations it runs.
+    #[test]
+    fn a_run_of_one_formulation_ignores_the_others_settings_issue_33() {
+        let cf = CaseFile { path: Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/x.json"), raw: raw() };
+        let limits = crate::budget::limits();
+        // 2 s is not a whole number of GEBF steps of 0.0003 s, and the step is no positive number.
+        for value in ["0.0003", "-1"] {
+            let ov: Override = format!("gebf:gebf.dt={value}").parse().unwrap();
+            let both = cf.expand_within(std::slice::from_ref(&ov), &limits, None).unwrap_err().to_string();
+            assert!(both.contains("gebf.dt"), "{both}");
+            let ancf = cf.expand_for(std::slice::from_ref(&ov), &limits, None, &[Formulation::Ancf]).unwrap();
+            assert_eq!(ancf[0].ancf.gebf.dt, 0.002, "the ANCF run's case keeps the file's GEBF step");
+            let e = cf.expand_for(&[ov], &limits, None, &[Formulation::Gebf]).unwrap_err().to_string();
+            assert!(e.contains("gebf.dt"), "{e}");
+        }
+        // The same with the settings in the file itself, and with a run of ANCF alone refused
+        // over ANCF's own.
+        let mut v = raw();
+        set_path(&mut v, "gebf.newton.max_iter", json!(10_000)).unwrap();
+        let c = parse_case(&v).unwrap();
+        assert!(c.validate().unwrap_err().contains("gebf.newton.max_iter"));
+        c.validate_for(&[Formulation::Ancf]).unwrap();
+        set_path(&mut v, "ancf.rho_inf", json!(2.0)).unwrap();
+        let e = parse_case(&v).unwrap().validate_for(&[Formulation::Ancf]).unwrap_err();
+        assert!(e.starts_with("ancf.rho_inf"), "{e}");
     }
 }

@@ -730,7 +730,8 @@ fn analysis_runs(
     has_block: impl Fn(&RunSpec) -> bool,
     missing: &str,
 ) -> Result<(Vec<RunSpec>, Option<Plan>)> {
-    let runs = CaseFile::read(&a.case)?.expand(&a.set.set)?;
+    let fs = a.formulation.formulations();
+    let runs = CaseFile::read(&a.case)?.expand_for(&a.set.set, &harness::budget::limits(), None, &fs)?;
     if !runs.iter().all(has_block) {
         let file = a.case.display().to_string();
         return Err(harness::Error::Case { file, msg: format!("{kind}: {missing}") }.into());
@@ -1105,7 +1106,7 @@ fn cmd_run(a: &RunArgs) -> Result<ExitCode> {
     let fs = a.formulation.formulations();
     let limits = harness::budget::limits();
     let file = CaseFile::read(&a.case)?;
-    let runs = variants(file.expand_within(set, &limits, a.max_steps)?, set, &fs, a.max_steps);
+    let runs = variants(file.expand_for(set, &limits, a.max_steps, &fs)?, set, &fs, a.max_steps);
     let progress = Progress::new(true);
     // VTK when --vtk asks for it or the case's `vtk` block does.
     let cli = a.vtk.then_some(a.vtk_stride);

@@ -178,7 +178,7 @@ fn load_case(path: &Path) -> Result<CaseResult, Error> {
 /// [`FormulationMetrics`] stored exactly.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct MetricsRecord {
-    f: [u64; 7],
+    f: [u64; 8],
     n: [usize; 5],
     error: Option<String>,
     /// Each oscillation's window start and end, frequency, growth rate, damping ratio, amplitude.
@@ -198,6 +198,7 @@ impl MetricsRecord {
                 b(m.energy_drift),
                 b(m.peak_kinetic),
                 b(m.max_constraint_residual),
+                b(m.kinetic_resolution),
             ],
             n: [m.n_steps, m.n_newton_iters, m.max_newton_iters, m.n_factorizations, m.n_dof],
             error: m.error.clone(),
@@ -226,6 +227,7 @@ impl MetricsRecord {
             t_reached: f(3),
             energy_drift: f(4),
             peak_kinetic: f(5),
+            kinetic_resolution: f(7),
             max_constraint_residual: f(6),
             error: self.error.clone(),
             aero_wall_s,

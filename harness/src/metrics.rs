@@ -84,6 +84,11 @@ pub struct FormulationMetrics {
     pub energy_drift: f64,
     /// Peak kinetic energy, J.
     pub peak_kinetic: f64,
+    /// The kinetic energy below which the run's motion is not resolved, J (NaN when not known):
+    /// see [`kinetic_resolution`]. A `peak_kinetic` at or below it makes
+    /// `energy_drift` a ratio of two residues of the solve
+    /// ([`resolved_energy_drift`](Self::resolved_energy_drift)).
+    pub kinetic_resolution: f64,
     /// Largest position-level constraint residual.
     pub max_constraint_residual: f64,
     /// Error that stopped the run.
@@ -119,6 +124,7 @@ impl FormulationMetrics {
             t_reached: run.rows.last().map_or(0.0, |r| r.t),
             energy_drift: if peak > 0.0 { drift / peak } else { drift },
             peak_kinetic: peak,
+            kinetic_resolution: f64::NAN,
             max_constraint_residual: run.rows.iter().map(|r| r.constraint_residual).fold(0.0, f64::max),
             error: run.error.clone(),
             aero_wall_s: run.aero_wall_s,
@@ -126,6 +132,14 @@ impl FormulationMetrics {
             oscillation_signal: "",
         }
         .with_oscillations(run)
+    }
+
+    /// The energy drift, or None when the peak kinetic energy it is divided by is at or below
+    /// the run's [`kinetic_resolution`](Self::kinetic_resolution): nothing moved that the solve
+    /// resolves, drift and peak are both its residues, and their ratio (about 1) measures
+    /// nothing. A run whose resolution is not known keeps its drift.
+    pub fn resolved_energy_drift(&self) -> Option<f64> {
+        if self.peak_kinetic <= self.kinetic_resolution { None } else { Some(self.energy_drift) }
     }
 
     fn with_oscillations(mut self, run: &RunOutput) -> Self {
@@ -139,6 +153,29 @@ impl FormulationMetrics {
         self.oscillation_signal = if fold { "fold" } else { "tip_z" };
         self
     }
+}
+
+/// The kinetic energy below which a run of `case` by formulation `f` does not resolve motion, J:
+/// the structure's whole mass M (beams and point masses) moving by Newton's absolute tolerance
+/// `atol` in one step `dt`,
+///
+/// $$T_{\text{res}} = \tfrac12\,M\,(\text{atol}/dt)^2 .$$
+///
+/// Newton accepts a step once its increments are below `atol` (m), so velocities below
+/// `atol/dt` are what the solve leaves, not motion; a run whose peak kinetic energy stays at or
+/// below this (a wing at zero incidence without gravity: 1e-18 J against 4e-14 J for the Goland
+/// wing) has no energy to measure its drift against.
+pub fn kinetic_resolution(case: &crate::case::Case, f: crate::case::Formulation) -> f64 {
+    let mass: f64 = case
+        .bodies
+        .iter()
+        .map(|b| b.section.mass * b.length + b.point_masses.iter().map(|p| p.mass).sum::<f64>())
+        .sum();
+    let (atol, dt) = match f {
+        crate::case::Formulation::Ancf => (case.ancf.newton.atol, case.ancf.dt),
+        crate::case::Formulation::Gebf => (case.gebf.newton.atol, case.gebf.dt),
+    };
+    0.5 * mass * (atol / dt).powi(2)
 }
 
 /// ANCF–GEBF tip difference.

@@ -10,7 +10,9 @@ use crate::Error;
 use crate::case::{Formulation, Gate, RunSpec};
 use crate::csv::{Curve, read_curve, to_csv, write_file};
 use crate::gate::{self, GateOutcome};
-use crate::metrics::{FormulationMetrics, PairMetrics, ReferenceMetrics, tip_curve, tip_difference, window_stats};
+use crate::metrics::{
+    FormulationMetrics, PairMetrics, ReferenceMetrics, kinetic_resolution, tip_curve, tip_difference, window_stats,
+};
 use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
 use crate::run::RunOutput;
 use plotters::style::RGBColor;
@@ -49,7 +51,14 @@ impl CaseResult {
     pub fn evaluate(spec: &RunSpec, runs: Vec<RunOutput>) -> Self {
         let case = &spec.ancf;
         let span = case.span();
-        let metrics = runs.iter().map(|r| (r.formulation, FormulationMetrics::of(r))).collect();
+        let metrics = runs
+            .iter()
+            .map(|r| {
+                let mut m = FormulationMetrics::of(r);
+                m.kinetic_resolution = kinetic_resolution(spec.case(r.formulation), r.formulation);
+                (r.formulation, m)
+            })
+            .collect();
         let find = |f: Formulation| runs.iter().find(|r| r.formulation == f && !r.rows.is_empty());
         let (pair, pair_diff) = match (find(Formulation::Ancf), find(Formulation::Gebf)) {
             (Some(a), Some(b)) => {
@@ -512,6 +521,42 @@ fn sci(v: Option<f64>, prec: usize) -> String {
     }
 }
 
+/// The energy-drift entry of a table: [`UNRESOLVED`] when the run's peak kinetic energy is at or
+/// below its [`kinetic_resolution`] (the ratio would be one residue over another).
+fn drift_cell(m: &FormulationMetrics) -> String {
+    match m.resolved_energy_drift() {
+        Some(d) => sci(Some(d), 2),
+        None => UNRESOLVED.into(),
+    }
+}
+
+/// The energy-drift entry of a run that did not move: see [`drift_cell`] and [`unresolved_note`].
+const UNRESOLVED: &str = "–*";
+
+/// What [`UNRESOLVED`] means, with the runs it stands for (`(name, formulation, metrics)`); None
+/// when there are none.
+fn unresolved_note<'a>(runs: impl Iterator<Item = (&'a str, Formulation, &'a FormulationMetrics)>) -> Option<String> {
+    let list: Vec<String> = runs
+        .filter(|(_, _, m)| m.resolved_energy_drift().is_none())
+        .map(|(name, f, m)| {
+            format!("{name} {f}: peak {:.1e} J, resolution {:.1e} J", m.peak_kinetic, m.kinetic_resolution)
+        })
+        .collect();
+    (!list.is_empty()).then(|| {
+        format!(
+            "{UNRESOLVED} energy drift not shown: the run's peak kinetic energy is at or below the kinetic energy it \
+             resolves, ½·M·(atol/dt)² (the structure's mass M moving by Newton's absolute tolerance in one step), \
+             so nothing moved and the drift would be a ratio of two residues of the solve ({}).",
+            list.join("; ")
+        )
+    })
+}
+
+/// Every run of `results` with its case's name, in table order.
+fn all_runs(results: &[CaseResult]) -> impl Iterator<Item = (&str, Formulation, &FormulationMetrics)> {
+    results.iter().flat_map(|r| r.metrics.iter().map(move |(f, m)| (r.name.as_str(), *f, m)))
+}
+
 /// Rows of the results table: one per case and formulation.
 fn table_rows(results: &[CaseResult]) -> Vec<[String; 11]> {
     let mut rows = Vec::new();
@@ -530,7 +575,7 @@ fn table_rows(results: &[CaseResult]) -> Vec<[String; 11]> {
                 if m.error.is_some() { format!("failed at {:.4} s", m.t_reached) } else { "ok".into() },
                 format!("{:.1}", 1e3 * m.wall_s),
                 format!("{:.2}", m.newton_per_step),
-                sci(Some(m.energy_drift), 2),
+                drift_cell(m),
                 sci(Some(m.max_constraint_residual), 1),
                 fixed(r.pair.as_ref().map(|p| 1e3 * p.all.max), 3),
                 fixed(r.pair.as_ref().map(|p| 1e3 * p.first_second.max), 3),
@@ -563,6 +608,9 @@ pub fn summary_markdown(results: &[CaseResult]) -> String {
     s.push_str(&format!("|{}\n", "---|".repeat(TABLE_HEAD.len())));
     for row in table_rows(results) {
         s.push_str(&format!("| {} |\n", row.join(" | ")));
+    }
+    if let Some(n) = unresolved_note(all_runs(results)) {
+        s.push_str(&format!("\n{n}\n"));
     }
     for r in results {
         let errs: Vec<String> = r
@@ -733,7 +781,7 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
                 format!("{:.1}", 1e3 * m.wall_s),
                 format!("{:.2}", m.newton_per_step),
                 m.max_newton_iters.to_string(),
-                sci(Some(m.energy_drift), 2),
+                drift_cell(m),
                 sci(Some(m.max_constraint_residual), 1),
             ]
         })
@@ -743,6 +791,9 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
         &rows,
         &|i| i >= 2,
     ));
+    if let Some(n) = unresolved_note(r.metrics.iter().map(|(f, m)| (r.name.as_str(), *f, m))) {
+        let _ = writeln!(s, "<p class=\"note\">{}</p>", esc(&n));
+    }
     let mut dist: Vec<Vec<String>> = Vec::new();
     if let Some(p) = &r.pair {
         dist.push(vec![
@@ -986,11 +1037,21 @@ pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> Stri
                 _ => String::new(),
             };
             let cell = if i == 0 { format!("<a href=\"#{0}\">{0}</a>", esc(c)) } else { esc(c) };
-            let _ = write!(t, "<td{class}>{cell}</td>");
+            // The reason for a drift left out, on the cell itself (and below the table).
+            let title = if i == 5 && c == UNRESOLVED {
+                " title=\"not shown: the peak kinetic energy is below what the run resolves (note below the table)\""
+            } else {
+                ""
+            };
+            let _ = write!(t, "<td{class}{title}>{cell}</td>");
         }
         t.push_str("</tr>\n");
     }
-    t.push_str("</table>\n<p>The same table in Markdown: <a href=\"summary.md\">summary.md</a>.</p>\n");
+    t.push_str("</table>\n");
+    if let Some(n) = unresolved_note(all_runs(results)) {
+        let _ = writeln!(t, "<p class=\"note\">{}</p>", esc(&n));
+    }
+    t.push_str("<p>The same table in Markdown: <a href=\"summary.md\">summary.md</a>.</p>\n");
     sections.push(Section {
         id: "results".into(),
         title: "Results".into(),
@@ -1003,7 +1064,7 @@ pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> Stri
     sections.extend(extra.iter().cloned());
 
     let mut s = format!(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Flared-hinge verification harness</title>\n<style>{STYLE}</style></head><body>\n<nav><h2>Contents</h2>"
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>flexmb report</title>\n<style>{STYLE}</style></head><body>\n<nav><h2>Contents</h2>"
     );
     for (group, title) in [(Group::Overview, None), (Group::Case, Some("Cases")), (Group::Study, Some("Studies"))] {
         let items: Vec<&Section> = sections.iter().filter(|x| x.group == group).collect();
@@ -1024,7 +1085,7 @@ pub fn index_html(out: &Path, results: &[CaseResult], extra: &[Section]) -> Stri
         }
         s.push_str("</ul>");
     }
-    s.push_str("</nav>\n<main>\n<h1>Flared-hinge verification harness: ANCF vs GEBF</h1>\n<div id=\"js-errors\" hidden></div>\n");
+    s.push_str("</nav>\n<main>\n<h1>flexmb report: ANCF and GEBF</h1>\n<div id=\"js-errors\" hidden></div>\n");
     for x in &sections {
         let badge =
             x.badge.as_ref().map(|(b, c)| format!(" <span class=\"{c}\">[{}]</span>", esc(b))).unwrap_or_default();
@@ -1063,5 +1124,41 @@ mod tests {
     fn millimetre_columns_are_fixed_point() {
         assert_eq!(fixed(Some(0.000123 * 1e3), 3), "0.123");
         assert_eq!(fixed(None, 3), "–");
+    }
+
+    /// The energy-drift column showed 1.0 for the Goland and HALE runs, whose peak kinetic
+    /// energy is 1e-18 J: a ratio of nothing to nothing (issue 33, item 9). A run at rest shows
+    /// "–*" and a note; a moving one its drift.
+    #[test]
+    fn a_run_at_rest_shows_no_energy_drift_issue_33() {
+        use crate::case::CaseFile;
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases");
+        let spec = |file: &str, set: &[&str]| {
+            let set: Vec<_> = set.iter().map(|s| s.parse().unwrap()).collect();
+            CaseFile::read(&dir.join(file)).unwrap().expand(&set).unwrap().remove(0)
+        };
+        let f = Formulation::Gebf;
+        // The Goland wing at zero incidence without gravity: nothing moves.
+        let goland = spec("goland_flutter.json", &[]);
+        let r = CaseResult::evaluate(&goland, vec![crate::scene::run_formulation(&goland.gebf, f)]);
+        let m = &r.metrics[&f];
+        assert!(m.error.is_none(), "{:?}", m.error);
+        // ½·M·(atol/dt)²: 35.71 kg/m over 6.096 m, atol 1e-10 m, dt 0.005 s.
+        let expected = 0.5 * 35.71 * 6.096 * (1e-10_f64 / 0.005).powi(2);
+        approx::assert_relative_eq!(m.kinetic_resolution, expected, max_relative = 1e-12);
+        assert!(m.peak_kinetic < 1e-3 * m.kinetic_resolution, "peak {:e} J", m.peak_kinetic);
+        assert_eq!(m.resolved_energy_drift(), None);
+        assert_eq!(drift_cell(m), UNRESOLVED);
+        assert!(m.energy_drift.is_finite(), "summary.json keeps the ratio");
+        let md = summary_markdown(std::slice::from_ref(&r));
+        assert!(md.contains("| –* |") && md.contains("energy drift not shown"), "{md}");
+        // The paper's pendulum moves: its drift is shown, and there is no note.
+        let pendulum = spec("double_pendulum_c1_beta45.json", &["t_end=0.1"]);
+        let r = CaseResult::evaluate(&pendulum, vec![crate::scene::run_formulation(&pendulum.gebf, f)]);
+        let m = &r.metrics[&f];
+        assert!(m.peak_kinetic > 1e6 * m.kinetic_resolution, "peak {:e} J", m.peak_kinetic);
+        assert_eq!(m.resolved_energy_drift(), Some(m.energy_drift));
+        assert_eq!(drift_cell(m), sci(Some(m.energy_drift), 2));
+        assert!(!summary_markdown(std::slice::from_ref(&r)).contains("not shown"));
     }
 }

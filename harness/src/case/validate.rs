@@ -1,0 +1,466 @@
+//! [`Case::validate`]: every value of a case checked before anything is built, each refusal
+//! naming the field. The checks run in a fixed order (the first failing one is reported), one
+//! group of fields per function.
+
+use super::{Case, Elements, FormSetting, Formulation, Joint, MAX_STATIC_POINTS, NewtonSettings, StaticSettings, clip};
+use super::{finite3, norm3, whole_steps};
+use crate::aero::AeroSettings;
+use crate::budget::{
+    MAX_BODIES, MAX_CHORDWISE, MAX_ELEMENTS_PER_BODY, MAX_LIST, MAX_NEWTON_ITER, MAX_PANELS_PER_BODY,
+    MAX_STEP_HALVINGS, MAX_SUB_ITERATIONS, MAX_WAKE_ROWS,
+};
+
+/// `v` is a finite positive number.
+fn positive(field: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{field}: {v} is not a positive number")) }
+}
+
+/// `v` is a finite number of at least zero.
+fn non_negative(field: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{field}: {v} is not a non-negative number")) }
+}
+
+/// The fields the two settings blocks (`ancf`, `gebf`) share, as validation reads them.
+struct Block<'a> {
+    elements: &'a Elements,
+    newton: &'a NewtonSettings,
+    dt: f64,
+    rho_inf: f64,
+    form: FormSetting,
+}
+
+/// The case-file key of a formulation's settings block.
+fn key(f: Formulation) -> &'static str {
+    f.as_str()
+}
+
+impl Case {
+    /// Check every value a run of both formulations reads; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        self.validate_for(&Formulation::ALL)
+    }
+
+    /// Check every value a run of the formulations `fs` reads: the shared fields, and of the
+    /// settings blocks (`ancf`, `gebf`) only those of `fs`, so that a run of one formulation is
+    /// not refused over the other's settings. The message names the field.
+    pub fn validate_for(&self, fs: &[Formulation]) -> Result<(), String> {
+        self.check_name()?;
+        self.check_counts()?;
+        self.check_bodies()?;
+        self.check_joints()?;
+        positive("stiffness_scale", self.stiffness_scale)?;
+        self.check_discretisation(fs)?;
+        if let Some(a) = &self.aero {
+            check_aero_caps(a)?;
+        }
+        // Everything else about the structure, as the formulations will check it (in degrees
+        // where the case speaks degrees). The scenes differ only in their element counts.
+        let first = fs.first().copied().unwrap_or(Formulation::Ancf);
+        self.scene(first).validate().map_err(|e| e.to_string())?;
+        self.check_times(fs)?;
+        self.check_references()?;
+        if let Some(a) = &self.aero {
+            self.check_aero(a, fs)?;
+        }
+        if !(self.pitch_deg.is_finite() && (-90.0..=90.0).contains(&self.pitch_deg)) {
+            return Err(format!("pitch_deg: {} is not in [-90, 90]", self.pitch_deg));
+        }
+        if let Some(g) = self.aero.as_ref().and_then(|a| a.gust.as_ref()) {
+            g.validate()?;
+        }
+        if let Some(g) = &self.gust {
+            g.validate(self)?;
+        }
+        match (&self.statics, self.aero.is_some()) {
+            (Some(st), false) => self.check_structural_static(st)?,
+            (Some(st), true) => check_aero_static(st)?,
+            (None, _) => {}
+        }
+        if let Some(st) = &self.stability {
+            if self.aero.is_none() {
+                return Err("stability: a stability analysis needs `aero`".into());
+            }
+            st.validate()?;
+        }
+        self.check_gate()
+    }
+
+    /// The name is a folder under the output directory (and a sweep adds `__key=value`).
+    fn check_name(&self) -> Result<(), String> {
+        let n = &self.name;
+        let safe = |c: char| c.is_ascii_alphanumeric() || "._-+=,".contains(c);
+        if n.is_empty() || n.len() > 120 || n == "." || n == ".." || !n.chars().all(safe) {
+            return Err(format!(
+                "name: `{n}` is not a safe file name (1 to 120 bytes of ASCII letters, digits and `._-+=,`; \
+                 not `.` or `..`)"
+            ));
+        }
+        Ok(())
+    }
+
+    /// At least one body, and the counts that the checks below (and the scene's) visit in pairs
+    /// within their limits.
+    fn check_counts(&self) -> Result<(), String> {
+        if self.bodies.is_empty() {
+            return Err("bodies: at least one body is needed".into());
+        }
+        let counts = [
+            ("bodies", self.bodies.len(), MAX_BODIES),
+            ("joints", self.joints.len(), MAX_BODIES),
+            ("references", self.references.len(), MAX_LIST),
+            ("gate.windows", self.gate.as_ref().map_or(0, |g| g.windows.len()), MAX_LIST),
+        ];
+        for (field, n, cap) in counts {
+            if n > cap {
+                return Err(format!("{field}: {n} entries, more than the limit of {cap}"));
+            }
+        }
+        if let Some(i) = self.bodies.iter().position(|b| b.point_masses.len() > MAX_LIST) {
+            return Err(format!(
+                "bodies[{i}].point_masses: {} entries, more than the limit of {MAX_LIST}",
+                self.bodies[i].point_masses.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// Unique non-empty names and a right-handed pair of section axes per body.
+    fn check_bodies(&self) -> Result<(), String> {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let f = |s: &str| format!("bodies[{i}].{s}");
+            if b.name.is_empty() {
+                return Err(f("name: empty"));
+            }
+            if self.bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(f(&format!("name: `{}` is used twice", b.name)));
+            }
+            if !finite3(&b.x_axis) || norm3(&b.x_axis) < 1e-12 {
+                return Err(f("x_axis: not a finite non-zero vector"));
+            }
+            if !finite3(&b.y_axis) || norm3(&b.y_axis) < 1e-12 {
+                return Err(f("y_axis: not a finite non-zero vector"));
+            }
+            let dot: f64 =
+                (0..3).map(|k| b.x_axis[k] * b.y_axis[k]).sum::<f64>() / (norm3(&b.x_axis) * norm3(&b.y_axis));
+            if dot.abs() > 1e-9 {
+                return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Every joint names existing bodies, flare angles lie in [−90°, 90°], and `fold_joint` is
+    /// a flared hinge.
+    fn check_joints(&self) -> Result<(), String> {
+        let body = |field: String, name: &str| -> Result<(), String> {
+            if self.body_index(name).is_some() { Ok(()) } else { Err(format!("{field}: no body named `{name}`")) }
+        };
+        for (i, j) in self.joints.iter().enumerate() {
+            match j {
+                Joint::GroundHinge { body: b, .. } => {
+                    body(format!("joints[{i}].body"), b)?;
+                }
+                Joint::FlaredHinge { parent, child, flare_deg, .. } => {
+                    body(format!("joints[{i}].parent"), parent)?;
+                    body(format!("joints[{i}].child"), child)?;
+                    if !(flare_deg.is_finite() && (-90.0..=90.0).contains(flare_deg)) {
+                        return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
+                    }
+                }
+                Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
+            }
+        }
+        if let Some(n) = &self.fold_joint {
+            match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
+                Some(Joint::FlaredHinge { .. }) => {}
+                Some(_) => return Err(format!("fold_joint: `{n}` is not a flared hinge")),
+                None => return Err(format!("fold_joint: no joint named `{n}`")),
+            }
+        }
+        Ok(())
+    }
+
+    /// Element counts of `fs`, then their Newton iteration counts and nesting, capped (each
+    /// multiplies the work of a step).
+    fn check_discretisation(&self, fs: &[Formulation]) -> Result<(), String> {
+        for &f in fs {
+            let n = self.block(f).elements;
+            n.check(&format!("{}.elements_per_body", key(f)), self.bodies.len())?;
+            if let Some(i) = (0..self.bodies.len()).find(|&i| n.for_body(i) > MAX_ELEMENTS_PER_BODY) {
+                return Err(format!(
+                    "{}.elements_per_body: {} elements on bodies[{i}], more than the limit of {MAX_ELEMENTS_PER_BODY}",
+                    key(f),
+                    n.for_body(i),
+                ));
+            }
+        }
+        for &f in fs {
+            let newton = self.block(f).newton;
+            if newton.max_iter > MAX_NEWTON_ITER {
+                return Err(format!(
+                    "{}.newton.max_iter: {} is more than the limit of {MAX_NEWTON_ITER}",
+                    key(f),
+                    newton.max_iter,
+                ));
+            }
+            if newton.max_step_halvings > MAX_STEP_HALVINGS {
+                return Err(format!(
+                    "{}.newton.max_step_halvings: {} is more than the limit of {MAX_STEP_HALVINGS}",
+                    key(f),
+                    newton.max_step_halvings,
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// What validation reads of `f`'s settings block.
+    fn block(&self, f: Formulation) -> Block<'_> {
+        match f {
+            Formulation::Ancf => {
+                let s = &self.ancf;
+                Block { elements: &s.elements_per_body, newton: &s.newton, dt: s.dt, rho_inf: s.rho_inf, form: s.form }
+            }
+            Formulation::Gebf => {
+                let s = &self.gebf;
+                Block { elements: &s.elements_per_body, newton: &s.newton, dt: s.dt, rho_inf: s.rho_inf, form: s.form }
+            }
+        }
+    }
+
+    /// End time, output interval and the refinement study's end time, then per formulation of
+    /// `fs` its step (a whole number of steps in each) and spectral radius, then the
+    /// integrator's own checks.
+    fn check_times(&self, fs: &[Formulation]) -> Result<(), String> {
+        positive("t_end", self.t_end)?;
+        if self.vtk.is_some_and(|v| v.stride == Some(0)) {
+            return Err("vtk.stride: must be at least 1".into());
+        }
+        if let Some(t) = self.converge_t_end {
+            positive("converge_t_end", t)?;
+        }
+        if let Some(o) = self.output_dt {
+            positive("output_dt", o)?;
+        }
+        for &f in fs {
+            let Block { dt, rho_inf: rho, .. } = self.block(f);
+            let f = key(f);
+            positive(&format!("{f}.dt"), dt)?;
+            // The time loops take whole steps: a t_end (or output interval) between two steps
+            // would end (or sample) the run somewhere else than the case says.
+            if self.t_end < dt * (1.0 - 1e-9) {
+                return Err(format!("{f}.dt: t_end = {} is shorter than one step of {dt} s", self.t_end));
+            }
+            for (name, t) in [("t_end", Some(self.t_end)), ("output_dt", self.output_dt)] {
+                if let Some(t) = t
+                    && whole_steps(t, dt).is_none()
+                {
+                    return Err(format!("{f}.dt: {name} = {t} is not a whole number of steps of {dt} s"));
+                }
+            }
+            if !(0.0..=1.0).contains(&rho) {
+                return Err(format!("{f}.rho_inf: {rho} is not in [0, 1]"));
+            }
+        }
+        // The integrator's own checks (Newton tolerances, iteration counts), named by case path.
+        for &f in fs {
+            if let Err(genalpha::Error::InvalidParameter { field, reason }) =
+                crate::scene::settings(self, f).params.validate()
+            {
+                return Err(format!("{f}.{field}: {reason}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Finite time shifts and positive gate limits of the external references.
+    fn check_references(&self) -> Result<(), String> {
+        for (k, r) in self.references.iter().enumerate() {
+            if !r.time_shift.is_finite() {
+                return Err(format!("references[{k}].time_shift: not finite"));
+            }
+            if let Some(t) = r.tip_max_m {
+                positive(&format!("references[{k}].tip_max_m"), t)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The aerodynamics: the form of `fs`, the flow, the lattice and its stations, the coupling.
+    fn check_aero(&self, a: &AeroSettings, fs: &[Formulation]) -> Result<(), String> {
+        // The coupled step holds the aerodynamic loads of t_{n+1} over the step; evaluated at
+        // the weighted instant t_{n+1-α_f}, they would make the coupling first order.
+        for &f in fs {
+            if self.block(f).form == FormSetting::ChungHulbert {
+                return Err(format!(
+                    "{}.form: chung_hulbert is not available with aerodynamics (the loads are those of \
+                     the step's end)",
+                    key(f)
+                ));
+            }
+        }
+        positive("aero.rho", a.rho)?;
+        positive("aero.chord", a.chord)?;
+        match (a.v_inf, a.airspeed) {
+            (None, None) => return Err("aero: give the free stream as `v_inf` or `airspeed`".into()),
+            (Some(v), _) if !finite3(&v) || norm3(&v) == 0.0 => {
+                return Err("aero.v_inf: not a finite non-zero vector".into());
+            }
+            (_, Some(u)) => positive("aero.airspeed", u)?,
+            _ => {}
+        }
+        if !a.le_offset.is_finite() {
+            return Err("aero.le_offset: not finite".into());
+        }
+        if a.n_chordwise == 0 {
+            return Err("aero.n_chordwise: must be at least 1".into());
+        }
+        if a.n_wake_rows == 0 {
+            return Err("aero.n_wake_rows: must be at least 1".into());
+        }
+        non_negative("aero.cutoff_radius", a.cutoff_radius)?;
+        if !(a.coupling.relaxation > 0.0 && a.coupling.relaxation <= 1.0) {
+            return Err(format!("aero.coupling.relaxation: {} is not in (0, 1]", a.coupling.relaxation));
+        }
+        positive("aero.coupling.tolerance", a.coupling.tolerance)?;
+        crate::aero::station_map(self, a)?;
+        // The lattice's own limit on a hinge column's slant, found here rather than at run time.
+        for (i, j) in self.joints.iter().enumerate() {
+            if let Joint::FlaredHinge { flare_deg, .. } = j
+                && flare_deg.abs() >= uvlm::lattice::MAX_HINGE_FLARE_DEG
+            {
+                return Err(format!(
+                    "joints[{i}].flare_deg: {flare_deg} is not below the lattice's limit of ±{}° (aero)",
+                    uvlm::lattice::MAX_HINGE_FLARE_DEG
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A structural static case (no `aero`): dead point loads at increasing load factors.
+    fn check_structural_static(&self, st: &StaticSettings) -> Result<(), String> {
+        if st.point_loads.is_empty() {
+            return Err(
+                "static: a case without `aero` needs `static.point_loads` (a static aeroelastic sweep needs `aero`)"
+                    .into(),
+            );
+        }
+        if !st.airspeeds.is_empty() {
+            return Err("static.airspeeds: a case without `aero` has no airspeeds".into());
+        }
+        if st.point_loads.len() > MAX_LIST {
+            return Err(format!("static.point_loads: {} loads, more than {}", st.point_loads.len(), MAX_LIST));
+        }
+        for (k, l) in st.point_loads.iter().enumerate() {
+            let Some(b) = self.bodies.iter().find(|b| b.name == l.body) else {
+                return Err(format!("static.point_loads[{k}].body: no body named `{}`", clip(&l.body)));
+            };
+            if let Some(at) = l.at
+                && !(at.is_finite() && (0.0..=b.length).contains(&at))
+            {
+                return Err(format!(
+                    "static.point_loads[{k}].at: {at} is not in [0, {}] (the body's length)",
+                    b.length
+                ));
+            }
+            for (what, v) in [("force", l.force), ("moment", l.moment)] {
+                if let Some(i) = v.iter().position(|x| !(x.is_finite() && x.abs() <= 1e12)) {
+                    return Err(format!(
+                        "static.point_loads[{k}].{what}[{i}]: {} is not a finite value of at most 1e12",
+                        v[i]
+                    ));
+                }
+            }
+        }
+        check_load_factors(&st.load_factors)?;
+        if !st.references.is_empty() {
+            return Err("static.references: coast-angle curves need `aero`".into());
+        }
+        if st.wake.is_some() {
+            return Err("static.wake: the steady wake needs `aero`".into());
+        }
+        Ok(())
+    }
+
+    /// The gate's tolerances and windows.
+    fn check_gate(&self) -> Result<(), String> {
+        let Some(g) = &self.gate else { return Ok(()) };
+        positive("gate.energy_drift", g.energy_drift)?;
+        positive("gate.constraint_residual", g.constraint_residual)?;
+        for (k, w) in g.windows.iter().enumerate() {
+            if !(w.t_start.is_finite() && w.t_end.is_finite() && w.t_end > w.t_start) {
+                return Err(format!("gate.windows[{k}]: t_end must exceed t_start"));
+            }
+            positive(&format!("gate.windows[{k}].tip_max_m"), w.tip_max_m)?;
+            positive(&format!("gate.windows[{k}].tip_rms_m"), w.tip_rms_m)?;
+        }
+        Ok(())
+    }
+}
+
+/// The lattice's sizes and the coupling's sub-iterations, capped.
+fn check_aero_caps(a: &AeroSettings) -> Result<(), String> {
+    let caps = [
+        ("aero.n_chordwise", a.n_chordwise, MAX_CHORDWISE),
+        ("aero.n_wake_rows", a.n_wake_rows, MAX_WAKE_ROWS),
+        ("aero.coupling.max_sub_iterations", a.coupling.max_sub_iterations, MAX_SUB_ITERATIONS),
+    ];
+    for (field, v, cap) in caps {
+        if v > cap {
+            return Err(format!("{field}: {v} is more than the limit of {cap}"));
+        }
+    }
+    if let Some(i) = a.panels_per_body.iter().position(|&p| p > MAX_PANELS_PER_BODY) {
+        return Err(format!(
+            "aero.panels_per_body[{i}]: {} is more than the limit of {MAX_PANELS_PER_BODY}",
+            a.panels_per_body[i]
+        ));
+    }
+    Ok(())
+}
+
+/// A structural static case's load factors: 1 to [`MAX_STATIC_POINTS`], each in (0, 1000],
+/// increasing.
+fn check_load_factors(factors: &[f64]) -> Result<(), String> {
+    if factors.is_empty() {
+        return Err("static.load_factors: empty list".into());
+    }
+    if factors.len() > MAX_STATIC_POINTS {
+        return Err(format!("static.load_factors: {} points, more than {MAX_STATIC_POINTS}", factors.len()));
+    }
+    for (k, &f) in factors.iter().enumerate() {
+        if !(f.is_finite() && f > 0.0 && f <= 1e3) {
+            return Err(format!("static.load_factors[{k}]: {f} is not in (0, 1000]"));
+        }
+        if k > 0 && f <= factors[k - 1] {
+            return Err(format!("static.load_factors[{k}]: {f} does not increase"));
+        }
+    }
+    Ok(())
+}
+
+/// A static aeroelastic sweep (with `aero`): airspeeds, labelled references, the steady wake.
+fn check_aero_static(st: &StaticSettings) -> Result<(), String> {
+    if !st.point_loads.is_empty() || !st.load_factors.is_empty() {
+        return Err("static.point_loads: point loads are for a structural static case (without `aero`)".into());
+    }
+    if st.airspeeds.is_empty() {
+        return Err("static.airspeeds: empty list".into());
+    }
+    if st.airspeeds.len() > MAX_STATIC_POINTS {
+        return Err(format!("static.airspeeds: {} points, more than {MAX_STATIC_POINTS}", st.airspeeds.len()));
+    }
+    for (k, &u) in st.airspeeds.iter().enumerate() {
+        positive(&format!("static.airspeeds[{k}]"), u)?;
+    }
+    for (k, r) in st.references.iter().enumerate() {
+        if r.label.is_empty() {
+            return Err(format!("static.references[{k}].label: empty"));
+        }
+    }
+    if let Some(w) = &st.wake {
+        w.validate("static.wake")?;
+    }
+    Ok(())
+}
