@@ -1048,7 +1048,7 @@ impl ConstrainedSystem for Model {
         match self.options.path {
             SolvePath::Dae => self.add_iteration_matrix(q, None, 0.0, 0.0, 1.0, true, k),
             SolvePath::Ode => {
-                let mut w = self.work.borrow_mut();
+                let mut w = scratch(&self.work);
                 let Workspace { q: qf, .. } = &mut *w;
                 self.reduction.expand_inplace(q, qf);
                 self.add_iteration_matrix(qf, None, 0.0, 0.0, 1.0, true, k);

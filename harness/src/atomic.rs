@@ -3,12 +3,16 @@
 //! * [`write()`]: the contents go to a temporary file beside the target, which is then renamed over
 //!   it, so a reader (or a run killed mid-write) sees the old file or the new one, never a part.
 //! * [`claim_dir`]: an exclusive lock on `<dir>/.lock` (`flock`, released by the kernel when the
-//!   process ends, however it ends). A second run into the same folder waits for the first.
+//!   process ends, however it ends). A second run into the same folder waits for the first,
+//!   polling so that a signal ends the wait; the same process claiming a folder twice is an
+//!   error, never a wait on itself.
 //!   While the lock is held the run clears the files an earlier run left ([`clear_outputs`]).
 
 use std::fs::{File, OpenOptions};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
 
 use crate::Error;
 
@@ -77,36 +81,86 @@ impl Drop for TempFile {
 pub struct DirLock {
     /// The folder.
     pub dir: PathBuf,
+    /// The folder's key in [`HELD`].
+    key: PathBuf,
     _file: File,
 }
 
-/// Take the exclusive lock of `dir` (created if missing), waiting while another run holds it.
+/// The folders this process holds: `flock` locks belong to an open file, so a second claim of
+/// a folder by the same process would wait on itself for ever. It is refused instead.
+static HELD: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// How often a lock wait looks at the lock and at the signal flag.
+const POLL: Duration = Duration::from_millis(50);
+
+fn held() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    HELD.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Take the exclusive lock of `dir` (created if missing), waiting while another process holds
+/// it. The wait polls the lock and the signal flag ([`crate::signal::interrupted`]): a SIGTERM
+/// or Ctrl-C ends it with an error. A folder this process already holds is an error at once
+/// (two runs of one command with the same name), never a wait.
 pub fn claim_dir(dir: &Path) -> Result<DirLock, Error> {
     let io = |e: std::io::Error| Error::Io(format!("{}: {e}", dir.display()));
     std::fs::create_dir_all(dir).map_err(io)?;
-    let file = OpenOptions::new().create(true).truncate(false).write(true).open(dir.join(".lock")).map_err(io)?;
-    lock(&file, dir).map_err(io)?;
-    Ok(DirLock { dir: dir.to_path_buf(), _file: file })
+    let key = std::fs::canonicalize(dir).map_err(io)?;
+    {
+        let mut h = held();
+        if h.contains(&key) {
+            return Err(Error::Io(format!(
+                "{}: this command already writes into this folder (two of its runs have the same name)",
+                dir.display()
+            )));
+        }
+        h.push(key.clone());
+    }
+    let locked = OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(dir.join(".lock"))
+        .and_then(|file| lock(&file, dir).map(|()| file));
+    match locked {
+        Ok(file) => Ok(DirLock { dir: dir.to_path_buf(), key, _file: file }),
+        Err(e) => {
+            held().retain(|k| k != &key);
+            Err(io(e))
+        }
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        held().retain(|k| k != &self.key);
+    }
 }
 
 #[cfg(target_os = "linux")]
 fn lock(file: &File, dir: &Path) -> std::io::Result<()> {
     use std::os::fd::AsRawFd;
     let fd = file.as_raw_fd();
-    // SAFETY: flock on a file descriptor this function borrows; no memory is shared.
-    if unsafe { libc::flock(fd, libc::LOCK_EX | libc::LOCK_NB) } == 0 {
-        return Ok(());
-    }
-    eprintln!("waiting for another run writing {}", dir.display());
+    let mut announced = false;
     loop {
-        // SAFETY: as above.
-        if unsafe { libc::flock(fd, libc::LOCK_EX) } == 0 {
+        // SAFETY: flock on a file descriptor this function borrows; no memory is shared.
+        if unsafe { libc::flock(fd, libc::LOCK_EX | libc::LOCK_NB) } == 0 {
             return Ok(());
         }
         let e = std::io::Error::last_os_error();
-        if e.kind() != std::io::ErrorKind::Interrupted {
+        if e.kind() != std::io::ErrorKind::WouldBlock && e.kind() != std::io::ErrorKind::Interrupted {
             return Err(e);
         }
+        if crate::signal::interrupted() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "interrupted while waiting for another run writing this folder",
+            ));
+        }
+        if !announced {
+            eprintln!("waiting for another run writing {}", dir.display());
+            announced = true;
+        }
+        std::thread::sleep(POLL);
     }
 }
 
@@ -160,6 +214,21 @@ mod tests {
         clear_outputs(&lock, &[]).unwrap();
         assert!(!p.exists());
         assert!(d.join(".lock").exists());
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    /// Issue 38: a sweep whose points had one name claimed its folder twice and waited for
+    /// ever on its own lock. The second claim is an error at once; after the first is dropped
+    /// the folder can be claimed again.
+    #[test]
+    fn a_second_claim_by_the_same_process_fails_at_once_issue_38() {
+        let d = std::env::temp_dir().join(format!("harness-atomic-twice-{}", std::process::id()));
+        let first = claim_dir(&d).unwrap();
+        let e = claim_dir(&d).unwrap_err().to_string();
+        assert!(e.contains("same name"), "{e}");
+        drop(first);
+        let again = claim_dir(&d).unwrap();
+        drop(again);
         let _ = std::fs::remove_dir_all(&d);
     }
 }

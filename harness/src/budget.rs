@@ -54,6 +54,11 @@ pub struct Limits {
     pub seconds: f64,
 }
 
+impl Limits {
+    /// No limit (for an expansion whose budget is checked another way).
+    pub const UNLIMITED: Limits = Limits { memory_bytes: f64::INFINITY, seconds: f64::INFINITY };
+}
+
 static LIMITS: OnceLock<Limits> = OnceLock::new();
 
 /// Set the limits for this process (the binary's `--max-memory` and `--max-hours`); the first
@@ -122,20 +127,29 @@ pub struct Estimate {
     pub structure_seconds: f64,
 }
 
-/// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
-/// overflows), run for at most `max_steps` steps when given.
-pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estimate {
-    let (elements, dt, newton) = match f {
-        Formulation::Ancf => (&case.ancf.elements_per_body, case.ancf.dt, case.ancf.newton),
-        Formulation::Gebf => (&case.gebf.elements_per_body, case.gebf.dt, case.gebf.newton),
+/// The unknowns of formulation `f` of `case` (coordinates plus constraint rows).
+fn unknowns(case: &Case, f: Formulation) -> f64 {
+    let elements = match f {
+        Formulation::Ancf => &case.ancf.elements_per_body,
+        Formulation::Gebf => &case.gebf.elements_per_body,
     };
     let nb = case.bodies.len();
     let nj = case.joints.len() as f64;
     let el: f64 = (0..nb).map(|i| elements.for_body(i) as f64).sum();
-    let n = match f {
+    match f {
         Formulation::Ancf => 12.0 * (el + nb as f64) + 12.0 * nj,
         Formulation::Gebf => 12.0 * el + 6.0 * nb as f64 + 6.0 * nj,
+    }
+}
+
+/// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
+/// overflows), run for at most `max_steps` steps when given.
+pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estimate {
+    let (dt, newton) = match f {
+        Formulation::Ancf => (case.ancf.dt, case.ancf.newton),
+        Formulation::Gebf => (case.gebf.dt, case.gebf.newton),
     };
+    let n = unknowns(case, f);
     let mut steps = (case.t_end / dt).round().max(1.0);
     if let Some(m) = max_steps {
         steps = steps.min(m as f64);
@@ -255,4 +269,180 @@ pub fn check_formulations(
         }
     }
     Ok(())
+}
+
+/// The analyses whose cost [`estimate_analysis`] bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Analysis {
+    /// `harness static`: equilibria over `static.airspeeds` (or `static.load_factors`).
+    Static,
+    /// `harness stability`: linearised roots over `stability.airspeeds`.
+    Stability,
+    /// `harness gust`: a static equilibrium, then a time march per gradient and hinge state.
+    Gust,
+}
+
+impl Analysis {
+    /// The command's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Analysis::Static => "static",
+            Analysis::Stability => "stability",
+            Analysis::Gust => "gust",
+        }
+    }
+}
+
+/// Newton iterations a static point is charged (with its continuation and retries).
+const STATIC_ITERATIONS: f64 = 40.0;
+/// Evaluations of the flutter determinant charged per stability airspeed.
+const STABILITY_EVALUATIONS: f64 = 200.0;
+
+/// The cost of one steady lattice solve with `bound` rings and `legs` wake legs (influence
+/// matrix, its LU), s, and its memory, bytes.
+fn steady_solve(bound: f64, legs: f64) -> (f64, f64) {
+    (2e-8 * bound * bound + 1e-9 * bound * bound * bound / 3.0 + 3e-8 * bound * legs, 16.0 * bound * bound)
+}
+
+/// Estimate analysis `a` of formulation `f` of `case` (a validated case with the analysis'
+/// block), like [`estimate`] for a run: generous constants, an upper bound rather than a
+/// prediction.
+///
+/// * static: per point [`STATIC_ITERATIONS`] residuals (a steady lattice solve each) and one
+///   aerodynamic tangent (a steady solve per unknown), plus the structure's dense tangent and
+///   LU; a structural case (no `aero`) 20 load steps per load factor;
+/// * stability: per airspeed the static equilibrium above, the linearised lattice with its
+///   frozen wake, and [`STABILITY_EVALUATIONS`] evaluations of the flutter determinant over the
+///   modal basis;
+/// * gust: the static equilibrium, then every run of the sweep (gradients × hinge states) as
+///   a time march of `gust.t_end` ([`estimate`]).
+pub fn estimate_analysis(case: &Case, f: Formulation, a: Analysis) -> Estimate {
+    let n = unknowns(case, f);
+    let structure_iter = 5.0 * (2e-6 * n + 4e-9 * n * n) + 2e-9 * n * n * n / 3.0;
+    let structure_bytes = 3.0 * 8.0 * n * n + 8.0 * n * 600.0;
+    let (mut bound, mut span) = (0.0, 0.0);
+    if let Some(a) = &case.aero {
+        span = a.panels_per_body.iter().map(|&p| p as f64).sum::<f64>() + 1.0;
+        bound = span * a.n_chordwise as f64;
+    }
+    let (solve_s, solve_bytes) = steady_solve(bound, 2.0 * span);
+    let static_point = if case.aero.is_some() {
+        STATIC_ITERATIONS * (solve_s + structure_iter) + n * solve_s
+    } else {
+        20.0 * STATIC_ITERATIONS * structure_iter
+    };
+    let mut e = Estimate {
+        unknowns: n,
+        steps: 0.0,
+        bound_rings: bound,
+        wake_rings: 0.0,
+        bytes: structure_bytes + solve_bytes + 8.0 * n * bound + 50e6,
+        seconds: 0.0,
+        structure_bytes,
+        aero_bytes: solve_bytes + 8.0 * n * bound,
+        structure_seconds: 0.0,
+    };
+    match a {
+        Analysis::Static => {
+            let st = case.statics.as_ref();
+            let points = st.map_or(0, |s| s.airspeeds.len().max(s.load_factors.len())) as f64;
+            e.seconds = points * static_point;
+            e.structure_seconds = points * STATIC_ITERATIONS * structure_iter;
+        }
+        Analysis::Stability => {
+            let Some(st) = case.stability.as_ref() else { return e };
+            let points = st.airspeeds.len() as f64;
+            let rows = st.wake.as_ref().map_or_else(|| case.aero.as_ref().map_or(0, |a| a.n_wake_rows), |w| w.rows);
+            let wake = span * rows as f64;
+            let basis = st.basis_modes.unwrap_or((2 * st.modes).max(20)) as f64;
+            let lattice = 16.0 * bound * (bound + wake) + 16.0 * (bound + wake) * basis;
+            let determinant = 1e-9 * (bound * bound * bound / 3.0 + bound * bound * basis + basis * basis * basis);
+            let linearise = 1e-8 * (bound + wake) * (bound + wake);
+            // The modal basis: once about the undeformed state, at each equilibrium otherwise.
+            let modes = 2e-9 * n * n * n;
+            let (per_point, once) = match st.about {
+                crate::stability::About::Equilibrium => (static_point + modes, 0.0),
+                crate::stability::About::Undeformed => (0.0, modes),
+            };
+            e.wake_rings = wake;
+            e.bytes += lattice + 16.0 * n * n;
+            e.aero_bytes += lattice;
+            e.seconds = once + points * (per_point + linearise + STABILITY_EVALUATIONS * determinant);
+            e.structure_seconds = once + points * per_point;
+        }
+        Analysis::Gust => {
+            let Some(g) = case.gust.as_ref() else { return e };
+            let runs = (g.gradients_m.len().max(g.frequencies_hz.len()) * g.hinges.len()) as f64;
+            let mut march = case.clone();
+            if let Some(t) = g.t_end {
+                march.t_end = t;
+            }
+            let r = estimate(&march, f, None);
+            e.steps = runs * r.steps;
+            e.wake_rings = r.wake_rings;
+            e.bytes = e.bytes.max(r.bytes);
+            e.aero_bytes = e.aero_bytes.max(r.aero_bytes);
+            e.structure_bytes = e.structure_bytes.max(r.structure_bytes);
+            e.seconds = static_point + runs * r.seconds;
+            e.structure_seconds = runs * r.structure_seconds;
+        }
+    }
+    e
+}
+
+/// Refuse analysis `a` of `case` when its estimate ([`estimate_analysis`]) for either
+/// formulation exceeds `lim`: the message names the field to change and gives the estimate.
+pub fn check_analysis(case: &Case, a: Analysis, fs: &[Formulation], lim: &Limits) -> Result<(), String> {
+    for &f in fs {
+        let e = estimate_analysis(case, f, a);
+        let over_memory = e.bytes > lim.memory_bytes;
+        if !over_memory && e.seconds <= lim.seconds {
+            continue;
+        }
+        let field = if e.aero_bytes > e.structure_bytes && over_memory
+            || !over_memory && 2.0 * e.structure_seconds < e.seconds
+        {
+            match a {
+                Analysis::Stability => "aero.panels_per_body / aero.n_chordwise / stability.wake (or aero.n_wake_rows)",
+                _ => "aero.panels_per_body / aero.n_chordwise",
+            }
+            .to_string()
+        } else if a == Analysis::Gust && e.steps > 1e4 {
+            format!("gust.t_end (or t_end) / {f}.dt / gust.gradients_m / gust.hinges")
+        } else {
+            format!("{f}.elements_per_body")
+        };
+        let points = match a {
+            Analysis::Static => "static.airspeeds / static.load_factors",
+            Analysis::Stability => "stability.airspeeds",
+            Analysis::Gust => "gust.gradients_m / gust.hinges",
+        };
+        let (what, limit, flag) = if over_memory {
+            (gb(e.bytes), gb(lim.memory_bytes), "--max-memory")
+        } else {
+            (duration(e.seconds), duration(lim.seconds), "--max-hours")
+        };
+        return Err(format!(
+            "{field} (or fewer {points}): the {f} {} analysis needs an estimated {what} ({:.0} unknowns, {:.0} bound \
+             and {:.0} wake rings), more than the limit of {limit} ({flag})",
+            a.name(),
+            e.unknowns,
+            e.bound_rings,
+            e.wake_rings
+        ));
+    }
+    Ok(())
+}
+
+/// A short account of analysis `a`'s estimate for the formulations `fs`, for the line the
+/// commands print before they start.
+pub fn describe_analysis(case: &Case, a: Analysis, fs: &[Formulation]) -> String {
+    let parts: Vec<String> = fs
+        .iter()
+        .map(|&f| {
+            let e = estimate_analysis(case, f, a);
+            format!("{f} at most ~{}, {}", duration(e.seconds), gb(e.bytes))
+        })
+        .collect();
+    parts.join("; ")
 }

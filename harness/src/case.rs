@@ -825,6 +825,31 @@ impl CaseFile {
         max_steps: Option<usize>,
         fs: &[Formulation],
     ) -> Result<Vec<RunSpec>, Error> {
+        self.expand_checked(overrides, fs, &|case, f| crate::budget::check_formulations(case, limits, max_steps, &[f]))
+    }
+
+    /// As [`expand_for`](Self::expand_for) for analysis `a`: each run is checked against
+    /// `limits` with the analysis' estimate ([`crate::budget::check_analysis`]) instead of a time
+    /// march's (a static or stability sweep never marches to `t_end`).
+    pub fn expand_for_analysis(
+        &self,
+        overrides: &[Override],
+        limits: &crate::budget::Limits,
+        a: crate::budget::Analysis,
+        fs: &[Formulation],
+    ) -> Result<Vec<RunSpec>, Error> {
+        self.expand_checked(overrides, fs, &|case, f| crate::budget::check_analysis(case, a, &[f], limits))
+    }
+
+    /// Expand the sweep and apply overrides; each point's case of a formulation in `fs` is
+    /// validated for `fs` and then checked by `check(case, formulation)` (the budget), the others
+    /// only parsed.
+    fn expand_checked(
+        &self,
+        overrides: &[Override],
+        fs: &[Formulation],
+        check: &dyn Fn(&Case, Formulation) -> Result<(), String>,
+    ) -> Result<Vec<RunSpec>, Error> {
         let file = self.path.display().to_string();
         let err = |msg: String| Error::Case { file: file.clone(), msg: clip(&msg) };
         // Global overrides first (they may change the sweep itself).
@@ -843,6 +868,16 @@ impl CaseFile {
         for (k, axis) in sweep.iter().enumerate() {
             if axis.values.is_empty() {
                 return Err(err(format!("sweep[{k}].values: empty list")));
+            }
+            // Two points of one name would write (and lock) one folder: an input error.
+            let mut seen: std::collections::HashMap<String, usize> = Default::default();
+            for (i, v) in axis.values.iter().enumerate() {
+                if let Some(j) = seen.insert(sweep_label(v), i) {
+                    return Err(err(format!(
+                        "sweep[{k}].values: values {j} and {i} are both {} (duplicate sweep points; give each point once)",
+                        sweep_label(v)
+                    )));
+                }
             }
             n_points = n_points.saturating_mul(axis.values.len());
             if n_points > crate::budget::MAX_SWEEP_POINTS {
@@ -881,13 +916,7 @@ impl CaseFile {
             for (path, v) in &point {
                 set_path(&mut raw, path, v.clone()).map_err(|e| err(format!("sweep: {e}")))?;
                 let key = path.rsplit('.').next().unwrap_or(path);
-                let val = match v {
-                    Value::String(s) => s.clone(),
-                    // `[0,1,0]` → `0,1,0`: brackets are not among a name's characters.
-                    Value::Array(a) => a.iter().map(Value::to_string).collect::<Vec<_>>().join(","),
-                    other => other.to_string(),
-                };
-                suffix.push_str(&format!("__{key}={val}"));
+                suffix.push_str(&format!("__{key}={}", sweep_label(v)));
             }
             let mut per = Vec::new();
             for f in Formulation::ALL {
@@ -902,7 +931,7 @@ impl CaseFile {
                     continue;
                 }
                 case.validate_for(fs).map_err(&err)?;
-                crate::budget::check_formulations(&case, limits, max_steps, fs).map_err(&err)?;
+                check(&case, f).map_err(&err)?;
                 for (k, r) in case.references.iter().enumerate() {
                     if checked.contains(&r.file) {
                         continue;
@@ -918,9 +947,22 @@ impl CaseFile {
             }
             let gebf = per.pop().expect("two formulations");
             let ancf = per.pop().expect("two formulations");
+            if let Some(same) = runs.iter().find(|r: &&RunSpec| r.name == ancf.name) {
+                return Err(err(format!("sweep: two points give the run name {} (duplicate sweep points)", same.name)));
+            }
             runs.push(RunSpec { name: ancf.name.clone(), dir: self.dir(), ancf, gebf });
         }
         Ok(runs)
+    }
+}
+
+/// A sweep value as it appears in the run's name (`__key=label`).
+fn sweep_label(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        // `[0,1,0]` → `0,1,0`: brackets are not among a name's characters.
+        Value::Array(a) => a.iter().map(Value::to_string).collect::<Vec<_>>().join(","),
+        other => other.to_string(),
     }
 }
 
@@ -1285,6 +1327,20 @@ mod tests {
         assert_eq!(runs[1].name, "double_pendulum_c1_beta45__stiffness_scale=1__flare_deg=45");
         assert_eq!(runs[5].ancf.stiffness_scale, 0.1);
         assert_eq!((runs[0].ancf.t_end, runs[0].gebf.t_end), (2.0, 1.0));
+    }
+
+    /// Issue 38: `"values": [1, 1]` expanded into two runs of one name, and `harness run` then
+    /// waited for ever on the folder lock the first of them held. Duplicate points (also `1`
+    /// and `"1"`, which name a run alike) are an input error naming the axis.
+    #[test]
+    fn duplicate_sweep_points_are_an_input_error_issue_38() {
+        for values in [json!([1, 1]), json!([0.5, 1, "1"])] {
+            let mut v = raw();
+            v["sweep"] = json!([{"path": "t_end", "values": [1, 2]}, {"path": "stiffness_scale", "values": values}]);
+            let cf = CaseFile { path: Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/x.json"), raw: v };
+            let e = cf.expand(&[]).unwrap_err().to_string();
+            assert!(e.contains("sweep[1].values") && e.contains("duplicate"), "{e}");
+        }
     }
 
     #[test]

@@ -319,6 +319,160 @@ fn is_number(v: &Value, path: &[Key]) -> bool {
     cur.is_number()
 }
 
+/// The command an input of a campaign goes through: `run` (as `harness check`: parse, validate,
+/// build, a few steps), `list` (parse, validate, expand), `gate` (the gated runs, a few steps,
+/// their gate), and the analyses `static`, `stability` and `gust` on mutants of the cases that
+/// declare them, each reduced first ([`reduce_for`]) and under the analysis budget.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FuzzCommand {
+    /// `harness check` / `harness run --max-steps`.
+    Run,
+    /// `harness list`.
+    List,
+    /// `harness gate`.
+    Gate,
+    /// `harness static`.
+    Static,
+    /// `harness stability`.
+    Stability,
+    /// `harness gust`.
+    Gust,
+}
+
+impl FuzzCommand {
+    /// The subcommand's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FuzzCommand::Run => "run",
+            FuzzCommand::List => "list",
+            FuzzCommand::Gate => "gate",
+            FuzzCommand::Static => "static",
+            FuzzCommand::Stability => "stability",
+            FuzzCommand::Gust => "gust",
+        }
+    }
+
+    /// The analysis, for the three analyses.
+    pub fn analysis(self) -> Option<crate::budget::Analysis> {
+        match self {
+            FuzzCommand::Static => Some(crate::budget::Analysis::Static),
+            FuzzCommand::Stability => Some(crate::budget::Analysis::Stability),
+            FuzzCommand::Gust => Some(crate::budget::Analysis::Gust),
+            _ => None,
+        }
+    }
+
+    /// The commands a seed case takes: `run`, `list` and `gate` always, each analysis where the
+    /// case has its block.
+    pub fn for_seed(text: &str) -> Vec<FuzzCommand> {
+        let v: Value = serde_json::from_str(text).unwrap_or(Value::Null);
+        let mut c = vec![FuzzCommand::Run, FuzzCommand::List, FuzzCommand::Gate];
+        for (key, cmd) in
+            [("static", FuzzCommand::Static), ("stability", FuzzCommand::Stability), ("gust", FuzzCommand::Gust)]
+        {
+            if v.get(key).is_some() {
+                c.push(cmd);
+            }
+        }
+        c
+    }
+}
+
+/// The seed text for `cmd`: unchanged for `run`, `list` and `gate`; for an analysis, its sweep
+/// cut to one point (the highest static airspeed or load factor, the first stability airspeed
+/// with at most 4 modes, the first gust gradient and hinge state with `gust.t_end` of
+/// `max_steps` steps), so that a campaign can afford thousands of analyses. The mutations then
+/// apply to the reduced case.
+pub fn reduce_for(cmd: FuzzCommand, text: &str, max_steps: usize) -> String {
+    let Ok(mut v) = serde_json::from_str::<Value>(text) else { return text.to_string() };
+    let keep_one = |x: &mut Value, last: bool| {
+        if let Value::Array(a) = x
+            && !a.is_empty()
+        {
+            let k = if last { a.len() - 1 } else { 0 };
+            *a = vec![a[k].clone()];
+        }
+    };
+    match cmd {
+        FuzzCommand::Static => {
+            if let Some(st) = v.get_mut("static") {
+                for key in ["airspeeds", "load_factors"] {
+                    if let Some(x) = st.get_mut(key) {
+                        let last = key == "airspeeds";
+                        keep_one(x, last);
+                    }
+                }
+            }
+        }
+        FuzzCommand::Stability => {
+            if let Some(st) = v.get_mut("stability") {
+                if let Some(x) = st.get_mut("airspeeds") {
+                    keep_one(x, false);
+                }
+                if let Some(m) = st.get_mut("modes")
+                    && m.as_u64().is_some_and(|n| n > 4)
+                {
+                    *m = serde_json::json!(4);
+                }
+                if let Some(o) = st.as_object_mut() {
+                    o.remove("basis_modes");
+                }
+            }
+        }
+        FuzzCommand::Gust => {
+            let dt = ["ancf", "gebf"]
+                .iter()
+                .filter_map(|f| v.get(*f).and_then(|x| x.get("dt")).and_then(Value::as_f64))
+                .fold(0.0_f64, f64::max);
+            if let Some(g) = v.get_mut("gust") {
+                for key in ["gradients_m", "frequencies_hz", "hinges"] {
+                    if let Some(x) = g.get_mut(key) {
+                        keep_one(x, false);
+                    }
+                }
+                if let (Some(o), true) = (g.as_object_mut(), dt > 0.0) {
+                    o.insert("t_end".into(), serde_json::json!(max_steps as f64 * dt));
+                }
+            }
+        }
+        _ => return text.to_string(),
+    }
+    coarsen(&mut v);
+    serde_json::to_string_pretty(&v).unwrap_or_else(|_| text.to_string())
+}
+
+/// Coarsen a case for an analysis of the campaign: at most 4 elements per body, 4 panels per
+/// body, 2 chordwise panels and 10 wake rows (the same code paths at a fraction of the cost).
+fn coarsen(v: &mut Value) {
+    let cap = |x: &mut Value, n: u64| match x {
+        Value::Number(k) if k.as_u64().is_some_and(|k| k > n) => *x = serde_json::json!(n),
+        Value::Array(a) => {
+            for y in a {
+                if y.as_u64().is_some_and(|k| k > n) {
+                    *y = serde_json::json!(n);
+                }
+            }
+        }
+        _ => {}
+    };
+    for f in ["ancf", "gebf"] {
+        if let Some(e) = v.get_mut(f).and_then(|x| x.get_mut("elements_per_body")) {
+            cap(e, 4);
+        }
+    }
+    if let Some(a) = v.get_mut("aero") {
+        for (key, n) in [("panels_per_body", 4), ("n_chordwise", 2), ("n_wake_rows", 10)] {
+            if let Some(x) = a.get_mut(key) {
+                cap(x, n);
+            }
+        }
+    }
+    if let Some(w) = v.get_mut("stability").and_then(|s| s.get_mut("wake")).and_then(|w| w.get_mut("rows")) {
+        cap(w, 10);
+    }
+}
+
 /// What became of an input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -339,6 +493,9 @@ pub enum Class {
     Signal,
     /// Did not end within the time limit.
     Hang,
+    /// A summary (stdout, summary JSON or report section) shows NaN where a failure should be
+    /// named (issue 38).
+    NanInSummary,
     /// Any other exit status.
     Other,
 }
@@ -348,7 +505,13 @@ impl Class {
     pub fn is_crash(self) -> bool {
         matches!(
             self,
-            Class::RejectedUnnamed | Class::Panic | Class::Abort | Class::Signal | Class::Hang | Class::Other
+            Class::RejectedUnnamed
+                | Class::Panic
+                | Class::Abort
+                | Class::Signal
+                | Class::Hang
+                | Class::NanInSummary
+                | Class::Other
         )
     }
 }
@@ -407,6 +570,132 @@ fn check_parsed(
     })
 }
 
+/// As [`check_file`], through command `cmd` ([`FuzzCommand`]): `list` expands only; `gate` runs
+/// the gated runs `max_steps` steps and evaluates their gate (a failed gate is
+/// [`Class::RunFailed`]); an analysis is refused (exit 2) without its block or over the budget,
+/// else runs, and its summaries must not show NaN ([`Class::NanInSummary`]).
+pub fn check_command(cmd: FuzzCommand, path: &Path, max_steps: usize, limits: &Limits) -> (Class, String) {
+    if cmd == FuzzCommand::Run {
+        return check_file(path, max_steps, limits);
+    }
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let rejected = |e: crate::Error| {
+            let m = e.to_string();
+            let named = m.contains(&path.display().to_string());
+            (if named { Class::Rejected } else { Class::RejectedUnnamed }, m)
+        };
+        let file = match CaseFile::read(path) {
+            Ok(f) => f,
+            Err(e) => return rejected(e),
+        };
+        match cmd {
+            FuzzCommand::List => match file.expand_within(&[], limits, None) {
+                Ok(_) => (Class::Ok, String::new()),
+                Err(e) => rejected(e),
+            },
+            FuzzCommand::Gate => {
+                let mut runs = match file.expand_within(&[], limits, Some(max_steps)) {
+                    Ok(r) => r,
+                    Err(e) => return rejected(e),
+                };
+                runs.retain(|r| r.ancf.gate.is_some());
+                runs.truncate(2);
+                for r in &mut runs {
+                    crate::driver::limit_steps(r, max_steps);
+                }
+                let results = crate::driver::run_all(&runs, &Formulation::ALL, false);
+                match results.iter().find(|r| r.status() != "pass") {
+                    Some(r) => (Class::RunFailed, format!("{}: gate {}", r.name, r.status())),
+                    None => (Class::Ok, String::new()),
+                }
+            }
+            _ => check_analysis(cmd, path, &file, limits),
+        }
+    }));
+    r.unwrap_or_else(|p| {
+        let msg = p
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_default();
+        (Class::Panic, msg)
+    })
+}
+
+/// One analysis of [`check_command`], as its command runs it (budget, block, sweep, summary).
+fn check_analysis(cmd: FuzzCommand, path: &Path, file: &CaseFile, limits: &Limits) -> (Class, String) {
+    let Some(a) = cmd.analysis() else { return (Class::Other, format!("{cmd:?} is not an analysis")) };
+    let runs = match file.expand_for_analysis(&[], limits, a, &Formulation::ALL) {
+        Ok(r) => r,
+        Err(e) => {
+            let m = e.to_string();
+            return (if m.contains(&path.display().to_string()) { Class::Rejected } else { Class::RejectedUnnamed }, m);
+        }
+    };
+    let Some(spec) = runs.first() else { return (Class::Ok, String::new()) };
+    let has = match cmd {
+        FuzzCommand::Static => spec.ancf.statics.is_some(),
+        FuzzCommand::Stability => spec.ancf.stability.is_some(),
+        _ => spec.ancf.gust.is_some(),
+    };
+    if !has {
+        return (Class::Rejected, format!("{}: {}: the case has no `{}` block", path.display(), a.name(), a.name()));
+    }
+    // The summaries' texts, and the failure messages they quote (which may say "NaN" of a
+    // residual: naming the failure is what they are for).
+    let (failed, texts, errors): (Option<String>, Vec<String>, Vec<String>) = match cmd {
+        FuzzCommand::Static => {
+            let outs: Vec<_> = Formulation::ALL.iter().map(|&f| crate::statics::run_static(spec.case(f), f)).collect();
+            let s = crate::static_out::summarise(&spec.ancf, &spec.dir, outs);
+            let failed = s.n_failed > 0 || s.runs.iter().any(|r| r.error.is_some());
+            let errors = s.runs.iter().flat_map(|r| r.error.iter().chain(r.points.iter().flat_map(|p| &p.error)));
+            let errors: Vec<String> = errors.cloned().collect();
+            let texts = vec![serde_json::to_string(&s).unwrap_or_default(), crate::static_out::section_html(&s, "x")];
+            (failed.then(|| s.failures.iter().map(|f| f.text()).collect::<Vec<_>>().join("; ")), texts, errors)
+        }
+        FuzzCommand::Stability => {
+            let outs: Vec<_> =
+                Formulation::ALL.iter().map(|&f| crate::stability::run_stability(spec.case(f), f)).collect();
+            let errors = outs.iter().flat_map(|o| o.error.iter().chain(o.points.iter().flat_map(|p| &p.error)));
+            let errors: Vec<String> = errors.cloned().collect();
+            (errors.first().cloned(), vec![crate::stability_out::section_html(&spec.name, "x", &outs)], errors)
+        }
+        _ => match crate::gust::run_sweep(spec, &Formulation::ALL) {
+            Err(m) => return (Class::Rejected, format!("{}: {m}", path.display())),
+            Ok(sweep) => {
+                let s = crate::gust_out::summarise(sweep);
+                let errors: Vec<String> = s.runs.iter().filter_map(|r| r.error.clone()).collect();
+                let texts = vec![serde_json::to_string(&s).unwrap_or_default(), crate::gust_out::section_html(&s, "x")];
+                (errors.first().cloned(), texts, errors)
+            }
+        },
+    };
+    let strip = |t: &String| {
+        let mut t = t.clone();
+        for e in &errors {
+            let json = serde_json::to_string(e).unwrap_or_default();
+            let json = json.trim_matches('"');
+            let html = e.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+            for x in [e.as_str(), json, &html, &html.replace('"', "&quot;")] {
+                if !x.is_empty() {
+                    t = t.replace(x, "");
+                }
+            }
+        }
+        t
+    };
+    let texts: Vec<String> = texts.iter().map(strip).collect();
+    if let Some(t) = texts.iter().find(|t| t.contains("NaN")) {
+        let at = t.find("NaN").unwrap_or(0);
+        let lo = t[..at].char_indices().rev().nth(120).map_or(0, |(i, _)| i);
+        return (Class::NanInSummary, format!("{}: ...{}", a.name(), &t[lo..(at + 3).min(t.len())]));
+    }
+    match failed {
+        Some(e) => (Class::RunFailed, e),
+        None => (Class::Ok, String::new()),
+    }
+}
+
 /// Settings of a campaign.
 #[derive(Debug, Clone)]
 pub struct Campaign {
@@ -424,7 +713,8 @@ pub struct Campaign {
     /// Child processes at once.
     pub jobs: usize,
     /// Time limit of one input: CPU time of its process (a child niced on a busy machine waits
-    /// without running), and 6 × this of wall time (a child blocked without running).
+    /// without running), and 6 × this of wall time not spent waiting for a CPU (a child
+    /// blocked without running, on a lock or a pipe; [`run_delay_seconds`]).
     pub timeout: Duration,
     /// Address-space limit of one child, bytes.
     pub address_space: u64,
@@ -477,18 +767,20 @@ impl Worker {
     /// Check one input; `Err(class)` means the worker is gone (the class comes from its status,
     /// or it was a hang: more than `timeout` of CPU time, or 6 × `timeout` of wall time, on the
     /// input).
-    fn check(&mut self, file: &Path, timeout: Duration) -> Result<(Class, String), Class> {
+    fn check(&mut self, cmd: FuzzCommand, file: &Path, timeout: Duration) -> Result<(Class, String), Class> {
         use std::io::Write as _;
         let cpu0 = cpu_seconds(self.child.id());
+        let delay0 = run_delay_seconds(self.child.id());
         let t0 = Instant::now();
-        let sent = writeln!(self.stdin, "{}", file.display()).and_then(|()| self.stdin.flush());
+        let sent = writeln!(self.stdin, "{}\t{}", cmd.name(), file.display()).and_then(|()| self.stdin.flush());
         let reply = if sent.is_ok() {
             loop {
                 match self.lines.recv_timeout(Duration::from_millis(250)) {
                     Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
                         let cpu = cpu_seconds(self.child.id()).zip(cpu0).map(|(a, b)| a - b);
                         let over = cpu.map_or(t0.elapsed() > timeout, |c| c > timeout.as_secs_f64());
-                        if over || t0.elapsed() > 6 * timeout {
+                        let awake = awake_seconds(self.child.id(), t0, delay0);
+                        if over || awake > 6.0 * timeout.as_secs_f64() {
                             break Some(Err(std::sync::mpsc::RecvTimeoutError::Timeout));
                         }
                     }
@@ -533,7 +825,12 @@ pub fn worker_main(max_steps: usize) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     for line in stdin.lock().lines() {
         let line = line?;
-        let (class, msg) = check_file(Path::new(&line), max_steps, &crate::budget::limits());
+        // `<command>\t<path>`, or a bare path for `run`.
+        let (cmd, file) = match line.split_once('\t') {
+            Some((c, f)) => (serde_json::from_value(Value::String(c.to_string())).unwrap_or(FuzzCommand::Run), f),
+            None => (FuzzCommand::Run, line.as_str()),
+        };
+        let (class, msg) = check_command(cmd, Path::new(file), max_steps, &crate::budget::limits());
         let k = serde_json::to_value(class).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default();
         let msg: String = msg.chars().take(4000).map(|c| if c == '\n' || c == '\t' { ' ' } else { c }).collect();
         writeln!(out, "{k}\t{msg}")?;
@@ -560,6 +857,35 @@ pub fn cpu_seconds(pid: u32) -> Option<f64> {
         let _ = pid;
         None
     }
+}
+
+/// Time the threads of a process have waited on a run queue, runnable but not running, s
+/// (Linux: `/proc/<pid>/task/*/schedstat`, summed over the threads alive now).
+pub fn run_delay_seconds(pid: u32) -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    {
+        let mut sum = 0.0;
+        for t in std::fs::read_dir(format!("/proc/{pid}/task")).ok()? {
+            let Ok(t) = t else { continue };
+            let Ok(st) = std::fs::read_to_string(t.path().join("schedstat")) else { continue };
+            sum += st.split_whitespace().nth(1).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0) * 1e-9;
+        }
+        Some(sum)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = pid;
+        None
+    }
+}
+
+/// The wall time since `t0` that a child was not kept waiting for a CPU (`delay0`: its
+/// [`run_delay_seconds`] at `t0`), s. A niced child on a busy machine waits on the run queue for
+/// most of its wall time; a child blocked on a lock sleeps, and that time counts.
+fn awake_seconds(pid: u32, t0: Instant, delay0: Option<f64>) -> f64 {
+    let wall = t0.elapsed().as_secs_f64();
+    let starved = run_delay_seconds(pid).zip(delay0).map_or(0.0, |(a, b)| (a - b).max(0.0));
+    (wall - starved).max(0.0)
 }
 
 /// Set the address-space limit (and no core files) of a child.
@@ -620,6 +946,8 @@ pub struct Report {
     pub seed: u64,
     /// Inputs kept in `crashes/`.
     pub crashes: Vec<String>,
+    /// Per command, per class.
+    pub commands: BTreeMap<FuzzCommand, BTreeMap<Class, usize>>,
 }
 
 /// The bytes of input `i` of a campaign with `seed` over the seed texts.
@@ -628,6 +956,23 @@ pub fn input(seeds: &[(String, String)], seed: u64, i: usize) -> (String, Vec<u8
     let (name, text) = &seeds[i % seeds.len()];
     let (bytes, m) = mutate(text, &mut rng);
     (name.clone(), bytes, m)
+}
+
+/// Input `i` of a campaign over every command: the seed's name, the command (one of those the
+/// seed takes, [`FuzzCommand::for_seed`], chosen by the input's generator), the mutant of the
+/// seed reduced for that command ([`reduce_for`]) and the mutations.
+pub fn input_command(
+    seeds: &[(String, String)],
+    seed: u64,
+    i: usize,
+    max_steps: usize,
+) -> (String, FuzzCommand, Vec<u8>, Vec<Mutation>) {
+    let mut rng = Rng::new(seed ^ (i as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+    let (name, text) = &seeds[i % seeds.len()];
+    let cmds = FuzzCommand::for_seed(text);
+    let cmd = cmds[rng.below(cmds.len())];
+    let (bytes, m) = mutate(&reduce_for(cmd, text, max_steps), &mut rng);
+    (name.clone(), cmd, bytes, m)
 }
 
 /// The seed cases of a folder: (file stem, text).
@@ -660,14 +1005,39 @@ fn copy_dir(from: &Path, to: &Path) -> std::io::Result<()> {
 /// Run one child, `exe check <file> --max-steps N` (or `exe run <file> --out <out> --max-steps
 /// N` with `c.run`), under the limits; its class.
 pub fn run_child(exe: &Path, file: &Path, out: &Path, c: &Campaign) -> (Class, String, f64) {
+    run_command_child(exe, FuzzCommand::Run, file, out, c)
+}
+
+/// As [`run_child`], through command `command`: `list --cases <the input's folder>`, `gate
+/// <file>`, `static|stability|gust <file> --out <out>` (what cannot finish within half the time
+/// limit refused by the budget: `--max-hours`).
+pub fn run_command_child(
+    exe: &Path,
+    command: FuzzCommand,
+    file: &Path,
+    out: &Path,
+    c: &Campaign,
+) -> (Class, String, f64) {
     let mut cmd = Command::new(exe);
-    if c.run {
-        cmd.arg("run").arg(file).arg("--out").arg(out);
-    } else {
-        cmd.arg("check").arg(file);
-    }
     let hours = c.timeout.as_secs_f64() / 2.0 / 3600.0;
-    cmd.arg("--max-steps").arg(c.max_steps.to_string()).arg("--max-hours").arg(hours.to_string());
+    match command {
+        FuzzCommand::Run if c.run => {
+            cmd.arg("run").arg(file).arg("--out").arg(out).arg("--max-steps").arg(c.max_steps.to_string());
+        }
+        FuzzCommand::Run => {
+            cmd.arg("check").arg(file).arg("--max-steps").arg(c.max_steps.to_string());
+        }
+        FuzzCommand::List => {
+            cmd.arg("list").arg("--cases").arg(file.parent().unwrap_or(Path::new(".")));
+        }
+        FuzzCommand::Gate => {
+            cmd.arg("gate").arg(file);
+        }
+        a => {
+            cmd.arg(a.name()).arg(file).arg("--out").arg(out);
+        }
+    }
+    cmd.arg("--max-hours").arg(hours.to_string());
     cmd.stdin(Stdio::null()).stdout(Stdio::null()).stderr(Stdio::piped());
     cmd.env("RUST_BACKTRACE", "0");
     limit(&mut cmd, c.address_space);
@@ -687,12 +1057,13 @@ pub fn run_child(exe: &Path, file: &Path, out: &Path, c: &Campaign) -> (Class, S
         String::from_utf8_lossy(&s).into_owned()
     });
     let pid = child.id();
+    let delay0 = run_delay_seconds(pid);
     let status = loop {
         match child.try_wait() {
             Ok(Some(s)) => break Some(s),
             Ok(None)
                 if cpu_seconds(pid).map_or(t0.elapsed() > c.timeout, |x| x > c.timeout.as_secs_f64())
-                    || t0.elapsed() > 6 * c.timeout =>
+                    || awake_seconds(pid, t0, delay0) > 6.0 * c.timeout.as_secs_f64() =>
             {
                 let _ = child.kill();
                 let _ = child.wait();
@@ -722,12 +1093,15 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
     let work = c.out.join("work");
     let crashes = c.out.join("crashes");
     std::fs::create_dir_all(&crashes).map_err(|e| io(&crashes, e))?;
-    // The mutants' folder, also without a `reference/` to copy (a seed folder of its own, such
-    // as `cases/statics`).
-    std::fs::create_dir_all(&work).map_err(|e| io(&work, e))?;
+    // The mutants' folders, one per job (`list` reads a whole folder), each with the seeds'
+    // `reference/` (a seed folder of its own, such as `cases/statics`, may have none).
     let refs = c.cases.join("reference");
-    if refs.is_dir() {
-        copy_dir(&refs, &work.join("reference")).map_err(|e| io(&work, e))?;
+    for w in 0..c.jobs.max(1) {
+        let d = work.join(format!("w{w}"));
+        std::fs::create_dir_all(&d).map_err(|e| io(&d, e))?;
+        if refs.is_dir() {
+            copy_dir(&refs, &d.join("reference")).map_err(|e| io(&d, e))?;
+        }
     }
     let next = AtomicUsize::new(c.first);
     let end = c.first + c.inputs;
@@ -745,14 +1119,14 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
                     if i >= end || crate::signal::interrupted() {
                         break;
                     }
-                    let (name, bytes, muts) = input(seeds, c.seed, i);
-                    let file = work.join(format!("w{w}_{name}.json"));
+                    let (name, command, bytes, muts) = input_command(seeds, c.seed, i, c.max_steps);
+                    let file = work.join(format!("w{w}")).join(format!("{name}.json"));
                     let out = work.join(format!("out{w}"));
                     let (class, err, secs) = if let Err(e) = std::fs::write(&file, &bytes) {
                         // Counted, not skipped: a campaign that cannot write its inputs says so.
                         (Class::Other, format!("{}: {e}", file.display()), 0.0)
                     } else if c.exec_each || c.run {
-                        let r = run_child(exe, &file, &out, c);
+                        let r = run_command_child(exe, command, &file, &out, c);
                         let _ = std::fs::remove_dir_all(&out);
                         r
                     } else {
@@ -760,7 +1134,7 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
                         if worker.is_none() {
                             worker = Worker::start(exe, c).ok();
                         }
-                        let r = match worker.as_mut().map(|wk| wk.check(&file, c.timeout)) {
+                        let r = match worker.as_mut().map(|wk| wk.check(command, &file, c.timeout)) {
                             Some(Ok((k, m))) => (k, m),
                             Some(Err(k)) => {
                                 worker = None;
@@ -778,13 +1152,18 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
                     let mut r = report.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
                     r.inputs += 1;
                     *r.classes.entry(class).or_default() += 1;
+                    *r.commands.entry(command).or_default().entry(class).or_default() += 1;
                     r.slowest_s = r.slowest_s.max(secs);
                     if class.is_crash() {
-                        let stem = format!("{:?}-{i}-{name}", class).to_lowercase();
+                        let stem = format!("{:?}-{i}-{}-{name}", class, command.name()).to_lowercase();
                         let _ = std::fs::write(crashes.join(format!("{stem}.json")), &bytes);
                         let _ = std::fs::write(
                             crashes.join(format!("{stem}.txt")),
-                            format!("input {i} seed {} mutations {muts:?} ({secs:.1} s)\n{err}", c.seed),
+                            format!(
+                                "input {i} seed {} command {} mutations {muts:?} ({secs:.1} s)\n{err}",
+                                c.seed,
+                                command.name()
+                            ),
                         );
                         r.crashes.push(stem);
                     }
@@ -820,8 +1199,14 @@ pub fn campaign(c: &Campaign) -> Result<Report, crate::Error> {
         r.wall_s,
         r.slowest_s
     );
+    let label = |k: &Class| serde_json::to_string(k).unwrap_or_default().trim_matches('"').to_string();
     for (k, n) in &r.classes {
-        md.push_str(&format!("| {} | {n} |\n", serde_json::to_string(k).unwrap_or_default().trim_matches('"')));
+        md.push_str(&format!("| {} | {n} |\n", label(k)));
+    }
+    md.push_str("\n| command | inputs | by class |\n|---|---|---|\n");
+    for (cmd, classes) in &r.commands {
+        let by: Vec<String> = classes.iter().map(|(k, n)| format!("{} {n}", label(k))).collect();
+        md.push_str(&format!("| {} | {} | {} |\n", cmd.name(), classes.values().sum::<usize>(), by.join(", ")));
     }
     crate::atomic::write(&c.out.join("fuzz.md"), md.as_bytes())?;
     let _ = std::fs::remove_dir_all(&work);

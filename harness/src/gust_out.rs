@@ -69,10 +69,11 @@ pub struct GustSummary {
     pub alleviation: Vec<Alleviation>,
     /// ANCF–GEBF differences (both formulations run).
     pub ancf_gebf: Vec<PairDifference>,
-    /// Largest ANCF–GEBF peak root bending moment difference, %.
-    pub max_peak_rbm_difference_percent: f64,
-    /// Largest ANCF–GEBF peak fold difference, degrees.
-    pub max_peak_fold_difference_deg: f64,
+    /// Largest ANCF–GEBF peak root bending moment difference over the runs both formulations
+    /// finished, %; None (`null`) when there is no such pair (see the runs' `error`).
+    pub max_peak_rbm_difference_percent: Option<f64>,
+    /// Largest ANCF–GEBF peak fold difference, degrees; None as above.
+    pub max_peak_fold_difference_deg: Option<f64>,
     /// Largest CPU time of one time march, s, per formulation.
     pub max_cpu_s: Vec<(Formulation, f64)>,
     /// Runs that failed or stopped early.
@@ -85,12 +86,14 @@ fn same_hinge(a: &HingeState, b: &HingeState) -> bool {
     a == b
 }
 
-/// Summarise a sweep.
+/// Summarise a sweep. The alleviations and the ANCF–GEBF differences are taken over the runs
+/// that finished; a failed run is named by its `error`, never compared as NaN.
 pub fn summarise(out: GustSweepOutput) -> GustSummary {
     let runs = out.runs;
+    let ok = |r: &&GustRun| r.error.is_none();
     let mut alleviation = Vec::new();
-    for r in runs.iter().filter(|r| !matches!(r.hinge, HingeState::Locked)) {
-        if let Some(l) = runs.iter().find(|l| {
+    for r in runs.iter().filter(ok).filter(|r| !matches!(r.hinge, HingeState::Locked)) {
+        if let Some(l) = runs.iter().filter(ok).find(|l| {
             l.formulation == r.formulation && matches!(l.hinge, HingeState::Locked) && l.gradient_m == r.gradient_m
         }) {
             alleviation.push(Alleviation {
@@ -103,8 +106,8 @@ pub fn summarise(out: GustSweepOutput) -> GustSummary {
         }
     }
     let mut ancf_gebf = Vec::new();
-    for a in runs.iter().filter(|r| r.formulation == Formulation::Ancf) {
-        if let Some(g) = runs.iter().find(|g| {
+    for a in runs.iter().filter(ok).filter(|r| r.formulation == Formulation::Ancf) {
+        if let Some(g) = runs.iter().filter(ok).find(|g| {
             g.formulation == Formulation::Gebf && same_hinge(&g.hinge, &a.hinge) && g.gradient_m == a.gradient_m
         }) {
             let (ma, mg) = (a.peak_delta_root_bending_moment.0, g.peak_delta_root_bending_moment.0);
@@ -117,8 +120,9 @@ pub fn summarise(out: GustSweepOutput) -> GustSummary {
         }
     }
     let nan_max = |v: &mut dyn Iterator<Item = f64>| v.fold(f64::NAN, |m, x| if x > m || m.is_nan() { x } else { m });
-    let max_peak_rbm_difference_percent = nan_max(&mut ancf_gebf.iter().map(|d| d.peak_rbm_percent));
-    let max_peak_fold_difference_deg = nan_max(&mut ancf_gebf.iter().map(|d| d.peak_fold_deg));
+    let some_max = |v: &mut dyn Iterator<Item = f64>| Some(nan_max(v)).filter(|x| x.is_finite());
+    let max_peak_rbm_difference_percent = some_max(&mut ancf_gebf.iter().map(|d| d.peak_rbm_percent));
+    let max_peak_fold_difference_deg = some_max(&mut ancf_gebf.iter().map(|d| d.peak_fold_deg));
     let max_cpu_s = Formulation::ALL
         .iter()
         .filter(|f| runs.iter().any(|r| r.formulation == **f))
@@ -359,15 +363,18 @@ fn esc(s: &str) -> String {
 pub fn section_html(s: &GustSummary, folder: &str) -> String {
     let mut h = String::new();
     let _ = writeln!(h, "<h3 id=\"gust-{0}\">{0}</h3>", esc(&s.name));
+    let pair = match (s.max_peak_rbm_difference_percent, s.max_peak_fold_difference_deg) {
+        (Some(m), Some(f)) => {
+            format!("ANCF–GEBF: peak ΔM_root within {m:.3} %, peak fold within {f:.3}° (runs both finished).")
+        }
+        _ => "ANCF–GEBF: no pair of runs both formulations finished.".into(),
+    };
     let _ = writeln!(
         h,
-        "<p>{} m/s, gust <code>{}</code>; {} run(s) failed. ANCF–GEBF: peak ΔM_root within {:.3} %, peak fold within {:.3}°. \
-         Largest CPU time of one run: {}.</p>",
+        "<p>{} m/s, gust <code>{}</code>; {} run(s) failed. {pair} Largest CPU time of one run: {}.</p>",
         s.airspeed,
         esc(&serde_json::to_string(&s.gust).unwrap_or_default()),
         s.n_failed,
-        s.max_peak_rbm_difference_percent,
-        s.max_peak_fold_difference_deg,
         s.max_cpu_s.iter().map(|(f, c)| format!("{f} {c:.2} s")).collect::<Vec<_>>().join(", ")
     );
     h.push_str(
@@ -391,19 +398,25 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
                 .find(|r| r.formulation == f && r.hinge == a.hinge && r.gradient_m == a.gradient_m)
                 .map_or(f64::NAN, |r| alleviation_of(s, r))
         };
+        // A failed run's peaks read "failed" (its error is named below the table).
+        let peak = |r: Option<&GustRun>, x: fn(&GustRun) -> f64, digits: usize| match r {
+            Some(r) if r.error.is_some() => "failed".to_string(),
+            Some(r) if x(r).is_finite() => format!("{:.*}", digits, x(r)),
+            _ => "–".into(),
+        };
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td>{:.3}</td><td>{:.3}</td><td>{:.3}</td><td>{:.5}</td><td>{:.5}</td><td>{:.3}</td>\
-             <td>{:.3}</td><td>{:.3}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{:.3}</td><td>{:.3}</td><td>{:.3}</td><td>{}</td><td>{}</td><td>{}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             esc(&hinge_name(&a.hinge)),
             a.gradient_m,
             a.frequency_hz,
             a.gust_velocity,
-            a.peak_delta_root_bending_moment.0,
-            g.map_or(f64::NAN, |g| g.peak_delta_root_bending_moment.0),
-            d.map_or(f64::NAN, |d| d.peak_rbm_percent),
-            a.peak_delta_fold_deg.0,
-            g.map_or(f64::NAN, |g| g.peak_delta_fold_deg.0),
+            peak(Some(a), |r| r.peak_delta_root_bending_moment.0, 5),
+            peak(g, |r| r.peak_delta_root_bending_moment.0, 5),
+            d.map_or_else(|| "–".into(), |d| format!("{:.3}", d.peak_rbm_percent)),
+            peak(Some(a), |r| r.peak_delta_fold_deg.0, 3),
+            peak(g, |r| r.peak_delta_fold_deg.0, 3),
             percent_cell(al(Formulation::Ancf)),
             percent_cell(al(Formulation::Gebf)),
         );

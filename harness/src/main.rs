@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use harness::budget::Analysis;
 use harness::case::{CaseFile, Formulation, Override, RunSpec, json_schema};
 use harness::driver::{
     any_interrupted, claim_outputs, discover, expand_all, finish_case, limit_steps, run_all, run_into, variant_name,
@@ -399,7 +400,14 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
             continue;
         }
         let bad = o.points.iter().filter(|p| p.error.is_some()).count();
-        let unconverged = o.points.iter().flat_map(|p| &p.roots).filter(|r| !r.converged).count();
+        let unconverged = harness::stability_out::unconverged_roots(o);
+        if unconverged > 0 {
+            eprintln!(
+                "stability {name} {}: WARNING: {unconverged} root(s) did not converge; the flutter and divergence \
+                 speeds may be wrong (stability_{}.json: \"roots_converged\": false)",
+                o.formulation, o.formulation
+            );
+        }
         for p in o.points.iter().filter(|p| p.error.is_some()) {
             eprintln!("stability {name} {} at {} m/s: {}", o.formulation, p.airspeed, p.error.as_deref().unwrap_or(""));
         }
@@ -471,10 +479,12 @@ fn gust_case(spec: &RunSpec, fs: &[Formulation], out: &Path, file: &str) -> Resu
             a.root_bending_moment_percent
         );
     }
-    println!(
-        "gust {}: ANCF-GEBF peak dM_root within {:.3} %, peak fold within {:.3} deg; sweep {:.1} s wall",
-        spec.name, summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg, summary.wall_s
-    );
+    let pair = match (summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg) {
+        (Some(m), Some(f)) => format!("ANCF-GEBF peak dM_root within {m:.3} %, peak fold within {f:.3} deg"),
+        _ if fs.len() == 2 => "ANCF-GEBF: no pair of runs both formulations finished".into(),
+        _ => "one formulation".into(),
+    };
+    println!("gust {}: {pair}; {} run(s) failed; sweep {:.1} s wall", spec.name, summary.n_failed, summary.wall_s);
     println!("wrote {}", dir.display());
     Ok(failed)
 }
@@ -595,7 +605,15 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
     }
     for r in &s.references {
         for (f, rms) in &r.rms_deg {
-            println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label);
+            match rms {
+                Some(rms) => {
+                    println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label)
+                }
+                None => println!(
+                    "static {} {f}: no RMS error against {}: no equilibrium at its airspeeds in 12-33 m/s ({f} failed, see below)",
+                    s.name, r.label
+                ),
+            }
         }
     }
     let mut held_failed = false;
@@ -661,12 +679,18 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             .fold(0.0, f64::max);
         println!("static {}: ANCF-GEBF max tip distance {d:.4e} m", s.name);
     } else if s.runs.len() == 2 {
-        println!(
-            "static {}: ANCF-GEBF max fold difference {:.4} deg, max root bending moment difference {:.3} %",
-            s.name,
-            s.max_fold_difference_deg,
-            100.0 * s.max_rbm_relative_difference
-        );
+        match (s.max_fold_difference_deg, s.max_rbm_relative_difference) {
+            (Some(d), Some(r)) => println!(
+                "static {}: ANCF-GEBF max fold difference {d:.4} deg, max root bending moment difference {:.3} % \
+                 (over the airspeeds both solved)",
+                s.name,
+                100.0 * r
+            ),
+            _ => println!("static {}: ANCF-GEBF: no comparison, no airspeed has an equilibrium in both", s.name),
+        }
+    }
+    for f in &s.failures {
+        eprintln!("static {}: FAILED: {}", s.name, f.text());
     }
     s.n_failed > 0 || held_failed || s.runs.iter().any(|r| r.error.is_some())
 }
@@ -687,6 +711,10 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
+            // A signal that ended a wait (a folder lock) is an interruption, not bad input.
+            if harness::signal::interrupted() {
+                return ExitCode::from(harness::signal::EXIT_INTERRUPTED);
+            }
             ExitCode::from(2)
         }
     }
@@ -722,16 +750,23 @@ fn variants(mut runs: Vec<RunSpec>, set: &[Override], fs: &[Formulation], max_st
     runs
 }
 
-/// The runs of an analysis's case file (`kind`: `static`, `stability` or `gust`), each checked
-/// for the analysis' block (`has_block`, else exit 2 with `missing`), and the shard plan over them.
+/// The runs of an analysis's case file, each checked for the analysis' block (`has_block`, else
+/// exit 2 with `missing`) and against the budget with the analysis' estimate (exit 2 naming the
+/// field to change), and the shard plan over them.
 fn analysis_runs(
     a: &AnalysisArgs,
-    kind: &str,
+    analysis: Analysis,
     has_block: impl Fn(&RunSpec) -> bool,
     missing: &str,
 ) -> Result<(Vec<RunSpec>, Option<Plan>)> {
+    let kind = analysis.name();
     let fs = a.formulation.formulations();
-    let runs = CaseFile::read(&a.case)?.expand_for(&a.set.set, &harness::budget::limits(), None, &fs)?;
+    let file = CaseFile::read(&a.case)?;
+    // The block first: a case without it has nothing to estimate.
+    let runs = file.expand_for(&a.set.set, &harness::budget::Limits::UNLIMITED, None, &fs)?;
+    if runs.iter().all(&has_block) {
+        file.expand_for_analysis(&a.set.set, &harness::budget::limits(), analysis, &fs)?;
+    }
     if !runs.iter().all(has_block) {
         let file = a.case.display().to_string();
         return Err(harness::Error::Case { file, msg: format!("{kind}: {missing}") }.into());
@@ -745,17 +780,32 @@ fn analysis_runs(
 /// Run `each` on the runs of this shard (`<kind>:<name>` units), then write the shard's manifest;
 /// exit 1 when `each` reports a failure for any run.
 fn analysis_loop(
-    kind: &str,
+    analysis: Analysis,
+    fs: &[Formulation],
     runs: &[RunSpec],
     plan: Option<&Plan>,
     out: &Path,
     mut each: impl FnMut(&RunSpec) -> Result<bool>,
 ) -> Result<ExitCode> {
+    let kind = analysis.name();
     let mut failed = false;
     let mut done = Vec::new();
     for spec in runs.iter().filter(|r| runs_here(plan, &format!("{kind}:{}", r.name))) {
+        let bound: f64 =
+            fs.iter().map(|&f| harness::budget::estimate_analysis(spec.case(f), f, analysis).seconds).sum();
+        eprintln!(
+            "{kind} {}: estimate {}",
+            spec.name,
+            harness::budget::describe_analysis(spec.case(fs[0]), analysis, fs)
+        );
+        let beat = harness::progress::Heartbeat::start(format!("{kind} {}", spec.name), bound);
         failed |= each(spec)?;
+        drop(beat);
         done.push(format!("{kind}:{}", spec.name));
+        if harness::signal::interrupted() {
+            eprintln!("interrupted: the sweeps finished so far are written");
+            return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
+        }
     }
     if let Some(p) = plan {
         p.write_manifest(out, serde_json::json!({}), &done)?;
@@ -767,10 +817,10 @@ fn analysis_loop(
 /// `static` block, 1 when a point failed.
 fn cmd_static(a: &AnalysisArgs) -> Result<ExitCode> {
     let missing = "the case has no `static` block (airspeeds to sweep)";
-    let (runs, plan) = analysis_runs(a, "static", |r| r.ancf.statics.is_some(), missing)?;
+    let (runs, plan) = analysis_runs(a, Analysis::Static, |r| r.ancf.statics.is_some(), missing)?;
     let fs = a.formulation.formulations();
     let out = &a.out.out;
-    analysis_loop("static", &runs, plan.as_ref(), out, |spec| {
+    analysis_loop(Analysis::Static, &fs, &runs, plan.as_ref(), out, |spec| {
         let summary = run_static_case(spec, &fs);
         let dir = out.join(&spec.name);
         harness::static_out::write(&dir, &summary)?;
@@ -784,10 +834,10 @@ fn cmd_static(a: &AnalysisArgs) -> Result<ExitCode> {
 /// `stability` block, 1 when a point could not be analysed.
 fn cmd_stability(a: &AnalysisArgs) -> Result<ExitCode> {
     let missing = "the case has no `stability` block (airspeeds to analyse)";
-    let (runs, plan) = analysis_runs(a, "stability", |r| r.ancf.stability.is_some(), missing)?;
+    let (runs, plan) = analysis_runs(a, Analysis::Stability, |r| r.ancf.stability.is_some(), missing)?;
     let fs = a.formulation.formulations();
     let out = &a.out.out;
-    analysis_loop("stability", &runs, plan.as_ref(), out, |spec| {
+    analysis_loop(Analysis::Stability, &fs, &runs, plan.as_ref(), out, |spec| {
         let outs = run_stability_case(spec, &fs);
         let dir = out.join(&spec.name);
         harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
@@ -801,10 +851,10 @@ fn cmd_stability(a: &AnalysisArgs) -> Result<ExitCode> {
 /// block, 1 when a run failed.
 fn cmd_gust(a: &AnalysisArgs) -> Result<ExitCode> {
     let missing = "the case has no `gust` block (gradients and hinge states to sweep)";
-    let (runs, plan) = analysis_runs(a, "gust", |r| r.ancf.gust.is_some(), missing)?;
+    let (runs, plan) = analysis_runs(a, Analysis::Gust, |r| r.ancf.gust.is_some(), missing)?;
     let fs = a.formulation.formulations();
     let file = a.case.display().to_string();
-    analysis_loop("gust", &runs, plan.as_ref(), &a.out.out, |spec| gust_case(spec, &fs, &a.out.out, &file))
+    analysis_loop(Analysis::Gust, &fs, &runs, plan.as_ref(), &a.out.out, |spec| gust_case(spec, &fs, &a.out.out, &file))
 }
 
 /// `harness check`: exit 0 (runs), 1 (a run failed), 101 (a panic), 2 (bad input).

@@ -124,3 +124,50 @@ impl Drop for RunProgress {
         }
     }
 }
+
+/// A progress line for a long computation without steps of its own (an analysis' sweep): every
+/// [`LINE_EVERY`] on stderr, the label, the time so far and the estimate's bound, until dropped.
+#[derive(Debug)]
+pub struct Heartbeat {
+    stop: std::sync::Arc<(std::sync::Mutex<bool>, std::sync::Condvar)>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Heartbeat {
+    /// Start the lines for `label`, whose estimate is at most `bound_s` seconds.
+    pub fn start(label: String, bound_s: f64) -> Self {
+        let stop = std::sync::Arc::new((std::sync::Mutex::new(false), std::sync::Condvar::new()));
+        let flag = stop.clone();
+        let thread = std::thread::spawn(move || {
+            let t0 = Instant::now();
+            let (lock, cv) = &*flag;
+            let mut done = lock.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            loop {
+                let (d, timeout) = cv.wait_timeout(done, LINE_EVERY).unwrap_or_else(std::sync::PoisonError::into_inner);
+                done = d;
+                if *done {
+                    return;
+                }
+                if timeout.timed_out() {
+                    eprintln!(
+                        "{label}: {:.0} s so far (estimated at most {:.0} s)",
+                        t0.elapsed().as_secs_f64(),
+                        bound_s
+                    );
+                }
+            }
+        });
+        Self { stop, thread: Some(thread) }
+    }
+}
+
+impl Drop for Heartbeat {
+    fn drop(&mut self) {
+        let (lock, cv) = &*self.stop;
+        *lock.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = true;
+        cv.notify_all();
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}

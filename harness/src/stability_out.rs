@@ -53,7 +53,19 @@ struct Summary<'a> {
     solve_s: f64,
     wall_s: f64,
     error: &'a Option<String>,
+    /// Airspeeds that could not be analysed (their `error` says why).
+    n_failed_points: usize,
+    /// Roots whose iteration did not converge, over all airspeeds (`converged: false` in
+    /// `points`); a script reads this, or `roots_converged`, to trust the flutter speed.
+    n_unconverged_roots: usize,
+    /// Every root of every analysed airspeed converged.
+    roots_converged: bool,
     points: &'a [crate::stability::StabilityPoint],
+}
+
+/// Roots that did not converge, over all airspeeds of a sweep.
+pub fn unconverged_roots(out: &StabilityOutput) -> usize {
+    out.points.iter().flat_map(|p| &p.roots).filter(|r| !r.converged).count()
 }
 
 /// Per-formulation metrics of the case's time-domain run (for the damping comparison).
@@ -87,6 +99,9 @@ pub fn write_with_history(
             solve_s: out.solve_s,
             wall_s: out.wall_s,
             error: &out.error,
+            n_failed_points: out.points.iter().filter(|p| p.error.is_some()).count(),
+            n_unconverged_roots: unconverged_roots(out),
+            roots_converged: unconverged_roots(out) == 0,
             points: &out.points,
         };
         let json = serde_json::to_string_pretty(&sum).map_err(|e| Error::Io(e.to_string()))?;

@@ -84,8 +84,10 @@ pub struct ReferenceErrors {
     /// Per formulation: the errors at the reference's airspeeds inside the sweep's converged
     /// range.
     pub errors: Vec<(Formulation, Vec<PointError>)>,
-    /// Per formulation: RMS error over 12–33 m/s, degrees.
-    pub rms_deg: Vec<(Formulation, f64)>,
+    /// Per formulation: RMS error over 12–33 m/s, degrees; None (`null`) when the formulation
+    /// has no equilibrium at the reference's airspeeds in that band (the summary's `failures`
+    /// say why).
+    pub rms_deg: Vec<(Formulation, Option<f64>)>,
 }
 
 /// The sweep's summary (`static_summary.json`).
@@ -99,18 +101,93 @@ pub struct StaticSummary {
     pub runs: Vec<StaticOutput>,
     /// References and the errors against them.
     pub references: Vec<ReferenceErrors>,
-    /// Largest |fold_ANCF − fold_GEBF| over the airspeeds both solved, degrees.
-    pub max_fold_difference_deg: f64,
-    /// Largest |RBM_ANCF − RBM_GEBF| / |RBM_GEBF| over the airspeeds both solved.
-    pub max_rbm_relative_difference: f64,
+    /// Largest |fold_ANCF − fold_GEBF| over the airspeeds both solved, degrees; None (`null`)
+    /// when no airspeed was solved by both (see `failures`).
+    pub max_fold_difference_deg: Option<f64>,
+    /// Largest |RBM_ANCF − RBM_GEBF| / |RBM_GEBF| over the airspeeds both solved; None as above.
+    pub max_rbm_relative_difference: Option<f64>,
     /// Points without an equilibrium, all formulations.
     pub n_failed: usize,
+    /// Each formulation with points without an equilibrium: where and why.
+    pub failures: Vec<Failure>,
     /// The case's own time history (when it was run alongside): its mean over the second half
     /// of the run against the static solution at the same airspeed.
     pub history: Vec<HistoryComparison>,
     /// The model held at the experiment's coast angles ([`crate::static_hold`]; filled by
     /// [`crate::static_hold::hold_references`]).
     pub held: Vec<crate::static_hold::HeldPoint>,
+}
+
+/// The points of one formulation's sweep without an equilibrium: which formulation, at which
+/// airspeeds (or load factors), and why. The summaries print this where a number would be NaN.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Failure {
+    /// Formulation.
+    pub formulation: Formulation,
+    /// The airspeeds (m/s), or the load factors of a structural case, without an equilibrium.
+    pub at: Vec<f64>,
+    /// Points of the sweep.
+    pub of: usize,
+    /// `"airspeeds"` or `"load factors"`.
+    pub unit: String,
+    /// The distinct reasons (at most [`MAX_REASONS`]), each with the first point it was given at.
+    pub reasons: Vec<(f64, String)>,
+}
+
+/// Most distinct reasons a [`Failure`] keeps.
+pub const MAX_REASONS: usize = 3;
+
+impl Failure {
+    /// `ANCF failed at 12 of 12 airspeeds (10, 12, …, 33): <reason> (at 10); …`.
+    pub fn text(&self) -> String {
+        let at: Vec<String> = self.at.iter().map(|x| format!("{x}")).collect();
+        let why: Vec<String> =
+            self.reasons.iter().map(|(x, r)| if x.is_finite() { format!("{r} (at {x})") } else { r.clone() }).collect();
+        format!(
+            "{} failed at {} of {} {} ({}): {}",
+            self.formulation.as_str().to_uppercase(),
+            self.at.len(),
+            self.of,
+            self.unit,
+            at.join(", "),
+            why.join("; ")
+        )
+    }
+}
+
+/// The failures of each sweep of `runs` (formulations without a failed point are left out).
+pub fn failures(runs: &[StaticOutput]) -> Vec<Failure> {
+    let mut v = Vec::new();
+    for r in runs {
+        let structural = r.points.iter().any(|p| p.load_factor.is_some());
+        let mut f = Failure {
+            formulation: r.formulation,
+            at: Vec::new(),
+            of: r.points.len(),
+            unit: if structural { "load factors" } else { "airspeeds" }.into(),
+            reasons: Vec::new(),
+        };
+        for p in &r.points {
+            let Some(e) = &p.error else { continue };
+            let x = p.load_factor.unwrap_or(p.airspeed);
+            f.at.push(x);
+            if f.reasons.len() < MAX_REASONS && !f.reasons.iter().any(|(_, r)| r == e) {
+                f.reasons.push((x, e.clone()));
+            }
+        }
+        if let (Some(e), true) = (&r.error, f.at.is_empty()) {
+            f.reasons.push((f64::NAN, e.clone()));
+        }
+        if !f.reasons.is_empty() {
+            v.push(f);
+        }
+    }
+    v
+}
+
+/// The failure text of formulation `f` in `failures`, or `fallback`.
+pub fn failure_of(failures: &[Failure], f: Formulation, fallback: &str) -> String {
+    failures.iter().find(|x| x.formulation == f).map_or_else(|| fallback.to_string(), Failure::text)
 }
 
 /// A time history's mean over a window against the static equilibrium at its airspeed.
@@ -258,11 +335,7 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
             let e: Vec<(f64, f64, f64, f64)> =
                 points.iter().filter_map(|&(u, a)| interp(&ours, u).map(|c| (u, a, c, c - a))).collect();
             let band: Vec<f64> = e.iter().filter(|x| (12.0 - 1e-9..=33.0 + 1e-9).contains(&x.0)).map(|x| x.3).collect();
-            let rms = if band.is_empty() {
-                f64::NAN
-            } else {
-                (band.iter().map(|x| x * x).sum::<f64>() / band.len() as f64).sqrt()
-            };
+            let rms = (!band.is_empty()).then(|| (band.iter().map(|x| x * x).sum::<f64>() / band.len() as f64).sqrt());
             errors.push((out.formulation, e));
             rms_deg.push((out.formulation, rms));
         }
@@ -275,23 +348,24 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
             rms_deg,
         });
     }
-    let (mut dfold, mut drbm) = (f64::NAN, f64::NAN);
+    let (mut dfold, mut drbm): (Option<f64>, Option<f64>) = (None, None);
     if let [a, g] = runs.as_slice() {
         for (pa, pg) in a.points.iter().zip(&g.points) {
             if pa.error.is_none() && pg.error.is_none() {
                 let d = (pa.fold_deg - pg.fold_deg).abs();
                 if d.is_finite() {
-                    dfold = if dfold.is_nan() { d } else { dfold.max(d) };
+                    dfold = Some(dfold.map_or(d, |x| x.max(d)));
                 }
                 let (ra, rg) = (pa.loads.root_bending_moment, pg.loads.root_bending_moment);
                 let r = (ra - rg).abs() / rg.abs().max(1e-12);
                 if r.is_finite() {
-                    drbm = if drbm.is_nan() { r } else { drbm.max(r) };
+                    drbm = Some(drbm.map_or(r, |x| x.max(r)));
                 }
             }
         }
     }
     let n_failed = runs.iter().flat_map(|r| &r.points).filter(|p| p.error.is_some()).count();
+    let failures = failures(&runs);
     StaticSummary {
         name: case.name.clone(),
         description: case.description.clone(),
@@ -300,14 +374,15 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
         max_fold_difference_deg: dfold,
         max_rbm_relative_difference: drbm,
         n_failed,
+        failures,
         history: Vec::new(),
         held: Vec::new(),
     }
 }
 
 /// RMS error of a model reference against an experiment reference of the same summary (at the
-/// experiment's airspeeds in 12–33 m/s), degrees.
-pub fn model_rms(summary: &StaticSummary) -> Vec<(String, f64)> {
+/// experiment's airspeeds in 12–33 m/s), degrees; None when the curves do not overlap there.
+pub fn model_rms(summary: &StaticSummary) -> Vec<(String, Option<f64>)> {
     let Some(exp) = summary.references.iter().find(|r| r.experiment) else { return Vec::new() };
     summary
         .references
@@ -322,8 +397,7 @@ pub fn model_rms(summary: &StaticSummary) -> Vec<(String, f64)> {
                 .filter(|p| (12.0 - 1e-9..=33.0 + 1e-9).contains(&p.0))
                 .filter_map(|&(u, a)| interp(&pts, u).map(|c| c - a))
                 .collect();
-            let rms =
-                if e.is_empty() { f64::NAN } else { (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt() };
+            let rms = (!e.is_empty()).then(|| (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt());
             (m.label.clone(), rms)
         })
         .collect()
@@ -606,13 +680,29 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
 pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     let mut h = String::new();
     let _ = write!(h, "<h3 id=\"static-{0}\">{0}</h3>\n<p>{1}</p>\n", s.name, html_escape(&s.description));
-    let _ = writeln!(
-        h,
-        "<p>ANCF–GEBF: coast angles within {:.3}°, root bending moments within {:.3} %; {} point(s) without an equilibrium.</p>",
-        s.max_fold_difference_deg,
-        100.0 * s.max_rbm_relative_difference,
-        s.n_failed
-    );
+    match (s.max_fold_difference_deg, s.max_rbm_relative_difference) {
+        (Some(d), Some(r)) => {
+            let _ = writeln!(
+                h,
+                "<p>ANCF–GEBF: coast angles within {d:.3}°, root bending moments within {:.3} % over the airspeeds \
+                 both solved; {} point(s) without an equilibrium.</p>",
+                100.0 * r,
+                s.n_failed
+            );
+        }
+        _ if s.runs.len() == 2 => {
+            let _ = writeln!(
+                h,
+                "<p>ANCF–GEBF: no comparison, no airspeed has an equilibrium in both; {} point(s) without an \
+                 equilibrium.</p>",
+                s.n_failed
+            );
+        }
+        _ => {}
+    }
+    for f in &s.failures {
+        let _ = writeln!(h, "<p class=\"fail\">FAILED: {}</p>", html_escape(&f.text()));
+    }
     h.push_str("<table><tr><th>airspeed [m/s]</th>");
     for r in &s.runs {
         let f = r.formulation.as_str().to_uppercase();
@@ -669,15 +759,25 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     h.push_str("</table>\n<ul>\n");
     for r in s.references.iter().filter(|r| r.experiment) {
         for (f, rms) in &r.rms_deg {
-            let _ = writeln!(
-                h,
-                "<li>{f} against {}: RMS coast-angle error {rms:.2}° over 12–33 m/s</li>",
-                html_escape(&r.label)
-            );
+            let label = html_escape(&r.label);
+            let _ = match rms {
+                Some(rms) => {
+                    writeln!(h, "<li>{f} against {label}: RMS coast-angle error {rms:.2}° over 12–33 m/s</li>")
+                }
+                None => writeln!(
+                    h,
+                    "<li>{f} against {label}: no RMS error, no equilibrium at its airspeeds in 12–33 m/s ({})</li>",
+                    html_escape(&failure_of(&s.failures, *f, "no converged point in the band"))
+                ),
+            };
         }
     }
     for (label, rms) in model_rms(s) {
-        let _ = writeln!(h, "<li>{} against the experiment: RMS {rms:.2}° over 12–33 m/s</li>", html_escape(&label));
+        let label = html_escape(&label);
+        let _ = match rms {
+            Some(rms) => writeln!(h, "<li>{label} against the experiment: RMS {rms:.2}° over 12–33 m/s</li>"),
+            None => writeln!(h, "<li>{label} against the experiment: no common airspeed in 12–33 m/s</li>"),
+        };
     }
     for c in &s.history {
         let _ = writeln!(

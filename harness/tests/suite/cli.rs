@@ -264,3 +264,76 @@ fn a_zero_newton_tolerance_is_an_input_error_for_list() {
     assert_eq!(o.status.code(), Some(2));
     assert_clean_error(&o, "gebf.newton.rtol: 0 is not a positive number");
 }
+
+/// Issue 38: `"sweep": [{"path": "stiffness_scale", "values": [1, 1]}]` made two runs of one
+/// name, and `harness run` waited for ever on the folder lock its first run held. It is an
+/// input error naming the sweep's field.
+#[test]
+fn duplicate_sweep_points_exit_2_naming_the_field_issue_38() {
+    let p = tmp_case("dup_sweep.json", |v| {
+        v["sweep"] = serde_json::json!([{ "path": "stiffness_scale", "values": [1, 1] }]);
+    });
+    let out = std::env::temp_dir().join(format!("harness-cli-dup-{}", std::process::id()));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["run", p.to_str().unwrap(), "--set", "t_end=0.01", "--out", out.to_str().unwrap()])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // A guard against the old behaviour (a wait for ever), not a timing: the run is refused
+    // before anything starts.
+    let status = wait_or_kill(&mut child, 120);
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    assert_eq!(status, Some(2), "{err}");
+    assert!(err.contains("sweep[0].values") && err.contains("duplicate"), "{err}");
+}
+
+/// The exit code of `child`, or None after killing it when it has not ended within `secs`.
+fn wait_or_kill(child: &mut std::process::Child, secs: u64) -> Option<i32> {
+    let t0 = std::time::Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s.code();
+        }
+        if t0.elapsed() > std::time::Duration::from_secs(secs) {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// Issue 38: a run waiting for another process's lock on its output folder ignored SIGTERM.
+/// The wait polls the signal flag: SIGTERM ends it with the interrupted exit code (130).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_run_waiting_on_a_folder_lock_answers_sigterm_issue_38() {
+    let out = std::env::temp_dir().join(format!("harness-cli-lock-{}", std::process::id()));
+    let case = root().join("cases/double_pendulum_c1_beta45.json");
+    // This test holds the folder the run will want.
+    let held = harness::atomic::claim_dir(&out.join("double_pendulum_c1_beta45__set_t_end=0.01")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["run", case.to_str().unwrap(), "--set", "t_end=0.01", "--out", out.to_str().unwrap()])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until it says it is waiting.
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        let n = std::io::BufRead::read_line(&mut stderr, &mut line).unwrap();
+        seen.push_str(&line);
+        assert!(n > 0, "the run ended without waiting: {seen}");
+        if line.contains("waiting for another run") {
+            break;
+        }
+    }
+    // SAFETY: kill sends a signal to the child this test started.
+    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    let status = wait_or_kill(&mut child, 120);
+    drop(held);
+    let _ = std::fs::remove_dir_all(&out);
+    assert_eq!(status, Some(130), "the run did not end on SIGTERM while waiting");
+}

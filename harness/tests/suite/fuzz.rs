@@ -112,3 +112,35 @@ fn a_campaign_over_cases_without_references_counts_every_input() {
     assert_eq!(counted, 60, "{report}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Issue 38: the fuzzer covers every command, the analyses on mutants of the cases that
+/// declare them (reduced to one point, under the analysis budget). 150 inputs of a fixed seed
+/// through `check_command` in this process: no crash (a panic, an unnamed refusal or NaN in a
+/// summary), and the analyses are reached (some of their inputs run or fail numerically rather
+/// than being refused).
+#[test]
+fn every_command_is_fuzzed_analyses_included_issue_38() {
+    use harness::fuzz::{FuzzCommand, check_command, input_command};
+    let seeds = seeds(&cases()).unwrap();
+    let path = cases().join("fuzz-command-input.json");
+    let limits = Limits { memory_bytes: 2e9, seconds: 3.0 };
+    let mut counts: BTreeMap<(FuzzCommand, Class), usize> = BTreeMap::new();
+    let mut crashes = Vec::new();
+    for i in 0..150_usize {
+        let (name, cmd, bytes, muts) = input_command(&seeds, 38, i, STEPS);
+        std::fs::write(&path, &bytes).unwrap();
+        let (class, msg) = check_command(cmd, &path, STEPS, &limits);
+        *counts.entry((cmd, class)).or_default() += 1;
+        if class.is_crash() {
+            crashes.push(format!("input {i} ({name}, {cmd:?}, {muts:?}): {class:?}: {msg}"));
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+    assert!(crashes.is_empty(), "{} crashes: {:#?}", crashes.len(), &crashes[..crashes.len().min(10)]);
+    let reached = |c: FuzzCommand| {
+        counts.get(&(c, Class::Ok)).copied().unwrap_or(0) + counts.get(&(c, Class::RunFailed)).copied().unwrap_or(0)
+    };
+    for c in [FuzzCommand::Run, FuzzCommand::List, FuzzCommand::Static, FuzzCommand::Stability] {
+        assert!(reached(c) > 0, "{c:?} never ran: {counts:?}");
+    }
+}

@@ -279,3 +279,39 @@ fn harness_static_reports_the_model_held_at_the_experiment() {
     assert!(section.contains("equivalent pitch"), "{section}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 38: after ANCF failed at every airspeed the summary printed "RMS error against
+/// Experiment … = NaN deg" and "ANCF-GEBF max fold difference NaN deg". With ANCF's wing made
+/// a millionth as stiff (`ancf:stiffness_scale`), its lattice folds over and no airspeed has an
+/// equilibrium: the sweep exits 1, and stdout, stderr, `static_summary.json` and the report's
+/// section name the formulation, its airspeeds and the reason, never NaN.
+#[test]
+fn a_failed_formulation_is_named_never_nan_issue_38() {
+    let dir = std::env::temp_dir().join(format!("harness-static-nan-{}", std::process::id()));
+    let o = harness(&[
+        "static",
+        "cases/healy_ffwt_flare10_aoa5.json",
+        "--set",
+        "ancf:stiffness_scale=1e-6",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.status.code(), Some(1), "{out}\n{err}");
+    let case_dir = std::fs::read_dir(&dir).unwrap().next().unwrap().unwrap().path();
+    let json = std::fs::read_to_string(case_dir.join("static_summary.json")).unwrap();
+    let html = std::fs::read_to_string(case_dir.join("static_section.html")).unwrap();
+    for (what, text) in [("stdout", &*out), ("stderr", &*err), ("static_summary.json", &json), ("section", &html)] {
+        assert!(!text.contains("NaN"), "{what} shows NaN:\n{text}");
+    }
+    assert!(err.contains("ANCF failed at 12 of 12 airspeeds (12, 13, 14,"), "{err}");
+    assert!(out.contains("ancf: no RMS error against Experiment"), "{out}");
+    assert!(out.contains("ANCF-GEBF: no comparison"), "{out}");
+    assert!(html.contains("FAILED: ANCF failed at 12 of 12 airspeeds"), "{html}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["failures"][0]["formulation"], "ancf");
+    assert_eq!(v["failures"][0]["at"].as_array().unwrap().len(), 12);
+    assert!(v["failures"].as_array().unwrap().len() == 1, "GEBF converges: {}", v["failures"]);
+    assert!(v["max_fold_difference_deg"].is_null());
+    let _ = std::fs::remove_dir_all(&dir);
+}
