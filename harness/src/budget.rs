@@ -294,9 +294,9 @@ impl Analysis {
 }
 
 /// Newton iterations a static point is charged (with its continuation and retries).
-const STATIC_ITERATIONS: f64 = 40.0;
+pub const STATIC_ITERATIONS: f64 = 40.0;
 /// Evaluations of the flutter determinant charged per stability airspeed.
-const STABILITY_EVALUATIONS: f64 = 200.0;
+pub const STABILITY_EVALUATIONS: f64 = 200.0;
 
 /// The cost of one steady lattice solve with `bound` rings and `legs` wake legs (influence
 /// matrix, its LU), s, and its memory, bytes.
