@@ -20,7 +20,7 @@ use nalgebra::{Matrix3, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::case::{Case, Joint};
 use formulation::Structure;
@@ -100,7 +100,7 @@ pub struct MirrorPlane {
 impl AeroSettings {
     /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images, reuse
     /// and aggregation of the wake; single-threaded (runs are parallel across cases) unless
-    /// [`set_run_alone`] says the run is alone.
+    /// [`register_runs`] counts this run alone.
     pub fn uvlm_params(&self, v_inf: [f64; 3]) -> uvlm::UvlmParams {
         let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
         params.n_wake_rows = self.n_wake_rows;
@@ -110,7 +110,8 @@ impl AeroSettings {
         params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
-        params.parallel = if RUN_ALONE.load(Ordering::Relaxed) { uvlm::Parallel::Auto } else { uvlm::Parallel::Off };
+        params.parallel =
+            if ACTIVE_RUNS.load(Ordering::SeqCst) == 1 { uvlm::Parallel::Auto } else { uvlm::Parallel::Off };
         params.wake_reuse = if self.coupling.reuse_wake { uvlm::WakeReuse::Frozen } else { uvlm::WakeReuse::Recompute };
         params.wake_aggregation =
             if self.wake_aggregation { uvlm::WakeAggregation::treecode() } else { uvlm::WakeAggregation::off() };
@@ -118,14 +119,27 @@ impl AeroSettings {
     }
 }
 
-/// Whether the current command runs a single aeroelastic run (see [`set_run_alone`]).
-static RUN_ALONE: AtomicBool = AtomicBool::new(false);
+/// Time marches under way in this process through [`register_runs`].
+static ACTIVE_RUNS: AtomicUsize = AtomicUsize::new(0);
 
-/// Tell the UVLM settings that one run is alone on the machine (its Biot–Savart sums may use
-/// every rayon thread, `uvlm::Parallel::Auto`) or that several run side by side (one thread
-/// each, the default).
-pub fn set_run_alone(alone: bool) {
-    RUN_ALONE.store(alone, Ordering::Relaxed);
+/// Registers `n` time marches that go side by side until the guard drops. While exactly one is
+/// under way it may use every rayon thread for its Biot–Savart sums (`uvlm::Parallel::Auto`);
+/// with several (or any other concurrent caller registering its own), each keeps one thread.
+/// A counter rather than a flag, so that concurrent callers (tests, library users) cannot
+/// switch each other's setting, and the guard releases it on a panic too.
+#[must_use = "the runs count as under way only while the guard lives"]
+pub fn register_runs(n: usize) -> RunsGuard {
+    ACTIVE_RUNS.fetch_add(n, Ordering::SeqCst);
+    RunsGuard(n)
+}
+
+/// Guard of [`register_runs`].
+pub struct RunsGuard(usize);
+
+impl Drop for RunsGuard {
+    fn drop(&mut self) {
+        ACTIVE_RUNS.fetch_sub(self.0, Ordering::SeqCst);
+    }
 }
 
 fn default_cutoff() -> f64 {

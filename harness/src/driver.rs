@@ -68,7 +68,7 @@ pub fn run_into(
     let jobs: Vec<(usize, Formulation)> =
         (0..runs.len()).flat_map(|i| formulations.iter().map(move |&f| (i, f))).collect();
     // A single run may thread its aerodynamics; several share the threads one each.
-    crate::aero::set_run_alone(jobs.len() == 1);
+    let _runs = crate::aero::register_runs(jobs.len());
     let outputs: Vec<_> = jobs
         .par_iter()
         .map(|&(i, f)| {
@@ -90,7 +90,6 @@ pub fn run_into(
             (i, out)
         })
         .collect();
-    crate::aero::set_run_alone(false);
     let mut per: Vec<Vec<_>> = vec![Vec::new(); runs.len()];
     for (i, o) in outputs {
         per[i].push(o);

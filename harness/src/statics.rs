@@ -243,7 +243,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
 
     /// Steady solves and aerodynamic-stiffness evaluations so far.
     pub fn counters(&self) -> (usize, usize) {
-        (lock(&self.aero_state).n_solves, lock(&self.tangent).n_refresh)
+        // One lock at a time: `update_tangent` takes them in the other order.
+        let solves = lock(&self.aero_state).n_solves;
+        (solves, lock(&self.tangent).n_refresh)
     }
 
     /// Station loads and the UVLM's lattice loads at `q`.
@@ -963,7 +965,7 @@ pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
 
 // `AeroStatic` is a `ConstrainedSystem` (methods on `&self`) whose residual sets loads on the
 // model and solves the lattice: its state sits behind locks, so it is `Send + Sync` like the
-// models. The model behind a read-write lock (its reads nest), the rest behind mutexes; a lock
+// models. The model behind a read-write lock (never taken twice by one thread: std's may deadlock), the rest behind mutexes; a lock
 // is poisoned only by a panic elsewhere, after which the state is rewritten before it is read.
 fn read<T>(l: &RwLock<T>) -> RwLockReadGuard<'_, T> {
     l.read().unwrap_or_else(PoisonError::into_inner)
