@@ -10,7 +10,6 @@ mod invariance;
 mod jacobians;
 mod memory;
 mod modal;
-mod near_rigid;
 mod pendulum;
 mod properties;
 mod rigid_limit;
