@@ -8,7 +8,6 @@ mod hinge;
 mod linear;
 mod linear_gust;
 mod properties;
-mod reuse;
 mod steady;
 mod steady_finite_wake;
 mod theodorsen;
