@@ -20,7 +20,7 @@ fn run(c: f64, beta: f64, path: SolvePath) -> f64 {
 fn bench(cr: &mut Criterion) {
     let mut group = cr.benchmark_group("double_pendulum");
     group.sample_size(10);
-    for (c, beta) in samples::PAPER_PENDULUM_CASES {
+    for (c, beta) in samples::PAPER_CASES {
         for path in [SolvePath::Dae, SolvePath::Ode] {
             group.bench_function(format!("c{c}_beta{beta}_{path:?}"), |b| b.iter(|| run(c, beta, path)));
         }

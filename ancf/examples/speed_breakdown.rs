@@ -36,7 +36,7 @@ fn main() {
     let banded = env("SOLVER").as_deref() == Some("banded");
     println!("case                  wall_ms  newton/step  fact/step  resid/step  halvings  tip_z       dev/excursion");
     let mut tips = Vec::new();
-    for (c, beta) in samples::PAPER_PENDULUM_CASES {
+    for (c, beta) in samples::PAPER_CASES {
         for path in [SolvePath::Dae, SolvePath::Ode] {
             let name = format!("c{c}_beta{beta}_{path:?}");
             let (bodies, joints, g) = samples::double_pendulum(c, beta, 5);

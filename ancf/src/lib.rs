@@ -63,7 +63,7 @@ mod node_tie;
 pub mod point_mass;
 pub mod reduction;
 mod rigid;
-pub mod samples;
+pub use scene::samples;
 pub mod shape;
 pub mod skyline;
 mod spec;

@@ -3,34 +3,14 @@
 use ancf::{ForceElement, Model, Options, PointLoad, PointMass, Scene, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use nalgebra::Vector3;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn per_step_primitives_do_not_allocate() {
     // the counter works
-    let c0 = ALLOCATIONS.load(Ordering::Relaxed);
-    let probe: Vec<u64> = Vec::with_capacity(16);
-    assert!(ALLOCATIONS.load(Ordering::Relaxed) > c0 && probe.capacity() >= 16);
+    let (probe, n) = alloc_count::count(|| Vec::<u64>::with_capacity(16));
+    assert!(n > 0 && probe.capacity() >= 16);
     for path in [SolvePath::Dae, SolvePath::Ode] {
         let (b, j, g) = samples::double_pendulum(1.0, 45.0, 4);
         let mut model = Model::new(&b, &j, g, Options { path, ..Default::default() }).unwrap();
@@ -41,29 +21,28 @@ fn per_step_primitives_do_not_allocate() {
         let mut r = vec![0.0; n];
         let mut phi = vec![0.0; m];
         let mut k = DenseMatrix::zeros(n, n);
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for _ in 0..3 {
-            model.set_point_loads(&loads).unwrap();
-            model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
-            model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.0, 1e-6, &mut k.view());
-            model.phi_inplace(0.0, &s.q, &mut phi);
-            let _ = model.tip_position(&s.q);
-            let _ = model.fold_angle(&s.q, 1).unwrap();
-            let _ = model.energies(&s.q, &s.v);
-            let _ = model.constraint_residual(&s.q);
-            let _ = model.section_frame(&s.q, 1, 0.25).unwrap();
-            let _ = model.material_velocity(&s.v, 1, 0.25, 0.1, 0.0).unwrap();
-        }
-        let after = ALLOCATIONS.load(Ordering::Relaxed);
-        assert_eq!(after - before, 0, "{path:?}: {} allocations", after - before);
+        let ((), allocations) = alloc_count::count(|| {
+            for _ in 0..3 {
+                model.set_point_loads(&loads).unwrap();
+                model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
+                model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.0, 1e-6, &mut k.view());
+                model.phi_inplace(0.0, &s.q, &mut phi);
+                let _ = model.tip_position(&s.q);
+                let _ = model.fold_angle(&s.q, 1).unwrap();
+                let _ = model.energies(&s.q, &s.v);
+                let _ = model.constraint_residual(&s.q);
+                let _ = model.section_frame(&s.q, 1, 0.25).unwrap();
+                let _ = model.material_velocity(&s.v, 1, 0.25, 0.1, 0.0).unwrap();
+            }
+        });
+        assert_eq!(allocations, 0, "{path:?}: {allocations} allocations");
     }
     spring_and_point_mass_primitives_do_not_allocate();
 }
 
 /// The same with hinge springs and dampers on both hinges, point masses and an offset section:
 /// the spring terms, the dampers' velocity expansion (ODE path), the hinge-angle bookkeeping of
-/// `post_step` and the new sensors allocate nothing either. (Called from the test above: the
-/// counter is global, and a second test running in parallel would count its allocations.)
+/// `post_step` and the new sensors allocate nothing either. (Called from the test above.)
 fn spring_and_point_mass_primitives_do_not_allocate() {
     for path in [SolvePath::Dae, SolvePath::Ode] {
         let (mut b, j, g) = samples::double_pendulum(1.0, 45.0, 4);
@@ -86,18 +65,18 @@ fn spring_and_point_mass_primitives_do_not_allocate() {
         let mut r = vec![0.0; n];
         let mut k = DenseMatrix::zeros(n, n);
         let (mut q, mut v, mut vd, mut a) = (s.q.clone(), s.v.clone(), s.v_dot.clone(), s.a.clone());
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for _ in 0..3 {
-            model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
-            model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.5, 1e-6, &mut k.view());
-            let _ = model.energies(&s.q, &s.v);
-            let _ = model.dissipation_power(&s.q, &s.v);
-            let _ = model.hinge_angle(&s.q, 1).unwrap();
-            q.copy_from_slice(&s.q);
-            model.post_step(0.0, &mut q, &mut v, &mut vd, &mut a);
-            model.reset_hinge_angles(&q);
-        }
-        let after = ALLOCATIONS.load(Ordering::Relaxed);
-        assert_eq!(after - before, 0, "{path:?}: {} allocations", after - before);
+        let ((), allocations) = alloc_count::count(|| {
+            for _ in 0..3 {
+                model.residual_inplace(0.0, &s.q, &s.v, &s.a, &mut r);
+                model.iteration_matrix_inplace(0.0, &s.q, &s.v, &s.a, 1.0, 0.5, 1e-6, &mut k.view());
+                let _ = model.energies(&s.q, &s.v);
+                let _ = model.dissipation_power(&s.q, &s.v);
+                let _ = model.hinge_angle(&s.q, 1).unwrap();
+                q.copy_from_slice(&s.q);
+                model.post_step(0.0, &mut q, &mut v, &mut vd, &mut a);
+                model.reset_hinge_angles(&q);
+            }
+        });
+        assert_eq!(allocations, 0, "{path:?}: {allocations} allocations");
     }
 }

@@ -88,7 +88,7 @@ mod options;
 pub mod quaternion;
 mod rigid;
 mod rigid_slice;
-pub mod samples;
+pub use scene::samples;
 mod section;
 pub mod simulate;
 mod statics;

@@ -5,34 +5,8 @@
 use gebf::{ForceElement, Model, Options, PointMass, Scene, samples};
 use genalpha::{GenAlpha, IntegratorParams};
 use nalgebra::Vector3;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-struct Counting;
-
-thread_local! {
-    /// Count the test thread's own allocations only: libtest's main thread registers the
-    /// running test in a hash map concurrently, and counting it made the test fail now and then
-    /// under load ("4 allocations in 200 steps", all in `test::run_tests`), as did the other
-    /// test's thread.
-    static COUNTED: Cell<bool> = const { Cell::new(false) };
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTED.try_with(Cell::get).unwrap_or(false) {
-            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        }
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn time_steps_do_not_allocate() {
@@ -65,16 +39,14 @@ fn steps_do_not_allocate(mut m: Model) {
     let mut s = m.initial_state();
     ga.initialize(&m, &mut s).unwrap();
     ga.step(&mut m, &mut s).unwrap(); // first step: lazy set-up, if any
-    COUNTED.with(|c| c.set(true));
-    let before = ALLOCATIONS.with(Cell::get);
-    for _ in 0..200 {
-        ga.step(&mut m, &mut s).unwrap();
-        std::hint::black_box(m.tip_position(&s.q));
-        std::hint::black_box(m.constraint_residual(&s.q));
-        std::hint::black_box(m.energies(&s.q, &s.v));
-        std::hint::black_box(m.dissipation_power(&s.q, &s.v));
-    }
-    let after = ALLOCATIONS.with(Cell::get);
-    COUNTED.with(|c| c.set(false));
-    assert_eq!(after - before, 0, "{} allocations in 200 steps", after - before);
+    let ((), allocations) = alloc_count::count(|| {
+        for _ in 0..200 {
+            ga.step(&mut m, &mut s).unwrap();
+            std::hint::black_box(m.tip_position(&s.q));
+            std::hint::black_box(m.constraint_residual(&s.q));
+            std::hint::black_box(m.energies(&s.q, &s.v));
+            std::hint::black_box(m.dissipation_power(&s.q, &s.v));
+        }
+    });
+    assert_eq!(allocations, 0, "{allocations} allocations in 200 steps");
 }

@@ -17,6 +17,7 @@ mod body;
 mod error;
 mod force;
 mod joint;
+pub mod samples;
 mod section;
 mod validate;
 

@@ -3,35 +3,11 @@
 //! single thread; prescribed and free wake, with a symmetry plane, without and with a disturbance
 //! field).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator and only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn step_does_not_allocate() {
@@ -60,17 +36,12 @@ fn step_does_not_allocate() {
             u.update_stations(&stations[k % 8], Some(&vel)).unwrap();
             u.step(0.01).unwrap();
         }
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for k in 0..8 {
-            u.update_stations(&stations[7 - k], Some(&vel)).unwrap();
-            u.step(0.01).unwrap();
-        }
-        let after = ALLOCATIONS.load(Ordering::Relaxed);
-        assert_eq!(
-            after - before,
-            0,
-            "{convection:?}, disturbed {disturbed}: {} allocations in 8 steps",
-            after - before
-        );
+        let ((), allocations) = alloc_count::count(|| {
+            for k in 0..8 {
+                u.update_stations(&stations[7 - k], Some(&vel)).unwrap();
+                u.step(0.01).unwrap();
+            }
+        });
+        assert_eq!(allocations, 0, "{convection:?}, disturbed {disturbed}: {allocations} allocations in 8 steps");
     }
 }

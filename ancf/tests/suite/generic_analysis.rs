@@ -28,7 +28,7 @@ const BEFORE: [f64; 10] = [
 
 /// L = 2 m, 8 elements, the section of `tests/suite/modal.rs`.
 fn cantilever(path: SolvePath) -> Model {
-    let mut sec = samples::pendulum_section(1.0);
+    let mut sec = samples::paper_section(1.0);
     (sec.mass, sec.rho_ixx, sec.rho_iyy, sec.rho_izz) = (2.0, 4e-5, 1e-5, 3e-5);
     (sec.ea, sec.ga_y, sec.ga_z, sec.gj, sec.ei_yy, sec.ei_zz) = (4e7, 1.5e7, 1.5e7, 300.0, 800.0, 2000.0);
     let (b, j) = samples::cantilever(sec, 2.0, 8);

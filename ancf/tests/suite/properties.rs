@@ -96,7 +96,7 @@ fn scene(
         start,
         length,
         frame,
-        section: samples::pendulum_section(c),
+        section: samples::paper_section(c),
         n_elements,
         point_masses: Vec::new(),
     };

@@ -124,7 +124,7 @@ fn stiff_body(length: f64) -> BodySpec {
         start: Vector3::zeros(),
         length,
         frame: Matrix3::identity(),
-        section: samples::pendulum_section(100.0),
+        section: samples::paper_section(100.0),
         n_elements: 4,
         point_masses: Vec::new(),
     }

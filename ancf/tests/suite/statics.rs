@@ -115,7 +115,7 @@ fn no_shear_locking_in_the_thin_limit() {
 /// hybrid curvature stays exact.
 #[test]
 fn kirchhoff_curvature_clamp_compliance_grows_with_refinement() {
-    let sec = samples::pendulum_section(1.0);
+    let sec = samples::paper_section(1.0);
     let l = 0.5;
     let err = |curvature: Curvature, n: usize| {
         let (b, j) = samples::cantilever(sec, l, n);
@@ -146,7 +146,7 @@ fn kirchhoff_curvature_clamp_compliance_grows_with_refinement() {
 #[test]
 fn flared_hinge_transmits_moments_without_mesh_dependent_compliance() {
     use ancf::{ForceElement, JointSpec, Scene};
-    let sec = samples::pendulum_section(1.0);
+    let sec = samples::paper_section(1.0);
     let beta = 45f64.to_radians();
     let (s, c) = beta.sin_cos();
     let errors = |n: usize, tie: f64| {

@@ -53,7 +53,7 @@ impl Sec {
         self.rho_iyy + self.rho_izz
     }
     fn ancf(&self) -> ancf::Section {
-        let mut s = ancf::samples::pendulum_section(self.c);
+        let mut s = ancf::samples::paper_section(self.c);
         (s.mass, s.rho_ixx, s.rho_iyy, s.rho_izz) = (self.mass, self.rho_ixx(), self.rho_iyy, self.rho_izz);
         s
     }

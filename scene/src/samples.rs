@@ -1,4 +1,5 @@
-//! A catalogue of reference scenes, shared by the tests, the benchmark and the harness.
+//! A catalogue of reference scenes, shared by both formulations' tests and benchmarks and by the
+//! harness (re-exported as `ancf::samples` and `gebf::samples`).
 
 use crate::{BodySpec, JointSpec, Section};
 use nalgebra::{Matrix3, Vector3};
