@@ -123,10 +123,14 @@ pub fn summarise(out: GustSweepOutput) -> GustSummary {
     let some_max = |v: &mut dyn Iterator<Item = f64>| Some(nan_max(v)).filter(|x| x.is_finite());
     let max_peak_rbm_difference_percent = some_max(&mut ancf_gebf.iter().map(|d| d.peak_rbm_percent));
     let max_peak_fold_difference_deg = some_max(&mut ancf_gebf.iter().map(|d| d.peak_fold_deg));
+    // Over the runs that have a CPU time (a run that failed before its march has none); a
+    // formulation without one is left out and the report says so.
     let max_cpu_s = Formulation::ALL
         .iter()
-        .filter(|f| runs.iter().any(|r| r.formulation == **f))
-        .map(|&f| (f, nan_max(&mut runs.iter().filter(|r| r.formulation == f).map(|r| r.cpu_s))))
+        .filter_map(|&f| {
+            let timed = runs.iter().filter(|r| r.formulation == f && r.cpu_s.is_finite());
+            some_max(&mut timed.map(|r| r.cpu_s)).map(|c| (f, c))
+        })
         .collect();
     let n_failed = runs.iter().filter(|r| r.error.is_some()).count();
     GustSummary {
@@ -359,6 +363,14 @@ fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
+/// "ancf 0.12 s, gebf 0.34 s", or what no run timed.
+fn cpu_phrase(max_cpu_s: &[(Formulation, f64)]) -> String {
+    if max_cpu_s.is_empty() {
+        return "none (no march ran)".into();
+    }
+    max_cpu_s.iter().map(|(f, c)| format!("{f} {c:.2} s")).collect::<Vec<_>>().join(", ")
+}
+
 /// The sweep's section of `reports/index.html`; plots linked under `folder`.
 pub fn section_html(s: &GustSummary, folder: &str) -> String {
     let mut h = String::new();
@@ -375,7 +387,7 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
         s.airspeed,
         esc(&serde_json::to_string(&s.gust).unwrap_or_default()),
         s.n_failed,
-        s.max_cpu_s.iter().map(|(f, c)| format!("{f} {c:.2} s")).collect::<Vec<_>>().join(", ")
+        cpu_phrase(&s.max_cpu_s)
     );
     h.push_str(
         "<table><tr><th>hinge</th><th>H [m]</th><th>f [Hz]</th><th>U_ds [m/s]</th>\
