@@ -52,7 +52,10 @@ pub fn poles(y: &[f64], dt: f64, max_order: usize) -> Vec<(C64, C64)> {
     let v2 = v.rows(1, l).into_owned();
     let Ok(pinv) = v1.pseudo_inverse(1e-12) else { return Vec::new() };
     let a = pinv * v2;
-    let z = a.complex_eigenvalues();
+    // Bounded: nalgebra's `complex_eigenvalues` iterates without bound when it cannot converge.
+    let Some(z) = nalgebra::Schur::try_new(a, f64::EPSILON, 10_000).map(|t| t.complex_eigenvalues()) else {
+        return Vec::new();
+    };
     // Residues by least squares on the Vandermonde system.
     let zm = DMatrix::from_fn(n, order, |k, i| z[i].powu(k as u32));
     let yc = DVector::from_iterator(n, y.iter().map(|&x| C64::new(x, 0.0)));

@@ -373,7 +373,7 @@ impl Reduced {
                 }
                 a.view_mut((nb, 0), (nb, nb)).copy_from(&(-(&lu * &frozen)));
                 a.view_mut((nb, nb), (nb, nb)).copy_from(&(-(&lu * &cc)));
-                let Some(ev) = a.clone().eigenvalues() else { return (s0, e) };
+                let Some(ev) = bounded_eigenvalues(a) else { return (s0, e) };
                 let best = ev.iter().copied().min_by(|x, y| (x - s0).norm().total_cmp(&(y - s0).norm())).unwrap_or(s0);
                 // The structural mode's unit vector starts Newton's method and normalises it
                 // (`eᴴη = 1`), which keeps it off a nearby root of another mode.
@@ -386,7 +386,13 @@ impl Reduced {
     pub fn static_stiffness_min(&self) -> f64 {
         let d0 = self.d(C64::new(0.0, 0.0)).map(|x| x.re);
         let Some(a) = self.m.clone().lu().solve(&d0) else { return f64::NAN };
-        let ev = a.complex_eigenvalues();
+        if !a.iter().all(|x| x.is_finite()) {
+            return f64::NAN;
+        }
+        let Some(ev) = nalgebra::Schur::try_new(a, f64::EPSILON, SCHUR_MAX_ITER).map(|t| t.complex_eigenvalues())
+        else {
+            return f64::NAN;
+        };
         let scale = ev.iter().map(|x| x.norm()).fold(0.0, f64::max).max(1e-300);
         ev.iter().filter(|x| x.im.abs() <= 1e-9 * scale).map(|x| x.re).fold(f64::INFINITY, f64::min)
     }
@@ -1197,4 +1203,18 @@ fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S
         }
     }
     out
+}
+
+/// Iteration bound of the Schur decompositions: nalgebra's plain `eigenvalues()` iterates
+/// without bound and never returns on a matrix with a non-finite entry (fuzz: airspeed 1e300
+/// made the dynamic pressure infinite and `harness stability` spun for ever).
+const SCHUR_MAX_ITER: usize = 10_000;
+
+/// Eigenvalues of `a`, or `None` when `a` has a non-finite entry or the Schur iteration does not
+/// converge within [`SCHUR_MAX_ITER`] sweeps.
+fn bounded_eigenvalues(a: DMatrix<C64>) -> Option<DVector<C64>> {
+    if !a.iter().all(|x| x.re.is_finite() && x.im.is_finite()) {
+        return None;
+    }
+    nalgebra::Schur::try_new(a, f64::EPSILON, SCHUR_MAX_ITER).and_then(|t| t.eigenvalues())
 }

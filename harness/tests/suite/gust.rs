@@ -250,3 +250,36 @@ fn small_gust_matches_the_linearised_model() {
         }
     }
 }
+
+/// Issue 38 (fuzz seed 38, 27 inputs): when every run of a formulation failed, the gust report
+/// read "Largest CPU time of one run: ancf NaN". With ANCF's wing a millionth as stiff its
+/// lattice folds over before any load is applied; the sweep names that failure, and stdout,
+/// stderr, `gust_summary.json` and the report's section show no NaN.
+#[test]
+fn a_failed_formulation_is_named_never_nan_in_the_gust_report_issue_38() {
+    let dir = std::env::temp_dir().join(format!("harness-gust-nan-{}", std::process::id()));
+    let o = harness_bin(&[
+        "gust",
+        "cases/wing_gust.json",
+        "--set",
+        "ancf:stiffness_scale=1e-6",
+        "--set",
+        "gust.gradients_m=[9]",
+        "--set",
+        r#"gust.hinges=[{"state":"free"}]"#,
+        "--set",
+        "gust.t_end=0.2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    let case_dir = dir.join("wing_gust");
+    let json = std::fs::read_to_string(case_dir.join("gust_summary.json")).unwrap();
+    let html = std::fs::read_to_string(case_dir.join("gust_section.html")).unwrap();
+    for (what, text) in [("stdout", &*out), ("stderr", &*err), ("gust_summary.json", &json), ("section", &html)] {
+        assert!(!text.contains("NaN"), "{what} shows NaN:\n{text}");
+    }
+    assert!(format!("{out}{err}").contains("ancf free H = 9 m: FAILED: static equilibrium"), "{out}\n{err}");
+    assert!(html.contains("1 run(s) failed") && html.contains("Largest CPU time of one run: gebf"), "{html}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -423,3 +423,17 @@ fn history_against_eigen(file: &str, sets: &[&str]) -> (harness::pencil::Oscilla
         .expect("roots");
     (o, root)
 }
+
+/// Fuzz seed 38, input 33943: at an accepted but absurd airspeed (1e300 m/s) the dynamic
+/// pressure overflows and nalgebra's unbounded Schur iteration on the infinite matrix never
+/// returned: `harness stability` spun for ever. The eigen-solves are bounded now: the analysis
+/// returns, every root it could not converge counted and flagged for a script.
+#[test]
+fn an_overflowing_airspeed_returns_with_its_roots_flagged_unconverged() {
+    let spec = case("hale_flutter.json", &["stability.airspeeds=[1e300]", "stability.modes=2"]);
+    let o = run_stability(&spec.gebf, Formulation::Gebf);
+    assert!(o.error.is_none(), "{:?}", o.error);
+    assert_eq!(o.points.len(), 1);
+    let n = harness::stability_out::unconverged_roots(&o);
+    assert!(n > 0, "{n} unconverged roots at 1e300 m/s");
+}
