@@ -1,7 +1,7 @@
 //! Gust response and load alleviation (docs/gust.md): the case field `aero.gust` (a frozen gust
 //! or turbulence field convected with the free stream), the top-level `gust` sweep block (gust
 //! gradients × hinge states), a gust run from the static aeroelastic equilibrium
-//! ([`gust_history`]) and the sweep ([`run_sweep`]). Outputs are in [`crate::gust_out`].
+//! ([`gust_history`]) and the sweep ([`run_sweep`]). The harness writes the outputs (`harness::gust_out`).
 //!
 //! A gust run starts at rest at the static equilibrium of its hinge state (docs/statics.md),
 //! with the steady wake of that lattice laid out behind it, so that without a gust it stays
@@ -9,15 +9,13 @@
 
 use std::time::Instant;
 
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
 use uvlm::FlowField;
 
 use formulation::Structure;
 
 use crate::aero::{AeroSettings, simulate_aero_from, station_map};
-use crate::case::{Case, Formulation, Joint, Spring};
-use crate::scene::{CaseModel, ForModel, dispatch};
+use crate::factory::{BuildModel, ForModel, dispatch};
+use crate::problem::{Formulation, Joint, Problem, Spring};
 
 /// Sea-level density of the standard atmosphere, kg/m³ (equivalent to true airspeed).
 pub const RHO_SEA_LEVEL: f64 = 1.225;
@@ -37,24 +35,26 @@ fn default_modes() -> usize {
 /// A gust or turbulence field (`aero.gust`). Every kind is frozen in the air and convected with
 /// the free stream; its front is `x0` metres upstream of the wing's most upstream leading-edge
 /// point when the run starts.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields))]
 pub enum GustSpec {
     /// The certification discrete gust `½ U_ds (1 − cos(π s/H))` over `0 ≤ s ≤ 2H`.
     OneMinusCosine {
         /// Gust gradient H, m (half the gust length; CS-25: 9 to 107 m).
         gradient_m: f64,
         /// Peak gust velocity U_ds, m/s (true airspeed). Give this or `certification`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         velocity: Option<f64>,
         /// U_ds from the certification rule instead of `velocity`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         certification: Option<Certification>,
         /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         x0: f64,
         /// Direction of the gust velocity, global (any non-zero length; default up, +Z).
-        #[serde(default = "up")]
+        #[cfg_attr(feature = "serde", serde(default = "up"))]
         direction: [f64; 3],
     },
     /// A sharp-edged gust of `velocity` behind its front.
@@ -62,10 +62,10 @@ pub enum GustSpec {
         /// Gust velocity, m/s.
         velocity: f64,
         /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         x0: f64,
         /// Direction of the gust velocity (default +Z).
-        #[serde(default = "up")]
+        #[cfg_attr(feature = "serde", serde(default = "up"))]
         direction: [f64; 3],
     },
     /// A sinusoidal gust `velocity · sin(2π s/λ)` behind its front.
@@ -73,19 +73,19 @@ pub enum GustSpec {
         /// Amplitude, m/s.
         velocity: f64,
         /// Frequency seen by a fixed point, Hz (λ = airspeed / f). Give this or `wavelength_m`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         frequency_hz: Option<f64>,
         /// Wavelength λ, m.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         wavelength_m: Option<f64>,
         /// Whole waves behind the front (default: unbounded).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         cycles: Option<f64>,
         /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         x0: f64,
         /// Direction of the gust velocity (default +Z).
-        #[serde(default = "up")]
+        #[cfg_attr(feature = "serde", serde(default = "up"))]
         direction: [f64; 3],
     },
     /// Continuous turbulence: a seeded realisation of the von Kármán spectrum.
@@ -95,35 +95,37 @@ pub enum GustSpec {
         /// Length scale L, m (762 m in the certification rule; scale with the wing).
         length_scale_m: f64,
         /// Seed of the random phases (required: a realisation is reproducible only from it).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         seed: Option<u64>,
         /// Spectral lines (default 200).
-        #[serde(default = "default_modes")]
+        #[cfg_attr(feature = "serde", serde(default = "default_modes"))]
         n_modes: usize,
         /// Shortest resolved wavelength, m (default: the chord).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         min_wavelength_m: Option<f64>,
         /// Distance of the front upstream of the wing's leading edge at the start, m (default 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         x0: f64,
         /// Direction of the turbulent velocity (default +Z).
-        #[serde(default = "up")]
+        #[cfg_attr(feature = "serde", serde(default = "up"))]
         direction: [f64; 3],
     },
 }
 
 /// The certification design gust velocity, `U_ds = scale · U_ref(altitude) · F_g · (H/107)^{1/6}`
 /// (CS-25.341(a)), U_ref in equivalent airspeed converted to true airspeed with `aero.rho`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Certification {
     /// Altitude, m (U_ref 17.07 m/s EAS at sea level, 13.41 at 4 572 m, 6.36 at 18 288 m and above).
     pub altitude_m: f64,
     /// Flight profile alleviation factor F_g, in (0, 1] (default 1).
-    #[serde(default = "one")]
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
     pub f_g: f64,
     /// Factor on the design velocity (default 1): a scaled model or a scaled regime.
-    #[serde(default = "one")]
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
     pub scale: f64,
 }
 
@@ -345,8 +347,10 @@ pub fn disturbance(
 }
 
 /// A state of the fold hinge in a gust sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "state", rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(tag = "state", rename_all = "snake_case", deny_unknown_fields))]
 pub enum HingeState {
     /// The hinge as the case has it, unlocked (with the case's own spring, if any).
     Free,
@@ -357,7 +361,7 @@ pub enum HingeState {
         /// Stiffness, N·m/rad.
         stiffness: f64,
         /// Damping, N·m·s/rad (default 0).
-        #[serde(default)]
+        #[cfg_attr(feature = "serde", serde(default))]
         damping: f64,
     },
 }
@@ -381,7 +385,7 @@ impl HingeState {
     }
 
     /// `case` with its fold hinge in this state.
-    pub fn apply(&self, case: &Case) -> Result<Case, String> {
+    pub fn apply(&self, case: &Problem) -> Result<Problem, String> {
         let mut c = case.clone();
         let j = c.fold_joint_index().ok_or("gust.hinges: the case has no flared hinge to free, lock or spring")?;
         if let Joint::FlaredHinge { locked, spring, .. } = &mut c.joints[j] {
@@ -403,20 +407,22 @@ impl HingeState {
 
 /// The gust sweep of a case (`gust`): 1-cos gusts of the case's `aero.gust` over gradients (or
 /// gust frequencies `f = V/(2H)`) and hinge states.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct GustSweep {
     /// Gust gradients H, m. Give this or `frequencies_hz`.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub gradients_m: Vec<f64>,
     /// Gust frequencies `f = V/(2H)`, Hz (the gust's length passes a point in 1/f).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub frequencies_hz: Vec<f64>,
     /// Hinge states, e.g. `[{"state": "free"}, {"state": "locked"}, {"state": "spring",
     /// "stiffness": 100}]`.
     pub hinges: Vec<HingeState>,
     /// Duration of each gust run, s (default: the case's `t_end`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub t_end: Option<f64>,
 }
 
@@ -426,7 +432,7 @@ pub const MAX_GUST_RUNS: usize = 400;
 impl GustSweep {
     /// Check the block against its case (which must have `aero` with a 1-cos `aero.gust` and a
     /// flared hinge), naming the field.
-    pub fn validate(&self, case: &Case) -> Result<(), String> {
+    pub fn validate(&self, case: &Problem) -> Result<(), String> {
         let Some(aero) = &case.aero else {
             return Err("gust: a gust sweep needs aerodynamics (`aero`)".into());
         };
@@ -492,7 +498,8 @@ impl GustSweep {
 }
 
 /// The values of the loads at the equilibrium a gust run starts from.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Equilibrium {
     /// Root bending moment, N·m.
     pub root_bending_moment: f64,
@@ -509,7 +516,8 @@ pub struct Equilibrium {
 /// The increments of a gust run's outputs over their equilibrium values at the output times: the
 /// time march's ([`GustHistory`]) and the linearised model's
 /// ([`crate::gust_linear::LinearGustHistory`]).
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Increments {
     /// Times, s (0 at the equilibrium; the gust's front starts `x0` upstream of the wing).
     pub t: Vec<f64>,
@@ -526,10 +534,11 @@ pub struct Increments {
 }
 
 /// One gust run: the incremental loads over their equilibrium values, at the output times.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct GustHistory {
     /// The increments.
-    #[serde(flatten)]
+    #[cfg_attr(feature = "serde", serde(flatten))]
     pub increments: Increments,
     /// The equilibrium.
     pub equilibrium: Equilibrium,
@@ -542,18 +551,18 @@ pub struct GustHistory {
 }
 
 fn cpu_now() -> (Instant, Option<f64>) {
-    (Instant::now(), crate::bench::thread_cpu_s())
+    (Instant::now(), crate::clock::thread_cpu_s())
 }
 
 fn cpu_since(t: (Instant, Option<f64>)) -> f64 {
-    match (t.1, crate::bench::thread_cpu_s()) {
+    match (t.1, crate::clock::thread_cpu_s()) {
         (Some(a), Some(b)) => b - a,
         _ => t.0.elapsed().as_secs_f64(),
     }
 }
 
 /// The static aeroelastic equilibrium of `case` at its airspeed: its coordinates.
-pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
+pub fn equilibrium_q(case: &Problem, f: Formulation) -> Result<Vec<f64>, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     // The steady state of the march's own wake, so that without a gust the run stays there.
     let wake = crate::stability::march_wake(case, f, aero.speed());
@@ -565,7 +574,7 @@ pub fn equilibrium_q(case: &Case, f: Formulation) -> Result<Vec<f64>, String> {
 /// static equilibrium `q_eq` (from [`equilibrium_q`]; computed when `None`) to `case.t_end`, and
 /// return the incremental loads. The function to call for one gust time history, e.g. to
 /// compare with a linearised model: `delta_root_bending_moment` against `t`.
-pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result<GustHistory, String> {
+pub fn gust_history(case: &Problem, f: Formulation, q_eq: Option<&[f64]>) -> Result<GustHistory, String> {
     let t0 = cpu_now();
     let owned;
     let q = match q_eq {
@@ -577,10 +586,10 @@ pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result
     };
     let static_cpu_s = cpu_since(t0);
     let t1 = cpu_now();
-    struct March<'a>(&'a Case, Formulation, &'a [f64]);
+    struct March<'a>(&'a Problem, Formulation, &'a [f64]);
     impl ForModel for March<'_> {
         type Output = Result<crate::run::RunOutput, String>;
-        fn run<M: CaseModel>(self) -> Self::Output {
+        fn run<M: BuildModel>(self) -> Self::Output {
             let mut m = M::build(self.0).map_err(|e| e.to_string())?;
             march(self.0, self.1, &mut m, self.2)
         }
@@ -612,10 +621,15 @@ pub fn gust_history(case: &Case, f: Formulation, q_eq: Option<&[f64]>) -> Result
     })
 }
 
-fn march<S: Structure>(case: &Case, f: Formulation, model: &mut S, q: &[f64]) -> Result<crate::run::RunOutput, String> {
+fn march<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    model: &mut S,
+    q: &[f64],
+) -> Result<crate::run::RunOutput, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let map = station_map(case, aero)?;
-    let settings = crate::scene::settings(case, f);
+    let settings = crate::factory::settings(case, f);
     Ok(simulate_aero_from(f, model, &settings, aero, &map, &mut crate::run::NoObserver, Some(q)))
 }
 
@@ -631,7 +645,8 @@ pub fn peak(t: &[f64], v: &[f64]) -> (f64, f64) {
 }
 
 /// One run of a gust sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct GustRun {
     /// Formulation.
     pub formulation: Formulation,
@@ -654,7 +669,7 @@ pub struct GustRun {
     /// Peak incremental lift, N, and its time.
     pub peak_delta_lift: (f64, f64),
     /// The history (skipped in the JSON summary; in `gust_history_<f>.csv`).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub history: Option<GustHistory>,
     /// The equilibrium.
     pub equilibrium: Option<Equilibrium>,
@@ -665,9 +680,10 @@ pub struct GustRun {
 }
 
 /// A formulation's sweep or a failure to start it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct GustSweepOutput {
-    /// Case (run) name.
+    /// Problem (run) name.
     pub name: String,
     /// Airspeed, m/s.
     pub airspeed: f64,
@@ -679,16 +695,16 @@ pub struct GustSweepOutput {
     pub wall_s: f64,
 }
 
-/// Run the gust sweep of `spec` (its `gust` block) with the formulations `fs`: first the static
+/// Run the gust sweep of `base` (its `gust` block) with each formulation of `cases` on its own problem: first the static
 /// equilibria of every (formulation, hinge state), then every gust run, each set in parallel
 /// (rayon).
-pub fn run_sweep(spec: &crate::case::RunSpec, fs: &[Formulation]) -> Result<GustSweepOutput, String> {
+pub fn run_sweep(base: &Problem, cases: &[(Formulation, &Problem)]) -> Result<GustSweepOutput, String> {
     use rayon::prelude::*;
     let t0 = Instant::now();
-    let case = &spec.ancf;
+    let case = base;
     let sweep = case.gust.as_ref().ok_or("the case has no `gust` block")?;
-    for &f in fs {
-        spec.case(f).gust.as_ref().ok_or("the case has no `gust` block")?.validate(spec.case(f))?;
+    for &(_, c) in cases {
+        c.gust.as_ref().ok_or("the case has no `gust` block")?.validate(c)?;
     }
     let aero = case.aero.as_ref().ok_or("gust: needs `aero`")?;
     let gust = aero.gust.clone().ok_or("aero.gust: missing")?;
@@ -696,12 +712,12 @@ pub fn run_sweep(spec: &crate::case::RunSpec, fs: &[Formulation]) -> Result<Gust
     let airspeed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let gradients = sweep.gradients(airspeed);
     // 1. Equilibria per (formulation, hinge state).
-    let pairs: Vec<(Formulation, HingeState)> =
-        fs.iter().flat_map(|&f| sweep.hinges.iter().map(move |&h| (f, h))).collect();
-    let equilibria: Vec<Result<(Case, Vec<f64>), String>> = pairs
+    let pairs: Vec<(Formulation, &Problem, HingeState)> =
+        cases.iter().flat_map(|&(f, c)| sweep.hinges.iter().map(move |&h| (f, c, h))).collect();
+    let equilibria: Vec<Result<(Problem, Vec<f64>), String>> = pairs
         .par_iter()
-        .map(|&(f, h)| {
-            let mut base = spec.case(f).clone();
+        .map(|&(f, c, h)| {
+            let mut base = c.clone();
             if let Some(t) = sweep.t_end {
                 base.t_end = t;
             }
@@ -715,7 +731,7 @@ pub fn run_sweep(spec: &crate::case::RunSpec, fs: &[Formulation]) -> Result<Gust
     let runs: Vec<GustRun> = jobs
         .par_iter()
         .map(|&(p, h)| {
-            let (f, hinge) = pairs[p];
+            let (f, _, hinge) = pairs[p];
             let g = gust.with_gradient(h);
             let mut run = GustRun {
                 formulation: f,
