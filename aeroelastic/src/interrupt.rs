@@ -1,6 +1,6 @@
 //! A stop request the time loops read before each step: a front end sets it from a signal
 //! handler (the harness on SIGINT/SIGTERM) or from its own code; the runs under way end after
-//! their current step with the rows so far and [`crate::run::interrupted_message`].
+//! their current step with the rows so far.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

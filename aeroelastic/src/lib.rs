@@ -11,16 +11,20 @@
 #![warn(missing_docs)]
 
 pub mod aero;
+pub mod aero_settings;
 pub mod clock;
 pub mod factory;
 pub mod gust;
+pub mod gust_field;
 pub mod gust_linear;
+pub mod gust_settings;
 pub mod interrupt;
 pub mod loads;
 pub mod pencil;
 pub mod problem;
 pub mod run;
 pub mod stability;
+pub mod stability_settings;
 pub mod static_hold;
 pub mod statics;
 

@@ -21,8 +21,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::SectionLoad;
 use crate::problem::{Formulation, Joint, Problem};
+use formulation::SectionLoad;
 
 /// The cut of a free body: its bodies and the point moments are taken about.
 #[derive(Debug, Clone, PartialEq)]

@@ -5,9 +5,9 @@
 //! (the harness's case file) builds one. [`Problem::scene`] maps it onto the [`scene::Scene`]
 //! both formulations build their models from.
 
-use crate::aero::AeroSettings;
-use crate::gust::GustSweep;
-use crate::stability::{StabilitySettings, WakeSettings};
+use crate::aero_settings::AeroSettings;
+use crate::gust_settings::GustSweep;
+use crate::stability_settings::{StabilitySettings, WakeSettings};
 
 #[cfg(feature = "serde")]
 fn default_rho_inf() -> f64 {

@@ -533,7 +533,7 @@ pub struct StaticOutput {
 pub fn equilibrium_at(
     case: &Problem,
     f: Formulation,
-    wake: crate::stability::WakeSettings,
+    wake: crate::stability_settings::WakeSettings,
 ) -> Result<StaticPoint, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let mut c = case.clone();
