@@ -58,18 +58,7 @@ pub struct BenchRow {
 
 /// CPU time consumed by the calling thread, s (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, ns
 /// resolution); `None` off Linux, where the caller falls back to wall time.
-#[cfg(target_os = "linux")]
-pub(crate) fn thread_cpu_s() -> Option<f64> {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: `ts` is a valid, writable timespec; the call only writes to it.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + 1e-9 * ts.tv_nsec as f64)
-}
-
-#[cfg(not(target_os = "linux"))]
-pub(crate) fn thread_cpu_s() -> Option<f64> {
-    None
-}
+pub(crate) use aeroelastic::clock::thread_cpu_s;
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);

@@ -645,7 +645,8 @@ fn check_analysis(cmd: FuzzCommand, path: &Path, file: &CaseFile, limits: &Limit
     // residual: naming the failure is what they are for).
     let (failed, texts, errors): (Option<String>, Vec<String>, Vec<String>) = match cmd {
         FuzzCommand::Static => {
-            let outs: Vec<_> = Formulation::ALL.iter().map(|&f| crate::statics::run_static(spec.case(f), f)).collect();
+            let outs: Vec<_> =
+                Formulation::ALL.iter().map(|&f| crate::statics::run_static(&spec.case(f).problem(), f)).collect();
             let s = crate::static_out::summarise(&spec.ancf, &spec.dir, outs);
             let failed = s.n_failed > 0 || s.runs.iter().any(|r| r.error.is_some());
             let errors = s.runs.iter().flat_map(|r| r.error.iter().chain(r.points.iter().flat_map(|p| &p.error)));
@@ -655,12 +656,12 @@ fn check_analysis(cmd: FuzzCommand, path: &Path, file: &CaseFile, limits: &Limit
         }
         FuzzCommand::Stability => {
             let outs: Vec<_> =
-                Formulation::ALL.iter().map(|&f| crate::stability::run_stability(spec.case(f), f)).collect();
+                Formulation::ALL.iter().map(|&f| crate::stability::run_stability(&spec.case(f).problem(), f)).collect();
             let errors = outs.iter().flat_map(|o| o.error.iter().chain(o.points.iter().flat_map(|p| &p.error)));
             let errors: Vec<String> = errors.cloned().collect();
             (errors.first().cloned(), vec![crate::stability_out::section_html(&spec.name, "x", &outs)], errors)
         }
-        _ => match crate::gust::run_sweep(spec, &Formulation::ALL) {
+        _ => match spec.gust_sweep(&Formulation::ALL) {
             Err(m) => return (Class::Rejected, format!("{}: {m}", path.display())),
             Ok(sweep) => {
                 let s = crate::gust_out::summarise(sweep);

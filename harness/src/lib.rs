@@ -9,7 +9,6 @@
 //! ([`shard`]) and are merged into one report ([`merge`]).
 #![warn(missing_docs)]
 
-pub mod aero;
 pub mod atomic;
 pub mod bench;
 pub mod budget;
@@ -20,28 +19,23 @@ pub mod driver;
 pub mod energy;
 pub mod fuzz;
 pub mod gate;
-pub mod gust;
-pub mod gust_linear;
 pub mod gust_out;
-pub mod loads;
 pub mod merge;
 pub mod metrics;
-pub mod pencil;
 pub mod plot;
 pub mod progress;
 pub mod report;
-pub mod run;
 pub mod scene;
 pub mod shard;
 pub mod signal;
-pub mod stability;
 pub mod stability_out;
-pub mod static_hold;
 pub mod static_out;
-pub mod statics;
 pub mod stress;
 pub mod view3d;
 pub mod vtk;
+
+// The analyses live in the `aeroelastic` library; their modules keep their harness paths.
+pub use aeroelastic::{aero, gust, gust_linear, loads, pencil, run, stability, static_hold, statics};
 
 /// Errors of the harness library (the binary adds context with anyhow).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -88,4 +82,12 @@ pub enum Error {
         /// What failed.
         msg: String,
     },
+}
+
+impl From<aeroelastic::Error> for Error {
+    fn from(e: aeroelastic::Error) -> Self {
+        match e {
+            aeroelastic::Error::Model { formulation, msg } => Error::Model { formulation, msg },
+        }
+    }
 }

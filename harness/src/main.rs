@@ -387,7 +387,7 @@ fn stress_extras(dir: &Path, set: &[Override]) -> Result<Vec<(String, RunSpec)>>
 /// The stability sweeps of `spec` with the formulations `fs`, in parallel.
 fn run_stability_case(spec: &RunSpec, fs: &[Formulation]) -> Vec<harness::stability::StabilityOutput> {
     use rayon::prelude::*;
-    fs.par_iter().map(|&f| harness::stability::run_stability(spec.case(f), f)).collect()
+    fs.par_iter().map(|&f| harness::stability::run_stability(&spec.case(f).problem(), f)).collect()
 }
 
 /// Print a stability sweep's results; true when a point failed.
@@ -438,8 +438,7 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
 /// `<out>/<case>/` and printed; true when a run of the sweep failed.
 fn gust_case(spec: &RunSpec, fs: &[Formulation], out: &Path, file: &str) -> Result<bool> {
     let mut failed = false;
-    let sweep =
-        harness::gust::run_sweep(spec, fs).map_err(|msg| harness::Error::Case { file: file.to_string(), msg })?;
+    let sweep = spec.gust_sweep(fs).map_err(|msg| harness::Error::Case { file: file.to_string(), msg })?;
     let summary = harness::gust_out::summarise(sweep);
     let dir = out.join(&spec.name);
     harness::gust_out::write(&dir, &summary)?;
@@ -554,9 +553,9 @@ fn run_stress(
 /// The static sweeps of `spec` with the formulations `fs`, in parallel, summarised.
 fn run_static_case(spec: &RunSpec, fs: &[Formulation]) -> harness::static_out::StaticSummary {
     use rayon::prelude::*;
-    let outs: Vec<_> = fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect();
+    let outs: Vec<_> = fs.par_iter().map(|&f| harness::statics::run_static(&spec.case(f).problem(), f)).collect();
     let mut summary = harness::static_out::summarise(&spec.ancf, &spec.dir, outs);
-    harness::static_hold::hold_references(spec, &mut summary);
+    harness::static_out::hold_references(spec, &mut summary);
     summary
 }
 

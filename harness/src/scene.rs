@@ -1,137 +1,34 @@
-//! Building each formulation's model from a case. Both models implement
-//! [`formulation::Structure`] in their own crates; the time loops and analyses are generic over
-//! it. [`dispatch`] is the one place that picks a formulation's model type.
+//! A case's runs: its problem ([`Case::problem`]) built and integrated by
+//! [`aeroelastic::factory`], the one place that picks a formulation's model type.
 
-use formulation::Structure;
-use genalpha::Predictor;
+pub use aeroelastic::factory::{BuildModel, ForModel, dispatch, predictor};
 
 use crate::Error;
-use crate::aero::{simulate_aero, station_map};
-use crate::case::{AncfPath, Case, Formulation};
-use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate};
-
-/// A formulation's model as a case builds it: [`Structure`] plus its construction and its
-/// Newton predictor. A third formulation implements this and adds one line to [`dispatch`].
-pub trait CaseModel: Structure + Send + Sync + Sized {
-    /// Newton's predictor for this formulation's time steps.
-    const PREDICTOR: Predictor;
-    /// Build the model of `case` (its scene and this formulation's options).
-    fn build(case: &Case) -> Result<Self, Error>;
-}
-
-impl CaseModel for ancf::Model {
-    /// ANCF's inertia is linear: constant accelerations.
-    const PREDICTOR: Predictor = Predictor::ConstantAcceleration;
-    fn build(case: &Case) -> Result<Self, Error> {
-        build_ancf(case)
-    }
-}
-
-impl CaseModel for gebf::Model {
-    /// GEBF starts Newton from extrapolated accelerations: its residual is quadratic in the
-    /// floating frames' angular velocities (Coriolis and centrifugal terms of the beam in a
-    /// frame spinning at up to 30 rad/s in the c = 0.01 case).
-    const PREDICTOR: Predictor = Predictor::ExtrapolatedAcceleration;
-    fn build(case: &Case) -> Result<Self, Error> {
-        build_gebf(case)
-    }
-}
-
-/// Work generic over a formulation's model type, run by [`dispatch`].
-pub trait ForModel {
-    /// What the work returns.
-    type Output;
-    /// Do the work with model type `M`.
-    fn run<M: CaseModel>(self) -> Self::Output;
-}
-
-/// The formulation factory: run `work` with the model type of formulation `f`.
-pub fn dispatch<W: ForModel>(f: Formulation, work: W) -> W::Output {
-    match f {
-        Formulation::Ancf => work.run::<ancf::Model>(),
-        Formulation::Gebf => work.run::<gebf::Model>(),
-    }
-}
-
-/// The Newton predictor of formulation `f` ([`CaseModel::PREDICTOR`]).
-pub fn predictor(f: Formulation) -> Predictor {
-    struct Of;
-    impl ForModel for Of {
-        type Output = Predictor;
-        fn run<M: CaseModel>(self) -> Predictor {
-            M::PREDICTOR
-        }
-    }
-    dispatch(f, Of)
-}
+use crate::case::{Case, Formulation};
+use crate::run::{Observer, RunOutput, RunSettings};
 
 /// The integrator parameters, end time and output interval of formulation `f` of a case.
 pub fn settings(case: &Case, f: Formulation) -> RunSettings {
-    let (dt, rho, newton, form) = match f {
-        Formulation::Ancf => (case.ancf.dt, case.ancf.rho_inf, case.ancf.newton, case.ancf.form),
-        Formulation::Gebf => (case.gebf.dt, case.gebf.rho_inf, case.gebf.newton, case.gebf.form),
-    };
-    let predictor = predictor(f);
-    let mut params = genalpha::IntegratorParams::new(rho, dt);
-    params.newton = newton.to_params(predictor);
-    // Both formulations default to the Arnold–Brüls form. GEBF's energy at rho_inf = 1 is better
-    // in the Chung–Hulbert form (the implicit midpoint rule: the β = 45° pendulum's energy error
-    // is 1.6e-4 of the peak kinetic energy instead of 1.35e-3), which costs 2 % more work on the
-    // c = 1 pendulums and 8–13 % on the soft ones (more Newton iterations where the tip twists,
-    // and B at two states), so a case opts in with `gebf.form`. Not even at rho_inf = 1, where
-    // it needs fewer Newton iterations on the paper cases: over the stress matrix's 72 GEBF
-    // cells at rho_inf = 1 (c × β × dt) it reaches the end at fixed steps in 46 against 51 (it
-    // fails on soft tips at 2–5 × dt, where step control then recovers them), although its
-    // energy error is 2–100 times smaller in most cells.
-    params.form = form.to_form();
-    // Wing loads are recorded with aerodynamics (the pendulums' outputs stay as they were).
-    let loads = if case.aero.is_some() { crate::loads::LoadModel::new(case, f) } else { None };
-    RunSettings { params, t_end: case.t_end, output_dt: case.output_dt, fold_joint: case.fold_joint_index(), loads }
+    aeroelastic::factory::settings(&case.problem(), f)
 }
 
 /// Build the ANCF model of a case (DAE or ODE path as the case says).
 pub fn build_ancf(case: &Case) -> Result<ancf::Model, Error> {
-    let path = match case.ancf.path {
-        AncfPath::Dae => ancf::SolvePath::Dae,
-        AncfPath::Ode => ancf::SolvePath::Ode,
-    };
-    ancf::Model::from_scene(&case.scene(Formulation::Ancf), ancf::Options { path, ..Default::default() })
-        .map_err(|e| Error::Model { formulation: Formulation::Ancf, msg: e.to_string() })
+    Ok(aeroelastic::factory::build_ancf(&case.problem())?)
 }
 
 /// Build the GEBF model of a case.
 pub fn build_gebf(case: &Case) -> Result<gebf::Model, Error> {
-    let options = gebf::Options { stabilization: case.gebf.stabilization, ..Default::default() };
-    gebf::Model::from_scene(&case.scene(Formulation::Gebf), options)
-        .map_err(|e| Error::Model { formulation: Formulation::Gebf, msg: e.to_string() })
+    Ok(aeroelastic::factory::build_gebf(&case.problem())?)
 }
 
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot
 /// be built gives a failed [`RunOutput`] with the reason.
 pub fn run_formulation(case: &Case, f: Formulation) -> RunOutput {
-    run_formulation_observed(case, f, &mut NoObserver)
+    aeroelastic::factory::run_formulation(&case.problem(), f)
 }
 
 /// As [`run_formulation`], handing every output step's geometry to `observer`.
 pub fn run_formulation_observed(case: &Case, f: Formulation, observer: &mut dyn Observer) -> RunOutput {
-    struct Run<'a, 'o> {
-        case: &'a Case,
-        f: Formulation,
-        observer: &'o mut dyn Observer,
-    }
-    impl ForModel for Run<'_, '_> {
-        type Output = Result<RunOutput, Error>;
-        fn run<M: CaseModel>(self) -> Self::Output {
-            let Run { case, f, observer } = self;
-            let s = settings(case, f);
-            match &case.aero {
-                None => M::build(case).map(|mut model| simulate(f, &mut model, &s, observer)),
-                Some(aero) => {
-                    let map = station_map(case, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
-                    M::build(case).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
-                }
-            }
-        }
-    }
-    dispatch(f, Run { case, f, observer }).unwrap_or_else(|e| RunOutput::failed(f, e.to_string()))
+    aeroelastic::factory::run_formulation_observed(&case.problem(), f, observer)
 }

@@ -4,10 +4,6 @@
 //! within [`GRACE`]: a computation that never looks at the flag (one static point, one
 //! eigen-solve) cannot keep a process alive against a single SIGTERM (`timeout`, a scheduler).
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
-static STOP: AtomicBool = AtomicBool::new(false);
-
 /// Exit status of a run ended by a signal (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
 
@@ -38,7 +34,7 @@ pub fn install() {
 
 #[cfg(target_os = "linux")]
 extern "C" fn handler(_sig: libc::c_int) {
-    if STOP.swap(true, Ordering::SeqCst) {
+    if aeroelastic::interrupt::request_stop() {
         // SAFETY: `_exit` is async-signal-safe.
         unsafe { libc::_exit(EXIT_INTERRUPTED as libc::c_int) }
     }
@@ -47,16 +43,16 @@ extern "C" fn handler(_sig: libc::c_int) {
 /// Whether a stop was requested.
 #[inline]
 pub fn interrupted() -> bool {
-    STOP.load(Ordering::Relaxed)
+    aeroelastic::interrupt::interrupted()
 }
 
 /// Ask the time loops to stop, as a signal does (for tests and embedding programs).
 pub fn request_stop() {
-    STOP.store(true, Ordering::SeqCst);
+    aeroelastic::interrupt::request_stop();
 }
 
 /// Clear a stop request once the runs it stopped have returned (an embedding program that goes
 /// on after an interrupt: the Python package after a `KeyboardInterrupt`).
 pub fn clear_stop() {
-    STOP.store(false, Ordering::SeqCst);
+    aeroelastic::interrupt::clear_stop();
 }

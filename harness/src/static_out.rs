@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use plotters::prelude::*;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Error;
@@ -114,7 +115,7 @@ pub struct StaticSummary {
     /// of the run against the static solution at the same airspeed.
     pub history: Vec<HistoryComparison>,
     /// The model held at the experiment's coast angles ([`crate::static_hold`]; filled by
-    /// [`crate::static_hold::hold_references`]).
+    /// [`hold_references`]).
     pub held: Vec<crate::static_hold::HeldPoint>,
 }
 
@@ -252,7 +253,7 @@ pub fn compare_with_history(summary: &mut StaticSummary, spec: &RunSpec, runs: &
         let fo: Vec<f64> = w.iter().map(|r| r.fold.to_degrees()).collect();
         let range = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
         let (tz_mean, fo_mean) = (tz.iter().sum::<f64>() / n, fo.iter().sum::<f64>() / n);
-        let run_wake = crate::stability::march_wake(case, run.formulation, airspeed);
+        let run_wake = crate::stability::march_wake(&case.problem(), run.formulation, airspeed);
         // A closed wake is the steady one: the point above, bit for bit.
         let like = if run_wake.closure { Ok((tip_z, fold)) } else { static_with_run_wake(case, run.formulation) };
         let (rw_tip, rw_fold, rw_err) = match like {
@@ -293,7 +294,8 @@ pub fn wake_label(w: &WakeSettings) -> String {
 /// A case without `aero`, or no equilibrium.
 pub fn static_with_run_wake(case: &Case, f: Formulation) -> Result<(f64, f64), String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
-    let p = crate::statics::equilibrium_at(case, f, crate::stability::march_wake(case, f, aero.speed()))?;
+    let problem = case.problem();
+    let p = crate::statics::equilibrium_at(&problem, f, crate::stability::march_wake(&problem, f, aero.speed()))?;
     Ok((p.tip[2], p.fold_deg))
 }
 
@@ -327,7 +329,7 @@ fn curve(out: &StaticOutput, f: impl Fn(&crate::statics::StaticPoint) -> f64) ->
 pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> StaticSummary {
     let mut references = Vec::new();
     for r in case.statics.iter().flat_map(|s| &s.references) {
-        let points = crate::statics::read_xy(&dir_of_case.join(&r.file)).unwrap_or_default();
+        let points = read_xy(&dir_of_case.join(&r.file)).unwrap_or_default();
         let mut errors = Vec::new();
         let mut rms_deg = Vec::new();
         for out in &runs {
@@ -863,4 +865,54 @@ fn held_html(held: &[crate::static_hold::HeldPoint]) -> String {
 
 fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+/// Hold each formulation's model of `spec` at every point of the experiment references of
+/// `summary` inside that formulation's converged airspeed range (the points its errors are
+/// taken at), in parallel; stored in `summary.held`. Nothing for a case without a free fold
+/// hinge or without an experiment.
+pub fn hold_references(spec: &RunSpec, summary: &mut StaticSummary) {
+    let mut jobs = Vec::new();
+    for r in summary.references.iter().filter(|r| r.experiment) {
+        for (f, errors) in &r.errors {
+            if !aeroelastic::static_hold::can_hold(&spec.case(*f).problem()) {
+                continue;
+            }
+            jobs.extend(errors.iter().map(|&(u, coast, _, _)| (*f, u, coast)));
+        }
+    }
+    summary.held = jobs
+        .par_iter()
+        .map(|&(f, u, coast)| aeroelastic::static_hold::hold(&spec.case(f).problem(), f, u, coast))
+        .collect();
+}
+
+/// Read a two-column CSV (a header line, then `x,y` rows; `#` comments allowed).
+pub fn read_xy(path: &Path) -> Result<Vec<(f64, f64)>, Error> {
+    let file = path.display().to_string();
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
+    parse_xy(&text).map_err(|msg| Error::Reference { file, msg })
+}
+
+/// Parse the text of [`read_xy`].
+pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
+    lines.next().ok_or("no header line")?;
+    let mut out = Vec::new();
+    for (n, line) in lines {
+        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        if f.len() < 2 {
+            return Err(format!("line {}: two columns expected", n + 1));
+        }
+        let num = |s: &str| s.parse::<f64>().map_err(|e| format!("line {}: {e}", n + 1));
+        let (x, y) = (num(f[0])?, num(f[1])?);
+        if !(x.is_finite() && y.is_finite()) {
+            return Err(format!("line {}: not finite", n + 1));
+        }
+        out.push((x, y));
+    }
+    if out.is_empty() {
+        return Err("no data rows".into());
+    }
+    Ok(out)
 }

@@ -170,7 +170,9 @@ fn static_sweep<'py>(
         interruptible(py, move || {
             specs
                 .iter()
-                .map(|spec| fs.par_iter().map(|&f| harness::statics::run_static(spec.case(f), f)).collect::<Vec<_>>())
+                .map(|spec| {
+                    fs.par_iter().map(|&f| harness::statics::run_static(&spec.case(f).problem(), f)).collect::<Vec<_>>()
+                })
                 .collect::<Vec<_>>()
         })?
     };
@@ -215,7 +217,9 @@ fn stability<'py>(
             specs
                 .iter()
                 .map(|spec| {
-                    fs.par_iter().map(|&f| harness::stability::run_stability(spec.case(f), f)).collect::<Vec<_>>()
+                    fs.par_iter()
+                        .map(|&f| harness::stability::run_stability(&spec.case(f).problem(), f))
+                        .collect::<Vec<_>>()
                 })
                 .collect::<Vec<_>>()
         })?

@@ -69,7 +69,7 @@ impl Case {
             g.validate()?;
         }
         if let Some(g) = &self.gust {
-            g.validate(self)?;
+            g.validate(&self.problem())?;
         }
         match (&self.statics, self.aero.is_some()) {
             (Some(st), false) => self.check_structural_static(st)?,
@@ -323,7 +323,7 @@ impl Case {
             return Err(format!("aero.coupling.relaxation: {} is not in (0, 1]", a.coupling.relaxation));
         }
         positive("aero.coupling.tolerance", a.coupling.tolerance)?;
-        crate::aero::station_map(self, a)?;
+        crate::aero::station_map(&self.problem(), a)?;
         // The lattice's own limit on a hinge column's slant, found here rather than at run time.
         for (i, j) in self.joints.iter().enumerate() {
             if let Joint::FlaredHinge { flare_deg, .. } = j

@@ -60,7 +60,7 @@ fn rigid_locked_wing_lift_matches_steady_uvlm() {
     let case = spec.case(Formulation::Ancf);
     let aero = case.aero.clone().unwrap();
     // The UVLM's own steady solution of the undeformed lattice, stations placed analytically.
-    let map = harness::aero::station_map(case, &aero).unwrap();
+    let map = harness::aero::station_map(&case.problem(), &aero).unwrap();
     // The scene's bodies carry the case's pitch.
     let scene = case.scene(Formulation::Ancf);
     let stations: Vec<uvlm::SpanStation> = map

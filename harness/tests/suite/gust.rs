@@ -36,7 +36,7 @@ fn no_gust_stays_at_equilibrium() {
         .flat_map(|(c, f)| [HingeState::Free, HingeState::Locked].into_iter().map(move |h| (c, f, h)))
     {
         let spec = case("wing_gust.json", &["t_end=2", &format!("aero.wake_closure={closure}")]);
-        let mut c = h.apply(spec.case(f)).unwrap();
+        let mut c = h.apply(&spec.case(f).problem()).unwrap();
         c.aero.as_mut().unwrap().gust = None;
         let hist = gust_history(&c, f, None).unwrap();
         assert!(hist.error.is_none(), "{f} {}: {:?}", h.label(), hist.error);
@@ -76,7 +76,7 @@ fn assert_formulations_agree(s: &harness::gust_out::GustSummary) {
 #[test]
 fn wing_gust_ancf_and_gebf_agree() {
     let spec = case("wing_gust.json", &["gust.gradients_m=[9, 107]"]);
-    let out = harness::gust::run_sweep(&spec, &Formulation::ALL).unwrap();
+    let out = spec.gust_sweep(&Formulation::ALL).unwrap();
     let s = harness::gust_out::summarise(out);
     assert_eq!(s.n_failed, 0);
     assert_formulations_agree(&s);
@@ -104,7 +104,7 @@ fn wing_gust_ancf_and_gebf_agree() {
 #[test]
 fn healy_free_hinge_gust_ancf_and_gebf_agree() {
     let spec = case("healy_ffwt_gust.json", &["gust.frequencies_hz=[4, 14]", "gust.hinges=[{\"state\": \"free\"}]"]);
-    let out = harness::gust::run_sweep(&spec, &Formulation::ALL).unwrap();
+    let out = spec.gust_sweep(&Formulation::ALL).unwrap();
     let s = harness::gust_out::summarise(out);
     assert_eq!(s.n_failed, 0);
     assert_eq!(s.ancf_gebf.len(), 2);
@@ -173,7 +173,7 @@ fn small_gust_matches_the_linearised_model() {
     let spec = case("wing_gust.json", &["t_end=4"]);
     for f in Formulation::ALL {
         for h in [HingeState::Free, HingeState::Locked] {
-            let mut c = h.apply(spec.case(f)).unwrap();
+            let mut c = h.apply(&spec.case(f).problem()).unwrap();
             c.aero.as_mut().unwrap().gust = Some(harness::gust::GustSpec::OneMinusCosine {
                 gradient_m: 25.0,
                 velocity: Some(0.025),

@@ -25,7 +25,7 @@ fn non_finite_section_load_fails_the_sweep_issue_33() {
     for f in Formulation::ALL {
         let mut case = spec.case(f).clone();
         case.statics.as_mut().unwrap().point_loads[0].force[1] = f64::NAN;
-        let out = run_static(&case, f);
+        let out = run_static(&case.problem(), f);
         assert!(!out.points.is_empty(), "{f}");
         for p in &out.points {
             let e = p.error.as_deref().unwrap_or_else(|| panic!("{f}: a point converged under a NaN load: {p:?}"));
@@ -45,7 +45,7 @@ fn out_of_range_section_load_fails_the_sweep_issue_33() {
         let mut case = spec.case(f).clone();
         let length = case.bodies.last().unwrap().length;
         case.statics.as_mut().unwrap().point_loads[0].at = Some(1.5 * length);
-        let out = run_static(&case, f);
+        let out = run_static(&case.problem(), f);
         let e = out.points[0].error.clone().unwrap_or_else(|| panic!("{f}: converged with a load off the body"));
         assert!(e.contains("station 0") && e.contains("outside"), "{f}: {e}");
         messages.push(e);

@@ -20,8 +20,10 @@ fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
 
 fn both(name: &str, set: &[&str]) -> (StabilityOutput, StabilityOutput) {
     let spec = case(name, set);
-    let (a, g) =
-        rayon::join(|| run_stability(&spec.ancf, Formulation::Ancf), || run_stability(&spec.gebf, Formulation::Gebf));
+    let (a, g) = rayon::join(
+        || run_stability(&spec.ancf.problem(), Formulation::Ancf),
+        || run_stability(&spec.gebf.problem(), Formulation::Gebf),
+    );
     for o in [&a, &g] {
         assert!(o.error.is_none(), "{name} {}: {:?}", o.formulation, o.error);
         assert!(o.points.iter().all(|p| p.error.is_none()), "{name} {}: a point failed", o.formulation);
@@ -112,7 +114,7 @@ fn goland_flutter_matches_sharpys_lattice_and_the_load_conventions_converge() {
                 "stability.airspeeds=[150,155,160,165,170,175,180]",
             ],
         );
-        let o = run_stability(&spec.gebf, Formulation::Gebf);
+        let o = run_stability(&spec.gebf.problem(), Formulation::Gebf);
         (o.flutter_speed.unwrap(), o.flutter_frequency_rad_s.unwrap())
     };
     let (v16, w16) = run(16, true);
@@ -231,7 +233,7 @@ fn the_aoa5_mode_converges_with_the_chordwise_lattice() {
                 ),
             ],
         );
-        let o = run_stability(&spec.ancf, Formulation::Ancf);
+        let o = run_stability(&spec.ancf.problem(), Formulation::Ancf);
         let r = o.points[0]
             .roots
             .iter()
@@ -308,7 +310,7 @@ fn a_perturbation_grows_or_decays_at_the_eigen_rate() {
             format!("aero.airspeed={u}"),
         ];
         let refs: Vec<&str> = common.iter().map(String::as_str).collect();
-        let lin = run_stability(&case("hale_flutter.json", &refs).gebf, Formulation::Gebf);
+        let lin = run_stability(&case("hale_flutter.json", &refs).gebf.problem(), Formulation::Gebf);
         // The flutter root: the least stable oscillatory root that the air acts on (at zero
         // incidence the in-plane bending mode, 31.7 rad/s, has no aerodynamic term and stays on
         // the imaginary axis; the tip's height does not see it).
@@ -405,7 +407,7 @@ fn sharpys_unsteady_load_makes_the_aoa5_mode_grow() {
 fn history_against_eigen(file: &str, sets: &[&str]) -> (harness::pencil::Oscillation, harness::stability::Root) {
     let spec = case(file, sets);
     let (lin, run) = rayon::join(
-        || run_stability(&spec.gebf, Formulation::Gebf),
+        || run_stability(&spec.gebf.problem(), Formulation::Gebf),
         || harness::scene::run_formulation(&spec.gebf, Formulation::Gebf),
     );
     assert!(run.error.is_none(), "{:?}", run.error);

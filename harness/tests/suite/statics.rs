@@ -24,8 +24,8 @@ fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
 fn both_formulations_reach_one_equilibrium_on_every_healy_case() {
     for name in ["healy_ffwt_flare10_aoa0.json", "healy_ffwt_flare10_aoa5.json", "healy_ffwt_flare30_aoa10.json"] {
         let spec = case(name, &[]);
-        let a = run_static(&spec.ancf, Formulation::Ancf);
-        let g = run_static(&spec.gebf, Formulation::Gebf);
+        let a = run_static(&spec.ancf.problem(), Formulation::Ancf);
+        let g = run_static(&spec.gebf.problem(), Formulation::Gebf);
         let scale = g.points.iter().map(|p| p.loads.root_bending_moment.abs()).fold(0.0, f64::max);
         for (pa, pg) in a.points.iter().zip(&g.points) {
             assert!(
@@ -58,7 +58,7 @@ fn a_damped_time_march_settles_on_the_static_equilibrium() {
         &["static.airspeeds=[20]", "aero.airspeed=20", "t_end=3", "aero.panels_per_body=[16,6]"],
     );
     for f in Formulation::ALL {
-        let st = run_static(spec.case(f), f);
+        let st = run_static(&spec.case(f).problem(), f);
         let p = &st.points[0];
         assert!(p.error.is_none(), "{f}: {:?}", p.error);
         let run = run_formulation(spec.case(f), f);
@@ -87,7 +87,7 @@ fn a_damped_time_march_settles_on_the_static_equilibrium() {
 fn the_hinge_moment_of_a_free_hinge_is_its_spring_moment() {
     let spec = case("healy_ffwt_flare30_aoa10.json", &["static.airspeeds=[14,24,33]"]);
     for f in Formulation::ALL {
-        for p in &run_static(spec.case(f), f).points {
+        for p in &run_static(&spec.case(f).problem(), f).points {
             let spring = 1e-4 * p.fold_deg.to_radians();
             assert!(
                 (p.loads.hinge_moment - spring).abs() < 2e-6,
@@ -110,7 +110,7 @@ fn gravity_alone_gives_the_weights_moments() {
         - 0.2592 * g * 0.365f64.powi(2) / 2.0
         - 0.02592 * g * (0.5f64.powi(2) - 0.365f64.powi(2)) / 2.0;
     for f in Formulation::ALL {
-        let p = &run_static(spec.case(f), f).points[0];
+        let p = &run_static(&spec.case(f).problem(), f).points[0];
         // The spar sags by a few millimetres: its moment arms shorten by less than 1e-4.
         assert!(
             (p.loads.root_bending_moment - rbm).abs() < 1e-4 * rbm.abs(),
@@ -192,8 +192,11 @@ fn static_with_the_runs_wake_meets_the_time_history_mean() {
     let f = Formulation::Gebf;
     let run = run_formulation(spec.case(f), f);
     assert!(run.error.is_none(), "{:?}", run.error);
-    let mut summary =
-        harness::static_out::summarise(spec.case(f), &root().join("cases"), vec![run_static(spec.case(f), f)]);
+    let mut summary = harness::static_out::summarise(
+        spec.case(f),
+        &root().join("cases"),
+        vec![run_static(&spec.case(f).problem(), f)],
+    );
     harness::static_out::compare_with_history(&mut summary, &spec, std::slice::from_ref(&run));
     let c = &summary.history[0];
     println!("{c:#?}");
@@ -221,13 +224,13 @@ fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
     let spec = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[27]"]);
     let lower = case("healy_ffwt_flare10_aoa5.json", &["static.airspeeds=[27]", "pitch_deg=3"]);
     for f in Formulation::ALL {
-        let own = run_static(spec.case(f), f).points[0].fold_deg;
-        let measured = run_static(lower.case(f), f).points[0].fold_deg;
+        let own = run_static(&spec.case(f).problem(), f).points[0].fold_deg;
+        let measured = run_static(&lower.case(f).problem(), f).points[0].fold_deg;
         assert!(own - measured > 5.0, "{f}: {own} vs {measured}");
-        let at_own = harness::static_hold::hold(spec.case(f), f, 27.0, own);
+        let at_own = harness::static_hold::hold(&spec.case(f).problem(), f, 27.0, own);
         assert!(at_own.error.is_none(), "{:?}", at_own.error);
         assert!(at_own.hinge_moment.abs() < 1e-5, "{f}: {at_own:?}");
-        let held = harness::static_hold::hold(spec.case(f), f, 27.0, measured);
+        let held = harness::static_hold::hold(&spec.case(f).problem(), f, 27.0, measured);
         println!("{held:?}");
         assert!(held.error.is_none(), "{:?}", held.error);
         assert!((held.fold_deg - measured).abs() < 1e-3, "{f}: held at {} for {measured}", held.fold_deg);
@@ -240,8 +243,8 @@ fn holding_the_tip_at_a_measured_angle_recovers_a_pitch_difference() {
         &["static.airspeeds=[27]", "joints.1.spring.stiffness=0.05", "joints.1.spring.rest_deg=3"],
     );
     for f in Formulation::ALL {
-        let own = run_static(sprung.case(f), f).points[0].fold_deg;
-        let at_own = harness::static_hold::hold(sprung.case(f), f, 27.0, own);
+        let own = run_static(&sprung.case(f).problem(), f).points[0].fold_deg;
+        let at_own = harness::static_hold::hold(&sprung.case(f).problem(), f, 27.0, own);
         assert!(at_own.hinge_moment.abs() < 1e-5, "{f}: {own} {at_own:?}");
     }
 }

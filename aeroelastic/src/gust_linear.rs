@@ -38,9 +38,9 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 use formulation::Structure;
 
 use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
-use crate::case::{Case, Formulation};
+use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::gust::Increments;
-use crate::scene::{CaseModel, ForModel, dispatch};
+use crate::problem::{Formulation, Problem};
 use crate::stability::{linear_wake, load_part, lump, reduce};
 
 type C64 = Complex<f64>;
@@ -72,15 +72,15 @@ const N_OUT: usize = 5;
 /// # Errors
 /// A case without `aero` or `aero.gust`, a failed equilibrium, or a failed reduction.
 pub fn linear_gust_history(
-    case: &Case,
+    case: &Problem,
     f: Formulation,
     basis_modes: Option<usize>,
     wake_motion: bool,
 ) -> Result<LinearGustHistory, String> {
-    struct Run<'a>(&'a Case, Formulation, Option<usize>, bool);
+    struct Run<'a>(&'a Problem, Formulation, Option<usize>, bool);
     impl ForModel for Run<'_> {
         type Output = Result<LinearGustHistory, String>;
-        fn run<M: CaseModel>(self) -> Self::Output {
+        fn run<M: BuildModel>(self) -> Self::Output {
             run(self.0, self.1, M::build, self.2, self.3)
         }
     }
@@ -88,9 +88,9 @@ pub fn linear_gust_history(
 }
 
 fn run<S: Structure>(
-    case: &Case,
+    case: &Problem,
     f: Formulation,
-    build: fn(&Case) -> Result<S, crate::Error>,
+    build: fn(&Problem) -> Result<S, crate::Error>,
     basis_modes: Option<usize>,
     wake_motion: bool,
 ) -> Result<LinearGustHistory, String> {
@@ -103,7 +103,7 @@ fn run<S: Structure>(
     let p = crate::statics::equilibrium_at(case, f, crate::stability::wake_settings(case, f, u))
         .map_err(|e| format!("static equilibrium: {e}"))?;
     let (q, lam, mu) = p.state.ok_or("static equilibrium: no state")?;
-    let settings = crate::scene::settings(case, f);
+    let settings = crate::factory::settings(case, f);
     let dt = settings.params.dt;
     let wake = linear_wake(case, f, u);
     let nb_req = basis_modes.or(case.stability.as_ref().and_then(|s| s.basis_modes)).unwrap_or(30);

@@ -9,12 +9,12 @@
 //! dominant oscillation is the complex pole pair with the largest amplitude.
 
 use nalgebra::{Complex, DMatrix, DVector};
-use serde::Serialize;
 
 type C64 = Complex<f64>;
 
 /// A damped oscillation found in a time window.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Oscillation {
     /// Window start, s.
     pub t_start: f64,

@@ -13,11 +13,7 @@
 //! stiffness, under 1e-3° here); the moment is the air and gravity moment about the axis at
 //! that state plus the case's own hinge spring.
 
-use rayon::prelude::*;
-use serde::Serialize;
-
-use crate::case::{Case, Formulation, Joint, RunSpec, Spring};
-use crate::static_out::StaticSummary;
+use crate::problem::{Formulation, Joint, Problem, Spring};
 
 /// Stiffness of the holding spring, N·m/rad (a hinge moment of 0.1 N·m moves the held fold by
 /// 6e-4°).
@@ -27,7 +23,8 @@ pub const HOLD_STIFFNESS: f64 = 1e4;
 pub const PITCH_STEP_DEG: f64 = 1.0;
 
 /// The model held at one measured coast angle.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct HeldPoint {
     /// Formulation.
     pub formulation: Formulation,
@@ -51,14 +48,14 @@ pub struct HeldPoint {
     /// incidence than the experiment's.
     pub equivalent_pitch_deg: f64,
     /// Why the point has no result, if it has none.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
     pub error: Option<String>,
 }
 
 /// `case` with its fold hinge held at `coast_deg` by the holding spring, at `airspeed` only,
 /// and its root pitch changed by `dpitch_deg`; with the case's own spring `(k, θ₀)` of the fold
 /// hinge. None when the case has no free fold hinge.
-fn held_case(case: &Case, airspeed: f64, coast_deg: f64, dpitch_deg: f64) -> Option<(Case, (f64, f64))> {
+fn held_case(case: &Problem, airspeed: f64, coast_deg: f64, dpitch_deg: f64) -> Option<(Problem, (f64, f64))> {
     let j = case.fold_joint_index()?;
     let mut c = case.clone();
     let Joint::FlaredHinge { locked: false, spring, .. } = &mut c.joints[j] else { return None };
@@ -67,14 +64,13 @@ fn held_case(case: &Case, airspeed: f64, coast_deg: f64, dpitch_deg: f64) -> Opt
     c.pitch_deg += dpitch_deg;
     let st = c.statics.as_mut()?;
     st.airspeeds = vec![airspeed];
-    st.references.clear();
     Some((c, own))
 }
 
 /// The fold (degrees) and the hinge moment with the case's own spring (N·m) of `case` held at
 /// `coast_deg`, root pitch changed by `dpitch_deg`.
 fn held_moment(
-    case: &Case,
+    case: &Problem,
     f: Formulation,
     airspeed: f64,
     coast_deg: f64,
@@ -94,7 +90,7 @@ fn held_moment(
 }
 
 /// The model of `case` held at the measured coast angle `coast_deg` at `airspeed`.
-pub fn hold(case: &Case, f: Formulation, airspeed: f64, coast_deg: f64) -> HeldPoint {
+pub fn hold(case: &Problem, f: Formulation, airspeed: f64, coast_deg: f64) -> HeldPoint {
     let rho = case.aero.as_ref().map_or(f64::NAN, |a| a.rho);
     let q = 0.5 * rho * airspeed * airspeed;
     let mut p = HeldPoint {
@@ -124,19 +120,7 @@ pub fn hold(case: &Case, f: Formulation, airspeed: f64, coast_deg: f64) -> HeldP
     p
 }
 
-/// Hold each formulation's model of `spec` at every point of the experiment references of
-/// `summary` inside that formulation's converged airspeed range (the points its errors are
-/// taken at), in parallel; stored in `summary.held`. Nothing for a case without a free fold
-/// hinge or without an experiment.
-pub fn hold_references(spec: &RunSpec, summary: &mut StaticSummary) {
-    let mut jobs = Vec::new();
-    for r in summary.references.iter().filter(|r| r.experiment) {
-        for (f, errors) in &r.errors {
-            if held_case(spec.case(*f), 0.0, 0.0, 0.0).is_none() {
-                continue;
-            }
-            jobs.extend(errors.iter().map(|&(u, coast, _, _)| (*f, u, coast)));
-        }
-    }
-    summary.held = jobs.par_iter().map(|&(f, u, coast)| hold(spec.case(f), f, u, coast)).collect();
+/// Whether `case` can be held: it has a free fold hinge and a `static` block.
+pub fn can_hold(case: &Problem) -> bool {
+    held_case(case, 0.0, 0.0, 0.0).is_some()
 }

@@ -3,9 +3,8 @@
 use std::time::Instant;
 
 use genalpha::{IntegratorParams, State, Stats};
-use serde::Serialize;
 
-use crate::case::Formulation;
+use crate::problem::Formulation;
 
 pub use formulation::{BeamGeometry, Energies, Structure};
 
@@ -89,7 +88,8 @@ impl<'o> SnapshotFeed<'o> {
 }
 
 /// One output row (the CSV columns).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Row {
     /// Time, s.
     pub t: f64,
@@ -293,7 +293,7 @@ pub fn simulate<S: Structure>(
         return out;
     }
     for k in 1..=n_steps {
-        if crate::signal::interrupted() {
+        if crate::interrupt::interrupted() {
             out.error = Some(interrupted_message(s.t));
             break;
         }

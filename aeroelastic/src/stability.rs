@@ -31,130 +31,22 @@
 use std::time::Instant;
 
 use nalgebra::{Complex, DMatrix, DVector, Vector3};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
 
 use formulation::Structure;
 
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
-use crate::case::{Case, Formulation};
-use crate::scene::{CaseModel, ForModel, dispatch};
+use crate::factory::{BuildModel, ForModel, dispatch};
+use crate::problem::{Formulation, Problem};
+
+pub use crate::stability_settings::{
+    About, AeroModel, MAX_LINEAR_WAKE_RINGS, MAX_STABILITY_POINTS, StabilitySettings, WakeSettings,
+};
 
 type C64 = Complex<f64>;
 
-/// The `stability` block of a case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct StabilitySettings {
-    /// Airspeeds of the sweep, m/s, in increasing order.
-    pub airspeeds: Vec<f64>,
-    /// Number of modes to track and report (the lowest structural modes).
-    pub modes: usize,
-    /// The state to linearise about: `"equilibrium"` (default; the static aeroelastic
-    /// equilibrium at each airspeed) or `"undeformed"` (the reference configuration, loads ignored).
-    #[serde(default)]
-    pub about: About,
-    /// Structural modes in the basis of the flutter equation (default: `max(2·modes, 20)`, at most
-    /// the free motions).
-    #[serde(default)]
-    pub basis_modes: Option<usize>,
-    /// The aerodynamics of the flutter equation: `"uvlm"` (default; the lattice) or `"strip"`
-    /// (2-D Theodorsen strips at the lattice's stations, R. T. Jones' approximation of C; no tip
-    /// loss: the model of strip-theory references such as Patil, Hodges & Cesnik's).
-    #[serde(default)]
-    pub aerodynamics: AeroModel,
-    /// The frozen wake of the linear aerodynamics; default: the time-marching wake
-    /// (`aero.n_wake_rows` rows of `airspeed·dt`, closed when `aero.wake_closure`).
-    #[serde(default)]
-    pub wake: Option<WakeSettings>,
-}
-
-/// The state a stability analysis linearises about.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum About {
-    /// The static aeroelastic equilibrium at each airspeed.
-    #[default]
-    Equilibrium,
-    /// The undeformed reference configuration.
-    Undeformed,
-}
-
-/// The aerodynamic model of a stability analysis.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum AeroModel {
-    /// The linearised UVLM.
-    #[default]
-    Uvlm,
-    /// Two-dimensional Theodorsen strips.
-    Strip,
-}
-
-/// A frozen wake of straight rows along the free stream: the linear aerodynamics'
-/// (`stability.wake`) or the static solution's (`static.wake`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct WakeSettings {
-    /// Length of a wake row along the free stream, m.
-    pub row_length: f64,
-    /// Number of rows.
-    pub rows: usize,
-    /// Close with semi-infinite legs. Default false.
-    #[serde(default)]
-    pub closure: bool,
-}
-
-/// Most airspeeds in one stability sweep.
-pub const MAX_STABILITY_POINTS: usize = 200;
-/// Most wake rings of the linear aerodynamics.
-pub const MAX_LINEAR_WAKE_RINGS: usize = 200_000;
-
-impl StabilitySettings {
-    /// Every impossible value, naming its field.
-    ///
-    /// # Errors
-    /// A message naming the field.
-    pub fn validate(&self) -> Result<(), String> {
-        if self.airspeeds.is_empty() {
-            return Err("stability.airspeeds: empty list".into());
-        }
-        if self.airspeeds.len() > MAX_STABILITY_POINTS {
-            return Err(format!(
-                "stability.airspeeds: {} points, more than {MAX_STABILITY_POINTS}",
-                self.airspeeds.len()
-            ));
-        }
-        for (k, &u) in self.airspeeds.iter().enumerate() {
-            if !(u.is_finite() && u > 0.0) {
-                return Err(format!("stability.airspeeds[{k}]: {u} is not a positive airspeed"));
-            }
-            if k > 0 && u <= self.airspeeds[k - 1] {
-                return Err(format!("stability.airspeeds[{k}]: {u} does not increase"));
-            }
-        }
-        if self.modes == 0 || self.modes > 100 {
-            return Err(format!("stability.modes: {} is not in 1..=100", self.modes));
-        }
-        if let Some(b) = self.basis_modes
-            && (b < self.modes || b > 400)
-        {
-            return Err(format!("stability.basis_modes: {b} is not in modes..=400"));
-        }
-        if let Some(w) = &self.wake {
-            if !(w.row_length.is_finite() && w.row_length > 0.0) {
-                return Err(format!("stability.wake.row_length: {} is not positive", w.row_length));
-            }
-            if w.rows == 0 || w.rows > 4000 {
-                return Err(format!("stability.wake.rows: {} is not in 1..=4000", w.rows));
-            }
-        }
-        Ok(())
-    }
-}
-
 /// One root of the flutter equation at one airspeed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Root {
     /// Index of the structural mode it was continued from (0 = lowest).
     pub mode: usize,
@@ -179,7 +71,8 @@ impl Root {
 }
 
 /// One airspeed of a stability sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StabilityPoint {
     /// Airspeed, m/s.
     pub airspeed: f64,
@@ -196,7 +89,8 @@ pub struct StabilityPoint {
 }
 
 /// A formulation's stability sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StabilityOutput {
     /// Formulation.
     pub formulation: Formulation,
@@ -230,14 +124,15 @@ pub struct StabilityOutput {
     pub wall_s: f64,
     /// Mode shapes of the first airspeed's structure: per mode, the displacement of each
     /// station's axis point (x, y, z per station) and the station arclengths.
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub shapes: Vec<ModeShape>,
     /// Why the sweep could not start.
     pub error: Option<String>,
 }
 
 /// Station displacements of one structural mode.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ModeShape {
     /// Natural frequency, rad/s.
     pub omega: f64,
@@ -624,8 +519,8 @@ pub fn reduce<S: Structure>(
     aero: &AeroSettings,
     wake: &uvlm::LinearWake,
     nb: usize,
-    shapes_out: Option<(&Case, &mut Vec<ModeShape>)>,
-    strip_case: Option<&Case>,
+    shapes_out: Option<(&Problem, &mut Vec<ModeShape>)>,
+    strip_case: Option<&Problem>,
 ) -> Result<Reduced, String> {
     let zero_loads: Vec<SectionLoad> = map
         .iter()
@@ -891,14 +786,14 @@ pub fn reduce<S: Structure>(
 }
 
 /// The linear wake of `case` at `airspeed`: the stability block's, or the time-marching one.
-pub fn linear_wake(case: &Case, f: Formulation, airspeed: f64) -> uvlm::LinearWake {
+pub fn linear_wake(case: &Problem, f: Formulation, airspeed: f64) -> uvlm::LinearWake {
     let w = wake_settings(case, f, airspeed);
     uvlm::LinearWake::uniform(w.rows, w.row_length, w.closure)
 }
 
 /// The time march's wake at `airspeed` with formulation `f`: `aero.n_wake_rows` rows of
 /// `airspeed·dt`, closed when `aero.wake_closure`.
-pub fn march_wake(case: &Case, f: Formulation, airspeed: f64) -> WakeSettings {
+pub fn march_wake(case: &Problem, f: Formulation, airspeed: f64) -> WakeSettings {
     let aero = case.aero.as_ref().expect("validated: needs aero");
     let dt = match f {
         Formulation::Ancf => case.ancf.dt,
@@ -911,7 +806,7 @@ pub fn march_wake(case: &Case, f: Formulation, airspeed: f64) -> WakeSettings {
 /// march's (`aero.n_wake_rows` rows of `airspeed·dt`, closed when `aero.wake_closure`). The
 /// equilibrium the analysis linearises about is that wake's steady state, as the time march's
 /// equilibrium is (`static.wake`, docs/statics.md §1).
-pub fn wake_settings(case: &Case, f: Formulation, airspeed: f64) -> WakeSettings {
+pub fn wake_settings(case: &Problem, f: Formulation, airspeed: f64) -> WakeSettings {
     case.stability.as_ref().and_then(|s| s.wake).unwrap_or_else(|| march_wake(case, f, airspeed))
 }
 
@@ -922,16 +817,16 @@ type Equilibrium = (Vec<f64>, Vec<f64>, Vec<f64>, f64);
 /// the machine's load), else wall time since the first call, s.
 fn cpu_now() -> f64 {
     static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
-    crate::bench::thread_cpu_s().unwrap_or_else(|| START.get_or_init(Instant::now).elapsed().as_secs_f64())
+    crate::clock::thread_cpu_s().unwrap_or_else(|| START.get_or_init(Instant::now).elapsed().as_secs_f64())
 }
 
 /// Run the stability sweep of `case` with formulation `f`.
-pub fn run_stability(case: &Case, f: Formulation) -> StabilityOutput {
+pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
-    struct Sweep<'a>(&'a Case, Formulation);
+    struct Sweep<'a>(&'a Problem, Formulation);
     impl ForModel for Sweep<'_> {
         type Output = StabilityOutput;
-        fn run<M: CaseModel>(self) -> StabilityOutput {
+        fn run<M: BuildModel>(self) -> StabilityOutput {
             sweep(self.0, self.1, M::build)
         }
     }
@@ -962,7 +857,11 @@ fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
     }
 }
 
-fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, crate::Error>) -> StabilityOutput {
+fn sweep<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    build: fn(&Problem) -> Result<S, crate::Error>,
+) -> StabilityOutput {
     let (Some(aero), Some(st)) = (case.aero.as_ref(), case.stability.as_ref()) else {
         return empty_output(f, Some("the case has no `aero` and `stability` blocks".into()));
     };
@@ -995,7 +894,7 @@ fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S
             let mut states = Vec::with_capacity(st.airspeeds.len());
             for (airspeeds, wake) in groups {
                 let mut c = case.clone();
-                c.statics = Some(crate::case::StaticSettings::at(airspeeds, Some(wake)));
+                c.statics = Some(crate::problem::StaticSettings::at(airspeeds, Some(wake)));
                 let so = crate::statics::run_static(&c, f);
                 if let Some(e) = so.error {
                     return empty_output(f, Some(e));

@@ -17,143 +17,11 @@
 //! 5. commit the UVLM step and add the aerodynamic work `∫ Σ (F·v + M·ω) dt` (trapezoidal).
 
 use nalgebra::{Matrix3, Vector3};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
 
-use crate::case::{Case, Joint};
+use crate::problem::{Joint, Problem};
+
+pub use crate::aero_settings::{AeroSettings, Coupling, MirrorPlane};
 use formulation::Structure;
-
-/// Aerodynamic settings of a case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AeroSettings {
-    /// Air density, kg/m³.
-    pub rho: f64,
-    /// Free-stream velocity, m/s (global). With `airspeed` it gives only the direction; omitted,
-    /// the free stream is `airspeed` along −Y.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub v_inf: Option<[f64; 3]>,
-    /// Free-stream speed, m/s: replaces the magnitude of `v_inf` (or flows along −Y without it).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub airspeed: Option<f64>,
-    /// Chord, m.
-    pub chord: f64,
-    /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
-    /// for a mid-chord axis).
-    pub le_offset: f64,
-    /// Spanwise panels per body, in body order.
-    pub panels_per_body: Vec<usize>,
-    /// Chordwise panels.
-    pub n_chordwise: usize,
-    /// Wake rows kept (truncation).
-    pub n_wake_rows: usize,
-    /// Vortex cut-off radius for bound and wake filaments, m (SHARPy-style; ~1 cm needed at high
-    /// AoA). Default 1e-6 m.
-    #[serde(default = "default_cutoff")]
-    pub cutoff_radius: f64,
-    /// Close the truncated wake with semi-infinite legs along the free stream (removes the
-    /// ≈ −1.3 % lift bias of a 40-row wake); default false (the paper's and SHARPy's set-up).
-    #[serde(default)]
-    pub wake_closure: bool,
-    /// Apply the Kutta–Joukowski force to the trailing-edge segment, whose net circulation
-    /// Γ_w0 − Γ_TE is what the last step shed (as SHARPy's linear UVLM and Ptera Software do);
-    /// default false (SHARPy's time-marching UVLM and the paper: the segment carries no load).
-    /// Zero in steady flow; a first-order discretisation term otherwise (≈ −ρ·h·Δy·dΓ_TE/dt with
-    /// h the wake row length), which vanishes as the chordwise panels are refined.
-    #[serde(default)]
-    pub te_segment_force: bool,
-    /// Give the last panel row's trailing-edge corners their quarter of the unsteady load term
-    /// ρ·A·n·dΓ/dt; default true (the whole term acts). False reproduces SHARPy's time-marching
-    /// UVLM, which skips those corners: the last row applies half its unsteady load.
-    #[serde(default = "default_true")]
-    pub unsteady_te_corners: bool,
-    /// Mirror planes (at most two, perpendicular): a wind-tunnel wall or floor at a wall-mounted
-    /// model's root, an aircraft's plane of symmetry, the ground. Each reflects every bound and
-    /// wake vortex (image vortices). Default none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub images: Vec<MirrorPlane>,
-    /// Coupling iteration settings.
-    #[serde(default)]
-    pub coupling: Coupling,
-    /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gust: Option<crate::gust::GustSpec>,
-}
-
-/// A mirror plane of the flow.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct MirrorPlane {
-    /// A point of the plane, m (global).
-    pub point: [f64; 3],
-    /// Its normal (any non-zero length), global.
-    pub normal: [f64; 3],
-}
-
-impl AeroSettings {
-    /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images;
-    /// single-threaded (runs are parallel across cases).
-    pub fn uvlm_params(&self, v_inf: [f64; 3]) -> uvlm::UvlmParams {
-        let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
-        params.n_wake_rows = self.n_wake_rows;
-        params.wake_closure = self.wake_closure;
-        params.te_segment_force = self.te_segment_force;
-        params.unsteady_te_corners = self.unsteady_te_corners;
-        params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
-        params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
-        params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
-        params.parallel = uvlm::Parallel::Off;
-        params
-    }
-}
-
-fn default_cutoff() -> f64 {
-    1e-6
-}
-
-fn default_true() -> bool {
-    true
-}
-
-impl AeroSettings {
-    /// The free-stream velocity, m/s: `v_inf`, scaled to `airspeed` when both are given, or
-    /// `airspeed` along −Y. Validated cases have one of them.
-    pub fn free_stream(&self) -> [f64; 3] {
-        match (self.v_inf, self.airspeed) {
-            (Some(v), None) => v,
-            (Some(v), Some(u)) => {
-                let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                [u * v[0] / n, u * v[1] / n, u * v[2] / n]
-            }
-            (None, Some(u)) => [0.0, -u, 0.0],
-            (None, None) => [0.0; 3],
-        }
-    }
-
-    /// The free stream's speed, m/s.
-    pub fn speed(&self) -> f64 {
-        let v = self.free_stream();
-        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-    }
-}
-
-/// Aero-structure coupling per step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields, default)]
-pub struct Coupling {
-    /// Extra sub-iterations per step (0 = loosely coupled).
-    pub max_sub_iterations: usize,
-    /// Relative change of the station loads that ends the sub-iterations.
-    pub tolerance: f64,
-    /// Relaxation factor of the loads between sub-iterations, in (0, 1].
-    pub relaxation: f64,
-}
-
-impl Default for Coupling {
-    fn default() -> Self {
-        Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0 }
-    }
-}
 
 pub use formulation::SectionLoad;
 
@@ -172,14 +40,14 @@ pub struct StationMap {
 
 impl StationMap {
     /// Arclength of the station along the wing, the bodies laid end to end, m.
-    pub fn wing_arc(&self, case: &Case) -> f64 {
+    pub fn wing_arc(&self, case: &Problem) -> f64 {
         case.bodies.iter().take(self.body).map(|b| b.length).sum::<f64>() + self.s
     }
 }
 
 /// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
 /// body's panels, the hinge column shared (driven by the inner body's end).
-pub fn station_map(case: &Case, aero: &AeroSettings) -> Result<Vec<StationMap>, String> {
+pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap>, String> {
     let nb = case.bodies.len();
     if aero.panels_per_body.len() != nb {
         return Err(format!("aero.panels_per_body: {} entries for {nb} bodies", aero.panels_per_body.len()));
@@ -224,7 +92,7 @@ pub fn station_map(case: &Case, aero: &AeroSettings) -> Result<Vec<StationMap>, 
 /// `tan γ = w tan β`, `w = max(0, 1 − d/D)` with `D = 2 max(le, c − le) |tan β|`, which keeps
 /// the leading- and trailing-edge nodes in spanwise order. Only the panel layout changes, not
 /// the planform; columns farther than `D` keep `γ = 0` exactly.
-fn grade_slants(case: &Case, aero: &AeroSettings, map: &mut [StationMap]) {
+fn grade_slants(case: &Problem, aero: &AeroSettings, map: &mut [StationMap]) {
     let arc = |m: &StationMap| m.wing_arc(case);
     let hinges: Vec<(f64, f64)> = map.iter().filter(|m| m.hinge).map(|m| (arc(m), m.slant)).collect();
     let reach = aero.le_offset.abs().max((aero.chord - aero.le_offset).abs());
@@ -314,7 +182,7 @@ fn power(loads: &[SectionLoad], vel: &[uvlm::StationVelocity]) -> f64 {
 /// Integrate an aeroelastic case (see the module docs for the scheme), from the model's initial
 /// state with an empty wake (an impulsive start).
 pub fn simulate_aero<S: Structure>(
-    formulation: crate::case::Formulation,
+    formulation: crate::problem::Formulation,
     model: &mut S,
     settings: &crate::run::RunSettings,
     aero: &AeroSettings,
@@ -331,7 +199,7 @@ pub fn simulate_aero<S: Structure>(
 /// (docs/gust.md §3). A gust (`aero.gust`) is attached in both cases, its front placed relative to
 /// the initial lattice's most upstream leading-edge point.
 pub fn simulate_aero_from<S: Structure>(
-    formulation: crate::case::Formulation,
+    formulation: crate::problem::Formulation,
     model: &mut S,
     settings: &crate::run::RunSettings,
     aero: &AeroSettings,
@@ -416,7 +284,7 @@ pub fn simulate_aero_from<S: Structure>(
         }
     }
     if let Some(g) = &aero.gust {
-        match crate::gust::disturbance(g, aero, &stations, settings.t_end, s.t) {
+        match crate::gust_field::disturbance(g, aero, &stations, settings.t_end, s.t) {
             Ok(d) => uv.set_disturbance(Some(d)),
             Err(e) => return fail(out, format!("aero.gust: {e}")),
         }
@@ -453,7 +321,7 @@ pub fn simulate_aero_from<S: Structure>(
     let mut dq = vec![0.0; s.v.len()];
     let mut vp = vec![0.0; s.v.len()];
     for k in 1..=n_steps {
-        if crate::signal::interrupted() {
+        if crate::interrupt::interrupted() {
             out.error = Some(crate::run::interrupted_message(s.t));
             break;
         }

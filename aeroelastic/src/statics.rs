@@ -18,22 +18,20 @@
 //! a point that fails is retried through intermediate airspeeds (bisection), and if it still
 //! fails it is reported and the sweep goes on from the last equilibrium.
 
-use std::path::Path;
 use std::sync::{Mutex, MutexGuard, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::Instant;
 
 use genalpha::analysis::{StaticParams, StaticSolution, StaticSolver};
 use genalpha::{ConstrainedSystem, MatView};
 use nalgebra::Vector3;
-use serde::Serialize;
 
 use crate::Error;
 use formulation::Structure;
 
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
-use crate::case::{Case, Formulation};
+use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::loads::{LoadModel, LoadScratch, WingLoads};
-use crate::scene::{CaseModel, ForModel, dispatch};
+use crate::problem::{Formulation, Problem};
 
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
@@ -463,7 +461,8 @@ impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
 }
 
 /// Lift per unit span of one lattice column at an equilibrium.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Strip {
     /// Arclength of the column's middle along the wing (bodies end to end), m.
     pub s: f64,
@@ -476,7 +475,8 @@ pub struct Strip {
 }
 
 /// One airspeed of a static sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StaticPoint {
     /// Airspeed, m/s.
     pub airspeed: f64,
@@ -494,19 +494,20 @@ pub struct StaticPoint {
     pub error: Option<String>,
     /// The load factor of a structural static case's point (`static.load_factors`; its
     /// airspeed is 0).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
     pub load_factor: Option<f64>,
     /// Spanwise lift distribution.
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub strips: Vec<Strip>,
     /// The equilibrium: coordinates and the multipliers of the holonomic and velocity
     /// constraints (for the linearisation about it).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub state: Option<(Vec<f64>, Vec<f64>, Vec<f64>)>,
 }
 
 /// A formulation's static sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StaticOutput {
     /// Formulation.
     pub formulation: Formulation,
@@ -530,13 +531,13 @@ pub struct StaticOutput {
 /// # Errors
 /// A case without `aero`, a failed sweep, or no equilibrium.
 pub fn equilibrium_at(
-    case: &Case,
+    case: &Problem,
     f: Formulation,
-    wake: crate::stability::WakeSettings,
+    wake: crate::stability_settings::WakeSettings,
 ) -> Result<StaticPoint, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let mut c = case.clone();
-    c.statics = Some(crate::case::StaticSettings::at(vec![aero.speed()], Some(wake)));
+    c.statics = Some(crate::problem::StaticSettings::at(vec![aero.speed()], Some(wake)));
     let out = run_static(&c, f);
     if let Some(e) = out.error {
         return Err(e);
@@ -551,12 +552,12 @@ pub fn equilibrium_at(
 
 /// Run the static sweep of `case` (its `static.airspeeds`, or for a structural case its
 /// `static.load_factors`) with formulation `f`.
-pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
+pub fn run_static(case: &Problem, f: Formulation) -> StaticOutput {
     let t0 = Instant::now();
-    struct Sweep<'a>(&'a Case, Formulation);
+    struct Sweep<'a>(&'a Problem, Formulation);
     impl ForModel for Sweep<'_> {
         type Output = StaticOutput;
-        fn run<M: CaseModel>(self) -> StaticOutput {
+        fn run<M: BuildModel>(self) -> StaticOutput {
             sweep(self.0, self.1, M::build)
         }
     }
@@ -565,7 +566,7 @@ pub fn run_static(case: &Case, f: Formulation) -> StaticOutput {
     out
 }
 
-fn failed_output(case: &Case, f: Formulation, msg: String) -> StaticOutput {
+fn failed_output(case: &Problem, f: Formulation, msg: String) -> StaticOutput {
     let speeds = case.statics.as_ref().map(|s| s.airspeeds.clone()).unwrap_or_default();
     StaticOutput {
         formulation: f,
@@ -618,7 +619,11 @@ const MAX_LOAD_STEP: f64 = 0.05;
 /// `static.load_factors`, each equilibrium reached from the previous one by equal load steps of
 /// at most [`MAX_LOAD_STEP`]. A point that fails ends the sweep (the later ones are reported as
 /// not reached).
-fn structural_sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
+fn structural_sweep<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    build: fn(&Problem) -> Result<S, Error>,
+) -> StaticOutput {
     let Some(st) = case.statics.as_ref() else {
         return failed_output(case, f, "the case has no `static` block".into());
     };
@@ -685,7 +690,7 @@ fn structural_sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) 
     StaticOutput { formulation: f, points, wall_s: 0.0, n_aero_solves: 0, n_tangents: 0, n_dof, error: None }
 }
 
-fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S, Error>) -> StaticOutput {
+fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Result<S, Error>) -> StaticOutput {
     if case.aero.is_none() && case.statics.as_ref().is_some_and(|s| !s.point_loads.is_empty()) {
         return structural_sweep(case, f, build);
     }
@@ -850,7 +855,7 @@ fn sweep<S: Structure>(case: &Case, f: Formulation, build: fn(&Case) -> Result<S
 fn point_at<S: Structure>(
     sys: &AeroStatic<'_, S>,
     q: &[f64],
-    case: &Case,
+    case: &Problem,
     loads_model: Option<&LoadModel>,
     map: &[StationMap],
     rho: f64,
@@ -913,37 +918,6 @@ pub fn lift_direction(v_inf: [f64; 3]) -> Vector3<f64> {
     let v = Vector3::from(v_inf).normalize();
     let span = Vector3::x() - v * v.x;
     v.cross(&span).normalize()
-}
-
-/// Read a two-column CSV (a header line, then `x,y` rows; `#` comments allowed).
-pub fn read_xy(path: &Path) -> Result<Vec<(f64, f64)>, Error> {
-    let file = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
-    parse_xy(&text).map_err(|msg| Error::Reference { file, msg })
-}
-
-/// Parse the text of [`read_xy`].
-pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
-    lines.next().ok_or("no header line")?;
-    let mut out = Vec::new();
-    for (n, line) in lines {
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() < 2 {
-            return Err(format!("line {}: two columns expected", n + 1));
-        }
-        let num = |s: &str| s.parse::<f64>().map_err(|e| format!("line {}: {e}", n + 1));
-        let (x, y) = (num(f[0])?, num(f[1])?);
-        if !(x.is_finite() && y.is_finite()) {
-            return Err(format!("line {}: not finite", n + 1));
-        }
-        out.push((x, y));
-    }
-    if out.is_empty() {
-        return Err("no data rows".into());
-    }
-    Ok(out)
 }
 
 // `AeroStatic` is a `ConstrainedSystem` (methods on `&self`) whose residual sets loads on the

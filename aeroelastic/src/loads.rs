@@ -21,8 +21,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::SectionLoad;
-use crate::case::{Case, Formulation, Joint};
+use crate::problem::{Formulation, Joint, Problem};
+use formulation::SectionLoad;
 
 /// The cut of a free body: its bodies and the point moments are taken about.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,11 +39,12 @@ struct BodyMass {
     mass: f64,
     cg: [f64; 2],
     rho_i: [f64; 3],
-    points: Vec<crate::case::PointMass>,
+    points: Vec<crate::problem::PointMass>,
 }
 
 /// Root and hinge loads of a case's wing at one state.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct WingLoads {
     /// Root force in the clamp's section frame `[axial, chordwise, normal]`, N (the load the
     /// wing puts on the clamp).
@@ -74,8 +75,8 @@ const GAUSS3: [(f64, f64); 3] =
 impl LoadModel {
     /// The free bodies of `case` as formulation `f` discretises it: the first clamp's body and
     /// everything joined outboard of it, and the outboard side of the fold hinge
-    /// ([`Case::fold_joint_index`]). `None` when the case has neither.
-    pub fn new(case: &Case, f: Formulation) -> Option<Self> {
+    /// ([`Problem::fold_joint_index`]). `None` when the case has neither.
+    pub fn new(case: &Problem, f: Formulation) -> Option<Self> {
         let n_el = match f {
             Formulation::Ancf => &case.ancf.elements_per_body,
             Formulation::Gebf => &case.gebf.elements_per_body,

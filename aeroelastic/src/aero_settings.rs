@@ -1,0 +1,142 @@
+//! The aerodynamic settings of a problem (`aero`): air, free stream, lattice, wake, images and
+//! the coupling iteration, and the UVLM parameters they give.
+
+use crate::gust_settings::GustSpec;
+
+/// Aerodynamic settings of a case.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct AeroSettings {
+    /// Air density, kg/m³.
+    pub rho: f64,
+    /// Free-stream velocity, m/s (global). With `airspeed` it gives only the direction; omitted,
+    /// the free stream is `airspeed` along −Y.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub v_inf: Option<[f64; 3]>,
+    /// Free-stream speed, m/s: replaces the magnitude of `v_inf` (or flows along −Y without it).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub airspeed: Option<f64>,
+    /// Chord, m.
+    pub chord: f64,
+    /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
+    /// for a mid-chord axis).
+    pub le_offset: f64,
+    /// Spanwise panels per body, in body order.
+    pub panels_per_body: Vec<usize>,
+    /// Chordwise panels.
+    pub n_chordwise: usize,
+    /// Wake rows kept (truncation).
+    pub n_wake_rows: usize,
+    /// Vortex cut-off radius for bound and wake filaments, m (SHARPy-style; ~1 cm needed at high
+    /// AoA). Default 1e-6 m.
+    #[cfg_attr(feature = "serde", serde(default = "default_cutoff"))]
+    pub cutoff_radius: f64,
+    /// Close the truncated wake with semi-infinite legs along the free stream (removes the
+    /// ≈ −1.3 % lift bias of a 40-row wake); default false (the paper's and SHARPy's set-up).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub wake_closure: bool,
+    /// Apply the Kutta–Joukowski force to the trailing-edge segment, whose net circulation
+    /// Γ_w0 − Γ_TE is what the last step shed (as SHARPy's linear UVLM and Ptera Software do);
+    /// default false (SHARPy's time-marching UVLM and the paper: the segment carries no load).
+    /// Zero in steady flow; a first-order discretisation term otherwise (≈ −ρ·h·Δy·dΓ_TE/dt with
+    /// h the wake row length), which vanishes as the chordwise panels are refined.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub te_segment_force: bool,
+    /// Give the last panel row's trailing-edge corners their quarter of the unsteady load term
+    /// ρ·A·n·dΓ/dt; default true (the whole term acts). False reproduces SHARPy's time-marching
+    /// UVLM, which skips those corners: the last row applies half its unsteady load.
+    #[cfg_attr(feature = "serde", serde(default = "default_true"))]
+    pub unsteady_te_corners: bool,
+    /// Mirror planes (at most two, perpendicular): a wind-tunnel wall or floor at a wall-mounted
+    /// model's root, an aircraft's plane of symmetry, the ground. Each reflects every bound and
+    /// wake vortex (image vortices). Default none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
+    pub images: Vec<MirrorPlane>,
+    /// Coupling iteration settings.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub coupling: Coupling,
+    /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub gust: Option<GustSpec>,
+}
+
+/// A mirror plane of the flow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct MirrorPlane {
+    /// A point of the plane, m (global).
+    pub point: [f64; 3],
+    /// Its normal (any non-zero length), global.
+    pub normal: [f64; 3],
+}
+
+impl AeroSettings {
+    /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images;
+    /// single-threaded (runs are parallel across cases).
+    pub fn uvlm_params(&self, v_inf: [f64; 3]) -> uvlm::UvlmParams {
+        let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
+        params.n_wake_rows = self.n_wake_rows;
+        params.wake_closure = self.wake_closure;
+        params.te_segment_force = self.te_segment_force;
+        params.unsteady_te_corners = self.unsteady_te_corners;
+        params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
+        params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
+        params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
+        params.parallel = uvlm::Parallel::Off;
+        params
+    }
+}
+
+fn default_cutoff() -> f64 {
+    1e-6
+}
+
+fn default_true() -> bool {
+    true
+}
+
+impl AeroSettings {
+    /// The free-stream velocity, m/s: `v_inf`, scaled to `airspeed` when both are given, or
+    /// `airspeed` along −Y. Validated cases have one of them.
+    pub fn free_stream(&self) -> [f64; 3] {
+        match (self.v_inf, self.airspeed) {
+            (Some(v), None) => v,
+            (Some(v), Some(u)) => {
+                let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                [u * v[0] / n, u * v[1] / n, u * v[2] / n]
+            }
+            (None, Some(u)) => [0.0, -u, 0.0],
+            (None, None) => [0.0; 3],
+        }
+    }
+
+    /// The free stream's speed, m/s.
+    pub fn speed(&self) -> f64 {
+        let v = self.free_stream();
+        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    }
+}
+
+/// Aero-structure coupling per step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct Coupling {
+    /// Extra sub-iterations per step (0 = loosely coupled).
+    pub max_sub_iterations: usize,
+    /// Relative change of the station loads that ends the sub-iterations.
+    pub tolerance: f64,
+    /// Relaxation factor of the loads between sub-iterations, in (0, 1].
+    pub relaxation: f64,
+}
+
+impl Default for Coupling {
+    fn default() -> Self {
+        Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0 }
+    }
+}

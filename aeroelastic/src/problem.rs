@@ -1,0 +1,664 @@
+//! The typed description of an aeroelastic problem: the structure (bodies, sections, point
+//! masses, joints with their springs, gravity, root pitch), each formulation's discretisation and
+//! integrator settings, and the optional aerodynamic, static, stability and gust settings. Every
+//! analysis of this crate takes a [`Problem`] (or parts of it) and a formulation; a front end
+//! (the harness's case file) builds one. [`Problem::scene`] maps it onto the [`scene::Scene`]
+//! both formulations build their models from.
+
+use crate::aero_settings::AeroSettings;
+use crate::gust_settings::GustSweep;
+use crate::stability_settings::{StabilitySettings, WakeSettings};
+
+#[cfg(feature = "serde")]
+fn default_rho_inf() -> f64 {
+    0.8
+}
+#[cfg(feature = "serde")]
+fn default_x_axis() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+#[cfg(feature = "serde")]
+fn default_y_axis() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// One problem: a structure, its discretisation per formulation and what acts on it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    /// Name (of the run).
+    pub name: String,
+    /// Bodies.
+    pub bodies: Vec<Body>,
+    /// Joints.
+    pub joints: Vec<Joint>,
+    /// Gravity, m/s² (global); none: zero.
+    pub gravity: Option<[f64; 3]>,
+    /// Nose-up root pitch of the whole structure about +X, degrees.
+    pub pitch_deg: f64,
+    /// Factor on every stiffness of every section.
+    pub stiffness_scale: f64,
+    /// End time of a time march, s.
+    pub t_end: f64,
+    /// Output interval of a time march, s (none: every step).
+    pub output_dt: Option<f64>,
+    /// Name of the joint whose fold angle is reported (none: the first flared hinge).
+    pub fold_joint: Option<String>,
+    /// ANCF's discretisation and integrator settings.
+    pub ancf: AncfSettings,
+    /// GEBF's discretisation and integrator settings.
+    pub gebf: GebfSettings,
+    /// Aerodynamics (none: in vacuo).
+    pub aero: Option<AeroSettings>,
+    /// The static sweep.
+    pub statics: Option<StaticSettings>,
+    /// The stability sweep.
+    pub stability: Option<StabilitySettings>,
+    /// The gust sweep.
+    pub gust: Option<GustSweep>,
+}
+
+/// The static sweep of a problem: airspeeds with aerodynamics, or dead point loads scaled by
+/// load factors without.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StaticSettings {
+    /// Airspeeds of the sweep, m/s.
+    pub airspeeds: Vec<f64>,
+    /// Dead point loads of a structural static problem.
+    pub point_loads: Vec<StaticPointLoad>,
+    /// Load factors of a structural static problem (increasing).
+    pub load_factors: Vec<f64>,
+    /// The steady wake of the static solution (none: semi-infinite legs along the free stream).
+    pub wake: Option<WakeSettings>,
+}
+
+impl StaticSettings {
+    /// An aeroelastic sweep over `airspeeds` with the steady wake `wake` (semi-infinite legs
+    /// when `None`).
+    pub fn at(airspeeds: Vec<f64>, wake: Option<WakeSettings>) -> Self {
+        Self { airspeeds, point_loads: Vec::new(), load_factors: Vec::new(), wake }
+    }
+}
+
+/// A dead point load of a structural static case (`static.point_loads`).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct StaticPointLoad {
+    /// Body name.
+    pub body: String,
+    /// Arclength of the loaded section from the body's start, m, in [0, length]. Default: the
+    /// body's end.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub at: Option<f64>,
+    /// Force, N, global components (held fixed: a dead load).
+    pub force: [f64; 3],
+    /// Moment, N·m, global components. Default zero.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub moment: [f64; 3],
+}
+
+/// Index of the body called `name` in `bodies`.
+pub fn body_index(bodies: &[Body], name: &str) -> Option<usize> {
+    bodies.iter().position(|b| b.name == name)
+}
+
+/// Index of the joint whose fold angle is reported: the joint called `fold_joint`, or the first
+/// flared hinge.
+pub fn fold_joint_index(joints: &[Joint], fold_joint: Option<&str>) -> Option<usize> {
+    match fold_joint {
+        Some(n) => joints.iter().position(|j| j.name() == Some(n)),
+        None => joints.iter().position(|j| matches!(j, Joint::FlaredHinge { .. })),
+    }
+}
+
+/// A straight beam body.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Body {
+    /// Name joints refer to.
+    pub name: String,
+    /// Start point, m (global).
+    pub start: [f64; 3],
+    /// Length, m.
+    pub length: f64,
+    /// Beam axis (section x) in global coordinates; normalised. Default +X.
+    #[cfg_attr(feature = "serde", serde(default = "default_x_axis"))]
+    pub x_axis: [f64; 3],
+    /// Section y axis in global coordinates; must be perpendicular to `x_axis`. Default +Y.
+    #[cfg_attr(feature = "serde", serde(default = "default_y_axis"))]
+    pub y_axis: [f64; 3],
+    /// Section properties per unit length.
+    pub section: Section,
+    /// Point masses fixed to the body's sections (default none).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
+    pub point_masses: Vec<PointMass>,
+}
+
+/// A rigid point mass fixed to a body's section.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct PointMass {
+    /// Arclength of the section it is fixed to, from the body's start, m.
+    pub at: f64,
+    /// Its centre relative to the section's axis point, `[x, y, z]` in the section frame, m
+    /// (default `[0, 0, 0]`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub offset: [f64; 3],
+    /// Mass, kg.
+    pub mass: f64,
+    /// Principal inertias about its own centre along the section axes `[I_xx, I_yy, I_zz]`,
+    /// kg·m² (default `[0, 0, 0]`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub inertia: [f64; 3],
+}
+
+/// A rotational spring and damper about a hinge's axis: the moment `−k (θ − θ₀) − c θ̇`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct Spring {
+    /// Stiffness k, N·m/rad (default 0).
+    pub stiffness: f64,
+    /// Damping c, N·m·s/rad (default 0).
+    pub damping: f64,
+    /// Rest angle θ₀, degrees, from the reference configuration (default 0).
+    pub rest_deg: f64,
+}
+
+/// Cross-section data per unit length (SI). The shear centre lies on the beam axis; the centre of
+/// mass may be offset by `cg_offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Section {
+    /// Mass per length m = ρA, kg/m.
+    pub mass: f64,
+    /// Torsional mass moment of inertia per length ρI_xx, kg·m.
+    pub rho_ixx: f64,
+    /// ρI_yy, kg·m.
+    pub rho_iyy: f64,
+    /// ρI_zz, kg·m.
+    pub rho_izz: f64,
+    /// Axial stiffness EA, N.
+    pub ea: f64,
+    /// Shear stiffness GA_y, N.
+    pub ga_y: f64,
+    /// Shear stiffness GA_z, N.
+    pub ga_z: f64,
+    /// Torsional stiffness GJ, N·m².
+    pub gj: f64,
+    /// Bending stiffness EI_yy, N·m².
+    pub ei_yy: f64,
+    /// Bending stiffness EI_zz, N·m².
+    pub ei_zz: f64,
+    /// Centre of mass in the section plane, `[y, z]` in the section frame, m (default `[0, 0]`).
+    /// The rotary inertias are about it.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero2"))]
+    pub cg_offset: [f64; 2],
+}
+
+fn is_zero2(v: &[f64; 2]) -> bool {
+    *v == [0.0; 2]
+}
+
+/// A joint.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(tag = "type", rename_all = "snake_case", deny_unknown_fields))]
+pub enum Joint {
+    /// The body's start point pinned to ground; rotation only about a fixed global axis.
+    GroundHinge {
+        /// Optional joint name.
+        #[cfg_attr(feature = "serde", serde(default))]
+        name: Option<String>,
+        /// Body name.
+        body: String,
+        /// Hinge axis, global (normalised).
+        axis: [f64; 3],
+        /// Rotational spring and damper about the axis (default none).
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+        spring: Option<Spring>,
+    },
+    /// Flared hinge from the end of `parent` to the start of `child`, axis
+    /// a = sin β·x + cos β·y in the parent's end section frame.
+    FlaredHinge {
+        /// Optional joint name.
+        #[cfg_attr(feature = "serde", serde(default))]
+        name: Option<String>,
+        /// Parent body name.
+        parent: String,
+        /// Child body name.
+        child: String,
+        /// Flare angle β, degrees, in [−90, 90].
+        flare_deg: f64,
+        /// Lock the hinge at its reference fold (the child welded to the parent's end section):
+        /// used for the rigid-wing check. Default false.
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "std::ops::Not::not"))]
+        locked: bool,
+        /// Rotational spring and damper about the hinge axis, on the fold angle (default none;
+        /// inactive while the hinge is `locked`).
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+        spring: Option<Spring>,
+    },
+    /// The body's start section clamped to ground.
+    Clamp {
+        /// Optional joint name.
+        #[cfg_attr(feature = "serde", serde(default))]
+        name: Option<String>,
+        /// Body name.
+        body: String,
+    },
+}
+
+impl Joint {
+    /// The joint's name, if any.
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            Joint::GroundHinge { name, .. } | Joint::FlaredHinge { name, .. } | Joint::Clamp { name, .. } => {
+                name.as_deref()
+            }
+        }
+    }
+}
+
+/// Newton settings (defaults as genalpha's, except `predictor`: see its field).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct NewtonSettings {
+    /// Maximum iterations per step.
+    pub max_iter: usize,
+    /// Relative increment tolerance.
+    pub rtol: f64,
+    /// Absolute increment tolerance (m).
+    pub atol: f64,
+    /// Holonomic constraint tolerance.
+    pub phi_tol: f64,
+    /// Velocity constraint tolerance (m/s).
+    pub psi_tol: f64,
+    /// Reuse factorisations while Newton contracts fast.
+    pub reuse_factorization: bool,
+    /// Stop Newton when the RADAU5-style convergence estimate θ/(1−θ)·|Δ| is below tolerance
+    /// (saves an iteration per step).
+    pub estimate_convergence: bool,
+    /// Broyden rank-one corrections of the steps made with a reused factorisation.
+    pub broyden: bool,
+    /// Retry a failed step as two half steps, at most this deep.
+    pub max_step_halvings: usize,
+    /// Local error control: halve a converged step whose error estimate
+    /// h²|β − 1/6|·max|Δa| (m; rotations weighted by the body length) exceeds this, within
+    /// `max_step_halvings`. 0 = off (default).
+    pub local_error_tol: f64,
+    /// Newton's starting point in each step. Default: `extrapolated_acceleration` for GEBF
+    /// (its floating frames' gyroscopic terms make Newton sensitive to the predicted
+    /// velocities), `constant_acceleration` for ANCF.
+    pub predictor: Option<PredictorSetting>,
+}
+
+/// Where the generalized-α step enforces the equations of motion (the constraints are
+/// enforced at the end of the step in both).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum FormSetting {
+    /// At the end of the step (Arnold & Brüls 2007); the trapezoidal rule at rho_inf = 1.
+    #[default]
+    ArnoldBruls,
+    /// At the α-weighted state inside the step (Chung & Hulbert 1993); the implicit midpoint
+    /// rule at rho_inf = 1, whose gyroscopic terms do no discrete work.
+    ChungHulbert,
+}
+
+impl FormSetting {
+    /// The name in case files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FormSetting::ArnoldBruls => "arnold_bruls",
+            FormSetting::ChungHulbert => "chung_hulbert",
+        }
+    }
+
+    /// The name in tables and legends.
+    pub fn label(self) -> &'static str {
+        match self {
+            FormSetting::ArnoldBruls => "Arnold–Brüls",
+            FormSetting::ChungHulbert => "Chung–Hulbert",
+        }
+    }
+
+    /// The genalpha form.
+    pub fn to_form(self) -> genalpha::Form {
+        match self {
+            FormSetting::ArnoldBruls => genalpha::Form::ArnoldBruls,
+            FormSetting::ChungHulbert => genalpha::Form::ChungHulbert,
+        }
+    }
+}
+
+/// Newton's starting point in each step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum PredictorSetting {
+    /// The acceleration of the last step.
+    ConstantAcceleration,
+    /// The acceleration extrapolated linearly from the last two steps.
+    ExtrapolatedAcceleration,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        let d = genalpha::NewtonParams::default();
+        Self {
+            max_iter: d.max_iter,
+            rtol: d.rtol,
+            atol: d.atol,
+            phi_tol: d.phi_tol,
+            psi_tol: d.psi_tol,
+            reuse_factorization: d.reuse_factorization,
+            estimate_convergence: d.estimate_convergence,
+            broyden: d.broyden,
+            max_step_halvings: d.max_step_halvings,
+            local_error_tol: d.local_error_tol,
+            predictor: None,
+        }
+    }
+}
+
+impl NewtonSettings {
+    /// As genalpha parameters, with `default_predictor` where the case sets none.
+    pub fn to_params(self, default_predictor: genalpha::Predictor) -> genalpha::NewtonParams {
+        genalpha::NewtonParams {
+            predictor: match self.predictor {
+                None => default_predictor,
+                Some(PredictorSetting::ConstantAcceleration) => genalpha::Predictor::ConstantAcceleration,
+                Some(PredictorSetting::ExtrapolatedAcceleration) => genalpha::Predictor::ExtrapolatedAcceleration,
+            },
+            max_iter: self.max_iter,
+            rtol: self.rtol,
+            atol: self.atol,
+            phi_tol: self.phi_tol,
+            psi_tol: self.psi_tol,
+            reuse_factorization: self.reuse_factorization,
+            estimate_convergence: self.estimate_convergence,
+            broyden: self.broyden,
+            max_step_halvings: self.max_step_halvings,
+            local_error_tol: self.local_error_tol,
+            ..Default::default()
+        }
+    }
+}
+
+/// Elements per body: one number for every body, or a list in body order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(untagged))]
+pub enum Elements {
+    /// The same count for every body.
+    Uniform(usize),
+    /// One count per body, in body order.
+    PerBody(Vec<usize>),
+}
+
+impl Elements {
+    /// Count for body `i` (the last entry repeats if the list is short; validation rejects that).
+    pub fn for_body(&self, i: usize) -> usize {
+        match self {
+            Elements::Uniform(n) => *n,
+            Elements::PerBody(v) => v.get(i).or(v.last()).copied().unwrap_or(0),
+        }
+    }
+    /// Every count multiplied by `k` (rounded, at least 1).
+    pub fn scaled(&self, k: f64) -> Elements {
+        let f = |n: usize| ((n as f64 * k).round() as usize).max(1);
+        match self {
+            Elements::Uniform(n) => Elements::Uniform(f(*n)),
+            Elements::PerBody(v) => Elements::PerBody(v.iter().map(|&n| f(n)).collect()),
+        }
+    }
+
+    /// Every impossible value, naming `field`: one count per body (or one for all), each at
+    /// least 1.
+    ///
+    /// # Errors
+    /// A message naming the field.
+    pub fn check(&self, field: &str, n_bodies: usize) -> Result<(), String> {
+        match self {
+            Elements::Uniform(0) => Err(format!("{field}: must be at least 1")),
+            Elements::Uniform(_) => Ok(()),
+            Elements::PerBody(v) if v.len() != n_bodies => {
+                Err(format!("{field}: {} entries for {n_bodies} bodies", v.len()))
+            }
+            Elements::PerBody(v) => match v.iter().position(|&n| n == 0) {
+                Some(i) => Err(format!("{field}[{i}]: must be at least 1")),
+                None => Ok(()),
+            },
+        }
+    }
+}
+
+impl std::fmt::Display for Elements {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Elements::Uniform(n) => write!(f, "{n}"),
+            Elements::PerBody(v) => {
+                let s: Vec<String> = v.iter().map(|n| n.to_string()).collect();
+                write!(f, "{}", s.join("+"))
+            }
+        }
+    }
+}
+
+/// ANCF solve path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum AncfPath {
+    /// Index-3 DAE with Lagrange multipliers.
+    #[default]
+    Dae,
+    /// Constraints eliminated with the constant velocity transformation B (paper eq. 6–7).
+    Ode,
+}
+
+/// ANCF settings.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct AncfSettings {
+    /// Two-node elements per body (a number, or a list in body order).
+    pub elements_per_body: Elements,
+    /// Time step, s.
+    pub dt: f64,
+    /// Spectral radius at infinite frequency. Default 0.8.
+    #[cfg_attr(feature = "serde", serde(default = "default_rho_inf"))]
+    pub rho_inf: f64,
+    /// DAE (default) or ODE path.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub path: AncfPath,
+    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
+    /// `chung_hulbert` is not available with aerodynamics.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub form: FormSetting,
+    /// Newton settings.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub newton: NewtonSettings,
+}
+
+/// GEBF settings.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct GebfSettings {
+    /// Three-node elements per body (a number, or a list in body order).
+    pub elements_per_body: Elements,
+    /// Time step, s.
+    pub dt: f64,
+    /// Spectral radius at infinite frequency. Default 0.8.
+    #[cfg_attr(feature = "serde", serde(default = "default_rho_inf"))]
+    pub rho_inf: f64,
+    /// Position-level projection of the joints after each step. Default off.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub stabilization: bool,
+    /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
+    /// `chung_hulbert` keeps the floating frames' gyroscopic forces from doing discrete work
+    /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies. Not available
+    /// with aerodynamics (the coupled step holds the loads of the step's end).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub form: FormSetting,
+    /// Newton settings.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub newton: NewtonSettings,
+}
+
+/// The two structural formulations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Formulation {
+    /// Absolute nodal coordinates.
+    Ancf,
+    /// Geometrically exact beam on floating frames.
+    Gebf,
+}
+
+impl Formulation {
+    /// Both, in report order.
+    pub const ALL: [Formulation; 2] = [Formulation::Ancf, Formulation::Gebf];
+    /// Lower-case name used in file names.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Formulation::Ancf => "ancf",
+            Formulation::Gebf => "gebf",
+        }
+    }
+}
+
+impl std::fmt::Display for Formulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl Problem {
+    /// Index of the body called `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        body_index(&self.bodies, name)
+    }
+
+    /// Index of the joint whose fold angle is reported.
+    pub fn fold_joint_index(&self) -> Option<usize> {
+        fold_joint_index(&self.joints, self.fold_joint.as_deref())
+    }
+
+    /// Total length of all bodies, m.
+    pub fn span(&self) -> f64 {
+        self.bodies.iter().map(|b| b.length).sum()
+    }
+
+    /// The scene of formulation `f`: bodies (stiffnesses scaled by `stiffness_scale`, element
+    /// counts of `f`), joints, hinge springs as force elements, gravity. Body names that do not
+    /// resolve become an index past the last body, which [`scene::Scene::validate`] rejects.
+    pub fn scene(&self, f: Formulation) -> scene::Scene {
+        let n_el = match f {
+            Formulation::Ancf => &self.ancf.elements_per_body,
+            Formulation::Gebf => &self.gebf.elements_per_body,
+        };
+        let unit = |v: [f64; 3]| nalgebra::Vector3::from(v).normalize();
+        // Nose-up pitch: a rotation about +X takes +Y (the leading edge) towards +Z.
+        let pitch = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), self.pitch_deg.to_radians());
+        let bodies = self
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let (x, y) = (pitch * unit(b.x_axis), pitch * unit(b.y_axis));
+                let s = &b.section;
+                let section = scene::Section {
+                    cg_offset: s.cg_offset,
+                    ..scene::Section::centred(
+                        s.mass, s.rho_ixx, s.rho_iyy, s.rho_izz, s.ea, s.ga_y, s.ga_z, s.gj, s.ei_yy, s.ei_zz,
+                    )
+                };
+                scene::BodySpec {
+                    name: b.name.clone(),
+                    start: pitch * nalgebra::Vector3::from(b.start),
+                    length: b.length,
+                    frame: nalgebra::Matrix3::from_columns(&[x, y, x.cross(&y)]),
+                    section: section.with_stiffness_scale(self.stiffness_scale),
+                    n_elements: n_el.for_body(i),
+                    point_masses: b
+                        .point_masses
+                        .iter()
+                        .map(|p| scene::PointMass {
+                            at: p.at,
+                            offset: p.offset.into(),
+                            mass: p.mass,
+                            inertia: p.inertia.into(),
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        let idx = |n: &str| self.body_index(n).unwrap_or(usize::MAX);
+        let joints = self
+            .joints
+            .iter()
+            .map(|j| match j {
+                Joint::GroundHinge { body, axis, .. } => {
+                    // Normalised here as the case promises (a zero axis stays zero for the
+                    // scene's validation to name).
+                    let a = nalgebra::Vector3::from(*axis);
+                    let axis = if a.norm() > 0.0 { a.normalize() } else { a };
+                    scene::JointSpec::GroundHinge { body: idx(body), axis }
+                }
+                Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
+                    let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
+                    if *locked {
+                        scene::JointSpec::LockedHinge { parent, child, beta }
+                    } else {
+                        scene::JointSpec::FlaredHinge { parent, child, beta }
+                    }
+                }
+                Joint::Clamp { body, .. } => scene::JointSpec::Clamp { body: idx(body) },
+            })
+            .collect();
+        let forces = self
+            .joints
+            .iter()
+            .enumerate()
+            .filter_map(|(joint, j)| match j {
+                // A locked hinge carries no spring: locking a sprung hinge (`--set
+                // joints.<i>.locked=true`) welds it and its spring does nothing.
+                Joint::FlaredHinge { locked: true, .. } => None,
+                Joint::GroundHinge { spring, .. } | Joint::FlaredHinge { spring, .. } => {
+                    spring.map(|s| scene::ForceElement::HingeSpring {
+                        joint,
+                        stiffness: s.stiffness,
+                        damping: s.damping,
+                        rest: s.rest_deg.to_radians(),
+                    })
+                }
+                Joint::Clamp { .. } => None,
+            })
+            .collect();
+        let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);
+        scene::Scene { bodies, joints, forces, gravity }
+    }
+}
