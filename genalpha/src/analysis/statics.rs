@@ -19,8 +19,17 @@
 //! [`increment_weight`](crate::ConstrainedSystem::increment_weight)) is at most
 //! [`StaticParams::tol`], or the residual has fallen below [`StaticParams::rel_residual_tol`]
 //! times its value at the start of the solve.
+//!
+//! The matrix is the model's [`residual_and_static_matrix_inplace`](crate::ConstrainedSystem::residual_and_static_matrix_inplace)
+//! (the exact tangent unless the model says otherwise). An iterate at which the residual
+//! cannot be evaluated (non-finite: e.g. an aerodynamic lattice that folds over) is not an error
+//! while the step can still be halved: the iteration goes back to the previous iterate and takes
+//! half the step, at most [`MAX_BACKTRACKS`] times per iteration.
 
 use crate::{ConstrainedSystem, DenseLu, DenseMatrix, Error, LinearSolver};
+
+/// Halvings of one Newton step whose iterate has a non-finite residual, before the solve fails.
+pub const MAX_BACKTRACKS: usize = 8;
 
 /// Settings of the static Newton iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,11 +105,15 @@ pub struct StaticSolver {
     lu: DenseLu,
     r: Vec<f64>,
     rhs: Vec<f64>,
-    q_new: Vec<f64>,
     zeros: Vec<f64>,
     weights: Vec<f64>,
     constraint: Vec<f64>,
     multipliers: Vec<f64>,
+    /// The previous iterate's coordinates and multipliers, and its step (all unknowns, the
+    /// multipliers' part unscaled), for halving a step that lands where the residual is not finite.
+    q_prev: Vec<f64>,
+    nu_prev: Vec<f64>,
+    step: Vec<f64>,
 }
 
 impl StaticSolver {
@@ -120,11 +133,13 @@ impl StaticSolver {
             lu,
             r: vec![0.0; n],
             rhs: vec![0.0; n_all],
-            q_new: vec![0.0; system.n_coords()],
             zeros: vec![0.0; n],
             weights: (0..n).map(|i| system.increment_weight(i)).collect(),
             constraint: vec![0.0; n_h + n_v],
             multipliers: vec![0.0; n_h + n_v],
+            q_prev: vec![0.0; system.n_coords()],
+            nu_prev: vec![0.0; n_h + n_v],
+            step: vec![0.0; n_all],
         }
     }
 
@@ -174,17 +189,26 @@ impl StaticSolver {
             "the system's dimensions differ from the solver's"
         );
         assert!(
-            x.q.len() == self.q_new.len() && x.lambda.len() == n_h && x.mu.len() == n_v,
+            x.q.len() == self.q_prev.len() && x.lambda.len() == n_h && x.mu.len() == n_v,
             "the estimate's dimensions differ from the system's"
         );
         let mut res0 = f64::NAN;
+        // Fraction of the last step taken, and its halvings so far (None before the first step).
+        let mut halving: Option<(f64, usize)> = None;
         for iter in 0..self.params.max_iter {
             let res = self.assemble(system, t, x);
             x.residual_norm = res;
             if !res.is_finite() {
-                return Err(Error::NonFinite { t, iter });
+                match halving {
+                    Some((alpha, k)) if k < MAX_BACKTRACKS => {
+                        self.take_step(system, x, 0.5 * alpha, &normalise);
+                        halving = Some((0.5 * alpha, k + 1));
+                        continue;
+                    }
+                    _ => return Err(Error::NonFinite { t, iter }),
+                }
             }
-            if iter == 0 {
+            if iter == 0 || res0.is_nan() {
                 res0 = res;
             } else if res <= self.params.rel_residual_tol * res0 {
                 self.finish(system, t, x);
@@ -197,12 +221,14 @@ impl StaticSolver {
             }
             let scale = self.constraint_scale();
             x.increment_norm = self.rhs[..n].iter().zip(&self.weights).fold(0.0_f64, |m, (d, w)| m.max((d * w).abs()));
-            system.retract_inplace(&x.q, &self.rhs[..n], &mut self.q_new);
-            normalise(&mut self.q_new);
-            std::mem::swap(&mut x.q, &mut self.q_new);
-            for (l, d) in x.lambda.iter_mut().chain(x.mu.iter_mut()).zip(&self.rhs[n..]) {
-                *l += scale * d;
+            self.q_prev.copy_from_slice(&x.q);
+            for (p, l) in self.nu_prev.iter_mut().zip(x.lambda.iter().chain(x.mu.iter())) {
+                *p = *l;
             }
+            self.step.copy_from_slice(&self.rhs);
+            self.step[n..].iter_mut().for_each(|d| *d *= scale);
+            self.take_step(system, x, 1.0, &normalise);
+            halving = Some((1.0, 0));
             x.n_iterations += 1;
             if x.increment_norm <= self.params.tol {
                 self.finish(system, t, x);
@@ -215,6 +241,23 @@ impl StaticSolver {
             residual_norm: x.residual_norm,
             increment_norm: x.increment_norm,
         })
+    }
+
+    /// `x ← (q_prev ∘ exp(α δq), ν_prev + α δν)` with the stored step.
+    fn take_step<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        x: &mut StaticSolution,
+        alpha: f64,
+        normalise: &impl Fn(&mut [f64]),
+    ) {
+        let n = self.n;
+        self.rhs[..n].iter_mut().zip(&self.step[..n]).for_each(|(r, d)| *r = alpha * d);
+        system.retract_inplace(&self.q_prev, &self.rhs[..n], &mut x.q);
+        normalise(&mut x.q);
+        for ((l, p), d) in x.lambda.iter_mut().chain(x.mu.iter_mut()).zip(&self.nu_prev).zip(&self.step[n..]) {
+            *l = p + alpha * d;
+        }
     }
 
     /// The scale of the constraint rows and columns: `max(1, max_i |K_ii|)`, read back from the
@@ -253,17 +296,7 @@ impl StaticSolver {
         self.mat.fill_zero();
         {
             let mut k = self.mat.block(0, 0, n, n);
-            system.residual_and_iteration_matrix_inplace(
-                t,
-                &x.q,
-                &self.zeros,
-                &self.zeros,
-                &mut self.r,
-                0.0,
-                0.0,
-                1.0,
-                &mut k,
-            );
+            system.residual_and_static_matrix_inplace(t, &x.q, &self.zeros, &mut self.r, &mut k);
             system.constraint_force_tangent_inplace(t, &x.q, &x.lambda, &x.mu, 1.0, &mut k);
         }
         self.constraint_rows(system, t, x);
