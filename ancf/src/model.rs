@@ -1056,6 +1056,10 @@ impl ConstrainedSystem for Model {
         }
     }
 
+    fn has_static_matrix(&self) -> bool {
+        true
+    }
+
     fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {
         if self.options.path == SolvePath::Dae {
             for (p, row) in phi.iter_mut().zip(&self.rows) {

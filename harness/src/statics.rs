@@ -445,6 +445,9 @@ impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
         read(&self.model).residual_and_static_matrix_inplace(t, q, zeros, r, k);
         self.add_aero(t, q, zeros, zeros, r, 1.0, k);
     }
+    fn has_static_matrix(&self) -> bool {
+        read(&self.model).has_static_matrix()
+    }
     fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
         read(&self.model).phi_inplace(t, q, phi);
     }
