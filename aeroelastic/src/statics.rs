@@ -305,6 +305,32 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         }
     }
 
+    /// The residual with the loads of `q` into `r`, and `c_k` times the aerodynamic stiffness
+    /// added to `k` (the structure's matrix is already there).
+    #[allow(clippy::too_many_arguments)] // the state, the residual and the matrix with its weight
+    fn add_aero(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64], c_k: f64, k: &mut MatView<'_>) {
+        if !self.apply_loads(q) {
+            r.iter_mut().for_each(|x| *x = f64::NAN);
+            return;
+        }
+        read(&self.model).residual_inplace(t, q, v, v_dot, r);
+        if c_k == 0.0 {
+            return;
+        }
+        self.update_tangent(t, q);
+        let tg = lock(&self.tangent);
+        let n = self.n_dof();
+        let scale = c_k * self.speed2 / tg.speed2;
+        for i in 0..n {
+            for j in 0..n {
+                let v = tg.k[i * n + j];
+                if v != 0.0 {
+                    k.add(i, j, scale * v);
+                }
+            }
+        }
+    }
+
     /// Decide whether to refresh the aerodynamic stiffness at `q`, and do it: the forward
     /// difference of the whole generalised aerodynamic load, so that both the lattice's
     /// response and the way a formulation applies a station load (ANCF's moments through the
@@ -405,26 +431,20 @@ impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
             return;
         }
         read(&self.model).residual_and_iteration_matrix_inplace(t, q, v, v_dot, r, c_m, c_c, c_k, k);
-        if !self.apply_loads(q) {
-            r.iter_mut().for_each(|x| *x = f64::NAN);
+        self.add_aero(t, q, v, v_dot, r, c_k, k);
+    }
+    fn residual_and_static_matrix_inplace(&self, t: f64, q: &[f64], zeros: &[f64], r: &mut [f64], k: &mut MatView<'_>) {
+        // The structure's Newton matrix at rest without loads, then as above.
+        if let Err(e) = write(&self.model).set_section_loads(&self.zero_loads) {
+            *lock(&self.error) = Some(e.to_string());
+            r.fill(f64::NAN);
             return;
         }
-        read(&self.model).residual_inplace(t, q, v, v_dot, r);
-        if c_k == 0.0 {
-            return;
-        }
-        self.update_tangent(t, q);
-        let tg = lock(&self.tangent);
-        let n = self.n_dof();
-        let scale = c_k * self.speed2 / tg.speed2;
-        for i in 0..n {
-            for j in 0..n {
-                let v = tg.k[i * n + j];
-                if v != 0.0 {
-                    k.add(i, j, scale * v);
-                }
-            }
-        }
+        read(&self.model).residual_and_static_matrix_inplace(t, q, zeros, r, k);
+        self.add_aero(t, q, zeros, zeros, r, 1.0, k);
+    }
+    fn has_static_matrix(&self) -> bool {
+        read(&self.model).has_static_matrix()
     }
     fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
         read(&self.model).phi_inplace(t, q, phi);

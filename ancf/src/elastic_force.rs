@@ -126,7 +126,7 @@ fn symmetric_times<const L: usize>(
 /// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a < b`;
 ///    diagonal blocks `a = b` on and above their diagonal only) at a time with fixed-size loops.
 #[inline(always)]
-fn add_group_tangent<const M: usize, const NB: usize, const NEWTON: bool>(
+fn add_group_tangent<const M: usize, const NB: usize, const MODE: u8>(
     plan: &StrainPlan,
     group: &StrainGroup,
     x: &[[f64; 3]; N_BLOCKS],
@@ -158,7 +158,7 @@ fn add_group_tangent<const M: usize, const NB: usize, const NEWTON: bool>(
         }
         let w = c * s.stiffness;
         let mut d = value - s.reference;
-        if NEWTON && newton_drops_geometric(s.kind, d) {
+        if MODE != EXACT && newton_drops_geometric(s.kind, d, MODE) {
             d = 0.0;
         }
         let wd = w * d;
@@ -196,14 +196,24 @@ fn add_group_tangent<const M: usize, const NB: usize, const NEWTON: bool>(
     }
 }
 
-/// Whether [`Element::add_newton_tangent_upper`] leaves out the geometric term of a strain of
-/// this kind at `s − s⁰ = d`: a section stretch penalty under compression, and the section shear
-/// penalty (`r_y·r_z`, whose geometric term is indefinite) always.
+/// The exact tangent.
+const EXACT: u8 = 0;
+/// Newton's matrix of a time step ([`Element::add_newton_tangent_upper`]).
+const TIME_STEP: u8 = 1;
+/// Newton's matrix at rest ([`Element::add_rest_tangent_upper`]).
+const AT_REST: u8 = 2;
+
+/// Whether a tangent of kind `mode` leaves out the geometric term of a strain of this kind at
+/// `s − s⁰ = d`. Time step: a section stretch penalty under compression, and the section shear
+/// penalty (`r_y·r_z`, whose geometric term is indefinite) always. At rest also the transverse
+/// shears (indefinite) always and the axial strain under compression.
 #[inline(always)]
-fn newton_drops_geometric(kind: StrainKind, d: f64) -> bool {
+fn newton_drops_geometric(kind: StrainKind, d: f64, mode: u8) -> bool {
     match kind {
         StrainKind::SectionYY | StrainKind::SectionZZ => d < 0.0,
         StrainKind::SectionYZ => true,
+        StrainKind::ShearY | StrainKind::ShearZ => mode == AT_REST,
+        StrainKind::Axial => mode == AT_REST && d < 0.0,
         _ => false,
     }
 }
@@ -330,7 +340,7 @@ impl Element {
     ///
     /// [`StrainGroup`]: crate::strain::StrainGroup
     pub fn add_elastic_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        self.add_tangent_upper::<false>(e, c, k)
+        self.add_tangent_upper::<EXACT>(e, c, k)
     }
 
     /// [`Self::add_elastic_tangent_upper`] for Newton's iteration matrix of a time step
@@ -342,29 +352,41 @@ impl Element {
     /// matrix and make it near-singular. Every other term is the exact tangent's; the residual is
     /// unchanged, so Newton converges to the same solution.
     pub fn add_newton_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        self.add_tangent_upper::<true>(e, c, k)
+        self.add_tangent_upper::<TIME_STEP>(e, c, k)
+    }
+
+    /// [`Self::add_elastic_tangent_upper`] for Newton's matrix at rest (statics, docs/ancf.md §9):
+    /// as [`Self::add_newton_tangent_upper`], and also without the geometric terms of the
+    /// transverse shears (indefinite) and of a compressed axial strain. With near-rigid shear and
+    /// axial stiffnesses (GA of 1e8–1e9 N) the transient strains of an iterate that turns a body
+    /// linearly (a stretch `θ²/2`) make these terms outweigh the bending and hinge stiffness by
+    /// orders of magnitude, and Newton's steps wander; at the equilibrium they are the stress
+    /// stiffening of the section forces, which are small against the elastic terms kept, so the
+    /// iteration still converges, to the same solution.
+    pub fn add_rest_tangent_upper(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.add_tangent_upper::<AT_REST>(e, c, k)
     }
 
     #[inline]
-    fn add_tangent_upper<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+    fn add_tangent_upper<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { self.tangent_avx2::<NEWTON>(e, c, k) };
+            unsafe { self.tangent_avx2::<MODE>(e, c, k) };
             return;
         }
-        self.tangent_generic::<NEWTON>(e, c, k)
+        self.tangent_generic::<MODE>(e, c, k)
     }
 
     /// [`Self::add_elastic_tangent_upper`] compiled with AVX2 (see the module documentation).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn tangent_avx2<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        self.tangent_generic::<NEWTON>(e, c, k)
+    fn tangent_avx2<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        self.tangent_generic::<MODE>(e, c, k)
     }
 
     #[inline(always)]
-    fn tangent_generic<const NEWTON: bool>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+    fn tangent_generic<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
         let x = relative_blocks(e);
         let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
         let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
@@ -373,10 +395,10 @@ impl Element {
             macro_rules! members {
                 ($nb:literal) => {
                     match group.n_members {
-                        1 => add_group_tangent::<1, $nb, NEWTON>(plan, group, &x, c, g, cols),
-                        2 => add_group_tangent::<2, $nb, NEWTON>(plan, group, &x, c, g, cols),
-                        3 => add_group_tangent::<3, $nb, NEWTON>(plan, group, &x, c, g, cols),
-                        _ => add_group_tangent::<MAX_GROUP, $nb, NEWTON>(plan, group, &x, c, g, cols),
+                        1 => add_group_tangent::<1, $nb, MODE>(plan, group, &x, c, g, cols),
+                        2 => add_group_tangent::<2, $nb, MODE>(plan, group, &x, c, g, cols),
+                        3 => add_group_tangent::<3, $nb, MODE>(plan, group, &x, c, g, cols),
+                        _ => add_group_tangent::<MAX_GROUP, $nb, MODE>(plan, group, &x, c, g, cols),
                     }
                 };
             }
@@ -603,11 +625,11 @@ mod tests {
             assert_eq!(f, f_base, "{c:?}");
             let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
             el.add_elastic_tangent_upper(&es[1], 0.7, &mut k);
-            el.tangent_generic::<false>(&es[1], 0.7, &mut k_base);
+            el.tangent_generic::<EXACT>(&es[1], 0.7, &mut k_base);
             assert_eq!(k, k_base, "{c:?}");
             let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
             el.add_newton_tangent_upper(&es[1], 0.7, &mut k);
-            el.tangent_generic::<true>(&es[1], 0.7, &mut k_base);
+            el.tangent_generic::<TIME_STEP>(&es[1], 0.7, &mut k_base);
             assert_eq!(k, k_base, "{c:?}");
         }
     }

@@ -729,14 +729,25 @@ impl Model {
     }
 
     /// `k += c_m M + c_c ∂r/∂v + c_k ∂r/∂q` at full coordinates `q` and velocities `v` (`None`:
-    /// zero; only the dampers read them), written through the chosen form.
-    #[allow(clippy::too_many_arguments)] // the state and the three generalized-α weights
-    fn add_iteration_matrix(&self, q: &[f64], v: Option<&[f64]>, c_m: f64, c_c: f64, c_k: f64, k: &mut MatView<'_>) {
+    /// zero; only the dampers read them), written through the chosen form; with `at_rest`
+    /// Newton's matrix of a static iteration (`c_m = c_c = 0`, docs/ancf.md §9).
+    #[allow(clippy::too_many_arguments)] // the state, the three generalized-α weights and the kind
+    fn add_iteration_matrix(
+        &self,
+        q: &[f64],
+        v: Option<&[f64]>,
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        at_rest: bool,
+        k: &mut MatView<'_>,
+    ) {
         // With both c_m and c_k it is Newton's matrix of a time step: the section penalties and
         // ties then keep only the positive semidefinite part of their geometric terms
-        // (docs/ancf.md §3.4). The analyses ask for M and K_t apart (c_m = 0 or c_k = 0) and get
+        // (docs/ancf.md §3.4); at rest the transverse shears and compressed axial strains lose
+        // theirs too (§9). The analyses ask for M and K_t apart (c_m = 0 or c_k = 0) and get
         // the exact tangent.
-        let newton = c_m != 0.0 && c_k != 0.0;
+        let newton = (c_m != 0.0 || at_rest) && c_k != 0.0;
         let mut ke = ElementMatrix::zeros();
         let mut e_index = 0;
         for b in &self.bodies {
@@ -750,7 +761,9 @@ impl Model {
                     }
                 }
                 let e = &q[first..first + ELEMENT_DOF];
-                if newton {
+                if at_rest && c_k != 0.0 {
+                    b.element.add_rest_tangent_upper(e, c_k, &mut ke);
+                } else if newton {
                     b.element.add_newton_tangent_upper(e, c_k, &mut ke);
                 } else if c_k != 0.0 {
                     b.element.add_elastic_tangent_upper(e, c_k, &mut ke);
@@ -781,7 +794,7 @@ impl Model {
         }
         for spring in &self.springs {
             let kin = spring.kinematics(q, true);
-            let t = spring.tangent(&kin, v, c_c, c_k, newton);
+            let t = spring.tangent(&kin, v, c_c, c_k, newton && !at_rest);
             self.scatter_spring(&kin, &t, k);
         }
     }
@@ -1012,7 +1025,7 @@ impl ConstrainedSystem for Model {
         k: &mut MatView<'_>,
     ) {
         match self.options.path {
-            SolvePath::Dae => self.add_iteration_matrix(q, Some(v), c_m, c_c, c_k, k),
+            SolvePath::Dae => self.add_iteration_matrix(q, Some(v), c_m, c_c, c_k, false, k),
             SolvePath::Ode => {
                 let mut w = scratch(&self.work);
                 let Workspace { q: qf, rate, .. } = &mut *w;
@@ -1023,9 +1036,28 @@ impl ConstrainedSystem for Model {
                 } else {
                     None
                 };
-                self.add_iteration_matrix(qf, vf, c_m, c_c, c_k, k);
+                self.add_iteration_matrix(qf, vf, c_m, c_c, c_k, false, k);
             }
         }
+    }
+
+    /// The residual at rest and Newton's matrix at rest (docs/ancf.md §9): the exact tangent
+    /// without the geometric terms of the near-rigid strains.
+    fn residual_and_static_matrix_inplace(&self, t: f64, q: &[f64], zeros: &[f64], r: &mut [f64], k: &mut MatView<'_>) {
+        self.residual_inplace(t, q, zeros, zeros, r);
+        match self.options.path {
+            SolvePath::Dae => self.add_iteration_matrix(q, None, 0.0, 0.0, 1.0, true, k),
+            SolvePath::Ode => {
+                let mut w = scratch(&self.work);
+                let Workspace { q: qf, .. } = &mut *w;
+                self.reduction.expand_inplace(q, qf);
+                self.add_iteration_matrix(qf, None, 0.0, 0.0, 1.0, true, k);
+            }
+        }
+    }
+
+    fn has_static_matrix(&self) -> bool {
+        true
     }
 
     fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {

@@ -121,6 +121,27 @@ pub trait ConstrainedSystem {
         None
     }
 
+    /// Newton's fallback matrix at rest ([`analysis::StaticSolver`](crate::analysis::StaticSolver)):
+    /// `r = r(q, 0, 0, t)` and `k += K̂` with `K̂` an approximation of the tangent `∂r/∂q` that
+    /// Newton's iteration converges with, if only linearly (the residual is exact, so the
+    /// equilibrium is the same). The static solver starts every solve with the exact tangent and
+    /// retries with this matrix, from the same estimate, only where the exact tangent's iteration
+    /// fails or stalls, and only when [`has_static_matrix`](Self::has_static_matrix). ANCF leaves
+    /// out the geometric terms of its near-rigid strains there, which a transient strain of an
+    /// iterate makes dominate the soft motions (docs/ancf.md §9). `zeros` holds `n_dof` zeros
+    /// (the velocities and accelerations at rest). Default: the exact tangent,
+    /// [`residual_and_iteration_matrix_inplace`](Self::residual_and_iteration_matrix_inplace)
+    /// with `c_k = 1`.
+    fn residual_and_static_matrix_inplace(&self, t: f64, q: &[f64], zeros: &[f64], r: &mut [f64], k: &mut MatView<'_>) {
+        self.residual_and_iteration_matrix_inplace(t, q, zeros, zeros, r, 0.0, 0.0, 1.0, k);
+    }
+
+    /// Whether [`residual_and_static_matrix_inplace`](Self::residual_and_static_matrix_inplace)
+    /// differs from the exact tangent (then the static solver falls back on it). Default: false.
+    fn has_static_matrix(&self) -> bool {
+        false
+    }
+
     /// Weight of tangent component `i` in the increment norm: 1 for positions in metres; a
     /// characteristic length for dimensionless coordinates (slopes, rotations). Default 1.
     fn increment_weight(&self, _i: usize) -> f64 {

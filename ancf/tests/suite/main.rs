@@ -10,6 +10,7 @@ mod invariance;
 mod jacobians;
 mod memory;
 mod modal;
+mod near_rigid;
 mod pendulum;
 mod properties;
 mod rigid_limit;

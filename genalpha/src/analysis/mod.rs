@@ -38,7 +38,10 @@ mod statics;
 pub use linearise::{Linearisation, linearise};
 pub use modes::{DampedMode, NaturalModes};
 pub use null_space::{NULL_SPACE_RTOL, null_space};
-pub use statics::{StaticParams, StaticSolution, StaticSolver, load_steps, solve_static, solve_static_path};
+pub use statics::{
+    MAX_BACKTRACKS, STALL_ITERATIONS, StaticParams, StaticSolution, StaticSolver, load_steps, solve_static,
+    solve_static_path,
+};
 
 use nalgebra::DMatrix;
 

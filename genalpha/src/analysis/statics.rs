@@ -19,8 +19,73 @@
 //! [`increment_weight`](crate::ConstrainedSystem::increment_weight)) is at most
 //! [`StaticParams::tol`], or the residual has fallen below [`StaticParams::rel_residual_tol`]
 //! times its value at the start of the solve.
+//!
+//! **Two matrices.** Every solve starts with the exact tangent (`residual_and_iteration_matrix_inplace`
+//! with `c_k = 1`), so Newton converges quadratically where it converges. A model may also offer
+//! a matrix at rest ([`residual_and_static_matrix_inplace`](crate::ConstrainedSystem::residual_and_static_matrix_inplace),
+//! with [`has_static_matrix`](crate::ConstrainedSystem::has_static_matrix)): ANCF's tangent
+//! without the geometric terms of its near-rigid strains. When the exact iteration fails (a
+//! non-finite residual after every halving, a singular matrix) or stalls
+//! ([`STALL_ITERATIONS`] iterations without a new smallest increment), the solve starts again from
+//! the same estimate with that matrix (linear convergence, the same equilibrium: the residual is
+//! exact). The iterations of both attempts count in [`StaticSolution::n_iterations`].
+//!
+//! An iterate at which the residual cannot be evaluated (non-finite: e.g. an aerodynamic lattice
+//! that folds over) is not an error while the step can still be halved: the iteration goes back
+//! to the previous iterate and takes half the step, at most [`MAX_BACKTRACKS`] times per
+//! iteration.
 
 use crate::{ConstrainedSystem, DenseLu, DenseMatrix, Error, LinearSolver};
+
+/// Halvings of one Newton step whose iterate has a non-finite residual, before the solve fails.
+pub const MAX_BACKTRACKS: usize = 8;
+
+/// Iterations without a new smallest increment after which Newton with the exact tangent is
+/// taken to stall, on a system that has a matrix at rest to fall back on.
+pub const STALL_ITERATIONS: usize = 5;
+
+/// The matrix of a Newton iteration at rest.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Tangent {
+    /// The exact tangent `∂r/∂q` ([`ConstrainedSystem::residual_and_iteration_matrix_inplace`]).
+    Exact,
+    /// The model's matrix at rest ([`ConstrainedSystem::residual_and_static_matrix_inplace`]).
+    AtRest,
+}
+
+/// Watches the weighted increments of a Newton iteration for a stall: [`STALL_ITERATIONS`]
+/// iterations in a row without a new smallest increment.
+#[derive(Debug, Default)]
+struct Stall {
+    best: Option<f64>,
+    since_best: usize,
+}
+
+impl Stall {
+    /// Record an increment; whether the iteration stalls.
+    fn record(&mut self, increment: f64) -> bool {
+        match self.best {
+            Some(b) if increment >= b => self.since_best += 1,
+            _ => {
+                self.best = Some(increment);
+                self.since_best = 0;
+            }
+        }
+        self.since_best >= STALL_ITERATIONS
+    }
+}
+
+/// Whether a failure of Newton with the exact tangent is retried with the matrix at rest: an
+/// iterate that left the region where the residual is finite, a singular tangent, or a stall
+/// (reported before the iteration cap `max_iter`). An iteration that still makes progress at the
+/// cap is not: the matrix at rest converges no faster.
+fn retry_at_rest(e: &Error, max_iter: usize) -> bool {
+    match e {
+        Error::NonFinite { .. } | Error::SingularMatrix { .. } => true,
+        Error::StaticNotConverged { iter, .. } => *iter < max_iter,
+        _ => false,
+    }
+}
 
 /// Settings of the static Newton iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,11 +161,19 @@ pub struct StaticSolver {
     lu: DenseLu,
     r: Vec<f64>,
     rhs: Vec<f64>,
-    q_new: Vec<f64>,
     zeros: Vec<f64>,
     weights: Vec<f64>,
     constraint: Vec<f64>,
     multipliers: Vec<f64>,
+    /// The previous iterate's coordinates and multipliers, and its step (all unknowns, the
+    /// multipliers' part unscaled), for halving a step that lands where the residual is not finite.
+    q_prev: Vec<f64>,
+    nu_prev: Vec<f64>,
+    step: Vec<f64>,
+    /// The estimate a solve starts from (coordinates; multipliers), for the retry with the
+    /// matrix at rest.
+    q_start: Vec<f64>,
+    nu_start: Vec<f64>,
 }
 
 impl StaticSolver {
@@ -120,11 +193,15 @@ impl StaticSolver {
             lu,
             r: vec![0.0; n],
             rhs: vec![0.0; n_all],
-            q_new: vec![0.0; system.n_coords()],
             zeros: vec![0.0; n],
             weights: (0..n).map(|i| system.increment_weight(i)).collect(),
             constraint: vec![0.0; n_h + n_v],
             multipliers: vec![0.0; n_h + n_v],
+            q_prev: vec![0.0; system.n_coords()],
+            nu_prev: vec![0.0; n_h + n_v],
+            step: vec![0.0; n_all],
+            q_start: vec![0.0; system.n_coords()],
+            nu_start: Vec::with_capacity(n_h + n_v),
         }
     }
 
@@ -134,11 +211,13 @@ impl StaticSolver {
     }
 
     /// Newton from the estimate `x` to the equilibrium of `system` at time `t` (forces as the
-    /// system currently defines them). On success `x` holds the equilibrium; on failure, the
-    /// last iterate with its residual and increment norms.
+    /// system currently defines them), with the exact tangent and, where that fails or stalls on
+    /// a system with a matrix at rest, again from `x` with that matrix (module documentation).
+    /// On success `x` holds the equilibrium; on failure, the last iterate with its residual and
+    /// increment norms.
     ///
     /// # Errors
-    /// [`Error::StaticNotConverged`] after `max_iter` iterations, [`Error::SingularMatrix`]
+    /// The last attempt's: [`Error::StaticNotConverged`] after `max_iter` iterations, [`Error::SingularMatrix`]
     /// (e.g. a mechanism: a motion with neither stiffness nor constraint), [`Error::NonFinite`].
     ///
     /// # Panics
@@ -174,17 +253,55 @@ impl StaticSolver {
             "the system's dimensions differ from the solver's"
         );
         assert!(
-            x.q.len() == self.q_new.len() && x.lambda.len() == n_h && x.mu.len() == n_v,
+            x.q.len() == self.q_prev.len() && x.lambda.len() == n_h && x.mu.len() == n_v,
             "the estimate's dimensions differ from the system's"
         );
+        self.q_start.copy_from_slice(&x.q);
+        self.nu_start.clear();
+        self.nu_start.extend(x.lambda.iter().chain(x.mu.iter()));
+        let exact = self.newton(system, t, x, &normalise, Tangent::Exact);
+        match exact {
+            Err(e) if system.has_static_matrix() && retry_at_rest(&e, self.params.max_iter) => {
+                x.q.copy_from_slice(&self.q_start);
+                let (l, m) = self.nu_start.split_at(n_h);
+                x.lambda.copy_from_slice(l);
+                x.mu.copy_from_slice(m);
+                self.newton(system, t, x, &normalise, Tangent::AtRest)
+            }
+            other => other,
+        }
+    }
+
+    /// Newton's iteration from `x` with the matrix `tangent`. With [`Tangent::Exact`] on a
+    /// system that has a matrix at rest, an iteration that stalls (see [`Stall`]) gives up early.
+    fn newton<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        x: &mut StaticSolution,
+        normalise: &impl Fn(&mut [f64]),
+        tangent: Tangent,
+    ) -> Result<(), Error> {
+        let n = self.n;
         let mut res0 = f64::NAN;
+        // Fraction of the last step taken, and its halvings so far (None before the first step).
+        let mut halving: Option<(f64, usize)> = None;
+        let mut stall = Stall::default();
+        let watch = tangent == Tangent::Exact && system.has_static_matrix();
         for iter in 0..self.params.max_iter {
-            let res = self.assemble(system, t, x);
+            let res = self.assemble(system, t, x, tangent);
             x.residual_norm = res;
             if !res.is_finite() {
-                return Err(Error::NonFinite { t, iter });
+                match halving {
+                    Some((alpha, k)) if k < MAX_BACKTRACKS => {
+                        self.take_step(system, x, 0.5 * alpha, normalise);
+                        halving = Some((0.5 * alpha, k + 1));
+                        continue;
+                    }
+                    _ => return Err(Error::NonFinite { t, iter }),
+                }
             }
-            if iter == 0 {
+            if iter == 0 || res0.is_nan() {
                 res0 = res;
             } else if res <= self.params.rel_residual_tol * res0 {
                 self.finish(system, t, x);
@@ -197,12 +314,22 @@ impl StaticSolver {
             }
             let scale = self.constraint_scale();
             x.increment_norm = self.rhs[..n].iter().zip(&self.weights).fold(0.0_f64, |m, (d, w)| m.max((d * w).abs()));
-            system.retract_inplace(&x.q, &self.rhs[..n], &mut self.q_new);
-            normalise(&mut self.q_new);
-            std::mem::swap(&mut x.q, &mut self.q_new);
-            for (l, d) in x.lambda.iter_mut().chain(x.mu.iter_mut()).zip(&self.rhs[n..]) {
-                *l += scale * d;
+            if watch && stall.record(x.increment_norm) {
+                return Err(Error::StaticNotConverged {
+                    t,
+                    iter,
+                    residual_norm: x.residual_norm,
+                    increment_norm: x.increment_norm,
+                });
             }
+            self.q_prev.copy_from_slice(&x.q);
+            for (p, l) in self.nu_prev.iter_mut().zip(x.lambda.iter().chain(x.mu.iter())) {
+                *p = *l;
+            }
+            self.step.copy_from_slice(&self.rhs);
+            self.step[n..].iter_mut().for_each(|d| *d *= scale);
+            self.take_step(system, x, 1.0, normalise);
+            halving = Some((1.0, 0));
             x.n_iterations += 1;
             if x.increment_norm <= self.params.tol {
                 self.finish(system, t, x);
@@ -215,6 +342,23 @@ impl StaticSolver {
             residual_norm: x.residual_norm,
             increment_norm: x.increment_norm,
         })
+    }
+
+    /// `x ← (q_prev ∘ exp(α δq), ν_prev + α δν)` with the stored step.
+    fn take_step<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        x: &mut StaticSolution,
+        alpha: f64,
+        normalise: &impl Fn(&mut [f64]),
+    ) {
+        let n = self.n;
+        self.rhs[..n].iter_mut().zip(&self.step[..n]).for_each(|(r, d)| *r = alpha * d);
+        system.retract_inplace(&self.q_prev, &self.rhs[..n], &mut x.q);
+        normalise(&mut x.q);
+        for ((l, p), d) in x.lambda.iter_mut().chain(x.mu.iter_mut()).zip(&self.nu_prev).zip(&self.step[n..]) {
+            *l = p + alpha * d;
+        }
     }
 
     /// The scale of the constraint rows and columns: `max(1, max_i |K_ii|)`, read back from the
@@ -248,22 +392,31 @@ impl StaticSolver {
     }
 
     /// The bordered matrix and the right-hand side at `x`; returns the residual's infinity norm.
-    fn assemble<S: ConstrainedSystem + ?Sized>(&mut self, system: &S, t: f64, x: &StaticSolution) -> f64 {
+    fn assemble<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        t: f64,
+        x: &StaticSolution,
+        tangent: Tangent,
+    ) -> f64 {
         let (n, n_c) = (self.n, self.n_h + self.n_v);
         self.mat.fill_zero();
         {
             let mut k = self.mat.block(0, 0, n, n);
-            system.residual_and_iteration_matrix_inplace(
-                t,
-                &x.q,
-                &self.zeros,
-                &self.zeros,
-                &mut self.r,
-                0.0,
-                0.0,
-                1.0,
-                &mut k,
-            );
+            match tangent {
+                Tangent::Exact => system.residual_and_iteration_matrix_inplace(
+                    t,
+                    &x.q,
+                    &self.zeros,
+                    &self.zeros,
+                    &mut self.r,
+                    0.0,
+                    0.0,
+                    1.0,
+                    &mut k,
+                ),
+                Tangent::AtRest => system.residual_and_static_matrix_inplace(t, &x.q, &self.zeros, &mut self.r, &mut k),
+            }
             system.constraint_force_tangent_inplace(t, &x.q, &x.lambda, &x.mu, 1.0, &mut k);
         }
         self.constraint_rows(system, t, x);
