@@ -20,7 +20,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::problem::{Joint, Problem};
 
-pub use crate::aero_settings::{AeroSettings, Coupling, MirrorPlane};
+pub use crate::aero_settings::{AeroSettings, Coupling, MirrorPlane, RunsGuard, register_runs};
 use formulation::Structure;
 
 pub use formulation::SectionLoad;

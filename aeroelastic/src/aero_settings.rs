@@ -1,6 +1,8 @@
 //! The aerodynamic settings of a problem (`aero`): air, free stream, lattice, wake, images and
 //! the coupling iteration, and the UVLM parameters they give.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use crate::gust_settings::GustSpec;
 
 /// Aerodynamic settings of a case.
@@ -60,6 +62,11 @@ pub struct AeroSettings {
     /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub gust: Option<GustSpec>,
+    /// Sum the wake through the UVLM's treecode, within 1e-6 of the free-stream speed at every
+    /// point (docs/uvlm.md §14); default false (every wake filament summed directly: on the
+    /// paper's wing the treecode did not beat the direct sum up to 320 wake rows).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub wake_aggregation: bool,
 }
 
 /// A mirror plane of the flow.
@@ -75,8 +82,9 @@ pub struct MirrorPlane {
 }
 
 impl AeroSettings {
-    /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images;
-    /// single-threaded (runs are parallel across cases).
+    /// The UVLM parameters of these settings with free stream `v_inf`: wake, cores, images, reuse
+    /// and aggregation of the wake; single-threaded (runs are parallel across cases) unless
+    /// [`register_runs`] counts this run alone.
     pub fn uvlm_params(&self, v_inf: [f64; 3]) -> uvlm::UvlmParams {
         let mut params = uvlm::UvlmParams::new(self.rho, v_inf);
         params.n_wake_rows = self.n_wake_rows;
@@ -86,8 +94,35 @@ impl AeroSettings {
         params.bound_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.wake_core = uvlm::CoreModel::CutOff { radius: self.cutoff_radius };
         params.images = self.images.iter().map(|p| uvlm::ImagePlane { point: p.point, normal: p.normal }).collect();
-        params.parallel = uvlm::Parallel::Off;
+        params.parallel =
+            if ACTIVE_RUNS.load(Ordering::SeqCst) == 1 { uvlm::Parallel::Auto } else { uvlm::Parallel::Off };
+        params.wake_reuse = if self.coupling.reuse_wake { uvlm::WakeReuse::Frozen } else { uvlm::WakeReuse::Recompute };
+        params.wake_aggregation =
+            if self.wake_aggregation { uvlm::WakeAggregation::treecode() } else { uvlm::WakeAggregation::off() };
         params
+    }
+}
+
+/// Time marches under way in this process through [`register_runs`].
+static ACTIVE_RUNS: AtomicUsize = AtomicUsize::new(0);
+
+/// Registers `n` time marches that go side by side until the guard drops. While exactly one is
+/// under way it may use every rayon thread for its Biot–Savart sums (`uvlm::Parallel::Auto`);
+/// with several (or any other concurrent caller registering its own), each keeps one thread.
+/// A counter rather than a flag, so that concurrent callers (tests, library users) cannot
+/// switch each other's setting, and the guard releases it on a panic too.
+#[must_use = "the runs count as under way only while the guard lives"]
+pub fn register_runs(n: usize) -> RunsGuard {
+    ACTIVE_RUNS.fetch_add(n, Ordering::SeqCst);
+    RunsGuard(n)
+}
+
+/// Guard of [`register_runs`].
+pub struct RunsGuard(usize);
+
+impl Drop for RunsGuard {
+    fn drop(&mut self) {
+        ACTIVE_RUNS.fetch_sub(self.0, Ordering::SeqCst);
     }
 }
 
@@ -133,10 +168,14 @@ pub struct Coupling {
     pub tolerance: f64,
     /// Relaxation factor of the loads between sub-iterations, in (0, 1].
     pub relaxation: f64,
+    /// Compute the wake's induction once per step and reuse it in the sub-iterations (only the
+    /// trailing-edge filaments and the bound rings follow the structure's motion; docs/uvlm.md
+    /// §9); default true. False recomputes the whole wake at every sub-iteration.
+    pub reuse_wake: bool,
 }
 
 impl Default for Coupling {
     fn default() -> Self {
-        Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0 }
+        Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0, reuse_wake: true }
     }
 }

@@ -67,6 +67,8 @@ pub fn run_into(
 ) -> Vec<CaseResult> {
     let jobs: Vec<(usize, Formulation)> =
         (0..runs.len()).flat_map(|i| formulations.iter().map(move |&f| (i, f))).collect();
+    // A single run may thread its aerodynamics; several share the threads one each.
+    let _runs = crate::aero::register_runs(jobs.len());
     let outputs: Vec<_> = jobs
         .par_iter()
         .map(|&(i, f)| {

@@ -261,12 +261,28 @@ impl BoundSystem {
     }
 }
 
+/// Which filaments of the known wake [`build_known_wake`] builds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum WakePart {
+    /// The whole known wake.
+    All,
+    /// The filaments touching the trailing edge (node row 0): the trailing-edge spanwise edge
+    /// and the chordwise legs of the newest ring row. They move with the lattice within a step.
+    Near,
+    /// Everything else (node rows ≥ 1: the newest row's downstream edge, the older rows and the
+    /// closure legs), fixed within a step once the wake has been advanced.
+    Far,
+}
+
 /// Build the known wake: every wake ring row with its shed circulation (explicit Kutta
 /// condition), net strengths per edge, optional closure legs along `closure_dir`, and images.
 /// Node row 0 is the trailing-edge ring row `te` (the upstream edge of the newest wake row, +Γ_w0),
 /// node row `r + 1` the wake's detached row `r`. Segments of exactly zero net strength are skipped.
 /// The spanwise edge on the trailing edge coincides with the bound trailing-edge edge and takes
-/// the bound core `te_core`, so that the two cancel exactly at steady state.
+/// the bound core `te_core`, so that the two cancel exactly at steady state. `part` selects the
+/// whole wake or its near / far part (the two together hold the filaments of `All`, each with
+/// only the nodes it uses).
+#[allow(clippy::too_many_arguments)] // the wake, its two cores, closure, images and the part
 pub(crate) fn build_known_wake(
     fil: &mut Filaments,
     te: &[[f64; 3]],
@@ -275,6 +291,7 @@ pub(crate) fn build_known_wake(
     core: &CoreModel,
     te_core: &CoreModel,
     planes: &[ImagePlane],
+    part: WakePart,
 ) {
     fil.clear();
     let len = wake.n_rows();
@@ -283,16 +300,24 @@ pub(crate) fn build_known_wake(
     if len == 0 {
         return;
     }
-    for p in te {
-        fil.push_node(*p);
-    }
-    for r in 0..len {
+    // Node rows held by this part: k_first ..= k_last.
+    let (k_first, k_last) = match part {
+        WakePart::All => (0, len),
+        WakePart::Near => (0, 1),
+        WakePart::Far => (1, len),
+    };
+    // Position of node (k, j): 0 = trailing edge, k ≥ 1 = detached row k − 1.
+    let pos = |k: usize, j: usize| if k == 0 { te[j] } else { wake.node(k - 1, j) };
+    for k in k_first..=k_last {
         for j in 0..nc {
-            fil.push_node(wake.node(r, j));
+            fil.push_node(pos(k, j));
         }
     }
-    // Node row k: 0 = trailing edge, k ≥ 1 = detached row k − 1.
-    let node = |k: usize, j: usize| (k * nc + j) as u32;
+    let node = |k: usize, j: usize| ((k - k_first) * nc + j) as u32;
+    let dist = |a: (usize, usize), b: (usize, usize)| {
+        let (p, q) = (pos(a.0, a.1), pos(b.0, b.1));
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+    };
     let closed = closure_dir.is_some();
     let g = |r: isize, j: isize| -> f64 {
         if r >= 0 && (r as usize) < len && j >= 0 && (j as usize) < n {
@@ -301,25 +326,29 @@ pub(crate) fn build_known_wake(
             0.0
         }
     };
+    // Spanwise edges at node rows [s_lo, s_hi], chordwise legs ending at node rows [c_lo, c_hi].
+    let (s_range, c_range) = match part {
+        WakePart::All => (0..=len, 1..=len),
+        WakePart::Near => (0..=0, 1..=1),
+        WakePart::Far => (1..=len, 2..=len),
+    };
     for k in 0..=len {
         // Spanwise edge at node row k: upstream edge of ring k (+Γ_k), downstream edge of ring k − 1 (−Γ_{k−1}).
         let r = k as isize;
-        for j in 0..n {
-            let up = if closed && k == len { 0.0 } else { g(r - 1, j as isize) };
-            let s = g(r, j as isize) - up;
-            if s != 0.0 {
-                let (k0, k1) = if k < len { (k, k + 1) } else { (k - 1, k) };
-                let d = |a: u32, b: u32| {
-                    let (p, q) = (fil.node(a as usize), fil.node(b as usize));
-                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-                };
-                let scale = 0.5 * (d(node(k0, j), node(k1, j)) + d(node(k0, j + 1), node(k1, j + 1)));
-                let c = if k == 0 { te_core } else { core };
-                fil.push_segment_scaled(node(k, j), node(k, j + 1), s, c, scale);
+        if s_range.contains(&k) {
+            for j in 0..n {
+                let up = if closed && k == len { 0.0 } else { g(r - 1, j as isize) };
+                let s = g(r, j as isize) - up;
+                if s != 0.0 {
+                    let (k0, k1) = if k < len { (k, k + 1) } else { (k - 1, k) };
+                    let scale = 0.5 * (dist((k0, j), (k1, j)) + dist((k0, j + 1), (k1, j + 1)));
+                    let c = if k == 0 { te_core } else { core };
+                    fil.push_segment_scaled(node(k, j), node(k, j + 1), s, c, scale);
+                }
             }
         }
         // Chordwise legs of ring k − 1: (k−1, j)→(k, j).
-        if k >= 1 {
+        if c_range.contains(&k) {
             for j in 0..nc {
                 let s = g(r - 1, j as isize - 1) - g(r - 1, j as isize);
                 if s != 0.0 {
@@ -328,13 +357,14 @@ pub(crate) fn build_known_wake(
             }
         }
     }
-    if let Some(dir) = closure_dir {
+    if let Some(dir) = closure_dir
+        && part != WakePart::Near
+    {
         let r = len as isize - 1;
         for j in 0..nc {
             let s = g(r, j as isize - 1) - g(r, j as isize);
             if s != 0.0 {
-                let (a, b) = (fil.node(node(len, j) as usize), fil.node(node(len - 1, j) as usize));
-                let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                let l = dist((len, j), (len - 1, j));
                 fil.push_leg(node(len, j), dir, s, core, l);
             }
         }
@@ -415,10 +445,10 @@ mod tests {
         let mut fil = Filaments::default();
         let te = &lat.ring_nodes()[2 * 3..];
         let core = CoreModel::default();
-        build_known_wake(&mut fil, te, &wake, None, &core, &core, &[]);
+        build_known_wake(&mut fil, te, &wake, None, &core, &core, &[], WakePart::All);
         // TE row (+Γ) and last row (−Γ): 2 + 2 spanwise; chordwise: only the two outer columns × 3 rows.
         assert_eq!(fil.n_segments(), 4 + 6);
-        build_known_wake(&mut fil, te, &wake, Some([1.0, 0.0, 0.0]), &core, &core, &[]);
+        build_known_wake(&mut fil, te, &wake, Some([1.0, 0.0, 0.0]), &core, &core, &[], WakePart::All);
         assert_eq!((fil.n_segments(), fil.n_legs()), (2 + 6, 2));
     }
 }

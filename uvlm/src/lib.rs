@@ -76,7 +76,9 @@
 //!   `wake_convection` (prescribed / free), `wake_closure`, `bound_core` / `wake_core`
 //!   ([`CoreModel`]: SHARPy cut-off or Scully core sized from the local panel), `images`
 //!   ([`ImagePlane`]: symmetry and/or ground), `te_segment_force`, `unsteady_term`, `parallel`,
-//!   `steady_wake` ([`SteadyWake`]: semi-infinite legs, or a finite frozen wake of a given length).
+//!   `steady_wake` ([`SteadyWake`]: semi-infinite legs, or a finite frozen wake of a given length),
+//!   `wake_reuse` ([`WakeReuse`]: sub-iterations of a step recompute the wake or reuse its far part),
+//!   `wake_aggregation` ([`WakeAggregation`]: a treecode for long wakes, with an error bound).
 //!
 //! ## Performance
 //! Filaments are stored once per shared edge in structure-of-arrays form; the kernels evaluate
@@ -105,6 +107,7 @@ pub mod samples;
 mod solver;
 mod station;
 mod stats;
+pub mod treecode;
 mod wake;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
@@ -116,8 +119,9 @@ pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
 pub use linear::{LinearGust, LinearUvlm, LinearWake, WakeNodeDerivatives, with_wake};
 pub use loads::{Loads, lift_drag_of, lump_columns};
-pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeConvection};
+pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 pub use solver::Uvlm;
 pub use station::{SpanStation, StationVelocity};
 pub use stats::Stats;
+pub use treecode::{TreeStats, Treecode};
 pub use wake::Wake;

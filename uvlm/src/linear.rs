@@ -37,7 +37,7 @@
 
 use nalgebra::{Complex, DMatrix};
 
-use crate::aic::{BoundSystem, TrailingEdge, build_known_wake};
+use crate::aic::{BoundSystem, TrailingEdge, WakePart, build_known_wake};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::error::{Result, UvlmError};
 use crate::flow::Flow;
@@ -136,7 +136,7 @@ impl Frozen {
         self.bs.build(lat, TrailingEdge::Unsteady, &p.bound_core, &p.images);
         self.bs.set_strengths(gamma);
         let te = &lat.ring_nodes()[m * (n + 1)..];
-        build_known_wake(&mut self.known, te, wake, closure, &p.wake_core, &p.bound_core, &p.images);
+        build_known_wake(&mut self.known, te, wake, closure, &p.wake_core, &p.bound_core, &p.images, WakePart::All);
         self.col.clear();
         for c in lat.collocation() {
             self.col.push(*c);

@@ -48,6 +48,67 @@ pub enum Parallel {
     Auto,
 }
 
+/// How repeated solves of one step ([`crate::Uvlm::solve_step`] called again within a step:
+/// the sub-iterations of a strongly coupled step) treat the wake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WakeReuse {
+    /// Every solve recomputes the whole wake's induction at the current collocation points and
+    /// segment midpoints (results depend only on the committed state and the final lattice).
+    #[default]
+    Recompute,
+    /// The induction of the wake beyond the trailing-edge filaments (which does not move within
+    /// a step) is computed once per step, at the points of the step's first solve, and reused by
+    /// the later solves of the step; the filaments touching the trailing edge (the newest ring
+    /// row's legs and the trailing-edge edge) and the bound rings are recomputed at the current
+    /// points. The error is the far wake's velocity gradient times the lattice's motion between
+    /// the first and the last solve of the step (docs/uvlm.md §9).
+    Frozen,
+}
+
+/// Far-field aggregation of the wake's induction: a treecode over the wake's segments with an
+/// error bound (docs/uvlm.md §14). Below `min_segments` wake segments, and when disabled (the
+/// default: on the paper's wing it did not beat the direct sum up to 320 wake rows, docs/uvlm.md
+/// §14), every wake filament is summed directly, bit for bit as without the option.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WakeAggregation {
+    /// Aggregate at all. Default false.
+    pub enabled: bool,
+    /// Sum the wake directly below this many segments (its images included). Default 0.
+    pub min_segments: usize,
+    /// Bound of the aggregation error of the induced velocity at every point, relative to the
+    /// free-stream speed |V∞|. Default 1e-6.
+    pub tolerance: f64,
+    /// Order p of the clusters' Cartesian expansions, ≤ 12. Default 6.
+    pub order: usize,
+    /// Most segments in a leaf cluster (summed directly when near), ≥ 1. Default 64.
+    pub leaf_size: usize,
+}
+
+impl WakeAggregation {
+    /// Aggregation switched off: every wake filament summed directly (the default).
+    pub fn off() -> Self {
+        Self { enabled: false, ..Self::default() }
+    }
+
+    /// The treecode at its default accuracy (1e-6 |V∞|) for every wake size.
+    pub fn treecode() -> Self {
+        Self { enabled: true, ..Self::default() }
+    }
+
+    /// Whether a wake of `n_segments` segments is aggregated.
+    pub fn applies(&self, n_segments: usize) -> bool {
+        self.enabled && n_segments >= self.min_segments
+    }
+}
+
+impl Default for WakeAggregation {
+    fn default() -> Self {
+        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 6, leaf_size: 64 }
+    }
+}
+
 /// Work per thread below which [`Parallel::Auto`] stays sequential (point–filament pairs).
 pub const PARALLEL_MIN_PAIRS: usize = 100_000;
 
@@ -103,6 +164,13 @@ pub struct UvlmParams {
     /// The wake of a steady solve. Default semi-infinite legs (unsteady steps ignore it).
     #[serde(default)]
     pub steady_wake: SteadyWake,
+    /// Reuse of the wake's induction by repeated solves of one step. Default recompute.
+    #[serde(default)]
+    pub wake_reuse: WakeReuse,
+    /// Far-field aggregation of the wake's induction. Default off (every filament summed
+    /// directly).
+    #[serde(default)]
+    pub wake_aggregation: WakeAggregation,
 }
 
 fn default_wake_rows() -> usize {
@@ -129,6 +197,8 @@ impl UvlmParams {
             unsteady_te_corners: true,
             parallel: Parallel::Auto,
             steady_wake: SteadyWake::SemiInfinite,
+            wake_reuse: WakeReuse::Recompute,
+            wake_aggregation: WakeAggregation::default(),
         }
     }
 
@@ -153,6 +223,16 @@ impl UvlmParams {
             && !(length.is_finite() && length > 0.0)
         {
             return Err(UvlmError::InvalidParameter { field: "steady_wake.length", value: length });
+        }
+        let a = &self.wake_aggregation;
+        if !(a.tolerance.is_finite() && a.tolerance > 0.0) {
+            return Err(UvlmError::InvalidParameter { field: "wake_aggregation.tolerance", value: a.tolerance });
+        }
+        if a.order > crate::treecode::MAX_ORDER {
+            return Err(UvlmError::InvalidParameter { field: "wake_aggregation.order", value: a.order as f64 });
+        }
+        if a.leaf_size == 0 {
+            return Err(UvlmError::InvalidParameter { field: "wake_aggregation.leaf_size", value: 0.0 });
         }
         validate_planes(&self.images)
     }

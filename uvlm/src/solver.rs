@@ -1,6 +1,6 @@
 //! The UVLM solver: steady solve and unsteady time steps on one lattice with its wake.
 
-use crate::aic::{BoundSystem, TrailingEdge, build_known_wake};
+use crate::aic::{BoundSystem, TrailingEdge, WakePart, build_known_wake};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
@@ -8,9 +8,10 @@ use crate::flow::{Flow, FlowField};
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
-use crate::params::{SteadyWake, UvlmParams, WakeConvection};
+use crate::params::{Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
+use crate::treecode::{Treecode, block_order};
 use crate::wake::Wake;
 use std::time::Instant;
 
@@ -53,7 +54,19 @@ pub struct Uvlm {
     bound: BoundSystem,
     bound_mode: Option<Mode>,
     has_solution: bool,
+    /// The known wake: all of it, or with [`WakeReuse::Frozen`] its part touching the trailing
+    /// edge (the rest is `far`).
     known: Filaments,
+    /// With [`WakeReuse::Frozen`]: the wake beyond the trailing-edge filaments, fixed within a
+    /// step; empty otherwise.
+    far: Filaments,
+    /// Whether `far` and its induction `u_far_col` / `u_far_mid` belong to the pending step.
+    far_ready: bool,
+    u_far_col: Vec<[f64; 3]>,
+    u_far_mid: Vec<[f64; 3]>,
+    /// Treecodes over `known` and `far` (when the aggregation applies), valid while the flags are.
+    known_tree: WakeTree,
+    far_tree: WakeTree,
     lu: DenseLu,
     aic: Vec<f64>,
     rhs: Vec<f64>,
@@ -102,6 +115,12 @@ impl Uvlm {
             bound_mode: None,
             has_solution: false,
             known: Filaments::default(),
+            far: Filaments::default(),
+            far_ready: false,
+            u_far_col: vec![[0.0; 3]; nr],
+            u_far_mid: Vec::new(),
+            known_tree: WakeTree::new(&params.wake_aggregation),
+            far_tree: WakeTree::new(&params.wake_aggregation),
             lu: DenseLu::new(nr),
             aic: vec![0.0; nr * nr],
             rhs: vec![0.0; nr],
@@ -227,6 +246,7 @@ impl Uvlm {
             add(self.bound.fil.velocity_at(p));
             if self.bound_mode == Some(Mode::Unsteady) {
                 add(self.known.velocity_at(p));
+                add(self.far.velocity_at(p));
             }
         }
         v
@@ -253,6 +273,12 @@ impl Uvlm {
         } else {
             Err(UvlmError::InvalidParameter { field: "v_inf", value: 0.0 })
         }
+    }
+
+    /// Absolute tolerance of the wake aggregation, m/s: its relative tolerance × |V∞|.
+    fn aggregation_tolerance(&self) -> f64 {
+        let v = self.flow.free_stream();
+        self.params.wake_aggregation.tolerance * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
     }
 
     /// Collocation points and normals into SoA buffers.
@@ -296,13 +322,30 @@ impl Uvlm {
         self.load_collocation();
         let nr = self.lattice.n_rings();
         if with_known_wake {
-            self.stats.n_pair_evaluations += induced_velocity_inplace(
-                &[&self.known],
+            let tol = self.aggregation_tolerance();
+            self.u_col.fill([0.0; 3]);
+            self.stats.n_pair_evaluations += self.known_tree.add_velocity(
+                &self.known,
                 &self.col,
+                tol,
                 &mut self.u_col,
                 self.params.parallel,
                 &mut self.blk,
             );
+            if self.params.wake_reuse == WakeReuse::Frozen {
+                if !self.far_ready {
+                    self.u_far_col.fill([0.0; 3]);
+                    self.stats.n_pair_evaluations += self.far_tree.add_velocity(
+                        &self.far,
+                        &self.col,
+                        tol,
+                        &mut self.u_far_col,
+                        self.params.parallel,
+                        &mut self.blk,
+                    );
+                }
+                add_to(&mut self.u_col, &self.u_far_col);
+            }
         } else {
             self.u_col.fill([0.0; 3]);
         }
@@ -343,7 +386,25 @@ impl Uvlm {
             self.mid.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])]);
         }
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
-        let pairs = if with_known_wake {
+        let tol = self.aggregation_tolerance();
+        let pairs = if with_known_wake && self.known_tree.applies(&self.known) {
+            let bound = induced_velocity_inplace(
+                &[&self.bound.fil],
+                &self.mid,
+                &mut self.u_mid,
+                self.params.parallel,
+                &mut self.blk,
+            );
+            bound
+                + self.known_tree.add_velocity(
+                    &self.known,
+                    &self.mid,
+                    tol,
+                    &mut self.u_mid,
+                    self.params.parallel,
+                    &mut self.blk,
+                )
+        } else if with_known_wake {
             induced_velocity_inplace(
                 &[&self.bound.fil, &self.known],
                 &self.mid,
@@ -361,6 +422,21 @@ impl Uvlm {
             )
         };
         self.stats.n_pair_evaluations += pairs;
+        if with_known_wake && self.params.wake_reuse == WakeReuse::Frozen {
+            if !self.far_ready {
+                self.u_far_mid.clear();
+                self.u_far_mid.resize(self.mid.len(), [0.0; 3]);
+                self.stats.n_pair_evaluations += self.far_tree.add_velocity(
+                    &self.far,
+                    &self.mid,
+                    tol,
+                    &mut self.u_far_mid,
+                    self.params.parallel,
+                    &mut self.blk,
+                );
+            }
+            add_to(&mut self.u_mid, &self.u_far_mid);
+        }
         self.v_mid.resize(self.mid.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
         let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
@@ -468,9 +544,22 @@ impl Uvlm {
         self.v_wake.resize(self.wpts.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.wpts, t, &mut self.v_wake);
         self.u_wake.resize(self.wpts.len(), [0.0; 3]);
-        if free {
+        if free && (self.known_tree.applies(&self.known) || self.far_tree.applies(&self.far)) {
+            let tol = self.aggregation_tolerance();
             self.stats.n_pair_evaluations += induced_velocity_inplace(
-                &[&self.bound.fil, &self.known],
+                &[&self.bound.fil],
+                &self.wpts,
+                &mut self.u_wake,
+                self.params.parallel,
+                &mut self.blk,
+            );
+            for (tree, set) in [(&mut self.known_tree, &self.known), (&mut self.far_tree, &self.far)] {
+                self.stats.n_pair_evaluations +=
+                    tree.add_velocity(set, &self.wpts, tol, &mut self.u_wake, self.params.parallel, &mut self.blk);
+            }
+        } else if free {
+            self.stats.n_pair_evaluations += induced_velocity_inplace(
+                &[&self.bound.fil, &self.known, &self.far],
                 &self.wpts,
                 &mut self.u_wake,
                 self.params.parallel,
@@ -523,6 +612,7 @@ impl Uvlm {
             self.gamma_row[j] = self.gamma_prev_te(m, j);
         }
         self.wake.push_front(&self.prev_te, &self.gamma_row);
+        self.far_ready = false;
         self.pending_dt = Some(dt);
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(())
@@ -545,15 +635,15 @@ impl Uvlm {
         self.prepare_aic(Mode::Unsteady)?;
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
         let te = &self.lattice.ring_nodes()[m * (n + 1)..];
-        build_known_wake(
-            &mut self.known,
-            te,
-            &self.wake,
-            closure,
-            &self.params.wake_core,
-            &self.params.bound_core,
-            &self.params.images,
-        );
+        let frozen = self.params.wake_reuse == WakeReuse::Frozen;
+        let (p, wake) = (&self.params, &self.wake);
+        let part = if frozen { WakePart::Near } else { WakePart::All };
+        build_known_wake(&mut self.known, te, wake, closure, &p.wake_core, &p.bound_core, &p.images, part);
+        self.known_tree.invalidate();
+        if frozen && !self.far_ready {
+            build_known_wake(&mut self.far, te, wake, closure, &p.wake_core, &p.bound_core, &p.images, WakePart::Far);
+            self.far_tree.invalidate();
+        }
         let t = self.time + dt;
         self.solve_gamma(true, t)?;
         for r in 0..self.gamma.len() {
@@ -564,6 +654,7 @@ impl Uvlm {
             };
         }
         self.update_loads(true, true, t);
+        self.far_ready = frozen;
         self.solved_pending = true;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(&self.loads)
@@ -588,6 +679,90 @@ impl Uvlm {
         self.solved_pending = false;
         self.stats.n_steps += 1;
         Ok(())
+    }
+}
+
+/// A wake filament set's induction: direct, or through a treecode built once per set.
+#[derive(Debug)]
+struct WakeTree {
+    settings: WakeAggregation,
+    tree: Treecode,
+    /// Whether `tree` holds the current set.
+    ready: bool,
+    order: Vec<u32>,
+    stack: Vec<(usize, usize)>,
+}
+
+impl WakeTree {
+    fn new(settings: &WakeAggregation) -> Self {
+        let tree =
+            if settings.enabled { Treecode::new(settings.order, settings.leaf_size) } else { Treecode::default() };
+        Self { settings: *settings, tree, ready: false, order: Vec::new(), stack: Vec::new() }
+    }
+
+    fn invalidate(&mut self) {
+        self.ready = false;
+    }
+
+    fn applies(&self, set: &Filaments) -> bool {
+        self.settings.applies(set.n_segments())
+    }
+
+    /// Add the velocity induced by `set` at `pts` to `out`: through the treecode (to within
+    /// `tol`, m/s) when the aggregation applies to the set, else directly. Returns the pairs
+    /// summed directly.
+    fn add_velocity(
+        &mut self,
+        set: &Filaments,
+        pts: &Points,
+        tol: f64,
+        out: &mut [[f64; 3]],
+        parallel: Parallel,
+        blk: &mut NodeBlock,
+    ) -> u64 {
+        if pts.is_empty() || set.n_filaments() == 0 {
+            return 0;
+        }
+        if !self.applies(set) {
+            if out.iter().all(|u| *u == [0.0; 3]) {
+                return induced_velocity_inplace(&[set], pts, out, parallel, blk);
+            }
+            let mut pairs = 0;
+            for b in 0..pts.len().div_ceil(crate::biot_savart::LANES) {
+                pairs += add_block_direct(set, pts, b, out, blk);
+            }
+            return pairs;
+        }
+        if !self.ready {
+            self.tree.build(set);
+            self.ready = true;
+        }
+        block_order(pts, &mut self.order, &mut self.stack);
+        self.tree.add_velocity_inplace(pts, &self.order, tol, out, parallel)
+    }
+}
+
+/// Add the direct induction of `set` at block `b` of `pts` to `out`.
+fn add_block_direct(set: &Filaments, pts: &Points, b: usize, out: &mut [[f64; 3]], blk: &mut NodeBlock) -> u64 {
+    use crate::biot_savart::{LANES, fill_block, load_lanes, velocity_block};
+    let (px, py, pz) = (load_lanes(&pts.x, b), load_lanes(&pts.y, b), load_lanes(&pts.z, b));
+    let mut u = [[0.0; LANES]; 3];
+    fill_block(set, &px, &py, &pz, blk);
+    velocity_block(set, blk, &mut u);
+    for l in 0..LANES.min(pts.len() - b * LANES) {
+        for q in 0..3 {
+            out[b * LANES + l][q] += u[q][l];
+        }
+    }
+    (LANES * set.n_filaments()) as u64
+}
+
+/// `a[i] += b[i]` componentwise.
+fn add_to(a: &mut [[f64; 3]], b: &[[f64; 3]]) {
+    for (x, y) in a.iter_mut().zip(b) {
+        for q in 0..3 {
+            x[q] += y[q];
+        }
     }
 }
 

@@ -8,6 +8,7 @@ mod hinge;
 mod linear;
 mod linear_gust;
 mod properties;
+mod reuse;
 mod steady;
 mod steady_finite_wake;
 mod theodorsen;

@@ -1,0 +1,127 @@
+//! CPU time of the calling thread per UVLM step of the paper's wing against the wake's length
+//! (40 to 320 rows), direct and through the treecode at 1e-6 |V∞| (orders 4, 6, 8), and the
+//! direct kernel's throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
+//! shared machine, where the wall time of `cargo bench -p uvlm --bench wake_scaling` / `--bench
+//! kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full.
+//! Run: `cargo run --release -p uvlm --example wake_scaling`.
+use uvlm::samples::FlaredWing;
+use uvlm::*;
+
+fn cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse().ok()))
+        .unwrap_or(0)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
+    let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+    let st = wing.stations(10f64.to_radians());
+    let lat = Lattice::from_stations(wing.spec(), &st).unwrap();
+    let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+    p.parallel = Parallel::Off;
+    p.n_wake_rows = rows;
+    p.wake_aggregation = agg;
+    let mut u = Uvlm::new(lat, p).unwrap();
+    for _ in 0..rows + 2 {
+        u.update_stations(&st, None).unwrap();
+        u.step(0.01).unwrap();
+    }
+    // The thread's CPU clock ticks coarsely on some kernels: time 20 steps at once, 3 times.
+    let times = (0..3)
+        .map(|_| {
+            let t0 = cpu_ns();
+            for _ in 0..20 {
+                u.update_stations(&st, None).unwrap();
+                std::hint::black_box(u.step(0.01).unwrap().total_force());
+            }
+            (cpu_ns() - t0) as f64 * 1e-6 / 20.0
+        })
+        .collect();
+    median(times)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,fma")]
+fn fma_avx512(n: usize) -> f64 {
+    use std::arch::x86_64::*;
+    let a = _mm512_set1_pd(0.999_999);
+    let b = _mm512_set1_pd(1e-7);
+    let mut x = [_mm512_set1_pd(1.0); 12];
+    for _ in 0..n {
+        for v in &mut x {
+            *v = _mm512_fmadd_pd(*v, a, b);
+        }
+    }
+    x.iter().map(|v| _mm512_reduce_add_pd(*v)).sum()
+}
+
+fn kernel() {
+    let mut fil = Filaments::default();
+    let core = CoreModel::CutOff { radius: 1e-6 };
+    let (nr, nc) = (64u32, 33u32);
+    for r in 0..nr {
+        for j in 0..nc {
+            fil.push_node([0.5 * j as f64, 2.0 + 0.25 * r as f64, 0.01 * (0.3 * j as f64).sin()]);
+        }
+    }
+    for r in 0..nr {
+        for j in 0..nc {
+            let k = r * nc + j;
+            if j + 1 < nc && fil.n_segments() < 4096 {
+                fil.push_segment(k, k + 1, 0.1 + 0.001 * k as f64, &core);
+            }
+            if r + 1 < nr && fil.n_segments() < 4096 {
+                fil.push_segment(k, k + nc, -0.2 + 0.001 * j as f64, &core);
+            }
+        }
+    }
+    let pts: Vec<[f64; 3]> = (0..512).map(|i| [0.03 * i as f64, 0.25 * (i % 4) as f64, 0.05]).collect();
+    let pairs = (pts.len() * fil.n_segments()) as f64;
+    let rate = median(
+        (0..5)
+            .map(|_| {
+                let t0 = cpu_ns();
+                for _ in 0..20 {
+                    std::hint::black_box(induced_velocity(&[&fil], &pts));
+                }
+                20.0 * pairs / ((cpu_ns() - t0) as f64 * 1e-9)
+            })
+            .collect(),
+    );
+    println!("direct kernel: {:.3e} point-segment pairs/s per core", rate);
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
+        let n = 20_000_000;
+        let flops = median(
+            (0..9)
+                .map(|_| {
+                    let t0 = cpu_ns();
+                    // SAFETY: features detected above.
+                    std::hint::black_box(unsafe { fma_avx512(std::hint::black_box(n)) });
+                    (n * 12 * 8 * 2) as f64 / ((cpu_ns() - t0) as f64 * 1e-9)
+                })
+                .collect(),
+        );
+        println!("FMA roofline (AVX-512): {:.3e} flop/s per core", flops);
+        println!("pairs per roofline flop: {:.4} (a pair is ~30 flops and one division)", rate / flops);
+    }
+}
+
+fn main() {
+    kernel();
+    println!("rows  direct_ms  tree4_ms  tree6_ms  tree8_ms   (CPU time per step, median of 3 × 20 steps)");
+    let tree = |order| WakeAggregation { order, ..WakeAggregation::treecode() };
+    for rows in [40usize, 80, 160, 320] {
+        let d = step_ms(rows, WakeAggregation::off());
+        let t4 = step_ms(rows, tree(4));
+        let t6 = step_ms(rows, tree(6));
+        let t8 = step_ms(rows, tree(8));
+        println!("{rows:4}  {d:9.3}  {t4:8.3}  {t6:8.3}  {t8:8.3}");
+    }
+}
