@@ -433,7 +433,7 @@ fn history_against_eigen(file: &str, sets: &[&str]) -> (harness::pencil::Oscilla
 #[test]
 fn an_overflowing_airspeed_returns_with_its_roots_flagged_unconverged() {
     let spec = case("hale_flutter.json", &["stability.airspeeds=[1e300]", "stability.modes=2"]);
-    let o = run_stability(&spec.gebf, Formulation::Gebf);
+    let o = run_stability(&spec.gebf.problem(), Formulation::Gebf);
     assert!(o.error.is_none(), "{:?}", o.error);
     assert_eq!(o.points.len(), 1);
     let n = harness::stability_out::unconverged_roots(&o);

@@ -332,8 +332,8 @@ fn near_rigid_shear_statics_converge_issue_38() {
             (0..2).flat_map(|b| ["ga_y", "ga_z"].map(|g| format!("bodies.{b}.section.{g}={ga}"))).collect();
         let set: Vec<&str> = set.iter().map(|s| s.as_str()).collect();
         let spec = case("healy_ffwt_flare10_aoa5.json", &set);
-        let a = run_static(&spec.ancf, Formulation::Ancf);
-        let g = run_static(&spec.gebf, Formulation::Gebf);
+        let a = run_static(&spec.ancf.problem(), Formulation::Ancf);
+        let g = run_static(&spec.gebf.problem(), Formulation::Gebf);
         assert_eq!(a.points.len(), 12);
         for (pa, pg) in a.points.iter().zip(&g.points) {
             assert!(
@@ -352,8 +352,8 @@ fn near_rigid_shear_statics_converge_issue_38() {
         }
     }
     let spec = case("goland_flutter.json", &["pitch_deg=3", "static={\"airspeeds\":[100,150]}"]);
-    let a = run_static(&spec.ancf, Formulation::Ancf);
-    let g = run_static(&spec.gebf, Formulation::Gebf);
+    let a = run_static(&spec.ancf.problem(), Formulation::Ancf);
+    let g = run_static(&spec.gebf.problem(), Formulation::Gebf);
     for (pa, pg) in a.points.iter().zip(&g.points) {
         assert!(pa.error.is_none() && pg.error.is_none(), "Goland {} m/s: {:?} {:?}", pa.airspeed, pa.error, pg.error);
         let (za, zg) = (pa.tip[2], pg.tip[2]);
