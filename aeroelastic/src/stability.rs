@@ -269,7 +269,14 @@ impl Reduced {
                 a.view_mut((nb, 0), (nb, nb)).copy_from(&(-(&lu * &frozen)));
                 a.view_mut((nb, nb), (nb, nb)).copy_from(&(-(&lu * &cc)));
                 let Some(ev) = bounded_eigenvalues(a) else { return (s0, e) };
-                let best = ev.iter().copied().min_by(|x, y| (x - s0).norm().total_cmp(&(y - s0).norm())).unwrap_or(s0);
+                // Upper half plane only: a real `s₀` is equally far from both members of a
+                // conjugate pair, and which one rounding picked must not matter.
+                let best = ev
+                    .iter()
+                    .copied()
+                    .filter(|x| x.im >= -1e-9 * x.norm())
+                    .min_by(|x, y| (x - s0).norm().total_cmp(&(y - s0).norm()))
+                    .unwrap_or(s0);
                 // The structural mode's unit vector starts Newton's method and normalises it
                 // (`eᴴη = 1`), which keeps it off a nearby root of another mode.
                 (best, e)
@@ -967,7 +974,7 @@ fn sweep<S: Structure>(
                 guess = guess
                     .into_iter()
                     .map(|(s, e)| match red.newton(s, e.clone(), &mut out.n_evaluations) {
-                        (s2, e2, true) => (C64::new(s2.re, s2.im.abs()), e2),
+                        (s2, e2, true) => upper(s2, e2),
                         _ => (s, e),
                     })
                     .collect();

@@ -4,6 +4,7 @@
 mod bad_input;
 mod common;
 mod energy;
+mod fold_mode;
 mod generic_analysis;
 mod inertia;
 mod invariance;

@@ -36,7 +36,7 @@ mod null_space;
 mod statics;
 
 pub use linearise::{Linearisation, linearise};
-pub use modes::{DampedMode, NaturalModes};
+pub use modes::{DampedMode, NaturalModes, SHIFT_RATIO};
 pub use null_space::{NULL_SPACE_RTOL, null_space};
 pub use statics::{
     MAX_BACKTRACKS, STALL_ITERATIONS, StaticParams, StaticSolution, StaticSolver, load_steps, solve_static,

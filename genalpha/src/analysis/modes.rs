@@ -18,12 +18,17 @@
 //! Schur form; a shape by inverse iteration on `P(s) = s² M_r + s C_r + K_r` next to `s`.
 //! Dense O(n³) eigen-solvers are adequate at our sizes (n_free < 500).
 //!
-//! **Precision.** A dense eigensolver makes absolute errors of order `ε ‖K̃‖ = ε ω_max²`, so a low
-//! frequency carries a relative error up to about `ε (ω_max/ω)² / 2`: 2e-6 for the first bending
-//! mode of a GEBF cantilever (ω_max/ω₁ ≈ 1.3e5), 5e-6 for ANCF, whose cross-section penalty modes
-//! reach ω_max ≈ 1e6–4e6 rad/s (measured differences are 10–30 times smaller). The damped
-//! (first-order) form is no better than that bound. Shift-and-invert about the low end of the
-//! spectrum would remove it, at the cost of a regular shifted matrix.
+//! **Precision.** A dense eigensolver makes absolute errors of order `ε ‖K̃‖ = ε ω_max²`, so in
+//! the direct form a low frequency carries a relative error up to about `ε (ω_max/ω)² / 2`: on
+//! ANCF, whose cross-section penalty modes reach ω_max ≈ 1e6–1e7 rad/s, a free hinge's fold mode
+//! (ω ≈ 0.2 rad/s, spring 1e-4 N·m/rad) is lost in round-off and may come out negative.
+//! [`natural_modes`](Linearisation::natural_modes) therefore solves by shift-and-invert about
+//! `σ = −τ`, `τ = SHIFT_RATIO · ‖K̃‖_F`: the eigenvalues `μ = 1/(ω² + τ)` of
+//! `Lᵀ (K_r + τ M_r)⁻¹ L` are found to `ε max|μ|`, which gives the low modes relative accuracy;
+//! the modes above the point where the direct form's bound is the smaller get their `ω²` by a
+//! Rayleigh–Ritz step in the subspace the inverse form's vectors span for them, so that the
+//! shapes stay one mass-orthonormal basis. The damped (first-order) form still has the direct
+//! form's bound.
 
 use super::{Linearisation, symmetrised};
 use crate::Error;
@@ -73,7 +78,9 @@ impl DampedMode {
 }
 
 impl Linearisation {
-    /// Undamped natural modes of the reduced, symmetrised problem `Nᵀ K N φ = ω² Nᵀ M N φ`
+    /// Undamped natural modes of the reduced, symmetrised problem `Nᵀ K N φ = ω² Nᵀ M N φ`, the
+    /// low ones by shift-and-invert and the high ones by a Rayleigh–Ritz step in their subspace
+    /// (module documentation, **Precision**)
     /// (`C` is ignored; an unsymmetric `K` is replaced by its symmetric part, see
     /// [`is_stiffness_symmetric`](Self::is_stiffness_symmetric) and
     /// [`damped_modes`](Self::damped_modes) for the exact eigenvalues then).
@@ -83,23 +90,27 @@ impl Linearisation {
     pub fn natural_modes(&self) -> Result<NaturalModes, Error> {
         let nf = self.n_free();
         let l = self.mass_factor()?;
-        let a = symmetrised(&congruence(&l, &symmetrised(&self.reduced_stiffness)));
-        let eig = a
-            .try_symmetric_eigen(f64::EPSILON, max_eigen_iter(nf))
-            .ok_or(Error::DecompositionNotConverged { n: nf })?;
-        let mut order: Vec<usize> = (0..nf).collect();
-        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-        let omega_squared: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
-        let omega = omega_squared.iter().map(|w2| w2.signum() * w2.abs().sqrt()).collect();
+        let k_r = symmetrised(&self.reduced_stiffness);
+        let k_tilde = symmetrised(&congruence(&l, &k_r));
+        // The largest |ω²| is at most the Frobenius norm, and at least that over √n: a scale for
+        // the shift and the error estimates, without a second eigen-solve.
+        let scale = k_tilde.norm();
+        let pairs = match shift_invert(&l, &k_r, scale)? {
+            Some(inverse) => split_and_refine(&k_tilde, inverse, scale)?,
+            None => symmetric_eigen(k_tilde)?,
+        };
+        let mut omega_squared = Vec::with_capacity(nf);
         let mut shapes = DMatrix::zeros(self.n_dof(), nf);
-        for (c, &i) in order.iter().enumerate() {
-            let y = l.tr_solve_lower_triangular(&eig.eigenvectors.column(i)).expect("a Cholesky factor is regular");
+        for (c, (w2, e)) in pairs.into_iter().enumerate() {
+            let y = l.tr_solve_lower_triangular(&e).expect("a Cholesky factor is regular");
             let mut phi = &self.null_space * y;
             if phi.iter().copied().fold(0.0_f64, |m, x| if x.abs() > m.abs() { x } else { m }) < 0.0 {
                 phi.neg_mut();
             }
             shapes.set_column(c, &phi);
+            omega_squared.push(w2);
         }
+        let omega = omega_squared.iter().map(|w2| w2.signum() * w2.abs().sqrt()).collect();
         Ok(NaturalModes { omega_squared, omega, shapes })
     }
 
@@ -167,6 +178,74 @@ impl Linearisation {
         let big = v.iter().copied().fold(Complex::new(0.0, 0.0), |m, x| if x.norm() > m.norm() { x } else { m });
         if big.norm() > 0.0 { v / big } else { v }
     }
+}
+
+/// Eigenpairs `(λ, e)` of a symmetric matrix, ascending in `λ`.
+fn symmetric_eigen(a: DMatrix<f64>) -> Result<Vec<(f64, DVector<f64>)>, Error> {
+    let n = a.nrows();
+    let eig = a.try_symmetric_eigen(f64::EPSILON, max_eigen_iter(n)).ok_or(Error::DecompositionNotConverged { n })?;
+    let mut pairs: Vec<(f64, DVector<f64>)> =
+        (0..n).map(|i| (eig.eigenvalues[i], eig.eigenvectors.column(i).into_owned())).collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(pairs)
+}
+
+/// The shift `−τ` of the inverse iteration, relative to the largest `|ω²|`: far enough from
+/// zero that `K_r + τ M_r` is regular with a free mechanism (`ω² = 0`), close enough that the
+/// low modes keep their digits (their `ω²` come with errors of about `ε τ`).
+pub const SHIFT_RATIO: f64 = 1e-8;
+
+/// Eigenpairs `(ω², e)` of the pencil `(K_r, M_r = L Lᵀ)` by shift-and-invert about `σ = −τ`,
+/// `τ = SHIFT_RATIO · scale`: the symmetric matrix `B = Lᵀ (K_r + τ M_r)⁻¹ L` has the
+/// eigenvalues `μ = 1/(ω² + τ)` and the same vectors `e` as `L⁻¹ K_r L⁻ᵀ`. A dense eigensolver
+/// gets `μ` to `ε max|μ|`, so the modes nearest zero come with relative accuracy (the direct form
+/// has absolute errors `ε max|ω²|`); ascending in `ω²`. `None` (no refinement) when the shifted
+/// matrix is singular to working precision.
+fn shift_invert(l: &DMatrix<f64>, k_r: &DMatrix<f64>, scale: f64) -> Result<Option<Vec<(f64, DVector<f64>)>>, Error> {
+    let n = k_r.nrows();
+    if n == 0 || !(scale.is_finite() && scale > 0.0) {
+        return Ok(None);
+    }
+    let tau = SHIFT_RATIO * scale;
+    let a = k_r + l * l.transpose() * tau;
+    let Some(x) = a.lu().solve(l) else { return Ok(None) }; // A⁻¹ L
+    if !x.iter().all(|v| v.is_finite()) {
+        return Ok(None);
+    }
+    let b = symmetrised(&(l.transpose() * x));
+    let mut pairs: Vec<(f64, DVector<f64>)> =
+        symmetric_eigen(b)?.into_iter().filter(|(mu, _)| *mu != 0.0).map(|(mu, e)| (1.0 / mu - tau, e)).collect();
+    if pairs.len() != n {
+        return Ok(None);
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(Some(pairs))
+}
+
+/// One mass-orthonormal basis from the shift-and-invert pairs (ascending in `ω²`): the low modes
+/// keep the inverse form's `ω²`, whose errors are about `ε (ω² + τ)² / (ω²_min + τ)`, as long as
+/// that is below the direct form's `ε · scale`; the vectors of the rest span the high subspace
+/// (orthogonal to the low modes to working precision, however the inverse form resolves them
+/// among themselves), and a Rayleigh–Ritz step in that subspace, the eigenpairs of `Eₕᵀ K̃ Eₕ`,
+/// gives their `ω²` to the direct form's accuracy. Taking whole modes from two separate solves
+/// instead can break a near-degenerate pair at the switch into two copies of one direction.
+fn split_and_refine(
+    k_tilde: &DMatrix<f64>,
+    inverse: Vec<(f64, DVector<f64>)>,
+    scale: f64,
+) -> Result<Vec<(f64, DVector<f64>)>, Error> {
+    let tau = SHIFT_RATIO * scale;
+    let low = inverse.first().map_or(0.0, |p| p.0) + tau;
+    let p = inverse.iter().take_while(|(w2, _)| (w2 + tau).powi(2) < scale * low).count();
+    let mut pairs = inverse;
+    let high = pairs.split_off(p);
+    if !high.is_empty() {
+        let e_h = DMatrix::from_columns(&high.iter().map(|(_, e)| e.clone()).collect::<Vec<_>>());
+        let h = symmetrised(&(e_h.transpose() * k_tilde * &e_h));
+        pairs.extend(symmetric_eigen(h)?.into_iter().map(|(w2, v)| (w2, &e_h * v)));
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(pairs)
 }
 
 /// `L⁻¹ A L⁻ᵀ` for a lower-triangular regular `L` (any square `A`).

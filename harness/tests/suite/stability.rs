@@ -174,14 +174,17 @@ fn paper_wing_roots_agree_on_the_papers_lattice() {
     }
 }
 
-/// The paper's wing at AoA 0° and 5° on the case meshes: every one of the ten roots converges
-/// with both formulations, no two coincide, and the first four pair up between the formulations
-/// (within 0.5 % + 0.01 1/s). Among them are the strongly damped fold roots a start lands on a
-/// neighbour's root for, found by following the mode up from low speed: at AoA 5° −6.93 + 4.80i
-/// 1/s (ζ = 0.82), at AoA 0° the over-damped −1.086 1/s (ANCF −1.0856, GEBF −1.0852).
+/// The paper's wing at AoA 0°, 5° and 10° on the case meshes: every one of the ten roots
+/// converges with both formulations, no two coincide, and the first four pair up between the
+/// formulations (within 0.5 % + 0.01 1/s). Among them are the strongly damped fold roots a start
+/// lands on a neighbour's root for, found by following the mode up from low speed: at AoA 5°
+/// −6.93 + 4.80i 1/s (ζ = 0.82), at AoA 0° the over-damped −1.086 1/s (ANCF −1.0856, GEBF
+/// −1.0852). At AoA 10° the first two are −4.74 1/s and −5.37 + 3.19i 1/s with both (measured
+/// ANCF −4.7412 and −5.3697 + 3.1902i, GEBF −4.7471 and −5.3658 + 3.1935i); they differed while
+/// a start in the lower half plane was flipped up without conjugating its vector.
 #[test]
 fn every_paper_wing_root_converges_and_the_strongly_damped_ones_agree() {
-    for aoa in [0, 5] {
+    for aoa in [0, 5, 10] {
         let (a, g) = both(&format!("wing_aoa{aoa}.json"), &[]);
         let s = |o: &StabilityOutput, m: usize| {
             let r = &o.points[0].roots[m];
@@ -438,4 +441,25 @@ fn an_overflowing_airspeed_returns_with_its_roots_flagged_unconverged() {
     assert_eq!(o.points.len(), 1);
     let n = harness::stability_out::unconverged_roots(&o);
     assert!(n > 0, "{n} unconverged roots at 1e300 m/s");
+}
+
+/// The paper's wing at AoA 5°, 25 m/s, with near-rigid shear (GA = 1e9 N, 200 times the case's),
+/// issue 38: both formulations' four lowest roots agree as with the case's shear (the tolerance
+/// of the test above). The lowest is the coasting tip's, whose structural mode is statically
+/// unstable under the held loads (ω² < 0): its real start lies as far from a conjugate pair as
+/// from its mirror, and a start taken in the lower half plane, flipped up without conjugating its
+/// vector, ended on a real root (−3.49) in one formulation and not the other.
+#[test]
+fn near_rigid_shear_keeps_the_paper_wing_roots_issue_38() {
+    let set: Vec<String> =
+        (0..2).flat_map(|b| ["ga_y", "ga_z"].map(|g| format!("bodies.{b}.section.{g}=1e9"))).collect();
+    let set: Vec<&str> = set.iter().map(|s| s.as_str()).collect();
+    let (a, g) = both("wing_aoa5.json", &set);
+    for m in 0..4 {
+        let (ra, rg) = (&a.points[0].roots[m], &g.points[0].roots[m]);
+        println!("mode {m}: ANCF {}+{}i, GEBF {}+{}i", ra.real, ra.imag, rg.real, rg.imag);
+        assert!(ra.converged && rg.converged, "mode {m}");
+        let tol = 5e-3 * ra.real.hypot(ra.imag) + 0.01;
+        assert!((ra.real - rg.real).hypot(ra.imag - rg.imag) < tol, "mode {m}: {ra:?} vs {rg:?}");
+    }
 }
