@@ -180,12 +180,14 @@ impl Linearisation {
     }
 }
 
+/// Eigenpairs `(λ, e)`: an eigenvalue and its unit vector.
+type Pairs = Vec<(f64, DVector<f64>)>;
+
 /// Eigenpairs `(λ, e)` of a symmetric matrix, ascending in `λ`.
-fn symmetric_eigen(a: DMatrix<f64>) -> Result<Vec<(f64, DVector<f64>)>, Error> {
+fn symmetric_eigen(a: DMatrix<f64>) -> Result<Pairs, Error> {
     let n = a.nrows();
     let eig = a.try_symmetric_eigen(f64::EPSILON, max_eigen_iter(n)).ok_or(Error::DecompositionNotConverged { n })?;
-    let mut pairs: Vec<(f64, DVector<f64>)> =
-        (0..n).map(|i| (eig.eigenvalues[i], eig.eigenvectors.column(i).into_owned())).collect();
+    let mut pairs: Pairs = (0..n).map(|i| (eig.eigenvalues[i], eig.eigenvectors.column(i).into_owned())).collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(pairs)
 }
@@ -201,7 +203,7 @@ pub const SHIFT_RATIO: f64 = 1e-8;
 /// gets `μ` to `ε max|μ|`, so the modes nearest zero come with relative accuracy (the direct form
 /// has absolute errors `ε max|ω²|`); ascending in `ω²`. `None` (no refinement) when the shifted
 /// matrix is singular to working precision.
-fn shift_invert(l: &DMatrix<f64>, k_r: &DMatrix<f64>, scale: f64) -> Result<Option<Vec<(f64, DVector<f64>)>>, Error> {
+fn shift_invert(l: &DMatrix<f64>, k_r: &DMatrix<f64>, scale: f64) -> Result<Option<Pairs>, Error> {
     let n = k_r.nrows();
     if n == 0 || !(scale.is_finite() && scale > 0.0) {
         return Ok(None);
@@ -229,11 +231,7 @@ fn shift_invert(l: &DMatrix<f64>, k_r: &DMatrix<f64>, scale: f64) -> Result<Opti
 /// among themselves), and a Rayleigh–Ritz step in that subspace, the eigenpairs of `Eₕᵀ K̃ Eₕ`,
 /// gives their `ω²` to the direct form's accuracy. Taking whole modes from two separate solves
 /// instead can break a near-degenerate pair at the switch into two copies of one direction.
-fn split_and_refine(
-    k_tilde: &DMatrix<f64>,
-    inverse: Vec<(f64, DVector<f64>)>,
-    scale: f64,
-) -> Result<Vec<(f64, DVector<f64>)>, Error> {
+fn split_and_refine(k_tilde: &DMatrix<f64>, inverse: Pairs, scale: f64) -> Result<Pairs, Error> {
     let tau = SHIFT_RATIO * scale;
     let low = inverse.first().map_or(0.0, |p| p.0) + tau;
     let p = inverse.iter().take_while(|(w2, _)| (w2 + tau).powi(2) < scale * low).count();
