@@ -1026,6 +1026,9 @@ fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
     }
 }
 
+/// The stability sweep of `case` with the models of `build`: the equilibria, then per airspeed
+/// the reduced model ([`reduce`], built once about a fixed state) and its roots, continued from
+/// the previous airspeed's; then the flutter and divergence speeds.
 fn sweep<S: Structure>(
     case: &Problem,
     f: Formulation,
@@ -1038,43 +1041,9 @@ fn sweep<S: Structure>(
         Ok(m) => m,
         Err(e) => return empty_output(f, Some(e)),
     };
-    // Equilibria.
-    let states: Vec<Result<Equilibrium, String>> = match st.about {
-        About::Undeformed => {
-            let model = match build(case) {
-                Ok(m) => m,
-                Err(e) => return empty_output(f, Some(e.to_string())),
-            };
-            let q = model.initial_state().q;
-            let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
-            let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
-            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
-        }
-        About::Equilibrium => {
-            // Each equilibrium is the steady state of the frozen wake linearised about it. The
-            // time march's default wake has rows of U·dt, so without closure its length changes
-            // with the airspeed: one static solve per airspeed then.
-            let wakes: Vec<WakeSettings> = st.airspeeds.iter().map(|&u| wake_settings(case, f, u)).collect();
-            let groups: Vec<(Vec<f64>, WakeSettings)> = if wakes.iter().all(|w| w.closure || *w == wakes[0]) {
-                vec![(st.airspeeds.clone(), wakes[0])]
-            } else {
-                st.airspeeds.iter().zip(&wakes).map(|(&u, &w)| (vec![u], w)).collect()
-            };
-            let mut states = Vec::with_capacity(st.airspeeds.len());
-            for (airspeeds, wake) in groups {
-                let mut c = case.clone();
-                c.statics = Some(crate::problem::StaticSettings::at(airspeeds, Some(wake)));
-                let so = crate::statics::run_static(&c, f);
-                if let Some(e) = so.error {
-                    return empty_output(f, Some(e));
-                }
-                states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
-                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
-                    (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
-                }));
-            }
-            states
-        }
+    let states = match equilibria(case, f, st, build) {
+        Ok(s) => s,
+        Err(e) => return empty_output(f, Some(e)),
     };
     let mut out = empty_output(f, None);
     let nb_req = st.basis_modes.unwrap_or((2 * st.modes).max(20));
@@ -1125,26 +1094,8 @@ fn sweep<S: Structure>(
         let Some((u0, red)) = cache.as_mut() else { continue };
         let target = u / *u0;
         let nmodes = st.modes.min(red.n_basis());
-        // The first airspeed's roots are continued from a quarter of it, where the structural
-        // modes are still near their aerodynamically coupled roots (the model scaled at its
-        // geometry: exact about a fixed state, a starting guess otherwise).
-        let first = if tracked.is_none() {
-            red.at_speed_ratio(0.25 * target);
-            let mut guess = red.starts(nmodes);
-            for frac in [0.5, 0.75] {
-                red.at_speed_ratio(frac * target);
-                guess = guess
-                    .into_iter()
-                    .map(|(s, e)| match red.newton(s, e.clone(), &mut out.n_evaluations) {
-                        (s2, e2, true) => (C64::new(s2.re, s2.im.abs()), e2),
-                        _ => (s, e),
-                    })
-                    .collect();
-            }
-            Some(guess)
-        } else {
-            None
-        };
+        let first =
+            if tracked.is_none() { Some(first_starts(red, nmodes, target, &mut out.n_evaluations)) } else { None };
         red.at_speed_ratio(target);
         out.n_free = red.omega.len();
         out.n_basis = red.n_basis();
@@ -1153,79 +1104,11 @@ fn sweep<S: Structure>(
         let ts = cpu_now();
         let starts: Vec<(C64, DVector<C64>)> = match (&tracked, &prev) {
             _ if first.is_some() => first.unwrap_or_default(),
-            (Some(t), Some(p)) if t.len() == nmodes => {
-                // Linear extrapolation in airspeed of the eigenvalue.
-                let du = u - st.airspeeds[i - 1];
-                t.iter()
-                    .zip(p)
-                    .map(|((s1, e1), (s0, _))| {
-                        let back = st.airspeeds[i - 1] - st.airspeeds[i.saturating_sub(2)];
-                        let slope = if back > 0.0 { (s1 - s0) / back } else { C64::new(0.0, 0.0) };
-                        (s1 + slope * du, e1.clone())
-                    })
-                    .collect()
-            }
+            (Some(t), Some(p)) if t.len() == nmodes => extrapolated_starts(t, p, &st.airspeeds, i),
             (Some(t), _) if t.len() == nmodes => t.clone(),
             _ => red.starts(nmodes),
         };
-        let mut found: Vec<(C64, DVector<C64>, bool)> = starts
-            .into_iter()
-            .map(|(s0, e0)| match red.newton(s0, e0.clone(), &mut out.n_evaluations) {
-                (s, e, true) => {
-                    let (s, e) = upper(s, e);
-                    (s, e, true)
-                }
-                _ => (s0, e0, false),
-            })
-            .collect();
-        let same = |a: C64, b: C64| (a - b).norm() <= 1e-6 * (1.0 + a.norm());
-        // Starts that do not converge, or that land on one root (a strongly damped mode can jump
-        // to a neighbour's root): follow each of those modes up from low speed instead, where it
-        // is near its structural root. A path's end is the mode's root unless a mode that was
-        // not in doubt holds it, or another path ends there too with smaller steps (the
-        // smoother path keeps the root: the other jumped branches); those restart from their
-        // paths.
-        let suspects: Vec<usize> = (0..found.len())
-            .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same(found[j].0, found[m].0)))
-            .collect();
-        if !suspects.is_empty() {
-            for &m in &suspects {
-                found[m].2 = false;
-            }
-            let paths: Vec<Vec<(C64, DVector<C64>)>> =
-                suspects.iter().map(|&m| red.continuation_path(m, target, &mut out.n_evaluations)).collect();
-            // Each path's end at the full speed ratio (None for a path cut short).
-            let ends: Vec<Option<C64>> =
-                paths.iter().map(|p| p.last().filter(|_| p.len() == CONTINUATION_STEPS).map(|x| x.0)).collect();
-            let mut pending = Vec::new();
-            for (i, &m) in suspects.iter().enumerate() {
-                let keeps = ends[i].is_some_and(|r| {
-                    !found.iter().any(|f| f.2 && same(f.0, r))
-                        && !(0..suspects.len()).any(|k| {
-                            k != i
-                                && ends[k].is_some_and(|rk| same(rk, r))
-                                && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
-                        })
-                });
-                match paths[i].last() {
-                    Some((s, e)) if keeps => found[m] = (*s, e.clone(), true),
-                    _ => pending.push(i),
-                }
-            }
-            for i in pending {
-                let m = suspects[i];
-                let claimed = |s: C64| found.iter().any(|f| f.2 && same(f.0, s));
-                if let Some((s, e)) = red.restart_from_path(&paths[i], &mut out.n_evaluations, claimed) {
-                    found[m] = (s, e, true);
-                }
-            }
-        }
-        // Starts that still share a root: the later one is not a root of its own.
-        for m in 0..found.len() {
-            if found[m].2 && (0..m).any(|j| found[j].2 && same(found[j].0, found[m].0)) {
-                found[m].2 = false;
-            }
-        }
+        let found = roots_from(red, starts, target, &mut out.n_evaluations);
         let mut roots = Vec::with_capacity(nmodes);
         let mut next = Vec::with_capacity(nmodes);
         for (m, (s, e, ok)) in found.into_iter().enumerate() {
@@ -1239,6 +1122,177 @@ fn sweep<S: Structure>(
         let omega = red.omega.iter().take(nb_req).copied().collect();
         out.points.push(point(roots, smin, omega, fold, None));
     }
+    flutter_and_divergence(&mut out);
+    out
+}
+
+/// The states a sweep linearises about, one per airspeed of `st`: the undeformed state, or the
+/// static aeroelastic equilibria (one static sweep per wake; see [`wake_settings`]). An error
+/// that stops the whole sweep is `Err`; a point without an equilibrium is an `Err` in the list.
+fn equilibria<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    st: &StabilitySettings,
+    build: fn(&Problem) -> Result<S, crate::Error>,
+) -> Result<Vec<Result<Equilibrium, String>>, String> {
+    Ok(match st.about {
+        About::Undeformed => {
+            let model = build(case).map_err(|e| e.to_string())?;
+            let q = model.initial_state().q;
+            let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
+            let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
+            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
+        }
+        About::Equilibrium => {
+            // Each equilibrium is the steady state of the frozen wake linearised about it. The
+            // time march's default wake has rows of U·dt, so without closure its length changes
+            // with the airspeed: one static solve per airspeed then.
+            let wakes: Vec<WakeSettings> = st.airspeeds.iter().map(|&u| wake_settings(case, f, u)).collect();
+            let groups: Vec<(Vec<f64>, WakeSettings)> = if wakes.iter().all(|w| w.closure || *w == wakes[0]) {
+                vec![(st.airspeeds.clone(), wakes[0])]
+            } else {
+                st.airspeeds.iter().zip(&wakes).map(|(&u, &w)| (vec![u], w)).collect()
+            };
+            let mut states = Vec::with_capacity(st.airspeeds.len());
+            for (airspeeds, wake) in groups {
+                let mut c = case.clone();
+                c.statics = Some(crate::problem::StaticSettings::at(airspeeds, Some(wake)));
+                let so = crate::statics::run_static(&c, f);
+                if let Some(e) = so.error {
+                    return Err(e);
+                }
+                states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
+                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
+                    (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
+                }));
+            }
+            states
+        }
+    })
+}
+
+/// The starts of the first airspeed's roots (at speed ratio `target`), continued from a quarter
+/// of it, where the structural modes are still near their aerodynamically coupled roots (the
+/// model scaled at its geometry: exact about a fixed state, a starting guess otherwise).
+fn first_starts(red: &mut Reduced, nmodes: usize, target: f64, n_evaluations: &mut usize) -> Vec<(C64, DVector<C64>)> {
+    red.at_speed_ratio(0.25 * target);
+    let mut guess = red.starts(nmodes);
+    for frac in [0.5, 0.75] {
+        red.at_speed_ratio(frac * target);
+        guess = guess
+            .into_iter()
+            .map(|(s, e)| match red.newton(s, e.clone(), n_evaluations) {
+                (s2, e2, true) => (C64::new(s2.re, s2.im.abs()), e2),
+                _ => (s, e),
+            })
+            .collect();
+    }
+    guess
+}
+
+/// Starts at airspeed `i` of `airspeeds`: the roots of the last airspeed (`tracked`), linearly
+/// extrapolated in airspeed from the one before (`prev`).
+fn extrapolated_starts(
+    tracked: &[(C64, DVector<C64>)],
+    prev: &[(C64, DVector<C64>)],
+    airspeeds: &[f64],
+    i: usize,
+) -> Vec<(C64, DVector<C64>)> {
+    let du = airspeeds[i] - airspeeds[i - 1];
+    tracked
+        .iter()
+        .zip(prev)
+        .map(|((s1, e1), (s0, _))| {
+            let back = airspeeds[i - 1] - airspeeds[i.saturating_sub(2)];
+            let slope = if back > 0.0 { (s1 - s0) / back } else { C64::new(0.0, 0.0) };
+            (s1 + slope * du, e1.clone())
+        })
+        .collect()
+}
+
+/// Whether two roots are one.
+fn same_root(a: C64, b: C64) -> bool {
+    (a - b).norm() <= 1e-6 * (1.0 + a.norm())
+}
+
+/// The roots (with their vectors and whether they converged) at speed ratio `target`, by
+/// Newton's method from `starts`, the doubtful ones followed up from low speed
+/// ([`follow_suspects`]); of starts that still share a root, the later one is not converged.
+fn roots_from(
+    red: &mut Reduced,
+    starts: Vec<(C64, DVector<C64>)>,
+    target: f64,
+    n_evaluations: &mut usize,
+) -> Vec<(C64, DVector<C64>, bool)> {
+    let mut found: Vec<(C64, DVector<C64>, bool)> = starts
+        .into_iter()
+        .map(|(s0, e0)| match red.newton(s0, e0.clone(), n_evaluations) {
+            (s, e, true) => {
+                let (s, e) = upper(s, e);
+                (s, e, true)
+            }
+            _ => (s0, e0, false),
+        })
+        .collect();
+    follow_suspects(red, &mut found, target, n_evaluations);
+    // Starts that still share a root: the later one is not a root of its own.
+    for m in 0..found.len() {
+        if found[m].2 && (0..m).any(|j| found[j].2 && same_root(found[j].0, found[m].0)) {
+            found[m].2 = false;
+        }
+    }
+    found
+}
+
+/// Starts that do not converge, or that land on one root (a strongly damped mode can jump to a
+/// neighbour's root): follow each of those modes up from low speed instead, by continuation to
+/// the speed ratio `target`, where it is near its structural root. A path's end is the mode's
+/// root unless a mode that was not in doubt holds it, or another path ends there too with
+/// smaller steps (the smoother path keeps the root: the other jumped branches); those restart
+/// from their paths.
+fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], target: f64, n_evaluations: &mut usize) {
+    let suspects: Vec<usize> = (0..found.len())
+        .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same_root(found[j].0, found[m].0)))
+        .collect();
+    if suspects.is_empty() {
+        return;
+    }
+    for &m in &suspects {
+        found[m].2 = false;
+    }
+    let paths: Vec<Vec<(C64, DVector<C64>)>> =
+        suspects.iter().map(|&m| red.continuation_path(m, target, n_evaluations)).collect();
+    // Each path's end at the full speed ratio (None for a path cut short).
+    let ends: Vec<Option<C64>> =
+        paths.iter().map(|p| p.last().filter(|_| p.len() == CONTINUATION_STEPS).map(|x| x.0)).collect();
+    let mut pending = Vec::new();
+    for (i, &m) in suspects.iter().enumerate() {
+        let keeps = ends[i].is_some_and(|r| {
+            !found.iter().any(|f| f.2 && same_root(f.0, r))
+                && !(0..suspects.len()).any(|k| {
+                    k != i
+                        && ends[k].is_some_and(|rk| same_root(rk, r))
+                        && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
+                })
+        });
+        match paths[i].last() {
+            Some((s, e)) if keeps => found[m] = (*s, e.clone(), true),
+            _ => pending.push(i),
+        }
+    }
+    for i in pending {
+        let m = suspects[i];
+        let claimed = |s: C64| found.iter().any(|f| f.2 && same_root(f.0, s));
+        if let Some((s, e)) = red.restart_from_path(&paths[i], n_evaluations, claimed) {
+            found[m] = (s, e, true);
+        }
+    }
+}
+
+/// The flutter speed, frequency and mode (the first sign change of a converged root's real part
+/// from negative to positive, interpolated linearly) and the divergence speed (the first sign
+/// change of the static stiffness) of a sweep's points.
+fn flutter_and_divergence(out: &mut StabilityOutput) {
     // Flutter: the first sign change of a root's real part from negative to positive.
     for w in out.points.windows(2) {
         let (a, b) = (&w[0], &w[1]);
@@ -1270,7 +1324,6 @@ fn sweep<S: Structure>(
             break;
         }
     }
-    out
 }
 
 /// Iteration bound of the Schur decompositions: nalgebra's plain `eigenvalues()` iterates
