@@ -964,10 +964,7 @@ pub fn linear_wake(case: &Problem, f: Formulation, airspeed: f64) -> uvlm::Linea
 /// `airspeed·dt`, closed when `aero.wake_closure`.
 pub fn march_wake(case: &Problem, f: Formulation, airspeed: f64) -> WakeSettings {
     let aero = case.aero.as_ref().expect("validated: needs aero");
-    let dt = match f {
-        Formulation::Ancf => case.ancf.dt,
-        Formulation::Gebf => case.gebf.dt,
-    };
+    let dt = case.block(f).dt;
     WakeSettings { rows: aero.n_wake_rows, row_length: airspeed * dt, closure: aero.wake_closure }
 }
 
