@@ -208,7 +208,6 @@ pub fn simulate_aero_from<S: Structure>(
     equilibrium: Option<&[f64]>,
 ) -> crate::run::RunOutput {
     use crate::run::{Dissipation, RunOutput, SnapshotFeed, row};
-    use genalpha::State;
     let start = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
     out.error = None;
@@ -234,58 +233,13 @@ pub fn simulate_aero_from<S: Structure>(
         s.q.copy_from_slice(q);
         s.v.iter_mut().for_each(|x| *x = 0.0);
     }
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
-    let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
-    let spec = lattice_spec(map, aero);
-    let mut params = aero.uvlm_params(aero.free_stream());
-    if equilibrium.is_some() && !aero.wake_closure {
-        // The equilibrium's steady solution with the march's own unclosed wake (its rows
-        // prefilled below), so that without a disturbance the run stays there.
-        params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * aero.speed() * dt };
-    }
-    let mut uv = match uvlm::Lattice::from_stations(spec, &stations).and_then(|l| uvlm::Uvlm::new(l, params)) {
-        Ok(u) => u,
-        Err(e) => return fail(out, format!("aerodynamic lattice: {e}")),
+    let mut c = match MarchAero::start(model, &s, map, aero, dt, equilibrium.is_some()) {
+        Ok(c) => c,
+        Err(e) => return fail(out, e),
     };
-    // The UVLM's clock, at which a disturbance is evaluated, starts at the structure's and
-    // advances with each commit.
-    if let Err(e) = uv.set_time(s.t) {
-        return fail(out, format!("aerodynamic clock: {e}"));
-    }
-    let span_dir = [1.0, 0.0, 0.0];
-    let mut loads: Vec<SectionLoad> = map
-        .iter()
-        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
-        .collect();
-    let mut new_loads = loads.clone();
-    let mut obuf: Vec<[f64; 3]> = Vec::with_capacity(map.len());
-    let (mut fbuf, mut mbuf) = (vec![[0.0; 3]; map.len()], vec![[0.0; 3]; map.len()]);
-    let mut lift0 = 0.0;
-    if equilibrium.is_some() {
-        // The steady solution on the equilibrium's lattice, its wake laid out as the unsteady
-        // solver would have shed it, its loads applied before the initial accelerations.
-        let l = match uv.solve_steady() {
-            Ok(l) => l,
-            Err(e) => return fail(out, format!("steady aerodynamics at the equilibrium: {e}")),
-        };
-        obuf.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
-        l.column_loads_inplace(&obuf, &mut fbuf, &mut mbuf);
-        for (j, t) in loads.iter_mut().enumerate() {
-            t.force = Vector3::from(fbuf[j]);
-            t.moment = Vector3::from(mbuf[j]);
-        }
-        lift0 = uvlm::lift_drag_of(l.total_force(), aero.free_stream(), span_dir).0;
-        if let Err(e) = uv.prefill_wake(dt) {
-            return fail(out, format!("steady wake at the equilibrium: {e}"));
-        }
-        if let Err(e) = model.set_section_loads(&loads) {
-            return fail(out, format!("loads at the equilibrium: {e}"));
-        }
-    }
     if let Some(g) = &aero.gust {
-        match crate::gust_field::disturbance(g, aero, &stations, settings.t_end, s.t) {
-            Ok(d) => uv.set_disturbance(Some(d)),
+        match crate::gust_field::disturbance(g, aero, &c.stations, settings.t_end, s.t) {
+            Ok(d) => c.uv.set_disturbance(Some(d)),
             Err(e) => return fail(out, format!("aero.gust: {e}")),
         }
     }
@@ -293,7 +247,6 @@ pub fn simulate_aero_from<S: Structure>(
         return fail(out, format!("initial accelerations: {e}"));
     }
     let mut work = 0.0;
-    let mut lift;
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s);
@@ -310,113 +263,249 @@ pub fn simulate_aero_from<S: Structure>(
     };
     let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
-    r0.lift = lift0;
-    with_loads(model, &mut r0, &s, &loads);
+    r0.lift = c.lift;
+    with_loads(model, &mut r0, &s, &c.loads);
     out.rows.push(r0);
-    if let Err(e) = feed.feed(model, &r0, &s.q, Some(&uv)) {
+    if let Err(e) = feed.feed(model, &r0, &s.q, Some(&c.uv)) {
         return fail(out, format!("output at t = {}: {e}", s.t));
     }
-    let mut qp = vec![0.0; s.q.len()];
-    let mut vel_n = Vec::with_capacity(map.len());
-    let mut dq = vec![0.0; s.v.len()];
-    let mut vp = vec![0.0; s.v.len()];
     for k in 1..=n_steps {
         if crate::interrupt::interrupted() {
             out.error = Some(crate::run::interrupted_message(s.t));
             break;
         }
-        let t1 = s.t + dt;
-        // 1. Predict the structure at t_{n+1} and move the lattice there.
-        for i in 0..dq.len() {
-            dq[i] = dt * s.v[i] + 0.5 * dt * dt * s.v_dot[i];
-            vp[i] = s.v[i] + dt * s.v_dot[i];
-        }
-        model.retract_inplace(&s.q, &dq, &mut qp);
-        vel_n.clear();
-        vel_n.extend_from_slice(&vel);
-        stations_at(model, &qp, &vp, map, aero, &mut scratch, &mut stations, &mut vel);
-        let mut solve = |uv: &mut uvlm::Uvlm,
-                         stations: &[uvlm::SpanStation],
-                         vel: &[uvlm::StationVelocity],
-                         target: &mut Vec<SectionLoad>|
-         -> Result<f64, String> {
-            uv.update_stations(stations, Some(vel)).map_err(|e| e.to_string())?;
-            let l = uv.solve_step().map_err(|e| e.to_string())?;
-            obuf.clear();
-            obuf.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
-            l.column_loads_inplace(&obuf, &mut fbuf, &mut mbuf);
-            for (j, t) in target.iter_mut().enumerate() {
-                t.force = Vector3::from(fbuf[j]);
-                t.moment = Vector3::from(mbuf[j]);
-            }
-            // Lift ⊥ the free stream (a direction: a disturbance would not turn it).
-            Ok(uvlm::lift_drag_of(l.total_force(), aero.free_stream(), span_dir).0)
-        };
-        // 2. Wake and aerodynamic solve at the predicted lattice.
-        if let Err(e) = uv.advance_wake(dt) {
-            return fail(out, format!("step {k} (t = {t1:.4} s): aerodynamics: {e}"));
-        }
-        match solve(&mut uv, &stations, &vel, &mut loads) {
-            Ok(l) => lift = l,
-            Err(e) => return fail(out, format!("step {k} (t = {t1:.4} s): aerodynamics: {e}")),
-        }
-        // 3. Structural step with these loads.
-        let s_n: State = s.clone();
-        if let Err(e) = model.set_section_loads(&loads) {
-            return fail(out, format!("step {k} (t = {t1:.4} s): {e}"));
-        }
-        let mut st = match ga.step(model, &mut s) {
+        let st = match c.step(model, &mut ga, &mut s, k) {
             Ok(st) => st,
-            Err(e) => return fail(out, format!("step {k}: {e}")),
+            Err(e) => return fail(out, e),
         };
-        // 4. Strong coupling.
-        for _ in 0..aero.coupling.max_sub_iterations {
-            stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
-            match solve(&mut uv, &stations, &vel, &mut new_loads) {
-                Ok(l) => lift = l,
-                Err(e) => return fail(out, format!("step {k} (t = {t1:.4} s): aerodynamics: {e}")),
-            }
-            let (mut num, mut den) = (0.0, 0.0);
-            let w = aero.coupling.relaxation;
-            for (a, b) in loads.iter_mut().zip(&new_loads) {
-                num += (b.force - a.force).norm_squared() + (b.moment - a.moment).norm_squared();
-                den += b.force.norm_squared() + b.moment.norm_squared();
-                a.force = w * b.force + (1.0 - w) * a.force;
-                a.moment = w * b.moment + (1.0 - w) * a.moment;
-            }
-            if num.sqrt() <= aero.coupling.tolerance * den.sqrt().max(1e-12) {
-                break;
-            }
-            s = s_n.clone();
-            if let Err(e) = model.set_section_loads(&loads) {
-                return fail(out, format!("step {k} (t = {t1:.4} s, sub-iteration): {e}"));
-            }
-            st = match ga.step(model, &mut s) {
-                Ok(st) => st,
-                Err(e) => return fail(out, format!("step {k} (sub-iteration): {e}")),
-            };
-        }
-        if let Err(e) = uv.commit_step() {
-            return fail(out, format!("step {k}: aerodynamics: {e}"));
-        }
-        debug_assert!((uv.time() - s.t).abs() <= 1e-9 * s.t.abs().max(1.0), "the UVLM's clock follows the structure's");
         // 5. Work of the aerodynamic loads over the step (trapezoidal in the station velocities).
-        stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
-        work += 0.5 * dt * (power(&loads, &vel_n) + power(&loads, &vel));
+        c.move_to(model, &s.q, &s.v);
+        work += 0.5 * dt * (power(&c.loads, &c.vel_n) + power(&c.loads, &c.vel));
         dissipation.step(model, &s);
         if k % every == 0 || k == n_steps {
             let mut r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
             r.aero_work = work;
-            r.lift = lift;
-            with_loads(model, &mut r, &s, &loads);
+            r.lift = c.lift;
+            with_loads(model, &mut r, &s, &c.loads);
             out.rows.push(r);
-            if let Err(e) = feed.feed(model, &r, &s.q, Some(&uv)) {
+            if let Err(e) = feed.feed(model, &r, &s.q, Some(&c.uv)) {
                 return fail(out, format!("step {k}: output: {e}"));
             }
         }
     }
     out.stats = *ga.stats();
     out.wall_s = start.elapsed().as_secs_f64();
-    out.aero_wall_s = uv.stats().wall_time;
+    out.aero_wall_s = c.uv.stats().wall_time;
     out
+}
+
+/// The span direction of the lift (the global X axis).
+const SPAN_DIR: [f64; 3] = [1.0, 0.0, 0.0];
+
+/// The lattice side of the time march and its reused buffers: the UVLM, the stations and their
+/// velocities (now and at the start of the step), the station loads applied to the structure
+/// and the last solve's, the lift, and the buffers of the lumping and of the predictor.
+struct MarchAero<'a> {
+    uv: uvlm::Uvlm,
+    map: &'a [StationMap],
+    aero: &'a AeroSettings,
+    dt: f64,
+    scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+    stations: Vec<uvlm::SpanStation>,
+    vel: Vec<uvlm::StationVelocity>,
+    vel_n: Vec<uvlm::StationVelocity>,
+    /// The loads applied to the structure.
+    loads: Vec<SectionLoad>,
+    /// The loads of a sub-iteration's solve, before relaxation.
+    new_loads: Vec<SectionLoad>,
+    /// Lift of the last solve, N.
+    lift: f64,
+    lumping: Lumping,
+    /// Predictor: coordinates, increment and velocity at `t_{n+1}`.
+    qp: Vec<f64>,
+    dq: Vec<f64>,
+    vp: Vec<f64>,
+}
+
+/// Buffers of the lumping of the lattice's nodal loads to the stations: the stations' origins,
+/// and the forces and moments about them.
+struct Lumping {
+    origins: Vec<[f64; 3]>,
+    force: Vec<[f64; 3]>,
+    moment: Vec<[f64; 3]>,
+}
+
+impl Lumping {
+    /// Buffers for `n` stations.
+    fn new(n: usize) -> Self {
+        Self { origins: Vec::with_capacity(n), force: vec![[0.0; 3]; n], moment: vec![[0.0; 3]; n] }
+    }
+
+    /// Lump the nodal loads `l` to `stations` (about their origins) into `target`; return the
+    /// lift, ⊥ the free stream `v_inf` (a direction: a disturbance would not turn it).
+    fn apply(
+        &mut self,
+        l: &uvlm::Loads,
+        stations: &[uvlm::SpanStation],
+        v_inf: [f64; 3],
+        target: &mut [SectionLoad],
+    ) -> f64 {
+        self.origins.clear();
+        self.origins.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
+        l.column_loads_inplace(&self.origins, &mut self.force, &mut self.moment);
+        for (j, t) in target.iter_mut().enumerate() {
+            t.force = Vector3::from(self.force[j]);
+            t.moment = Vector3::from(self.moment[j]);
+        }
+        uvlm::lift_drag_of(l.total_force(), v_inf, SPAN_DIR).0
+    }
+}
+
+impl<'a> MarchAero<'a> {
+    /// The lattice of `model` at `s` with an empty wake or, `at_equilibrium`, the steady solution
+    /// there with its wake prefilled and its loads applied to `model`; the UVLM's clock, at which
+    /// a disturbance is evaluated, starts at the structure's and advances with each commit.
+    fn start<S: Structure>(
+        model: &mut S,
+        s: &genalpha::State,
+        map: &'a [StationMap],
+        aero: &'a AeroSettings,
+        dt: f64,
+        at_equilibrium: bool,
+    ) -> Result<Self, String> {
+        let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+        let (mut stations, mut vel) = (Vec::new(), Vec::new());
+        stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
+        let spec = lattice_spec(map, aero);
+        let mut params = aero.uvlm_params(aero.free_stream());
+        if at_equilibrium && !aero.wake_closure {
+            // The equilibrium's steady solution with the march's own unclosed wake (its rows
+            // prefilled below), so that without a disturbance the run stays there.
+            params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * aero.speed() * dt };
+        }
+        let uv = uvlm::Lattice::from_stations(spec, &stations)
+            .and_then(|l| uvlm::Uvlm::new(l, params))
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let loads: Vec<SectionLoad> = map
+            .iter()
+            .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+            .collect();
+        let mut c = MarchAero {
+            uv,
+            map,
+            aero,
+            dt,
+            scratch,
+            stations,
+            vel,
+            vel_n: Vec::with_capacity(map.len()),
+            new_loads: loads.clone(),
+            loads,
+            lift: 0.0,
+            lumping: Lumping::new(map.len()),
+            qp: vec![0.0; s.q.len()],
+            dq: vec![0.0; s.v.len()],
+            vp: vec![0.0; s.v.len()],
+        };
+        c.uv.set_time(s.t).map_err(|e| format!("aerodynamic clock: {e}"))?;
+        if at_equilibrium {
+            c.steady_start(model)?;
+        }
+        Ok(c)
+    }
+
+    /// The steady solution on the equilibrium's lattice, its wake laid out as the unsteady solver
+    /// would have shed it, its loads applied to `model` before the initial accelerations.
+    fn steady_start<S: Structure>(&mut self, model: &mut S) -> Result<(), String> {
+        let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics at the equilibrium: {e}"))?;
+        self.lift = self.lumping.apply(l, &self.stations, self.aero.free_stream(), &mut self.loads);
+        self.uv.prefill_wake(self.dt).map_err(|e| format!("steady wake at the equilibrium: {e}"))?;
+        model.set_section_loads(&self.loads).map_err(|e| format!("loads at the equilibrium: {e}"))
+    }
+
+    /// Move the stations (and their velocities) to the structure at `(q, v)`.
+    fn move_to<S: Structure>(&mut self, model: &S, q: &[f64], v: &[f64]) {
+        stations_at(model, q, v, self.map, self.aero, &mut self.scratch, &mut self.stations, &mut self.vel);
+    }
+
+    /// Move the lattice to the stations, solve the pending UVLM step and lump its loads into
+    /// `loads` (`into_new`: `new_loads`); the lift of the solve.
+    fn solve(&mut self, into_new: bool) -> Result<f64, String> {
+        self.uv.update_stations(&self.stations, Some(&self.vel)).map_err(|e| e.to_string())?;
+        let l = self.uv.solve_step().map_err(|e| e.to_string())?;
+        let target = if into_new { &mut self.new_loads } else { &mut self.loads };
+        Ok(self.lumping.apply(l, &self.stations, self.aero.free_stream(), target))
+    }
+
+    /// Relax the applied loads towards the sub-iteration's; whether the relative change was
+    /// within the coupling's tolerance.
+    fn relax(&mut self) -> bool {
+        let (mut num, mut den) = (0.0, 0.0);
+        let w = self.aero.coupling.relaxation;
+        for (a, b) in self.loads.iter_mut().zip(&self.new_loads) {
+            num += (b.force - a.force).norm_squared() + (b.moment - a.moment).norm_squared();
+            den += b.force.norm_squared() + b.moment.norm_squared();
+            a.force = w * b.force + (1.0 - w) * a.force;
+            a.moment = w * b.moment + (1.0 - w) * a.moment;
+        }
+        num.sqrt() <= self.aero.coupling.tolerance * den.sqrt().max(1e-12)
+    }
+
+    /// Step `k` of the march, steps 1–4 of the scheme (module docs) and the commit of the UVLM
+    /// step; `vel_n` keeps the stations' velocities at the start of the step.
+    fn step<S: Structure>(
+        &mut self,
+        model: &mut S,
+        ga: &mut genalpha::GenAlpha<S::Solver>,
+        s: &mut genalpha::State,
+        k: usize,
+    ) -> Result<genalpha::StepStats, String> {
+        let dt = self.dt;
+        let t1 = s.t + dt;
+        // 1. Predict the structure at t_{n+1} and move the lattice there.
+        for i in 0..self.dq.len() {
+            self.dq[i] = dt * s.v[i] + 0.5 * dt * dt * s.v_dot[i];
+            self.vp[i] = s.v[i] + dt * s.v_dot[i];
+        }
+        model.retract_inplace(&s.q, &self.dq, &mut self.qp);
+        self.vel_n.clear();
+        self.vel_n.extend_from_slice(&self.vel);
+        stations_at(
+            model,
+            &self.qp,
+            &self.vp,
+            self.map,
+            self.aero,
+            &mut self.scratch,
+            &mut self.stations,
+            &mut self.vel,
+        );
+        // 2. Wake and aerodynamic solve at the predicted lattice.
+        let aero_err = |e: String| format!("step {k} (t = {t1:.4} s): aerodynamics: {e}");
+        self.uv.advance_wake(dt).map_err(|e| aero_err(e.to_string()))?;
+        self.lift = self.solve(false).map_err(aero_err)?;
+        // 3. Structural step with these loads.
+        let s_n: genalpha::State = s.clone();
+        model.set_section_loads(&self.loads).map_err(|e| format!("step {k} (t = {t1:.4} s): {e}"))?;
+        let mut st = ga.step(model, s).map_err(|e| format!("step {k}: {e}"))?;
+        // 4. Strong coupling.
+        for _ in 0..self.aero.coupling.max_sub_iterations {
+            self.move_to(model, &s.q, &s.v);
+            self.lift = self.solve(true).map_err(aero_err)?;
+            if self.relax() {
+                break;
+            }
+            *s = s_n.clone();
+            model
+                .set_section_loads(&self.loads)
+                .map_err(|e| format!("step {k} (t = {t1:.4} s, sub-iteration): {e}"))?;
+            st = ga.step(model, s).map_err(|e| format!("step {k} (sub-iteration): {e}"))?;
+        }
+        self.uv.commit_step().map_err(|e| format!("step {k}: aerodynamics: {e}"))?;
+        debug_assert!(
+            (self.uv.time() - s.t).abs() <= 1e-9 * s.t.abs().max(1.0),
+            "the UVLM's clock follows the structure's"
+        );
+        Ok(st)
+    }
 }

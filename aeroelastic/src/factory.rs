@@ -7,7 +7,7 @@ use genalpha::Predictor;
 
 use crate::Error;
 use crate::aero::{simulate_aero, station_map};
-use crate::problem::{AncfPath, Formulation, Problem};
+use crate::problem::{AncfPath, Block, Formulation, Problem};
 use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate};
 
 /// A formulation's model as a problem builds it: [`Structure`] plus its construction and its
@@ -70,10 +70,7 @@ pub fn predictor(f: Formulation) -> Predictor {
 
 /// The integrator parameters, end time and output interval of formulation `f` of a problem.
 pub fn settings(problem: &Problem, f: Formulation) -> RunSettings {
-    let (dt, rho, newton, form) = match f {
-        Formulation::Ancf => (problem.ancf.dt, problem.ancf.rho_inf, problem.ancf.newton, problem.ancf.form),
-        Formulation::Gebf => (problem.gebf.dt, problem.gebf.rho_inf, problem.gebf.newton, problem.gebf.form),
-    };
+    let Block { dt, rho_inf: rho, newton, form, .. } = problem.block(f);
     let predictor = predictor(f);
     let mut params = genalpha::IntegratorParams::new(rho, dt);
     params.newton = newton.to_params(predictor);

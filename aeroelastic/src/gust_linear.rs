@@ -37,11 +37,11 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
+use crate::aero::{SectionLoad, StationMap, lattice_spec, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::gust::Increments;
 use crate::problem::{Formulation, Problem};
-use crate::stability::{linear_wake, load_part, lump, reduce};
+use crate::stability::{MovedLattice, linear_wake, load_part, lump, mode_step, reduce, zero_loads};
 
 type C64 = Complex<f64>;
 
@@ -104,22 +104,16 @@ fn run<S: Structure>(
         .map_err(|e| format!("static equilibrium: {e}"))?;
     let (q, lam, mu) = p.state.ok_or("static equilibrium: no state")?;
     let settings = crate::factory::settings(case, f);
-    let dt = settings.params.dt;
     let wake = linear_wake(case, f, u);
     let nb_req = basis_modes.or(case.stability.as_ref().and_then(|s| s.basis_modes)).unwrap_or(30);
     let red = reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, &map, aero, &wake, nb_req, None, None)?;
-    let phi = red.phi.clone();
-    let nb = phi.ncols();
+    let nb = red.phi.ncols();
     let mut model = build(case).map_err(|e| e.to_string())?;
-    let zero_loads: Vec<SectionLoad> = map
-        .iter()
-        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
-        .collect();
+    let zero_loads = zero_loads(&map);
     model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
 
     // The linear UVLM on the equilibrium's lattice and the gust's input to it.
-    let n_dof = model.n_dof();
-    let zeros = vec![0.0; n_dof];
+    let zeros = vec![0.0; model.n_dof()];
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(&model, &q, &zeros, &map, aero, &mut scratch, &mut stations, &mut vel);
@@ -134,127 +128,24 @@ fn run<S: Structure>(
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
     let f0: Vec<f64> = steady.nodal.iter().flatten().copied().collect();
     let l0 = lump(&map, &steady.positions, &origins, &f0);
-    let (nr, nf, ns) = (la.n_rings(), la.n_force(), map.len());
 
-    // Lumping `C_l` (6·stations × nodal forces) and `H = Φᵀ P C_l`.
-    let ref_pos = la.lattice().ring_nodes().to_vec();
-    let flat = |l: &[SectionLoad]| -> Vec<f64> {
-        l.iter().flat_map(|x| [x.force.x, x.force.y, x.force.z, x.moment.x, x.moment.y, x.moment.z]).collect()
-    };
-    let mut cl = DMatrix::zeros(6 * ns, nf);
-    let mut unit = vec![0.0; nf];
-    for a in 0..nf {
-        unit.fill(0.0);
-        unit[a] = 1.0;
-        cl.set_column(a, &DVector::from_vec(flat(&lump(&map, &ref_pos, &origins, &unit))));
-    }
-    let mut p = DMatrix::zeros(n_dof, 6 * ns);
-    for j in 0..6 * ns {
-        let mut l = zero_loads.clone();
-        let comp = j % 6;
-        if comp < 3 {
-            l[j / 6].force[comp] = 1.0;
-        } else {
-            l[j / 6].moment[comp - 3] = 1.0;
-        }
-        p.set_column(j, &DVector::from_vec(load_part(&mut model, &q, &l, &zero_loads)?));
-    }
-    let h = phi.transpose() * &p * &cl;
-
-    // Geometric terms along each mode: residual, station loads and nodal forces of the moved
-    // lattice with the reference circulations held (as the stability reduction's).
-    let mut lat = la.lattice().clone();
-    let te_start = {
-        let l = la.lattice();
-        l.n_chordwise() * (l.n_spanwise() + 1)
-    };
-    type Eval = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
-    let mut eval = |model: &S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<Eval, String> {
-        let (mut st, mut ve) = (Vec::new(), Vec::new());
-        stations_at(model, qq, vv, &map, aero, &mut scratch, &mut st, &mut ve);
-        lat.update_stations(&st, if with_vel { Some(&ve) } else { None })
-            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        let (r, fz) = la.evaluate(&lat).map_err(|e| e.to_string())?;
-        let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
-        let te: Vec<f64> = lat.ring_nodes()[te_start..].iter().flatten().copied().collect();
-        Ok((r, flat(&lump(&map, lat.ring_nodes(), &org, &fz)), fz, te))
-    };
-    let (mut rx, mut rv) = (DMatrix::zeros(nr, nb), DMatrix::zeros(nr, nb));
-    let (mut lx, mut lv) = (DMatrix::zeros(6 * ns, nb), DMatrix::zeros(6 * ns, nb));
-    let (mut fx, mut fv) = (DMatrix::zeros(nf, nb), DMatrix::zeros(nf, nb));
-    let n_te = la.te_rings.len() + 1;
-    let mut xte = DMatrix::zeros(3 * n_te, nb);
-    // Outputs along each mode (position, velocity, acceleration) and per unit station load.
-    let (mut yx, mut yv, mut ya) = (DMatrix::zeros(N_OUT, nb), DMatrix::zeros(N_OUT, nb), DMatrix::zeros(N_OUT, nb));
-    let mut yl = DMatrix::zeros(N_OUT, 6 * ns);
-    let lm = settings.loads.as_ref();
-    let fold = settings.fold_joint;
-    let mut ls = crate::loads::LoadScratch::default();
-    let mut outputs = |model: &S, qq: &[f64], motion: (&[f64], &[f64]), loads: &[SectionLoad]| -> [f64; N_OUT] {
-        let w = lm.map(|lm| lm.evaluate(model, qq, Some(motion), loads, &mut ls));
-        let fold_deg = fold.map_or(f64::NAN, |j| model.fold(qq, j).to_degrees());
-        match w {
-            Some(w) => [w.root_bending_moment, w.root_torque, w.hinge_moment, fold_deg, 0.0],
-            None => [f64::NAN, f64::NAN, f64::NAN, fold_deg, 0.0],
-        }
-    };
-    let span = aero.chord.max(1e-3);
-    let (mut qp, mut qm) = (vec![0.0; q.len()], vec![0.0; q.len()]);
-    for i in 0..nb {
-        let col: Vec<f64> = phi.column(i).iter().copied().collect();
-        let neg: Vec<f64> = col.iter().map(|x| -x).collect();
-        let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
-        let eps = 1e-6 * span / big;
-        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
-        model.retract_inplace(&q, &dq, &mut qp);
-        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
-        model.retract_inplace(&q, &dq, &mut qm);
-        let (r1, l1, f1, te1) = eval(&model, &qp, &zeros, false)?;
-        let (r2, l2, f2, te2) = eval(&model, &qm, &zeros, false)?;
-        let d =
-            |a: &[f64], b: &[f64], k: f64| DVector::from_iterator(a.len(), a.iter().zip(b).map(|(x, y)| (x - y) * k));
-        rx.set_column(i, &d(&r1, &r2, 0.5 / eps));
-        lx.set_column(i, &d(&l1, &l2, 0.5 / eps));
-        fx.set_column(i, &d(&f1, &f2, 0.5 / eps));
-        xte.set_column(i, &d(&te1, &te2, 0.5 / eps));
-        let (r1, l1, f1, _) = eval(&model, &q, &col, true)?;
-        let (r2, l2, f2, _) = eval(&model, &q, &neg, true)?;
-        rv.set_column(i, &d(&r1, &r2, 0.5));
-        lv.set_column(i, &d(&l1, &l2, 0.5));
-        fv.set_column(i, &d(&f1, &f2, 0.5));
-        let (y1, y2) = (outputs(&model, &qp, (&zeros, &zeros), &l0), outputs(&model, &qm, (&zeros, &zeros), &l0));
-        yx.set_column(i, &d(&y1, &y2, 0.5 / eps));
-        let (y1, y2) = (outputs(&model, &q, (&col, &zeros), &l0), outputs(&model, &q, (&neg, &zeros), &l0));
-        yv.set_column(i, &d(&y1, &y2, 0.5));
-        let (y1, y2) = (outputs(&model, &q, (&zeros, &col), &l0), outputs(&model, &q, (&zeros, &neg), &l0));
-        ya.set_column(i, &d(&y1, &y2, 0.5));
-    }
-    for j in 0..6 * ns {
-        let (mut lp, mut lmn) = (l0.clone(), l0.clone());
-        let comp = j % 6;
-        for (l, sg) in [(&mut lp, 1.0), (&mut lmn, -1.0)] {
-            if comp < 3 {
-                l[j / 6].force[comp] += sg;
-            } else {
-                l[j / 6].moment[comp - 3] += sg;
-            }
-        }
-        let (y1, y2) = (outputs(&model, &q, (&zeros, &zeros), &lp), outputs(&model, &q, (&zeros, &zeros), &lmn));
-        for o in 0..N_OUT {
-            yl[(o, j)] = 0.5 * (y1[o] - y2[o]);
-        }
-    }
-    // The wake's nodes: where the trailing edge was (structure), drifted by the gust.
+    let (cl, h) = load_maps(&mut model, &q, &red.phi, &map, &zero_loads, &la, &origins)?;
+    let mut outputs = Outputs { lm: settings.loads.as_ref(), fold: settings.fold_joint, ls: Default::default() };
+    let mut moved = MovedLattice::new(&la, &map, aero);
+    let d = mode_derivatives(&model, &q, &red.phi, &mut moved, &mut outputs, &l0)?;
+    let te_start = moved.te_start();
+    let yl = output_per_station_load(&model, &q, &mut outputs, &l0);
+    let (nr, nf) = (la.n_rings(), la.n_force());
     let mut parts = Parts {
-        rx,
-        rv,
-        fx,
-        fv,
-        lx,
-        lv,
-        yx,
-        yv,
-        ya,
+        rx: d.rx,
+        rv: d.rv,
+        fx: d.fx,
+        fv: d.fv,
+        lx: d.lx,
+        lv: d.lv,
+        yx: d.yx,
+        yv: d.yv,
+        ya: d.ya,
         yl,
         h: h.map(C64::from),
         cl: cl.map(C64::from),
@@ -267,35 +158,238 @@ fn run<S: Structure>(
         drift_f: DMatrix::zeros(nf, 0),
     };
     if wake_motion {
-        let wd = la.wake_node_derivatives();
-        let te_nodes = &la.lattice().ring_nodes()[te_start..];
-        let vh = Vector3::from(v_inf) / u;
-        let te_delay: Vec<f64> =
-            te_nodes.iter().map(|x| vh.dot(&(Vector3::from(*x) - Vector3::from(front))) / u).collect();
-        let n_rows = wd.residual.len();
-        let (mut dr, mut df) = (DMatrix::zeros(nr, n_rows * n_te), DMatrix::zeros(nf, n_rows * n_te));
-        for k in 0..n_rows {
-            parts.rw.push(&wd.residual[k] * &xte);
-            parts.fw.push(&wd.force[k] * &xte);
-            let tau = la.row_delays[k];
-            for (j, &te_tau) in te_delay.iter().enumerate() {
-                let c = k * n_te + j;
-                for a in 0..3 {
-                    let g = tau * gust_dir[a];
-                    for r in 0..nr {
-                        dr[(r, c)] += g * wd.residual[k][(r, 3 * j + a)];
-                    }
-                    for r in 0..nf {
-                        df[(r, c)] += g * wd.force[k][(r, 3 * j + a)];
-                    }
-                }
-                parts.drift_delays.push(tau + te_tau);
+        add_wake_motion(&mut parts, &la, &d.xte, (v_inf, u), front, gust_dir, te_start);
+    }
+    parts.lift = lift_row(nf, v_inf).map(C64::from);
+    let field = crate::gust::disturbance(spec, aero, &stations, 2.0 * settings.t_end, 0.0)?;
+    let model_parts = Model { red: &red, la: &la, lg: &lg, parts: &parts };
+    let increments = synthesise(&*field, front, gust_dir, &settings, &model_parts)?;
+    let n = 2 * n_run(&settings).max(8);
+    Ok(LinearGustHistory { increments, n_basis: nb, n_frequencies: n / 2 + 1, n_wake_rows: wake.row_lengths.len() })
+}
+
+/// Station loads stacked as `[F, M]` per station.
+fn flat(l: &[SectionLoad]) -> Vec<f64> {
+    l.iter().flat_map(|x| [x.force.x, x.force.y, x.force.z, x.moment.x, x.moment.y, x.moment.z]).collect()
+}
+
+/// `(a − b)·k`.
+fn diff(a: &[f64], b: &[f64], k: f64) -> DVector<f64> {
+    DVector::from_iterator(a.len(), a.iter().zip(b).map(|(x, y)| (x - y) * k))
+}
+
+/// The lumping `C_l` (6·stations × nodal forces of `la`, about `origins`) and `H = Φᵀ P C_l`,
+/// `P` the generalised load part per unit station load at `q`.
+fn load_maps<S: Structure>(
+    model: &mut S,
+    q: &[f64],
+    phi: &DMatrix<f64>,
+    map: &[StationMap],
+    zero_loads: &[SectionLoad],
+    la: &uvlm::LinearUvlm,
+    origins: &[[f64; 3]],
+) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+    let (nf, ns) = (la.n_force(), map.len());
+    let ref_pos = la.lattice().ring_nodes().to_vec();
+    let mut cl = DMatrix::zeros(6 * ns, nf);
+    let mut unit = vec![0.0; nf];
+    for a in 0..nf {
+        unit.fill(0.0);
+        unit[a] = 1.0;
+        cl.set_column(a, &DVector::from_vec(flat(&lump(map, &ref_pos, origins, &unit))));
+    }
+    let mut p = DMatrix::zeros(model.n_dof(), 6 * ns);
+    for j in 0..6 * ns {
+        let mut l = zero_loads.to_vec();
+        let comp = j % 6;
+        if comp < 3 {
+            l[j / 6].force[comp] = 1.0;
+        } else {
+            l[j / 6].moment[comp - 3] = 1.0;
+        }
+        p.set_column(j, &DVector::from_vec(load_part(model, q, &l, zero_loads)?));
+    }
+    let h = phi.transpose() * &p * &cl;
+    Ok((cl, h))
+}
+
+/// The outputs of [`Increments`] at a state (the lift, linear in the nodal forces, is 0 here):
+/// root bending moment, root torque and hinge moment of the load model, and the fold angle.
+struct Outputs<'a> {
+    lm: Option<&'a crate::loads::LoadModel>,
+    fold: Option<usize>,
+    ls: crate::loads::LoadScratch,
+}
+
+impl Outputs<'_> {
+    /// The outputs of `model` at `q` moving with `motion` (velocity, acceleration) under `loads`.
+    fn at<S: Structure>(
+        &mut self,
+        model: &S,
+        q: &[f64],
+        motion: (&[f64], &[f64]),
+        loads: &[SectionLoad],
+    ) -> [f64; N_OUT] {
+        let w = self.lm.map(|lm| lm.evaluate(model, q, Some(motion), loads, &mut self.ls));
+        let fold_deg = self.fold.map_or(f64::NAN, |j| model.fold(q, j).to_degrees());
+        match w {
+            Some(w) => [w.root_bending_moment, w.root_torque, w.hinge_moment, fold_deg, 0.0],
+            None => [f64::NAN, f64::NAN, f64::NAN, fold_deg, 0.0],
+        }
+    }
+}
+
+/// The geometric terms and the outputs along each basis mode (central differences of a step of
+/// `1e-6` chord along its position, and along its velocity and acceleration): residual, station
+/// loads and nodal forces of the moved lattice with the reference circulations held (as the
+/// stability reduction's), the trailing edge's motion, and the outputs under the steady loads
+/// `l0`.
+struct ModeDerivatives {
+    rx: DMatrix<f64>,
+    rv: DMatrix<f64>,
+    lx: DMatrix<f64>,
+    lv: DMatrix<f64>,
+    fx: DMatrix<f64>,
+    fv: DMatrix<f64>,
+    xte: DMatrix<f64>,
+    yx: DMatrix<f64>,
+    yv: DMatrix<f64>,
+    ya: DMatrix<f64>,
+}
+
+/// [`ModeDerivatives`] of `model` about `q` along the modes `phi`.
+fn mode_derivatives<S: Structure>(
+    model: &S,
+    q: &[f64],
+    phi: &DMatrix<f64>,
+    moved: &mut MovedLattice<'_>,
+    outputs: &mut Outputs<'_>,
+    l0: &[SectionLoad],
+) -> Result<ModeDerivatives, String> {
+    let (la, chord) = (moved.linear(), moved.chord());
+    let (nr, nf, ns, nb) = (la.n_rings(), la.n_force(), l0.len(), phi.ncols());
+    let n_te = la.te_rings.len() + 1;
+    let zeros = vec![0.0; model.n_dof()];
+    let mut d = ModeDerivatives {
+        rx: DMatrix::zeros(nr, nb),
+        rv: DMatrix::zeros(nr, nb),
+        lx: DMatrix::zeros(6 * ns, nb),
+        lv: DMatrix::zeros(6 * ns, nb),
+        fx: DMatrix::zeros(nf, nb),
+        fv: DMatrix::zeros(nf, nb),
+        xte: DMatrix::zeros(3 * n_te, nb),
+        yx: DMatrix::zeros(N_OUT, nb),
+        yv: DMatrix::zeros(N_OUT, nb),
+        ya: DMatrix::zeros(N_OUT, nb),
+    };
+    let mut eval = |qq: &[f64], vv: &[f64], with_vel: bool| -> Result<_, String> {
+        let m = moved.at(model, qq, vv, with_vel)?;
+        Ok((m.residual, flat(&m.loads), m.forces, m.te))
+    };
+    let span = chord.max(1e-3);
+    let (mut qp, mut qm) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+    for i in 0..nb {
+        let (col, eps) = mode_step(phi, i, span);
+        let neg: Vec<f64> = col.iter().map(|x| -x).collect();
+        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
+        model.retract_inplace(q, &dq, &mut qp);
+        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
+        model.retract_inplace(q, &dq, &mut qm);
+        let (r1, l1, f1, te1) = eval(&qp, &zeros, false)?;
+        let (r2, l2, f2, te2) = eval(&qm, &zeros, false)?;
+        d.rx.set_column(i, &diff(&r1, &r2, 0.5 / eps));
+        d.lx.set_column(i, &diff(&l1, &l2, 0.5 / eps));
+        d.fx.set_column(i, &diff(&f1, &f2, 0.5 / eps));
+        d.xte.set_column(i, &diff(&te1, &te2, 0.5 / eps));
+        let (r1, l1, f1, _) = eval(q, &col, true)?;
+        let (r2, l2, f2, _) = eval(q, &neg, true)?;
+        d.rv.set_column(i, &diff(&r1, &r2, 0.5));
+        d.lv.set_column(i, &diff(&l1, &l2, 0.5));
+        d.fv.set_column(i, &diff(&f1, &f2, 0.5));
+        let (y1, y2) = (outputs.at(model, &qp, (&zeros, &zeros), l0), outputs.at(model, &qm, (&zeros, &zeros), l0));
+        d.yx.set_column(i, &diff(&y1, &y2, 0.5 / eps));
+        let (y1, y2) = (outputs.at(model, q, (&col, &zeros), l0), outputs.at(model, q, (&neg, &zeros), l0));
+        d.yv.set_column(i, &diff(&y1, &y2, 0.5));
+        let (y1, y2) = (outputs.at(model, q, (&zeros, &col), l0), outputs.at(model, q, (&zeros, &neg), l0));
+        d.ya.set_column(i, &diff(&y1, &y2, 0.5));
+    }
+    Ok(d)
+}
+
+/// The outputs per unit station load (outputs × 6·stations), by central differences of unit
+/// loads about the steady loads `l0` at `q`.
+fn output_per_station_load<S: Structure>(
+    model: &S,
+    q: &[f64],
+    outputs: &mut Outputs<'_>,
+    l0: &[SectionLoad],
+) -> DMatrix<f64> {
+    let zeros = vec![0.0; model.n_dof()];
+    let ns = l0.len();
+    let mut yl = DMatrix::zeros(N_OUT, 6 * ns);
+    for j in 0..6 * ns {
+        let (mut lp, mut lmn) = (l0.to_vec(), l0.to_vec());
+        let comp = j % 6;
+        for (l, sg) in [(&mut lp, 1.0), (&mut lmn, -1.0)] {
+            if comp < 3 {
+                l[j / 6].force[comp] += sg;
+            } else {
+                l[j / 6].moment[comp - 3] += sg;
             }
         }
-        parts.drift_r = dr;
-        parts.drift_f = df;
+        let (y1, y2) = (outputs.at(model, q, (&zeros, &zeros), &lp), outputs.at(model, q, (&zeros, &zeros), &lmn));
+        for o in 0..N_OUT {
+            yl[(o, j)] = 0.5 * (y1[o] - y2[o]);
+        }
     }
-    // Lift: the total nodal force along the lift direction (uvlm::lift_drag_of, linear).
+    yl
+}
+
+/// The wake's nodes in [`Parts`]: where the trailing edge was (the structure's motion, `xte`
+/// along each mode), drifted by the gust (direction `gust_dir`, front `front`) in the free
+/// stream `(v_inf, u)`; `te_start` is the first trailing-edge node of the lattice.
+fn add_wake_motion(
+    parts: &mut Parts,
+    la: &uvlm::LinearUvlm,
+    xte: &DMatrix<f64>,
+    (v_inf, u): ([f64; 3], f64),
+    front: [f64; 3],
+    gust_dir: Vector3<f64>,
+    te_start: usize,
+) {
+    let (nr, nf) = (la.n_rings(), la.n_force());
+    let n_te = la.te_rings.len() + 1;
+    let wd = la.wake_node_derivatives();
+    let te_nodes = &la.lattice().ring_nodes()[te_start..];
+    let vh = Vector3::from(v_inf) / u;
+    let te_delay: Vec<f64> = te_nodes.iter().map(|x| vh.dot(&(Vector3::from(*x) - Vector3::from(front))) / u).collect();
+    let n_rows = wd.residual.len();
+    let (mut dr, mut df) = (DMatrix::zeros(nr, n_rows * n_te), DMatrix::zeros(nf, n_rows * n_te));
+    for k in 0..n_rows {
+        parts.rw.push(&wd.residual[k] * xte);
+        parts.fw.push(&wd.force[k] * xte);
+        let tau = la.row_delays[k];
+        for (j, &te_tau) in te_delay.iter().enumerate() {
+            let c = k * n_te + j;
+            for a in 0..3 {
+                let g = tau * gust_dir[a];
+                for r in 0..nr {
+                    dr[(r, c)] += g * wd.residual[k][(r, 3 * j + a)];
+                }
+                for r in 0..nf {
+                    df[(r, c)] += g * wd.force[k][(r, 3 * j + a)];
+                }
+            }
+            parts.drift_delays.push(tau + te_tau);
+        }
+    }
+    parts.drift_r = dr;
+    parts.drift_f = df;
+}
+
+/// The lift of the nodal forces (`nf` components) as a row: their total along the lift
+/// direction of the free stream `v_inf` (uvlm::lift_drag_of, linear).
+fn lift_row(nf: usize, v_inf: [f64; 3]) -> DMatrix<f64> {
     let n_nodes = nf / 3;
     let mut lift_row = DMatrix::zeros(1, nf);
     for k in 0..n_nodes {
@@ -305,10 +399,36 @@ fn run<S: Structure>(
             lift_row[(0, 3 * k + c)] = uvlm::lift_drag_of(e, v_inf, [1.0, 0.0, 0.0]).0;
         }
     }
+    lift_row
+}
 
+/// Steps of the time march over `[0, t_end]`.
+fn n_run(settings: &crate::run::RunSettings) -> usize {
+    (settings.t_end / settings.params.dt).round().max(1.0) as usize
+}
+
+/// The linear model whose transfer [`transfer`] evaluates.
+struct Model<'a> {
+    red: &'a crate::stability::Reduced,
+    la: &'a uvlm::LinearUvlm,
+    lg: &'a uvlm::LinearGust,
+    parts: &'a Parts,
+}
+
+/// The time history of the outputs at the run's output times, by the inverse Fourier transform
+/// on a contour shifted by `σ`: the gust `field` sampled at `front` along `gust_dir` on the time
+/// march's steps over twice its duration, windowed by `e^{−σt}`, each frequency's response from
+/// [`transfer`].
+fn synthesise(
+    field: &dyn uvlm::FlowField,
+    front: [f64; 3],
+    gust_dir: Vector3<f64>,
+    settings: &crate::run::RunSettings,
+    model: &Model<'_>,
+) -> Result<Increments, String> {
     // The gust at the front's reference point, sampled on the time march's steps over T = 2 t_end.
-    let field = crate::gust::disturbance(spec, aero, &stations, 2.0 * settings.t_end, 0.0)?;
-    let n_run = (settings.t_end / dt).round().max(1.0) as usize;
+    let dt = settings.params.dt;
+    let n_run = n_run(settings);
     let n = 2 * n_run.max(8);
     let period = n as f64 * dt;
     let sigma = 18.4 / period;
@@ -316,7 +436,6 @@ fn run<S: Structure>(
     let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
     let out_steps: Vec<usize> = (0..=n_run).filter(|k| k % every == 0 || *k == n_run).collect();
     let mut acc = vec![[0.0; N_OUT]; out_steps.len()];
-    parts.lift = lift_row.map(C64::from);
     for k in 0..=n / 2 {
         let omega = 2.0 * std::f64::consts::PI * k as f64 / period;
         let s = C64::new(sigma, omega);
@@ -332,7 +451,7 @@ fn run<S: Structure>(
         if w_hat.norm() == 0.0 {
             continue;
         }
-        let y = transfer(s, &red, &la, &lg, &parts)?;
+        let y = transfer(s, model.red, model.la, model.lg, model.parts)?;
         let weight = if k == 0 || 2 * k == n { 1.0 } else { 2.0 };
         for (row, &step) in acc.iter_mut().zip(&out_steps) {
             let t = step as f64 * dt;
@@ -344,18 +463,13 @@ fn run<S: Structure>(
     }
     let scale: Vec<f64> = out_steps.iter().map(|&k| (sigma * k as f64 * dt).exp() / n as f64).collect();
     let series = |o: usize| acc.iter().zip(&scale).map(|(r, sc)| r[o] * sc).collect::<Vec<f64>>();
-    Ok(LinearGustHistory {
-        increments: Increments {
-            t: out_steps.iter().map(|&k| k as f64 * dt).collect(),
-            delta_root_bending_moment: series(0),
-            delta_root_torque: series(1),
-            delta_hinge_moment: series(2),
-            delta_fold_deg: series(3),
-            delta_lift: series(4),
-        },
-        n_basis: nb,
-        n_frequencies: n / 2 + 1,
-        n_wake_rows: wake.row_lengths.len(),
+    Ok(Increments {
+        t: out_steps.iter().map(|&k| k as f64 * dt).collect(),
+        delta_root_bending_moment: series(0),
+        delta_root_torque: series(1),
+        delta_hinge_moment: series(2),
+        delta_fold_deg: series(3),
+        delta_lift: series(4),
     })
 }
 

@@ -77,10 +77,7 @@ impl LoadModel {
     /// everything joined outboard of it, and the outboard side of the fold hinge
     /// ([`Problem::fold_joint_index`]). `None` when the case has neither.
     pub fn new(case: &Problem, f: Formulation) -> Option<Self> {
-        let n_el = match f {
-            Formulation::Ancf => &case.ancf.elements_per_body,
-            Formulation::Gebf => &case.gebf.elements_per_body,
-        };
+        let n_el = case.block(f).elements_per_body;
         let bodies: Vec<BodyMass> = case
             .bodies
             .iter()

@@ -526,6 +526,78 @@ pub struct GebfSettings {
     pub newton: NewtonSettings,
 }
 
+/// The settings every formulation's block (`ancf`, `gebf`) has, read from the block of one:
+/// callers pick a block by [`Formulation`] ([`Problem::block`], [`blocks`]) instead of
+/// matching on it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Block<'a> {
+    /// Elements per body.
+    pub elements_per_body: &'a Elements,
+    /// Time step, s.
+    pub dt: f64,
+    /// Spectral radius at infinite frequency.
+    pub rho_inf: f64,
+    /// Where the generalized-α step enforces the equations of motion.
+    pub form: FormSetting,
+    /// Newton settings.
+    pub newton: NewtonSettings,
+}
+
+/// The shared settings of one formulation's block, to change in place.
+#[derive(Debug)]
+pub struct BlockMut<'a> {
+    /// Elements per body.
+    pub elements_per_body: &'a mut Elements,
+    /// Time step, s.
+    pub dt: &'a mut f64,
+    /// Spectral radius at infinite frequency.
+    pub rho_inf: &'a mut f64,
+    /// Where the generalized-α step enforces the equations of motion.
+    pub form: &'a mut FormSetting,
+    /// Newton settings.
+    pub newton: &'a mut NewtonSettings,
+}
+
+/// The block of formulation `f` of a pair of blocks (a problem's or a case file's).
+pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings) -> Block<'a> {
+    match f {
+        Formulation::Ancf => Block {
+            elements_per_body: &ancf.elements_per_body,
+            dt: ancf.dt,
+            rho_inf: ancf.rho_inf,
+            form: ancf.form,
+            newton: ancf.newton,
+        },
+        Formulation::Gebf => Block {
+            elements_per_body: &gebf.elements_per_body,
+            dt: gebf.dt,
+            rho_inf: gebf.rho_inf,
+            form: gebf.form,
+            newton: gebf.newton,
+        },
+    }
+}
+
+/// [`blocks`], to change in place.
+pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut GebfSettings) -> BlockMut<'a> {
+    match f {
+        Formulation::Ancf => BlockMut {
+            elements_per_body: &mut ancf.elements_per_body,
+            dt: &mut ancf.dt,
+            rho_inf: &mut ancf.rho_inf,
+            form: &mut ancf.form,
+            newton: &mut ancf.newton,
+        },
+        Formulation::Gebf => BlockMut {
+            elements_per_body: &mut gebf.elements_per_body,
+            dt: &mut gebf.dt,
+            rho_inf: &mut gebf.rho_inf,
+            form: &mut gebf.form,
+            newton: &mut gebf.newton,
+        },
+    }
+}
+
 /// The two structural formulations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -541,6 +613,10 @@ pub enum Formulation {
 impl Formulation {
     /// Both, in report order.
     pub const ALL: [Formulation; 2] = [Formulation::Ancf, Formulation::Gebf];
+    /// The formulation whose [`Formulation::as_str`] is `name`.
+    pub fn from_name(name: &str) -> Option<Formulation> {
+        Formulation::ALL.into_iter().find(|f| f.as_str() == name)
+    }
     /// Lower-case name used in file names.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -567,6 +643,16 @@ impl Problem {
         fold_joint_index(&self.joints, self.fold_joint.as_deref())
     }
 
+    /// The settings of formulation `f`'s block.
+    pub fn block(&self, f: Formulation) -> Block<'_> {
+        blocks(f, &self.ancf, &self.gebf)
+    }
+
+    /// The settings of formulation `f`'s block, to change in place.
+    pub fn block_mut(&mut self, f: Formulation) -> BlockMut<'_> {
+        blocks_mut(f, &mut self.ancf, &mut self.gebf)
+    }
+
     /// Total length of all bodies, m.
     pub fn span(&self) -> f64 {
         self.bodies.iter().map(|b| b.length).sum()
@@ -576,10 +662,7 @@ impl Problem {
     /// counts of `f`), joints, hinge springs as force elements, gravity. Body names that do not
     /// resolve become an index past the last body, which [`scene::Scene::validate`] rejects.
     pub fn scene(&self, f: Formulation) -> scene::Scene {
-        let n_el = match f {
-            Formulation::Ancf => &self.ancf.elements_per_body,
-            Formulation::Gebf => &self.gebf.elements_per_body,
-        };
+        let n_el = self.block(f).elements_per_body;
         let unit = |v: [f64; 3]| nalgebra::Vector3::from(v).normalize();
         // Nose-up pitch: a rotation about +X takes +Y (the leading edge) towards +Z.
         let pitch = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), self.pitch_deg.to_radians());

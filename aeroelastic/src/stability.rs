@@ -514,33 +514,55 @@ pub(crate) fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 
         .collect()
 }
 
-/// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
-/// `aero`, with `nb` basis modes.
-#[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
-pub fn reduce<S: Structure>(
-    mut model: S,
+/// Reused buffers of [`stations_at`].
+type StationScratch = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Zero station loads at the stations of `map`.
+pub(crate) fn zero_loads(map: &[StationMap]) -> Vec<SectionLoad> {
+    map.iter()
+        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+        .collect()
+}
+
+/// Column `i` of the modal basis `phi`, and the step along it for central differences: the
+/// largest coordinate moves by `1e-6 · length`.
+pub(crate) fn mode_step(phi: &DMatrix<f64>, i: usize, length: f64) -> (Vec<f64>, f64) {
+    let col: Vec<f64> = phi.column(i).iter().copied().collect();
+    let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+    (col, 1e-6 * length / big)
+}
+
+/// The structural part of a reduction: the first basis modes and the modal matrices.
+struct ModalBasis {
+    /// The modes `Φ` (tangent unknowns × basis modes), mass-normalised.
+    phi: DMatrix<f64>,
+    /// `Φᵀ M Φ`, `Φᵀ C Φ` and `Φᵀ K Φ` of the unloaded structure.
+    m: DMatrix<f64>,
+    c: DMatrix<f64>,
+    k: DMatrix<f64>,
+    /// Natural frequencies of all free motions, rad/s.
+    omega: Vec<f64>,
+}
+
+/// The first `nb` (at most the free motions) natural modes of `model` about `(q, λ, μ)` under
+/// the steady station loads of the lattice held fixed, and the modal matrices of the unloaded
+/// structure.
+fn modal_basis<S: Structure>(
+    model: &mut S,
     q: &[f64],
-    lambda: &[f64],
-    mu: &[f64],
+    (lambda, mu): (&[f64], &[f64]),
     map: &[StationMap],
     aero: &AeroSettings,
-    wake: &uvlm::LinearWake,
+    zero_loads: &[SectionLoad],
     nb: usize,
-    shapes_out: Option<(&Problem, &mut Vec<ModeShape>)>,
-    strip_case: Option<&Problem>,
-) -> Result<Reduced, String> {
-    let zero_loads: Vec<SectionLoad> = map
-        .iter()
-        .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
-        .collect();
-    model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
+) -> Result<ModalBasis, String> {
     let mut lin =
-        genalpha::analysis::linearise(&model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
+        genalpha::analysis::linearise(&*model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
     // The structural modes are those of the structure under its equilibrium's steady station
     // loads held fixed (their stiffness as each formulation applies them), so that they describe a
     // state in equilibrium; the flutter equation itself takes every aerodynamic term from the
-    // geometric differences below (the held-load stiffness is part of them).
-    let held = held_load_stiffness(&mut model, q, map, aero, &zero_loads)?;
+    // geometric differences (the held-load stiffness is part of them).
+    let held = held_load_stiffness(model, q, map, aero, zero_loads)?;
     if let Some(kl) = &held {
         lin.stiffness += kl;
         lin.reduced_stiffness = lin.null_space.transpose() * &lin.stiffness * &lin.null_space;
@@ -555,127 +577,116 @@ pub fn reduce<S: Structure>(
     let m = phi.transpose() * &lin.mass * &phi;
     let c = phi.transpose() * &lin.damping * &phi;
     let k = phi.transpose() * &lin.stiffness * &phi;
-    let n_dof = model.n_dof();
-    let zeros = vec![0.0; n_dof];
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
-    let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(&model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
-    if let Some((case, out)) = shapes_out {
-        let span = case.span().max(1e-3);
-        for i in 0..nb {
-            let col: Vec<f64> = phi.column(i).iter().copied().collect();
-            let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
-            let eps = 1e-6 * span / big;
-            let mut qp = vec![0.0; q.len()];
-            let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
-            model.retract_inplace(q, &dq, &mut qp);
-            let (mut st2, mut v2) = (Vec::new(), Vec::new());
-            stations_at(&model, &qp, &zeros, map, aero, &mut scratch, &mut st2, &mut v2);
-            let mut d: Vec<[f64; 3]> =
-                st2.iter().zip(&stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
-            let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
-            d.iter_mut().flatten().for_each(|x| *x /= dm);
-            out.push(ModeShape {
-                omega: modes.omega[i],
-                s: map.iter().map(|x| x.wing_arc(case)).collect(),
-                displacement: d,
-            });
-        }
-    }
-    if let Some(case) = strip_case {
-        // Station plunge and pitch along each mode, by central differences of the stations.
-        let lift = crate::statics::lift_direction(aero.free_stream());
-        let ns = map.len();
-        let (mut z, mut alpha) = (DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb));
-        let span_len = case.span().max(1e-3);
-        for i in 0..nb {
-            let col: Vec<f64> = phi.column(i).iter().copied().collect();
-            let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
-            let eps = 1e-6 * span_len / big;
-            let mut pm = Vec::new();
-            for sg in [1.0, -1.0] {
-                let mut qq = vec![0.0; q.len()];
-                let dq: Vec<f64> = col.iter().map(|x| sg * eps * x).collect();
-                model.retract_inplace(q, &dq, &mut qq);
-                let (mut s2, mut v2) = (Vec::new(), Vec::new());
-                stations_at(&model, &qq, &zeros, map, aero, &mut scratch, &mut s2, &mut v2);
-                pm.push(s2);
-            }
-            for j in 0..ns {
-                let d = (pm[0][j].origin - pm[1][j].origin) / (2.0 * eps);
-                let w = (pm[0][j].frame - pm[1][j].frame) * stations[j].frame.transpose() / (2.0 * eps);
-                let rot = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
-                // Nose-up axis: the leading-edge direction turned towards the lift.
-                let le = stations[j].frame.column(1).into_owned();
-                let axis = le.cross(&lift).normalize();
-                z[(j, i)] = d.dot(&lift);
-                alpha[(j, i)] = rot.dot(&axis);
-            }
-        }
-        let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();
-        let width = (0..ns)
-            .map(|j| {
-                let lo = if j > 0 { 0.5 * (arcs[j] - arcs[j - 1]) } else { 0.0 };
-                let hi = if j + 1 < ns { 0.5 * (arcs[j + 1] - arcs[j]) } else { 0.0 };
-                lo + hi
-            })
-            .collect();
-        let b = 0.5 * aero.chord;
-        let strips = Strips {
-            z,
-            alpha,
-            width,
-            rho: aero.rho,
-            b,
-            a: (aero.le_offset - b) / b,
-            speed: aero.airspeed.unwrap_or(0.0),
-        };
-        let e = DMatrix::zeros(0, nb);
-        return Ok(Reduced {
-            m,
-            c,
-            k,
-            gx: DMatrix::zeros(nb, nb),
-            gv: DMatrix::zeros(nb, nb),
-            ratio: 1.0,
-            rx: e.clone(),
-            rv: e,
-            aic: DMatrix::zeros(0, 0),
-            w_rows: Vec::new(),
-            delays: Vec::new(),
-            te_rings: Vec::new(),
-            t_gamma: DMatrix::zeros(nb, 0),
-            t_gamma_dot: DMatrix::zeros(nb, 0),
-            t_rows: Vec::new(),
-            wake_r: Vec::new(),
-            wake_g: Vec::new(),
-            strip: Some(strips),
-            omega: modes.omega.clone(),
-            n_rings: 0,
-            n_wake_rings: 0,
-            phi,
+    Ok(ModalBasis { phi, m, c, k, omega: modes.omega.clone() })
+}
+
+/// The shapes of the basis modes for the report: the stations' displacement along each mode
+/// (a forward difference of `1e-6` span), scaled to a largest component of 1.
+fn mode_shapes<S: Structure>(
+    model: &mut S,
+    q: &[f64],
+    stations: &[uvlm::SpanStation],
+    basis: &ModalBasis,
+    (map, aero, case): (&[StationMap], &AeroSettings, &Problem),
+) -> Vec<ModeShape> {
+    let zeros = vec![0.0; model.n_dof()];
+    let mut scratch = StationScratch::default();
+    let span = case.span().max(1e-3);
+    let mut out = Vec::with_capacity(basis.phi.ncols());
+    for i in 0..basis.phi.ncols() {
+        let (col, eps) = mode_step(&basis.phi, i, span);
+        let mut qp = vec![0.0; q.len()];
+        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
+        model.retract_inplace(q, &dq, &mut qp);
+        let (mut st2, mut v2) = (Vec::new(), Vec::new());
+        stations_at(&*model, &qp, &zeros, map, aero, &mut scratch, &mut st2, &mut v2);
+        let mut d: Vec<[f64; 3]> =
+            st2.iter().zip(stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
+        let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+        d.iter_mut().flatten().for_each(|x| *x /= dm);
+        out.push(ModeShape {
+            omega: basis.omega[i],
+            s: map.iter().map(|x| x.wing_arc(case)).collect(),
+            displacement: d,
         });
     }
-    let spec = crate::aero::lattice_spec(map, aero);
-    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
-    let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
-    let (nr, nf) = (la.n_rings(), la.n_force());
-    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let ref_pos = la.lattice().ring_nodes().to_vec();
-    // H = Φᵀ P Cl: generalised (modal) load part per unit nodal force, by the linearity of the
-    // load part in the station loads and of the lumping in the nodal forces.
+    out
+}
+
+/// Theodorsen strips at the stations: each station's plunge and pitch along each basis mode
+/// (central differences of the stations), and each strip's width.
+fn strip_model<S: Structure>(
+    model: &mut S,
+    q: &[f64],
+    stations: &[uvlm::SpanStation],
+    phi: &DMatrix<f64>,
+    (map, aero, case): (&[StationMap], &AeroSettings, &Problem),
+) -> Strips {
+    let zeros = vec![0.0; model.n_dof()];
+    let mut scratch = StationScratch::default();
+    let nb = phi.ncols();
+    let lift = crate::statics::lift_direction(aero.free_stream());
     let ns = map.len();
-    let mut p = DMatrix::zeros(n_dof, 6 * ns);
+    let (mut z, mut alpha) = (DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb));
+    let span_len = case.span().max(1e-3);
+    for i in 0..nb {
+        let (col, eps) = mode_step(phi, i, span_len);
+        let mut pm = Vec::new();
+        for sg in [1.0, -1.0] {
+            let mut qq = vec![0.0; q.len()];
+            let dq: Vec<f64> = col.iter().map(|x| sg * eps * x).collect();
+            model.retract_inplace(q, &dq, &mut qq);
+            let (mut s2, mut v2) = (Vec::new(), Vec::new());
+            stations_at(&*model, &qq, &zeros, map, aero, &mut scratch, &mut s2, &mut v2);
+            pm.push(s2);
+        }
+        for j in 0..ns {
+            let d = (pm[0][j].origin - pm[1][j].origin) / (2.0 * eps);
+            let w = (pm[0][j].frame - pm[1][j].frame) * stations[j].frame.transpose() / (2.0 * eps);
+            let rot = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
+            // Nose-up axis: the leading-edge direction turned towards the lift.
+            let le = stations[j].frame.column(1).into_owned();
+            let axis = le.cross(&lift).normalize();
+            z[(j, i)] = d.dot(&lift);
+            alpha[(j, i)] = rot.dot(&axis);
+        }
+    }
+    let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();
+    let width = (0..ns)
+        .map(|j| {
+            let lo = if j > 0 { 0.5 * (arcs[j] - arcs[j - 1]) } else { 0.0 };
+            let hi = if j + 1 < ns { 0.5 * (arcs[j + 1] - arcs[j]) } else { 0.0 };
+            lo + hi
+        })
+        .collect();
+    let b = 0.5 * aero.chord;
+    Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset - b) / b, speed: aero.airspeed.unwrap_or(0.0) }
+}
+
+/// `H = Φᵀ P C_l` (basis modes × nodal forces): the generalised (modal) load part per unit nodal
+/// force of the lattice `la` (lumped about `origins`), by the linearity of the load part in the
+/// station loads and of the lumping in the nodal forces.
+fn modal_load_per_nodal_force<S: Structure>(
+    model: &mut S,
+    q: &[f64],
+    phi: &DMatrix<f64>,
+    map: &[StationMap],
+    zero_loads: &[SectionLoad],
+    la: &uvlm::LinearUvlm,
+    origins: &[[f64; 3]],
+) -> Result<DMatrix<f64>, String> {
+    let (nb, nf, ns) = (phi.ncols(), la.n_force(), map.len());
+    let ref_pos = la.lattice().ring_nodes().to_vec();
+    let mut p = DMatrix::zeros(model.n_dof(), 6 * ns);
     for j in 0..ns {
         for comp in 0..6 {
-            let mut l = zero_loads.clone();
+            let mut l = zero_loads.to_vec();
             if comp < 3 {
                 l[j].force[comp] = 1.0;
             } else {
                 l[j].moment[comp - 3] = 1.0;
             }
-            let g = load_part(&mut model, q, &l, &zero_loads)?;
+            let g = load_part(model, q, &l, zero_loads)?;
             p.column_mut(6 * j + comp).copy_from_slice(&g);
         }
     }
@@ -685,7 +696,7 @@ pub fn reduce<S: Structure>(
     for a in 0..nf {
         unit.fill(0.0);
         unit[a] = 1.0;
-        let l = lump(map, &ref_pos, &origins, &unit);
+        let l = lump(map, &ref_pos, origins, &unit);
         for (j, sl) in l.iter().enumerate() {
             for comp in 0..3 {
                 let (fv, mv) = (sl.force[comp], sl.moment[comp]);
@@ -702,59 +713,217 @@ pub fn reduce<S: Structure>(
             }
         }
     }
-    // Geometric terms along each basis mode.
-    let span = aero.chord.max(1e-3);
-    let mut rx = DMatrix::zeros(nr, nb);
-    let mut rv = DMatrix::zeros(nr, nb);
-    let mut gx = DMatrix::zeros(nb, nb);
-    let mut gv = DMatrix::zeros(nb, nb);
-    let mut lat = la.lattice().clone();
-    let te_start = lat.n_chordwise() * (lat.n_spanwise() + 1);
-    let n_te = 3 * (lat.n_spanwise() + 1);
-    let mut xte = DMatrix::zeros(n_te, nb);
-    type Eval = (Vec<f64>, Vec<f64>, Vec<f64>);
-    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<Eval, String> {
+    Ok(h)
+}
+
+/// The lattice of a linear UVLM moved with the structure, its reference circulations held: the
+/// residual, nodal forces, station loads and trailing-edge nodes at a moved state (the geometric
+/// terms of the stability reduction and of the linear gust response).
+pub(crate) struct MovedLattice<'a> {
+    la: &'a uvlm::LinearUvlm,
+    lat: uvlm::Lattice,
+    map: &'a [StationMap],
+    aero: &'a AeroSettings,
+    /// First trailing-edge node of the lattice.
+    te_start: usize,
+    scratch: StationScratch,
+}
+
+/// What [`MovedLattice::at`] evaluates.
+pub(crate) struct Moved {
+    /// Non-penetration residual (bound rings).
+    pub residual: Vec<f64>,
+    /// Stacked nodal forces.
+    pub forces: Vec<f64>,
+    /// The nodal forces lumped to station loads.
+    pub loads: Vec<SectionLoad>,
+    /// Stacked trailing-edge node positions.
+    pub te: Vec<f64>,
+}
+
+impl<'a> MovedLattice<'a> {
+    /// The lattice of `la` on the stations of `map`.
+    pub(crate) fn new(la: &'a uvlm::LinearUvlm, map: &'a [StationMap], aero: &'a AeroSettings) -> Self {
+        let lat = la.lattice().clone();
+        let te_start = lat.n_chordwise() * (lat.n_spanwise() + 1);
+        Self { la, lat, map, aero, te_start, scratch: StationScratch::default() }
+    }
+
+    /// First trailing-edge node of the lattice.
+    pub(crate) fn te_start(&self) -> usize {
+        self.te_start
+    }
+
+    /// The linear UVLM.
+    pub(crate) fn linear(&self) -> &'a uvlm::LinearUvlm {
+        self.la
+    }
+
+    /// The chord of the lattice, m.
+    pub(crate) fn chord(&self) -> f64 {
+        self.aero.chord
+    }
+
+    /// The lattice moved to the stations of `model` at `(q, v)`, their velocities counted when
+    /// `with_vel`.
+    pub(crate) fn at<S: Structure + ?Sized>(
+        &mut self,
+        model: &S,
+        q: &[f64],
+        v: &[f64],
+        with_vel: bool,
+    ) -> Result<Moved, String> {
         let (mut st, mut ve) = (Vec::new(), Vec::new());
-        stations_at(&*model, qq, vv, map, aero, &mut scratch, &mut st, &mut ve);
-        lat.update_stations(&st, if with_vel { Some(&ve) } else { None })
+        stations_at(model, q, v, self.map, self.aero, &mut self.scratch, &mut st, &mut ve);
+        self.lat
+            .update_stations(&st, if with_vel { Some(&ve) } else { None })
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        let (r, f) = la.evaluate(&lat).map_err(|e| e.to_string())?;
+        let (residual, forces) = self.la.evaluate(&self.lat).map_err(|e| e.to_string())?;
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
-        let loads = lump(map, lat.ring_nodes(), &org, &f);
-        let g = load_part(model, qq, &loads, &zero_loads)?;
-        let te = lat.ring_nodes()[te_start..].iter().flatten().copied().collect();
-        Ok((r, g, te))
+        let loads = lump(self.map, self.lat.ring_nodes(), &org, &forces);
+        let te = self.lat.ring_nodes()[self.te_start..].iter().flatten().copied().collect();
+        Ok(Moved { residual, forces, loads, te })
+    }
+}
+
+/// The geometric terms along each basis mode at fixed circulation: the residual along the
+/// position (`rx`) and velocity (`rv`), the modal load along them (`gx`, `gv`) and the
+/// trailing-edge nodes along the position (`xte`).
+struct Geometric {
+    rx: DMatrix<f64>,
+    rv: DMatrix<f64>,
+    gx: DMatrix<f64>,
+    gv: DMatrix<f64>,
+    xte: DMatrix<f64>,
+}
+
+/// [`Geometric`] by central differences along each mode of `phi` (a step of `1e-6` chord).
+fn geometric_terms<S: Structure>(
+    model: &mut S,
+    q: &[f64],
+    phi: &DMatrix<f64>,
+    moved: &mut MovedLattice<'_>,
+    zero_loads: &[SectionLoad],
+) -> Result<Geometric, String> {
+    let (nr, nb) = (moved.la.n_rings(), phi.ncols());
+    let zeros = vec![0.0; model.n_dof()];
+    let span = moved.aero.chord.max(1e-3);
+    let n_te = 3 * (moved.lat.n_spanwise() + 1);
+    let mut g = Geometric {
+        rx: DMatrix::zeros(nr, nb),
+        rv: DMatrix::zeros(nr, nb),
+        gx: DMatrix::zeros(nb, nb),
+        gv: DMatrix::zeros(nb, nb),
+        xte: DMatrix::zeros(n_te, nb),
+    };
+    // Residual, generalised load part and trailing edge of the moved lattice.
+    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<_, String> {
+        let m = moved.at(&*model, qq, vv, with_vel)?;
+        let gl = load_part(model, qq, &m.loads, zero_loads)?;
+        Ok((m.residual, gl, m.te))
     };
     for i in 0..nb {
-        let col: Vec<f64> = phi.column(i).iter().copied().collect();
-        let big = col.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
-        let eps = 1e-6 * span / big;
+        let (col, eps) = mode_step(phi, i, span);
         let mut qp = vec![0.0; q.len()];
         let mut qm = vec![0.0; q.len()];
         let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
         model.retract_inplace(q, &dq, &mut qp);
         let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
         model.retract_inplace(q, &dq, &mut qm);
-        let (r1, g1, te1) = eval(&mut model, &qp, &zeros, false)?;
-        let (r2, g2, te2) = eval(&mut model, &qm, &zeros, false)?;
+        let (r1, g1, te1) = eval(model, &qp, &zeros, false)?;
+        let (r2, g2, te2) = eval(model, &qm, &zeros, false)?;
         for a in 0..nr {
-            rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
+            g.rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
         }
         for a in 0..n_te {
-            xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
+            g.xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
         }
         let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
-        gx.set_column(i, &gp);
+        g.gx.set_column(i, &gp);
         // Velocity along the mode: the residual and the loads are linear in it.
-        let (r1, g1, _) = eval(&mut model, q, &col, true)?;
+        let (r1, g1, _) = eval(model, q, &col, true)?;
         let neg: Vec<f64> = col.iter().map(|x| -x).collect();
-        let (r2, g2, _) = eval(&mut model, q, &neg, true)?;
+        let (r2, g2, _) = eval(model, q, &neg, true)?;
         for a in 0..nr {
-            rv[(a, i)] = 0.5 * (r1[a] - r2[a]);
+            g.rv[(a, i)] = 0.5 * (r1[a] - r2[a]);
         }
         let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) * 0.5;
-        gv.set_column(i, &gp);
+        g.gv.set_column(i, &gp);
     }
+    Ok(g)
+}
+
+impl Reduced {
+    /// The flutter equation of Theodorsen `strips` on the structure of `basis`.
+    fn of_strips(basis: ModalBasis, strips: Strips) -> Self {
+        let nb = basis.phi.ncols();
+        let e = DMatrix::zeros(0, nb);
+        Reduced {
+            m: basis.m,
+            c: basis.c,
+            k: basis.k,
+            gx: DMatrix::zeros(nb, nb),
+            gv: DMatrix::zeros(nb, nb),
+            ratio: 1.0,
+            rx: e.clone(),
+            rv: e,
+            aic: DMatrix::zeros(0, 0),
+            w_rows: Vec::new(),
+            delays: Vec::new(),
+            te_rings: Vec::new(),
+            t_gamma: DMatrix::zeros(nb, 0),
+            t_gamma_dot: DMatrix::zeros(nb, 0),
+            t_rows: Vec::new(),
+            wake_r: Vec::new(),
+            wake_g: Vec::new(),
+            strip: Some(strips),
+            omega: basis.omega,
+            n_rings: 0,
+            n_wake_rings: 0,
+            phi: basis.phi,
+        }
+    }
+}
+
+/// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
+/// `aero`, with `nb` basis modes: the structural basis, optionally the mode shapes for the
+/// report, then either Theodorsen strips (`strip_case`) or the linear UVLM on the equilibrium's
+/// lattice with its geometric terms along the modes and the wake nodes' motion.
+#[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
+pub fn reduce<S: Structure>(
+    mut model: S,
+    q: &[f64],
+    lambda: &[f64],
+    mu: &[f64],
+    map: &[StationMap],
+    aero: &AeroSettings,
+    wake: &uvlm::LinearWake,
+    nb: usize,
+    shapes_out: Option<(&Problem, &mut Vec<ModeShape>)>,
+    strip_case: Option<&Problem>,
+) -> Result<Reduced, String> {
+    let zero_loads = zero_loads(map);
+    model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
+    let basis = modal_basis(&mut model, q, (lambda, mu), map, aero, &zero_loads, nb)?;
+    let zeros = vec![0.0; model.n_dof()];
+    let mut scratch = StationScratch::default();
+    let (mut stations, mut vel) = (Vec::new(), Vec::new());
+    stations_at(&model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
+    if let Some((case, out)) = shapes_out {
+        out.extend(mode_shapes(&mut model, q, &stations, &basis, (map, aero, case)));
+    }
+    if let Some(case) = strip_case {
+        let strips = strip_model(&mut model, q, &stations, &basis.phi, (map, aero, case));
+        return Ok(Reduced::of_strips(basis, strips));
+    }
+    let spec = crate::aero::lattice_spec(map, aero);
+    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
+    let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
+    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
+    let h = modal_load_per_nodal_force(&mut model, q, &basis.phi, map, &zero_loads, &la, &origins)?;
+    let mut moved = MovedLattice::new(&la, map, aero);
+    let geo = geometric_terms(&mut model, q, &basis.phi, &mut moved, &zero_loads)?;
     // The wake's nodes follow the trailing edge's past motion, as the time march sheds them:
     // node (k, j) is where trailing-edge node j was τ_k ago. They matter only where the steady
     // wake carries circulation (its trailing vortices), so an unloaded lattice skips them.
@@ -762,19 +931,19 @@ pub fn reduce<S: Structure>(
     if la.te_rings.iter().any(|&r| la.gamma0()[r] != 0.0) {
         let wd = la.wake_node_derivatives();
         for (zr, zf) in wd.residual.iter().zip(&wd.force) {
-            wake_r.push(zr * &xte);
-            wake_g.push(&h * (zf * &xte));
+            wake_r.push(zr * &geo.xte);
+            wake_g.push(&h * (zf * &geo.xte));
         }
     }
     Ok(Reduced {
-        m,
-        c,
-        k,
-        gx,
-        gv,
+        m: basis.m,
+        c: basis.c,
+        k: basis.k,
+        gx: geo.gx,
+        gv: geo.gv,
         ratio: 1.0,
-        rx,
-        rv,
+        rx: geo.rx,
+        rv: geo.rv,
         aic: la.aic.map(C64::from),
         w_rows: la.row_normalwash.clone(),
         delays: la.row_delays.clone(),
@@ -785,10 +954,10 @@ pub fn reduce<S: Structure>(
         wake_r,
         wake_g,
         strip: None,
-        omega: modes.omega.clone(),
-        n_rings: nr,
+        omega: basis.omega,
+        n_rings: la.n_rings(),
         n_wake_rings: wake.row_lengths.len() * la.te_rings.len(),
-        phi,
+        phi: basis.phi,
     })
 }
 
@@ -802,10 +971,7 @@ pub fn linear_wake(case: &Problem, f: Formulation, airspeed: f64) -> uvlm::Linea
 /// `airspeed·dt`, closed when `aero.wake_closure`.
 pub fn march_wake(case: &Problem, f: Formulation, airspeed: f64) -> WakeSettings {
     let aero = case.aero.as_ref().expect("validated: needs aero");
-    let dt = match f {
-        Formulation::Ancf => case.ancf.dt,
-        Formulation::Gebf => case.gebf.dt,
-    };
+    let dt = case.block(f).dt;
     WakeSettings { rows: aero.n_wake_rows, row_length: airspeed * dt, closure: aero.wake_closure }
 }
 
@@ -864,6 +1030,9 @@ fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
     }
 }
 
+/// The stability sweep of `case` with the models of `build`: the equilibria, then per airspeed
+/// the reduced model ([`reduce`], built once about a fixed state) and its roots, continued from
+/// the previous airspeed's; then the flutter and divergence speeds.
 fn sweep<S: Structure>(
     case: &Problem,
     f: Formulation,
@@ -876,43 +1045,9 @@ fn sweep<S: Structure>(
         Ok(m) => m,
         Err(e) => return empty_output(f, Some(e)),
     };
-    // Equilibria.
-    let states: Vec<Result<Equilibrium, String>> = match st.about {
-        About::Undeformed => {
-            let model = match build(case) {
-                Ok(m) => m,
-                Err(e) => return empty_output(f, Some(e.to_string())),
-            };
-            let q = model.initial_state().q;
-            let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
-            let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
-            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
-        }
-        About::Equilibrium => {
-            // Each equilibrium is the steady state of the frozen wake linearised about it. The
-            // time march's default wake has rows of U·dt, so without closure its length changes
-            // with the airspeed: one static solve per airspeed then.
-            let wakes: Vec<WakeSettings> = st.airspeeds.iter().map(|&u| wake_settings(case, f, u)).collect();
-            let groups: Vec<(Vec<f64>, WakeSettings)> = if wakes.iter().all(|w| w.closure || *w == wakes[0]) {
-                vec![(st.airspeeds.clone(), wakes[0])]
-            } else {
-                st.airspeeds.iter().zip(&wakes).map(|(&u, &w)| (vec![u], w)).collect()
-            };
-            let mut states = Vec::with_capacity(st.airspeeds.len());
-            for (airspeeds, wake) in groups {
-                let mut c = case.clone();
-                c.statics = Some(crate::problem::StaticSettings::at(airspeeds, Some(wake)));
-                let so = crate::statics::run_static(&c, f);
-                if let Some(e) = so.error {
-                    return empty_output(f, Some(e));
-                }
-                states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
-                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
-                    (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
-                }));
-            }
-            states
-        }
+    let states = match equilibria(case, f, st, build) {
+        Ok(s) => s,
+        Err(e) => return empty_output(f, Some(e)),
     };
     let mut out = empty_output(f, None);
     let nb_req = st.basis_modes.unwrap_or((2 * st.modes).max(20));
@@ -963,26 +1098,8 @@ fn sweep<S: Structure>(
         let Some((u0, red)) = cache.as_mut() else { continue };
         let target = u / *u0;
         let nmodes = st.modes.min(red.n_basis());
-        // The first airspeed's roots are continued from a quarter of it, where the structural
-        // modes are still near their aerodynamically coupled roots (the model scaled at its
-        // geometry: exact about a fixed state, a starting guess otherwise).
-        let first = if tracked.is_none() {
-            red.at_speed_ratio(0.25 * target);
-            let mut guess = red.starts(nmodes);
-            for frac in [0.5, 0.75] {
-                red.at_speed_ratio(frac * target);
-                guess = guess
-                    .into_iter()
-                    .map(|(s, e)| match red.newton(s, e.clone(), &mut out.n_evaluations) {
-                        (s2, e2, true) => upper(s2, e2),
-                        _ => (s, e),
-                    })
-                    .collect();
-            }
-            Some(guess)
-        } else {
-            None
-        };
+        let first =
+            if tracked.is_none() { Some(first_starts(red, nmodes, target, &mut out.n_evaluations)) } else { None };
         red.at_speed_ratio(target);
         out.n_free = red.omega.len();
         out.n_basis = red.n_basis();
@@ -991,79 +1108,11 @@ fn sweep<S: Structure>(
         let ts = cpu_now();
         let starts: Vec<(C64, DVector<C64>)> = match (&tracked, &prev) {
             _ if first.is_some() => first.unwrap_or_default(),
-            (Some(t), Some(p)) if t.len() == nmodes => {
-                // Linear extrapolation in airspeed of the eigenvalue.
-                let du = u - st.airspeeds[i - 1];
-                t.iter()
-                    .zip(p)
-                    .map(|((s1, e1), (s0, _))| {
-                        let back = st.airspeeds[i - 1] - st.airspeeds[i.saturating_sub(2)];
-                        let slope = if back > 0.0 { (s1 - s0) / back } else { C64::new(0.0, 0.0) };
-                        (s1 + slope * du, e1.clone())
-                    })
-                    .collect()
-            }
+            (Some(t), Some(p)) if t.len() == nmodes => extrapolated_starts(t, p, &st.airspeeds, i),
             (Some(t), _) if t.len() == nmodes => t.clone(),
             _ => red.starts(nmodes),
         };
-        let mut found: Vec<(C64, DVector<C64>, bool)> = starts
-            .into_iter()
-            .map(|(s0, e0)| match red.newton(s0, e0.clone(), &mut out.n_evaluations) {
-                (s, e, true) => {
-                    let (s, e) = upper(s, e);
-                    (s, e, true)
-                }
-                _ => (s0, e0, false),
-            })
-            .collect();
-        let same = |a: C64, b: C64| (a - b).norm() <= 1e-6 * (1.0 + a.norm());
-        // Starts that do not converge, or that land on one root (a strongly damped mode can jump
-        // to a neighbour's root): follow each of those modes up from low speed instead, where it
-        // is near its structural root. A path's end is the mode's root unless a mode that was
-        // not in doubt holds it, or another path ends there too with smaller steps (the
-        // smoother path keeps the root: the other jumped branches); those restart from their
-        // paths.
-        let suspects: Vec<usize> = (0..found.len())
-            .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same(found[j].0, found[m].0)))
-            .collect();
-        if !suspects.is_empty() {
-            for &m in &suspects {
-                found[m].2 = false;
-            }
-            let paths: Vec<Vec<(C64, DVector<C64>)>> =
-                suspects.iter().map(|&m| red.continuation_path(m, target, &mut out.n_evaluations)).collect();
-            // Each path's end at the full speed ratio (None for a path cut short).
-            let ends: Vec<Option<C64>> =
-                paths.iter().map(|p| p.last().filter(|_| p.len() == CONTINUATION_STEPS).map(|x| x.0)).collect();
-            let mut pending = Vec::new();
-            for (i, &m) in suspects.iter().enumerate() {
-                let keeps = ends[i].is_some_and(|r| {
-                    !found.iter().any(|f| f.2 && same(f.0, r))
-                        && !(0..suspects.len()).any(|k| {
-                            k != i
-                                && ends[k].is_some_and(|rk| same(rk, r))
-                                && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
-                        })
-                });
-                match paths[i].last() {
-                    Some((s, e)) if keeps => found[m] = (*s, e.clone(), true),
-                    _ => pending.push(i),
-                }
-            }
-            for i in pending {
-                let m = suspects[i];
-                let claimed = |s: C64| found.iter().any(|f| f.2 && same(f.0, s));
-                if let Some((s, e)) = red.restart_from_path(&paths[i], &mut out.n_evaluations, claimed) {
-                    found[m] = (s, e, true);
-                }
-            }
-        }
-        // Starts that still share a root: the later one is not a root of its own.
-        for m in 0..found.len() {
-            if found[m].2 && (0..m).any(|j| found[j].2 && same(found[j].0, found[m].0)) {
-                found[m].2 = false;
-            }
-        }
+        let found = roots_from(red, starts, target, &mut out.n_evaluations);
         let mut roots = Vec::with_capacity(nmodes);
         let mut next = Vec::with_capacity(nmodes);
         for (m, (s, e, ok)) in found.into_iter().enumerate() {
@@ -1077,6 +1126,177 @@ fn sweep<S: Structure>(
         let omega = red.omega.iter().take(nb_req).copied().collect();
         out.points.push(point(roots, smin, omega, fold, None));
     }
+    flutter_and_divergence(&mut out);
+    out
+}
+
+/// The states a sweep linearises about, one per airspeed of `st`: the undeformed state, or the
+/// static aeroelastic equilibria (one static sweep per wake; see [`wake_settings`]). An error
+/// that stops the whole sweep is `Err`; a point without an equilibrium is an `Err` in the list.
+fn equilibria<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    st: &StabilitySettings,
+    build: fn(&Problem) -> Result<S, crate::Error>,
+) -> Result<Vec<Result<Equilibrium, String>>, String> {
+    Ok(match st.about {
+        About::Undeformed => {
+            let model = build(case).map_err(|e| e.to_string())?;
+            let q = model.initial_state().q;
+            let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
+            let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
+            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
+        }
+        About::Equilibrium => {
+            // Each equilibrium is the steady state of the frozen wake linearised about it. The
+            // time march's default wake has rows of U·dt, so without closure its length changes
+            // with the airspeed: one static solve per airspeed then.
+            let wakes: Vec<WakeSettings> = st.airspeeds.iter().map(|&u| wake_settings(case, f, u)).collect();
+            let groups: Vec<(Vec<f64>, WakeSettings)> = if wakes.iter().all(|w| w.closure || *w == wakes[0]) {
+                vec![(st.airspeeds.clone(), wakes[0])]
+            } else {
+                st.airspeeds.iter().zip(&wakes).map(|(&u, &w)| (vec![u], w)).collect()
+            };
+            let mut states = Vec::with_capacity(st.airspeeds.len());
+            for (airspeeds, wake) in groups {
+                let mut c = case.clone();
+                c.statics = Some(crate::problem::StaticSettings::at(airspeeds, Some(wake)));
+                let so = crate::statics::run_static(&c, f);
+                if let Some(e) = so.error {
+                    return Err(e);
+                }
+                states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
+                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
+                    (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
+                }));
+            }
+            states
+        }
+    })
+}
+
+/// The starts of the first airspeed's roots (at speed ratio `target`), continued from a quarter
+/// of it, where the structural modes are still near their aerodynamically coupled roots (the
+/// model scaled at its geometry: exact about a fixed state, a starting guess otherwise).
+fn first_starts(red: &mut Reduced, nmodes: usize, target: f64, n_evaluations: &mut usize) -> Vec<(C64, DVector<C64>)> {
+    red.at_speed_ratio(0.25 * target);
+    let mut guess = red.starts(nmodes);
+    for frac in [0.5, 0.75] {
+        red.at_speed_ratio(frac * target);
+        guess = guess
+            .into_iter()
+            .map(|(s, e)| match red.newton(s, e.clone(), n_evaluations) {
+                (s2, e2, true) => upper(s2, e2),
+                _ => (s, e),
+            })
+            .collect();
+    }
+    guess
+}
+
+/// Starts at airspeed `i` of `airspeeds`: the roots of the last airspeed (`tracked`), linearly
+/// extrapolated in airspeed from the one before (`prev`).
+fn extrapolated_starts(
+    tracked: &[(C64, DVector<C64>)],
+    prev: &[(C64, DVector<C64>)],
+    airspeeds: &[f64],
+    i: usize,
+) -> Vec<(C64, DVector<C64>)> {
+    let du = airspeeds[i] - airspeeds[i - 1];
+    tracked
+        .iter()
+        .zip(prev)
+        .map(|((s1, e1), (s0, _))| {
+            let back = airspeeds[i - 1] - airspeeds[i.saturating_sub(2)];
+            let slope = if back > 0.0 { (s1 - s0) / back } else { C64::new(0.0, 0.0) };
+            (s1 + slope * du, e1.clone())
+        })
+        .collect()
+}
+
+/// Whether two roots are one.
+fn same_root(a: C64, b: C64) -> bool {
+    (a - b).norm() <= 1e-6 * (1.0 + a.norm())
+}
+
+/// The roots (with their vectors and whether they converged) at speed ratio `target`, by
+/// Newton's method from `starts`, the doubtful ones followed up from low speed
+/// ([`follow_suspects`]); of starts that still share a root, the later one is not converged.
+fn roots_from(
+    red: &mut Reduced,
+    starts: Vec<(C64, DVector<C64>)>,
+    target: f64,
+    n_evaluations: &mut usize,
+) -> Vec<(C64, DVector<C64>, bool)> {
+    let mut found: Vec<(C64, DVector<C64>, bool)> = starts
+        .into_iter()
+        .map(|(s0, e0)| match red.newton(s0, e0.clone(), n_evaluations) {
+            (s, e, true) => {
+                let (s, e) = upper(s, e);
+                (s, e, true)
+            }
+            _ => (s0, e0, false),
+        })
+        .collect();
+    follow_suspects(red, &mut found, target, n_evaluations);
+    // Starts that still share a root: the later one is not a root of its own.
+    for m in 0..found.len() {
+        if found[m].2 && (0..m).any(|j| found[j].2 && same_root(found[j].0, found[m].0)) {
+            found[m].2 = false;
+        }
+    }
+    found
+}
+
+/// Starts that do not converge, or that land on one root (a strongly damped mode can jump to a
+/// neighbour's root): follow each of those modes up from low speed instead, by continuation to
+/// the speed ratio `target`, where it is near its structural root. A path's end is the mode's
+/// root unless a mode that was not in doubt holds it, or another path ends there too with
+/// smaller steps (the smoother path keeps the root: the other jumped branches); those restart
+/// from their paths.
+fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], target: f64, n_evaluations: &mut usize) {
+    let suspects: Vec<usize> = (0..found.len())
+        .filter(|&m| !found[m].2 || (0..found.len()).any(|j| j != m && found[j].2 && same_root(found[j].0, found[m].0)))
+        .collect();
+    if suspects.is_empty() {
+        return;
+    }
+    for &m in &suspects {
+        found[m].2 = false;
+    }
+    let paths: Vec<Vec<(C64, DVector<C64>)>> =
+        suspects.iter().map(|&m| red.continuation_path(m, target, n_evaluations)).collect();
+    // Each path's end at the full speed ratio (None for a path cut short).
+    let ends: Vec<Option<C64>> =
+        paths.iter().map(|p| p.last().filter(|_| p.len() == CONTINUATION_STEPS).map(|x| x.0)).collect();
+    let mut pending = Vec::new();
+    for (i, &m) in suspects.iter().enumerate() {
+        let keeps = ends[i].is_some_and(|r| {
+            !found.iter().any(|f| f.2 && same_root(f.0, r))
+                && !(0..suspects.len()).any(|k| {
+                    k != i
+                        && ends[k].is_some_and(|rk| same_root(rk, r))
+                        && (largest_step(&paths[k]), k) < (largest_step(&paths[i]), i)
+                })
+        });
+        match paths[i].last() {
+            Some((s, e)) if keeps => found[m] = (*s, e.clone(), true),
+            _ => pending.push(i),
+        }
+    }
+    for i in pending {
+        let m = suspects[i];
+        let claimed = |s: C64| found.iter().any(|f| f.2 && same_root(f.0, s));
+        if let Some((s, e)) = red.restart_from_path(&paths[i], n_evaluations, claimed) {
+            found[m] = (s, e, true);
+        }
+    }
+}
+
+/// The flutter speed, frequency and mode (the first sign change of a converged root's real part
+/// from negative to positive, interpolated linearly) and the divergence speed (the first sign
+/// change of the static stiffness) of a sweep's points.
+fn flutter_and_divergence(out: &mut StabilityOutput) {
     // Flutter: the first sign change of a root's real part from negative to positive.
     for w in out.points.windows(2) {
         let (a, b) = (&w[0], &w[1]);
@@ -1108,7 +1328,6 @@ fn sweep<S: Structure>(
             break;
         }
     }
-    out
 }
 
 /// Iteration bound of the Schur decompositions: nalgebra's plain `eigenvalues()` iterates

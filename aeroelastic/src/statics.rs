@@ -742,104 +742,16 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
     let loads_model = LoadModel::new(case, f);
     let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
     // 1. The first equilibrium at the highest airspeed, by load stepping.
-    let mut iters = 0;
-    // Newton in rounds of up to 25 iterations: the aerodynamic stiffness (the costly part of the
-    // tangent) is kept within a round and from the previous point, and re-evaluated at the start
-    // of every further round.
-    let solve =
-        |sys: &mut AeroStatic<'_, S>, solver: &mut StaticSolver, x: &mut StaticSolution| -> Result<(), String> {
-            let mut last = String::new();
-            let x0 = x.clone();
-            for round in 0..ROUNDS {
-                sys.begin_solve(round > 0);
-                let s: &AeroStatic<'_, S> = sys;
-                // Borrowed only for the call: the system borrows the model mutably to apply its loads.
-                match solver.solve_normalised(s, 0.0, x, |q| read(&s.model).normalise(q)) {
-                    // The residual at the converged state is evaluated once more; the lattice
-                    // must still be valid there.
-                    Ok(()) if !x.residual_norm.is_finite() => {
-                        return Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into()));
-                    }
-                    Ok(()) => return Ok(()),
-                    Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
-                    // A kept aerodynamic stiffness can send the first iterate past the lattice's
-                    // limits: start again from the same estimate with a fresh one.
-                    Err(e) if round == 0 => {
-                        last = sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"));
-                        *x = x0.clone();
-                    }
-                    Err(e) => return Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
-                }
-            }
-            Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
-        };
-    {
-        // Load stepping from the unloaded reference: gravity λ g and dynamic pressure λ q (the
-        // airspeed √λ V), so that the ratio of weight to air load, which sets the fold, is the
-        // final one at every step while the elastic deflection grows from zero. A step that
-        // fails is halved. (Newton straight to the full load can land on a spurious state of a
-        // folded-over lattice on a flexible wing.)
-        let g = case.gravity.unwrap_or([0.0; 3]);
-        let (mut lambda, mut step) = (0.0_f64, 0.25_f64);
-        let mut good = x.clone();
-        while lambda < 1.0 {
-            let next = (lambda + step).min(1.0);
-            let mut c = case.clone();
-            c.gravity = case.gravity.map(|_| [next * g[0], next * g[1], next * g[2]]);
-            match build(&c) {
-                Ok(m) => sys.set_model(m),
-                Err(e) => return failed_output(case, f, e.to_string()),
-            }
-            let attempt = sys.set_airspeed(top * next.sqrt(), &x.q).and_then(|()| solve(&mut sys, &mut solver, &mut x));
-            match attempt {
-                Ok(()) => {
-                    lambda = next;
-                    good = x.clone();
-                    step = (1.5 * step).min(0.25);
-                }
-                Err(e) => {
-                    x = good.clone();
-                    step *= 0.5;
-                    if step < 1e-3 {
-                        return failed_output(
-                            case,
-                            f,
-                            format!("at {top} m/s: load stepping stalled at {lambda:.4} of the load: {e}"),
-                        );
-                    }
-                }
-            }
-        }
+    if let Err(e) = load_stepping(case, build, top, &mut sys, &mut solver, &mut x) {
+        return failed_output(case, f, e);
     }
-    iters += x.n_iterations;
+    let mut iters = x.n_iterations;
     // 2. Down the airspeeds, bisecting a step that fails.
     let mut current = top;
     for &i in &order {
         let target = st.airspeeds[i];
         let good = x.clone();
-        let mut path = vec![target];
-        let mut last_err = None;
-        let mut halvings = 0;
-        while let Some(&u) = path.last() {
-            let attempt = sys.set_airspeed(u, &x.q).and_then(|()| solve(&mut sys, &mut solver, &mut x));
-            match attempt {
-                Ok(()) => {
-                    current = u;
-                    path.pop();
-                }
-                Err(e) => {
-                    x = good.clone();
-                    let _ = sys.set_airspeed(current, &x.q);
-                    if halvings >= 6 {
-                        last_err = Some(e);
-                        break;
-                    }
-                    halvings += 1;
-                    // Restart from the last equilibrium towards the midpoint.
-                    path.push(0.5 * (current + u));
-                }
-            }
-        }
+        let last_err = bisect_to(target, &mut current, &mut sys, &mut solver, &mut x);
         let n_it = x.n_iterations - iters;
         iters = x.n_iterations;
         points[i] = Some(match last_err {
@@ -869,6 +781,115 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
         n_dof,
         error: None,
     }
+}
+
+/// Newton on the aeroelastic system from `x`, in rounds of up to [`ROUND_ITERATIONS`]
+/// iterations: the aerodynamic stiffness (the costly part of the tangent) is kept within a round
+/// and from the previous point, and re-evaluated at the start of every further round.
+fn solve_rounds<S: Structure>(
+    sys: &mut AeroStatic<'_, S>,
+    solver: &mut StaticSolver,
+    x: &mut StaticSolution,
+) -> Result<(), String> {
+    let mut last = String::new();
+    let x0 = x.clone();
+    for round in 0..ROUNDS {
+        sys.begin_solve(round > 0);
+        let s: &AeroStatic<'_, S> = sys;
+        // Borrowed only for the call: the system borrows the model mutably to apply its loads.
+        match solver.solve_normalised(s, 0.0, x, |q| read(&s.model).normalise(q)) {
+            // The residual at the converged state is evaluated once more; the lattice
+            // must still be valid there.
+            Ok(()) if !x.residual_norm.is_finite() => {
+                return Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into()));
+            }
+            Ok(()) => return Ok(()),
+            Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
+            // A kept aerodynamic stiffness can send the first iterate past the lattice's
+            // limits: start again from the same estimate with a fresh one.
+            Err(e) if round == 0 => {
+                last = sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"));
+                *x = x0.clone();
+            }
+            Err(e) => return Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
+        }
+    }
+    Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
+}
+
+/// The first equilibrium, at airspeed `top`, by load stepping from the unloaded reference:
+/// gravity λ g and dynamic pressure λ q (the airspeed √λ V), so that the ratio of weight to air
+/// load, which sets the fold, is the final one at every step while the elastic deflection grows
+/// from zero. A step that fails is halved. (Newton straight to the full load can land on a
+/// spurious state of a folded-over lattice on a flexible wing.)
+fn load_stepping<S: Structure>(
+    case: &Problem,
+    build: fn(&Problem) -> Result<S, Error>,
+    top: f64,
+    sys: &mut AeroStatic<'_, S>,
+    solver: &mut StaticSolver,
+    x: &mut StaticSolution,
+) -> Result<(), String> {
+    let g = case.gravity.unwrap_or([0.0; 3]);
+    let (mut lambda, mut step) = (0.0_f64, 0.25_f64);
+    let mut good = x.clone();
+    while lambda < 1.0 {
+        let next = (lambda + step).min(1.0);
+        let mut c = case.clone();
+        c.gravity = case.gravity.map(|_| [next * g[0], next * g[1], next * g[2]]);
+        sys.set_model(build(&c).map_err(|e| e.to_string())?);
+        let attempt = sys.set_airspeed(top * next.sqrt(), &x.q).and_then(|()| solve_rounds(sys, solver, x));
+        match attempt {
+            Ok(()) => {
+                lambda = next;
+                good = x.clone();
+                step = (1.5 * step).min(0.25);
+            }
+            Err(e) => {
+                *x = good.clone();
+                step *= 0.5;
+                if step < 1e-3 {
+                    return Err(format!("at {top} m/s: load stepping stalled at {lambda:.4} of the load: {e}"));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// From the equilibrium `x` at airspeed `current` to the one at `target`, restarting from the
+/// last equilibrium towards the midpoint of a step that fails, at most 6 times; the last error
+/// when it does not get there (`x` and the system's airspeed are then the last equilibrium's).
+fn bisect_to<S: Structure>(
+    target: f64,
+    current: &mut f64,
+    sys: &mut AeroStatic<'_, S>,
+    solver: &mut StaticSolver,
+    x: &mut StaticSolution,
+) -> Option<String> {
+    let good = x.clone();
+    let mut path = vec![target];
+    let mut halvings = 0;
+    while let Some(&u) = path.last() {
+        let attempt = sys.set_airspeed(u, &x.q).and_then(|()| solve_rounds(sys, solver, x));
+        match attempt {
+            Ok(()) => {
+                *current = u;
+                path.pop();
+            }
+            Err(e) => {
+                *x = good.clone();
+                let _ = sys.set_airspeed(*current, &x.q);
+                if halvings >= 6 {
+                    return Some(e);
+                }
+                halvings += 1;
+                // Restart from the last equilibrium towards the midpoint.
+                path.push(0.5 * (*current + u));
+            }
+        }
+    }
+    None
 }
 
 /// The outputs at the equilibrium `q` of `sys`.

@@ -239,7 +239,7 @@ fn svg(path: &Path, rows: &[BenchRow], targets: &impl Fn(&str) -> bool) -> Resul
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], color.filled()));
     }
     for (f, t) in TARGET_MS {
-        let color = if f == Formulation::Ancf { colors::ANCF } else { colors::GEBF };
+        let color = colors::of(f);
         let segs: Vec<PathElement<(f64, f64)>> = cases
             .iter()
             .enumerate()

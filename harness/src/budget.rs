@@ -17,7 +17,7 @@
 
 use std::sync::OnceLock;
 
-use crate::case::{Case, Formulation};
+use crate::case::{Block, Case, Formulation};
 use crate::run::Row;
 
 /// Largest `newton.max_iter`.
@@ -129,10 +129,7 @@ pub struct Estimate {
 
 /// The unknowns of formulation `f` of `case` (coordinates plus constraint rows).
 fn unknowns(case: &Case, f: Formulation) -> f64 {
-    let elements = match f {
-        Formulation::Ancf => &case.ancf.elements_per_body,
-        Formulation::Gebf => &case.gebf.elements_per_body,
-    };
+    let elements = case.block(f).elements_per_body;
     let nb = case.bodies.len();
     let nj = case.joints.len() as f64;
     let el: f64 = (0..nb).map(|i| elements.for_body(i) as f64).sum();
@@ -145,10 +142,7 @@ fn unknowns(case: &Case, f: Formulation) -> f64 {
 /// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
 /// overflows), run for at most `max_steps` steps when given.
 pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estimate {
-    let (dt, newton) = match f {
-        Formulation::Ancf => (case.ancf.dt, case.ancf.newton),
-        Formulation::Gebf => (case.gebf.dt, case.gebf.newton),
-    };
+    let Block { dt, newton, .. } = case.block(f);
     let n = unknowns(case, f);
     let mut steps = (case.t_end / dt).round().max(1.0);
     if let Some(m) = max_steps {

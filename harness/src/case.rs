@@ -14,8 +14,8 @@ mod to_lib;
 mod validate;
 
 pub use aeroelastic::problem::{
-    AncfPath, AncfSettings, Body, Elements, FormSetting, Formulation, GebfSettings, Joint, NewtonSettings, PointMass,
-    PredictorSetting, Section, Spring, StaticPointLoad,
+    AncfPath, AncfSettings, Block, BlockMut, Body, Elements, FormSetting, Formulation, GebfSettings, Joint,
+    NewtonSettings, PointMass, PredictorSetting, Section, Spring, StaticPointLoad,
 };
 
 fn one() -> f64 {
@@ -226,9 +226,7 @@ impl std::str::FromStr for Override {
         let bad = || Error::Override(format!("`{s}` is not of the form [ancf:|gebf:]path=value"));
         let (lhs, rhs) = s.split_once('=').ok_or_else(bad)?;
         let (only, path) = match lhs.split_once(':') {
-            Some(("ancf", p)) => (Some(Formulation::Ancf), p),
-            Some(("gebf", p)) => (Some(Formulation::Gebf), p),
-            Some(_) => return Err(bad()),
+            Some((name, p)) => (Some(Formulation::from_name(name).ok_or_else(bad)?), p),
             None => (None, lhs),
         };
         if path.is_empty() {
@@ -670,6 +668,14 @@ impl RunSpec {
             Formulation::Gebf => &self.gebf,
         }
     }
+
+    /// The case seen by formulation `f`, to change in place.
+    pub fn case_mut(&mut self, f: Formulation) -> &mut Case {
+        match f {
+            Formulation::Ancf => &mut self.ancf,
+            Formulation::Gebf => &mut self.gebf,
+        }
+    }
 }
 
 /// The number of steps of `dt` in `t` when `t` is a whole multiple of it (within a relative
@@ -695,6 +701,16 @@ fn norm3(v: &[f64; 3]) -> f64 {
 }
 
 impl Case {
+    /// The settings of formulation `f`'s block (`ancf` or `gebf`).
+    pub fn block(&self, f: Formulation) -> Block<'_> {
+        aeroelastic::problem::blocks(f, &self.ancf, &self.gebf)
+    }
+
+    /// The settings of formulation `f`'s block, to change in place.
+    pub fn block_mut(&mut self, f: Formulation) -> BlockMut<'_> {
+        aeroelastic::problem::blocks_mut(f, &mut self.ancf, &mut self.gebf)
+    }
+
     /// Index of the body called `name`.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         aeroelastic::problem::body_index(&self.bodies, name)

@@ -23,7 +23,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::Error;
-use crate::case::{Elements, Formulation, RunSpec};
+use crate::case::{Block, Elements, Formulation, RunSpec};
 use crate::csv::{Curve, read_curve, write_file};
 use crate::metrics::{tip_curve, tip_difference, window_stats};
 use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
@@ -160,23 +160,15 @@ fn peers(
 
 fn rung_spec(spec: &RunSpec, f: Formulation, elements: Elements, dt: f64) -> crate::case::Case {
     let mut c = spec.case(f).clone();
-    let base_dt = match f {
-        Formulation::Ancf => std::mem::replace(&mut c.ancf.dt, dt),
-        Formulation::Gebf => std::mem::replace(&mut c.gebf.dt, dt),
-    };
-    match f {
-        Formulation::Ancf => c.ancf.elements_per_body = elements,
-        Formulation::Gebf => c.gebf.elements_per_body = elements,
-    }
+    let block = c.block_mut(f);
+    let base_dt = std::mem::replace(block.dt, dt);
+    *block.elements_per_body = elements;
     if let Some(t) = c.converge_t_end {
         c.t_end = t.min(c.t_end);
     }
     // Every rung ends at t_end: a step that does not divide it is rounded to one that does.
     let dt = crate::case::commensurate_dt(c.t_end, dt);
-    match f {
-        Formulation::Ancf => c.ancf.dt = dt,
-        Formulation::Gebf => c.gebf.dt = dt,
-    }
+    *c.block_mut(f).dt = dt;
     // The wake sheds one row per step: keep its physical length (rows × V·dt) as dt changes, so
     // that every rung discretises the same wake.
     if let Some(aero) = c.aero.as_mut() {
@@ -208,10 +200,7 @@ fn plan(spec: &RunSpec) -> Plan {
     let fine = 2f64.powi(l);
     for f in Formulation::ALL {
         let c = spec.case(f);
-        let (n, h) = match f {
-            Formulation::Ancf => (&c.ancf.elements_per_body, c.ancf.dt),
-            Formulation::Gebf => (&c.gebf.elements_per_body, c.gebf.dt),
-        };
+        let Block { elements_per_body: n, dt: h, .. } = c.block(f);
         // time: h·{2, 1, …, 2/fine} against h/fine
         for k in -1..=l {
             p.push((f, Ladder::Time, n.clone(), h / 2f64.powi(k), k == l));
@@ -360,10 +349,7 @@ pub fn write(dir: &Path, r: &ConvergeResult) -> Result<(), Error> {
     write_file(&dir.join("converge.json"), &serde_json::to_string_pretty(r).map_err(|e| Error::Io(e.to_string()))?)?;
     // Colour: the formulation; dash and marker: the ladder.
     let style = |f: Formulation, l: Ladder| {
-        let c = match f {
-            Formulation::Ancf => colors::ANCF,
-            Formulation::Gebf => colors::GEBF,
-        };
+        let c = colors::of(f);
         match l {
             Ladder::Diagonal => Style::solid(c).marker(Marker::Circle).width(2),
             Ladder::Time => Style::solid(c).dash(Dash::Dashed).marker(Marker::Square),

@@ -77,10 +77,7 @@ pub fn run_into(
                 Ok(c) => c,
                 Err(e) => return (i, RunOutput::failed(f, e.to_string())),
             };
-            let dt = match f {
-                Formulation::Ancf => case.ancf.dt,
-                Formulation::Gebf => case.gebf.dt,
-            };
+            let dt = case.block(f).dt;
             let mut obs = Streamed {
                 csv,
                 progress: progress.run(&runs[i].name, f, case.t_end, dt),
@@ -226,14 +223,8 @@ pub fn write_reports(out: &Path, results: &[CaseResult]) -> Result<(), Error> {
 /// steps.
 pub fn limit_steps(spec: &mut RunSpec, steps: usize) {
     for f in Formulation::ALL {
-        let case = match f {
-            Formulation::Ancf => &mut spec.ancf,
-            Formulation::Gebf => &mut spec.gebf,
-        };
-        let dt = match f {
-            Formulation::Ancf => case.ancf.dt,
-            Formulation::Gebf => case.gebf.dt,
-        };
+        let case = spec.case_mut(f);
+        let dt = case.block(f).dt;
         let t = steps as f64 * dt;
         if t < case.t_end {
             case.t_end = t;

@@ -68,18 +68,10 @@ pub fn select(runs: &[RunSpec]) -> Vec<RunSpec> {
 /// `refine`, recording every step, without gate or references.
 fn study_case(base: &Case, f: Formulation, form: FormSetting, refine: f64) -> Case {
     let mut k = base.clone();
-    match f {
-        Formulation::Ancf => {
-            k.ancf.rho_inf = 1.0;
-            k.ancf.form = form;
-            k.ancf.dt /= refine;
-        }
-        Formulation::Gebf => {
-            k.gebf.rho_inf = 1.0;
-            k.gebf.form = form;
-            k.gebf.dt /= refine;
-        }
-    }
+    let block = k.block_mut(f);
+    *block.rho_inf = 1.0;
+    *block.form = form;
+    *block.dt /= refine;
     k.output_dt = None;
     k.gate = None;
     k.references.clear();
@@ -192,10 +184,7 @@ pub fn write(dir: &Path, runs: &[EnergyRun]) -> Result<(), Error> {
     cases.dedup();
     // Colour: the formulation; dash and marker: the form.
     let style = |f: Formulation, form: FormSetting| {
-        let c = match f {
-            Formulation::Ancf => colors::ANCF,
-            Formulation::Gebf => colors::GEBF,
-        };
+        let c = colors::of(f);
         match form {
             FormSetting::ArnoldBruls => Style::solid(c),
             FormSetting::ChungHulbert => Style::solid(c).dash(Dash::Dashed).marker(Marker::Circle),

@@ -171,10 +171,8 @@ pub fn kinetic_resolution(case: &crate::case::Case, f: crate::case::Formulation)
         .iter()
         .map(|b| b.section.mass * b.length + b.point_masses.iter().map(|p| p.mass).sum::<f64>())
         .sum();
-    let (atol, dt) = match f {
-        crate::case::Formulation::Ancf => (case.ancf.newton.atol, case.ancf.dt),
-        crate::case::Formulation::Gebf => (case.gebf.newton.atol, case.gebf.dt),
-    };
+    let b = case.block(f);
+    let (atol, dt) = (b.newton.atol, b.dt);
     0.5 * mass * (atol / dt).powi(2)
 }
 

@@ -129,6 +129,13 @@ pub mod colors {
     pub const ANCF: RGBColor = RGBColor(0, 114, 178);
     /// GEBF.
     pub const GEBF: RGBColor = RGBColor(213, 94, 0);
+    /// The colour of formulation `f`.
+    pub fn of(f: crate::case::Formulation) -> RGBColor {
+        match f {
+            crate::case::Formulation::Ancf => ANCF,
+            crate::case::Formulation::Gebf => GEBF,
+        }
+    }
     /// External references, in order.
     pub const REFS: [RGBColor; 4] =
         [RGBColor(30, 30, 30), RGBColor(0, 158, 115), RGBColor(204, 121, 167), RGBColor(120, 120, 120)];

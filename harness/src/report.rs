@@ -319,6 +319,14 @@ pub fn plots(r: &CaseResult) -> Vec<PlotFile> {
 
 /// The SVG plots of one case (the files [`plots`] lists).
 pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
+    write_tip(dir, r)?;
+    write_tip_difference(dir, r)?;
+    write_energy(dir, r)?;
+    write_per_run(dir, r)
+}
+
+/// `tip.svg`: tip X, Y, Z of each run and of the references.
+fn write_tip(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     let t_max = t_end(r);
     // Tip X, Y, Z: references first, so the formulations are drawn on top of them.
     let axis = ["X", "Y", "Z"];
@@ -356,8 +364,11 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
             }
         })
         .collect();
-    panels_svg(&dir.join("tip.svg"), &tip_panels, 1, (1000, 300))?;
+    panels_svg(&dir.join("tip.svg"), &tip_panels, 1, (1000, 300))
+}
 
+/// `tip_difference.svg`: the tip distance between the formulations and to each reference.
+fn write_tip_difference(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     // Differences: ANCF–GEBF, and each formulation against each reference (colour: the
     // reference; dash and marker: the formulation).
     let mut diff = vec![Series::new("|ANCF − GEBF|", Style::solid(colors::PALETTE[4]).width(2), r.pair_diff.clone())];
@@ -383,8 +394,11 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         series: diff,
         ..Panel::default()
     };
-    panels_svg(&dir.join("tip_difference.svg"), &[diff_panel], 1, (1000, 380))?;
+    panels_svg(&dir.join("tip_difference.svg"), &[diff_panel], 1, (1000, 380))
+}
 
+/// `energy.svg`: the energy components of each run and its energy balance's drift.
+fn write_energy(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     // Energies: only the components the case has; colour: the component, dash: the formulation.
     type Get = fn(&crate::run::Row) -> f64;
     let mut components: Vec<(&str, Get, RGBColor)> = vec![
@@ -447,8 +461,12 @@ pub fn write_plots(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         ],
         1,
         (1000, 340),
-    )?;
+    )
+}
 
+/// `constraint.svg`, and with aerodynamics `lift.svg`, with a fold hinge `fold.svg`: one series
+/// per run.
+fn write_per_run(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     let per_run = |get: &dyn Fn(&RunOutput) -> Vec<(f64, f64)>| -> Vec<Series> {
         r.runs
             .iter()

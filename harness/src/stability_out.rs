@@ -149,10 +149,7 @@ fn history_table(runs: &[StabilityOutput], h: &History) -> String {
 }
 
 fn color(f: Formulation) -> plotters::style::RGBColor {
-    match f {
-        Formulation::Ancf => colors::ANCF,
-        Formulation::Gebf => colors::GEBF,
-    }
+    colors::of(f)
 }
 
 fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {

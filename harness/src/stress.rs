@@ -342,10 +342,7 @@ pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
         .map(|&(i, f)| {
             let case = extras[i].1.case(f);
             // These runs take minutes: show their progress (simulated time, steps/s, time left).
-            let dt = match f {
-                Formulation::Ancf => case.ancf.dt,
-                Formulation::Gebf => case.gebf.dt,
-            };
+            let dt = case.block(f).dt;
             let mut progress = Progressed(progress.run(&extras[i].0, f, case.t_end, dt));
             let out = crate::scene::run_formulation_observed(case, f, &mut progress);
             let recovery =

@@ -2,7 +2,7 @@
 //! naming the field. The checks run in a fixed order (the first failing one is reported), one
 //! group of fields per function.
 
-use super::{Case, Elements, FormSetting, Formulation, Joint, MAX_STATIC_POINTS, NewtonSettings, StaticSettings, clip};
+use super::{Block, Case, FormSetting, Formulation, Joint, MAX_STATIC_POINTS, StaticSettings, clip};
 use super::{finite3, norm3, whole_steps};
 use crate::aero::AeroSettings;
 use crate::budget::{
@@ -18,15 +18,6 @@ fn positive(field: &str, v: f64) -> Result<(), String> {
 /// `v` is a finite number of at least zero.
 fn non_negative(field: &str, v: f64) -> Result<(), String> {
     if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{field}: {v} is not a non-negative number")) }
-}
-
-/// The fields the two settings blocks (`ancf`, `gebf`) share, as validation reads them.
-struct Block<'a> {
-    elements: &'a Elements,
-    newton: &'a NewtonSettings,
-    dt: f64,
-    rho_inf: f64,
-    form: FormSetting,
 }
 
 /// The case-file key of a formulation's settings block.
@@ -184,7 +175,7 @@ impl Case {
     /// multiplies the work of a step).
     fn check_discretisation(&self, fs: &[Formulation]) -> Result<(), String> {
         for &f in fs {
-            let n = self.block(f).elements;
+            let n = self.block(f).elements_per_body;
             n.check(&format!("{}.elements_per_body", key(f)), self.bodies.len())?;
             if let Some(i) = (0..self.bodies.len()).find(|&i| n.for_body(i) > MAX_ELEMENTS_PER_BODY) {
                 return Err(format!(
@@ -212,20 +203,6 @@ impl Case {
             }
         }
         Ok(())
-    }
-
-    /// What validation reads of `f`'s settings block.
-    fn block(&self, f: Formulation) -> Block<'_> {
-        match f {
-            Formulation::Ancf => {
-                let s = &self.ancf;
-                Block { elements: &s.elements_per_body, newton: &s.newton, dt: s.dt, rho_inf: s.rho_inf, form: s.form }
-            }
-            Formulation::Gebf => {
-                let s = &self.gebf;
-                Block { elements: &s.elements_per_body, newton: &s.newton, dt: s.dt, rho_inf: s.rho_inf, form: s.form }
-            }
-        }
     }
 
     /// End time, output interval and the refinement study's end time, then per formulation of
