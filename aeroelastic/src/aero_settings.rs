@@ -67,6 +67,14 @@ pub struct AeroSettings {
     /// paper's wing the treecode did not beat the direct sum up to 320 wake rows).
     #[cfg_attr(feature = "serde", serde(default))]
     pub wake_aggregation: bool,
+    /// Section polars (issue 37, docs/section_aero.md): the lattice's loads on the strips of
+    /// these bodies are corrected by the polar (lift, profile drag, moment); default none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
+    pub polars: Vec<crate::section_polars::PolarSpec>,
+    /// Kinematic viscosity of the air, m²/s, for the strips' Reynolds number `V c / ν` with
+    /// `polars`; default 1.5e-5 (air near 20 °C).
+    #[cfg_attr(feature = "serde", serde(default = "default_kinematic_viscosity"))]
+    pub kinematic_viscosity: f64,
 }
 
 /// A mirror plane of the flow.
@@ -128,6 +136,10 @@ impl Drop for RunsGuard {
 
 fn default_cutoff() -> f64 {
     1e-6
+}
+
+fn default_kinematic_viscosity() -> f64 {
+    1.5e-5
 }
 
 fn default_true() -> bool {

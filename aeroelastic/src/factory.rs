@@ -120,6 +120,9 @@ pub fn run_formulation(problem: &Problem, f: Formulation) -> RunOutput {
 
 /// As [`run_formulation`], handing every output step's geometry to `observer`.
 pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mut dyn Observer) -> RunOutput {
+    if let Err(e) = crate::section_polars::refuse_unwired(problem, "time march") {
+        return RunOutput::failed(f, e);
+    }
     struct Run<'a, 'o> {
         problem: &'a Problem,
         f: Formulation,

@@ -305,6 +305,7 @@ pub fn run_sweep(base: &Problem, cases: &[(Formulation, &Problem)]) -> Result<Gu
     let t0 = Instant::now();
     let case = base;
     let sweep = case.gust.as_ref().ok_or("the case has no `gust` block")?;
+    crate::section_polars::refuse_unwired(case, "gust analysis")?;
     for &(_, c) in cases {
         c.gust.as_ref().ok_or("the case has no `gust` block")?.validate(c)?;
     }

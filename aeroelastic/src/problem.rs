@@ -55,6 +55,8 @@ pub struct Problem {
     pub stability: Option<StabilitySettings>,
     /// The gust sweep.
     pub gust: Option<GustSweep>,
+    /// The section polars of `aero.polars`, loaded (none: the lattice's loads uncorrected).
+    pub polars: Vec<crate::section_polars::BodyPolar>,
 }
 
 /// The static sweep of a problem: airspeeds with aerodynamics, or dead point loads scaled by

@@ -996,6 +996,9 @@ fn cpu_now() -> f64 {
 /// Run the stability sweep of `case` with formulation `f`.
 pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
+    if let Err(e) = crate::section_polars::refuse_unwired(case, "stability analysis") {
+        return empty_output(f, Some(e));
+    }
     struct Sweep<'a>(&'a Problem, Formulation);
     impl ForModel for Sweep<'_> {
         type Output = StabilityOutput;

@@ -31,6 +31,7 @@ use formulation::Structure;
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::loads::{LoadModel, LoadScratch, WingLoads};
+use crate::polar_correction::{StripPolars, StripReport};
 use crate::problem::{Formulation, Problem};
 
 /// The steady aerodynamics of a lattice that follows the structure.
@@ -44,6 +45,8 @@ struct SteadyAero {
     fbuf: Vec<[f64; 3]>,
     mbuf: Vec<[f64; 3]>,
     n_solves: usize,
+    /// The section polars' correction of the last solve.
+    report: StripReport,
 }
 
 impl SteadyAero {
@@ -67,6 +70,7 @@ impl SteadyAero {
             fbuf: vec![[0.0; 3]; map.len()],
             mbuf: vec![[0.0; 3]; map.len()],
             n_solves: 0,
+            report: StripReport::default(),
         };
         stations_at(model, q, &s.zeros, map, aero, &mut s.scratch, &mut s.stations, &mut s.vel);
         let spec = crate::aero::lattice_spec(map, aero);
@@ -78,13 +82,16 @@ impl SteadyAero {
         Ok(s)
     }
 
-    /// Station loads of the steady solution on the lattice of `model` at `q`, into `out`.
+    /// Station loads of the steady solution on the lattice of `model` at `q`, into `out`,
+    /// corrected by the section polars `polars` (the structure at rest: each strip sees the free
+    /// stream).
     fn loads_at<S: Structure>(
         &mut self,
         model: &S,
         q: &[f64],
         map: &[StationMap],
         aero: &AeroSettings,
+        polars: Option<(&StripPolars, f64)>,
         out: &mut [SectionLoad],
     ) -> Result<(), String> {
         stations_at(model, q, &self.zeros, map, aero, &mut self.scratch, &mut self.stations, &mut self.vel);
@@ -97,6 +104,10 @@ impl SteadyAero {
         for (j, t) in out.iter_mut().enumerate() {
             t.force = Vector3::from(self.fbuf[j]);
             t.moment = Vector3::from(self.mbuf[j]);
+        }
+        if let Some((p, re_factor)) = polars {
+            let v = Vector3::from(self.uv.params().v_inf);
+            p.correct(&self.stations, map, self.uv.loads(), |_, _| v, re_factor, out, &mut self.report)?;
         }
         Ok(())
     }
@@ -150,6 +161,10 @@ pub struct AeroStatic<'a, S: Structure> {
     speed2: f64,
     /// Forward-difference step of the aerodynamic stiffness, in the increment weights' units.
     fd_step: f64,
+    /// The section polars that correct the lattice's loads (none: uncorrected).
+    polars: Option<StripPolars>,
+    /// The airspeed whose Reynolds numbers the polars are read at (none: the current one).
+    reynolds_airspeed: Option<f64>,
 }
 
 impl<'a, S: Structure> AeroStatic<'a, S> {
@@ -194,7 +209,30 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
             wake,
             speed2: v.iter().map(|x| x * x).sum(),
             fd_step: 1e-7 * span.max(1e-3),
+            polars: None,
+            reynolds_airspeed: None,
         })
+    }
+
+    /// Correct the lattice's loads by the section polars `polars` from now on (none: the
+    /// lattice's own loads). The aerodynamic stiffness, a difference quotient of the corrected
+    /// loads, then holds the correction's derivative (docs/section_aero.md §7).
+    pub fn set_polars(&mut self, polars: Option<StripPolars>) {
+        self.polars = polars;
+        self.begin_solve(true);
+    }
+
+    /// Read the polars at the Reynolds numbers of `airspeed` whatever the current airspeed (none:
+    /// at the current one). The load stepping of a sweep ramps the dynamic pressure through low
+    /// airspeeds, which would otherwise leave a polar's Reynolds range.
+    pub fn hold_reynolds_at(&mut self, airspeed: Option<f64>) {
+        self.reynolds_airspeed = airspeed;
+    }
+
+    /// The section polars' correction at the last evaluation of the loads (empty without
+    /// polars).
+    pub fn strip_report(&self) -> StripReport {
+        lock(&self.aero_state).report.clone()
     }
 
     /// Change the airspeed (the free stream keeps its direction): the lattice is rebuilt at `q`;
@@ -249,7 +287,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// Station loads and the UVLM's lattice loads at `q`.
     fn station_loads(&self, q: &[f64], out: &mut [SectionLoad]) -> bool {
         let model = read(&self.model);
-        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, out) {
+        let re_factor = self.reynolds_airspeed.map_or(1.0, |u| u / self.speed2.sqrt());
+        let polars = self.polars.as_ref().map(|p| (p, re_factor));
+        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, polars, out) {
             Ok(()) => true,
             Err(e) => {
                 *lock(&self.error) = Some(e);
@@ -492,6 +532,9 @@ pub struct Strip {
     pub lift_per_span: f64,
     /// Section lift coefficient `l / (½ ρ V² c)`.
     pub cl: f64,
+    /// Effective incidence of the strip (from the lattice's lift, docs/section_aero.md §4), rad;
+    /// NaN on a strip without a section polar.
+    pub alpha: f64,
 }
 
 /// One airspeed of a static sweep.
@@ -508,6 +551,9 @@ pub struct StaticPoint {
     pub loads: WingLoads,
     /// Total lift, N.
     pub lift: f64,
+    /// Total drag (along the free stream), N: the lattice's induced drag, plus the profile drag
+    /// of the section polars when the case has them.
+    pub drag: f64,
     /// Newton iterations spent on this point (its intermediate airspeeds included).
     pub newton_iterations: usize,
     /// Why the point has no equilibrium, if it has none.
@@ -612,6 +658,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
             hinge_moment: f64::NAN,
         },
         lift: f64::NAN,
+        drag: f64::NAN,
         newton_iterations: 0,
         error: Some(msg),
         load_factor: None,
@@ -737,12 +784,19 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
         Ok(s) => s,
         Err(e) => return failed_output(case, f, e),
     };
+    match StripPolars::of(case) {
+        Ok(p) => sys.set_polars(p),
+        Err(e) => return failed_output(case, f, e),
+    }
     let mut solver = StaticSolver::new(&sys, static_params());
     let mut x = StaticSolution::guess(&sys, &q_ref);
     let loads_model = LoadModel::new(case, f);
     let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
     // 1. The first equilibrium at the highest airspeed, by load stepping.
-    if let Err(e) = load_stepping(case, build, top, &mut sys, &mut solver, &mut x) {
+    sys.hold_reynolds_at(Some(top));
+    let stepped = load_stepping(case, build, top, &mut sys, &mut solver, &mut x);
+    sys.hold_reynolds_at(None);
+    if let Err(e) = stepped {
         return failed_output(case, f, e);
     }
     let mut iters = x.n_iterations;
@@ -920,23 +974,27 @@ fn point_at<S: Structure>(
     );
     let v_inf = sys.aero.free_stream();
     let lift_dir = lift_direction(v_inf);
-    let lift = Vector3::from(uv_loads.total_force()).dot(&lift_dir);
+    let report = sys.strip_report();
+    let total = Vector3::from(uv_loads.total_force()) + report.total_delta;
+    let lift = total.dot(&lift_dir);
+    let drag = total.dot(&Vector3::from(v_inf).normalize());
     // Column j of the lattice lies between stations j and j + 1.
     let arc = |m: &StationMap| m.wing_arc(case);
     let qdyn = 0.5 * rho * airspeed * airspeed;
     let chord = sys.aero.chord;
     let strips = (0..stations.len().saturating_sub(1))
         .filter_map(|j| {
-            let f = uv_loads.strip.get(j)?;
+            let f = Vector3::from(*uv_loads.strip.get(j)?) + report.delta_force.get(j).copied().unwrap_or_default();
             let (a, b) = (stations[j].origin, stations[j + 1].origin);
             let width = (b - a).norm();
-            let l = Vector3::from(*f).dot(&lift_dir) / width;
+            let l = f.dot(&lift_dir) / width;
             let mid = 0.5 * (a + b);
             Some(Strip {
                 s: 0.5 * (arc(&map[j]) + arc(&map[j + 1])),
                 position: mid.into(),
                 lift_per_span: l,
                 cl: l / (qdyn * chord),
+                alpha: report.alpha.get(j).copied().unwrap_or(f64::NAN),
             })
         })
         .collect();
@@ -946,6 +1004,7 @@ fn point_at<S: Structure>(
         tip: model.tip(q),
         loads,
         lift,
+        drag,
         newton_iterations: 0,
         error: None,
         load_factor: None,

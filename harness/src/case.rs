@@ -10,6 +10,7 @@ use serde_json::Value;
 
 use crate::Error;
 
+mod polars;
 mod to_lib;
 mod validate;
 
@@ -96,6 +97,11 @@ pub struct Case {
     /// `aero.gust` and the hinge states to fly through them (docs/gust.md). Needs `aero.gust`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust: Option<crate::gust::GustSweep>,
+    /// The polars of `aero.polars`, read by [`Case::load_polars`] when the case is expanded (not
+    /// a case-file field).
+    #[serde(skip)]
+    #[schemars(skip)]
+    pub polars: Vec<aeroelastic::section_polars::BodyPolar>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -458,6 +464,7 @@ impl CaseFile {
                 }
                 let mut case = parse_case(&r).map_err(&err)?;
                 case.name.push_str(&suffix);
+                case.load_polars(&self.dir()).map_err(&err)?;
                 if !fs.contains(&f) {
                     per.push(case);
                     continue;

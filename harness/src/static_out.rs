@@ -16,7 +16,7 @@ use crate::statics::StaticOutput;
 
 /// Column header of `static_<f>.csv`.
 pub const HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
-root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged";
+root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag";
 
 /// Column header of `static_lift_<f>.csv`.
 pub const LIFT_HEADER: &str = "airspeed,strip,s,x,y,z,lift_per_span,cl";
@@ -29,7 +29,7 @@ pub fn to_csv(out: &StaticOutput) -> String {
         let l = &p.loads;
         let _ = writeln!(
             s,
-            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{}",
+            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e}",
             p.airspeed,
             p.fold_deg,
             p.tip[0],
@@ -46,7 +46,8 @@ pub fn to_csv(out: &StaticOutput) -> String {
             l.root_moment[1],
             l.root_moment[2],
             p.newton_iterations,
-            u8::from(p.error.is_none())
+            u8::from(p.error.is_none()),
+            p.drag
         );
     }
     s

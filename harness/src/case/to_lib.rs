@@ -25,6 +25,7 @@ impl Case {
             statics: self.statics.as_ref().map(StaticSettings::problem),
             stability: self.stability.clone(),
             gust: self.gust.clone(),
+            polars: self.polars.clone(),
         }
     }
 }

@@ -11,6 +11,7 @@ mod gust;
 mod honest;
 mod loads_lost;
 mod observer;
+mod polars;
 mod properties;
 mod send_sync;
 mod shard;

@@ -1,0 +1,77 @@
+//! The section polars of a case (`aero.polars`): each file read relative to the case file's
+//! folder and validated, the body indices checked, and the free stream's Reynolds number checked
+//! against each table's range, into the typed [`aeroelastic::section_polars::BodyPolar`]s that
+//! [`Case::problem`] hands to the analyses. Every refusal names the field (and the file's own
+//! errors the file, line and column).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use aeroelastic::section_polars::{BodyPolar, ReBound};
+
+use super::Case;
+
+impl Case {
+    /// Read the polar files of `aero.polars` (relative to `dir`) into [`Case::polars`].
+    ///
+    /// # Errors
+    /// A missing, unreadable or invalid file (unsorted, non-finite, fewer than two rows per
+    /// table), an unknown or repeated body, a non-positive `aero.kinematic_viscosity`, or a
+    /// free-stream Reynolds number (`aero.airspeed` and every `static.airspeeds`) outside a
+    /// multi-Re table's range while `bounds.re` is `error`; the message names the field.
+    pub fn load_polars(&mut self, dir: &Path) -> Result<(), String> {
+        self.polars.clear();
+        let Some(aero) = &self.aero else { return Ok(()) };
+        if aero.polars.is_empty() {
+            return Ok(());
+        }
+        let nu = aero.kinematic_viscosity;
+        if !(nu.is_finite() && nu > 0.0) {
+            return Err(format!("aero.kinematic_viscosity: {nu} is not a positive number"));
+        }
+        let mut loaded = Vec::with_capacity(aero.polars.len());
+        for (i, spec) in aero.polars.iter().enumerate() {
+            if spec.bodies.is_empty() {
+                return Err(format!("aero.polars[{i}].bodies: empty list"));
+            }
+            for (k, &b) in spec.bodies.iter().enumerate() {
+                if b >= self.bodies.len() {
+                    return Err(format!(
+                        "aero.polars[{i}].bodies[{k}]: body {b} does not exist (the case has {} bodies)",
+                        self.bodies.len()
+                    ));
+                }
+                if let Some(j) = aero.polars[..i]
+                    .iter()
+                    .position(|s| s.bodies.contains(&b))
+                    .or_else(|| spec.bodies[..k].contains(&b).then_some(i))
+                {
+                    return Err(format!(
+                        "aero.polars[{i}].bodies[{k}]: body {b} already has the polar of aero.polars[{j}]"
+                    ));
+                }
+            }
+            let polar = aerofoil::read_polar(&dir.join(&spec.file))
+                .map_err(|e| format!("aero.polars[{i}].file: {e}"))?
+                .with_bounds(spec.bounds.aerofoil());
+            if let (Some((lo, hi)), ReBound::Error) = (polar.re_range(), spec.bounds.re) {
+                let speeds = aero.airspeed.iter().chain(self.statics.iter().flat_map(|s| s.airspeeds.iter()));
+                for &v in speeds {
+                    let re = v * aero.chord / nu;
+                    if !(lo..=hi).contains(&re) {
+                        return Err(format!(
+                            "aero.polars[{i}].file: {}: the free stream's Reynolds number {re:.4e} at {v} m/s \
+                             (aero.chord {} m, aero.kinematic_viscosity {nu} m²/s) is outside the table's range \
+                             [{lo:.4e}, {hi:.4e}]; give a polar that covers it or set aero.polars[{i}].bounds.re \
+                             to \"clamp\"",
+                            spec.file, aero.chord
+                        ));
+                    }
+                }
+            }
+            loaded.push(BodyPolar { bodies: spec.bodies.clone(), polar: Arc::new(polar) });
+        }
+        self.polars = loaded;
+        Ok(())
+    }
+}
