@@ -72,9 +72,9 @@ pub fn tip_inertia(flare_deg: f64) -> f64 {
 /// estimate holds because the fold frequency lies far below every elastic one (the first
 /// bending is 5.6 Hz): the elastic motion the tip's inertia forces at the fold frequency lowers
 /// `ω` by about `(ω/ω_bending)²`, 4e-5 at k = 1e-4 and 4e-3 at 1e-2. The second mode must lie
-/// more than ten times above the fold's. Measured errors: ANCF −1.9e-4 … −3e-5 (k = 1e-4),
-/// GEBF −4.6e-3 … −5e-6 (its floor: `ε ‖K_r‖` of the near-rigid shear, 1e9 N, in the fold's
-/// mass-normalised coordinates); both −4.3e-3 … at k = 1e-2 (the elastic lowering).
+/// more than ten times above the fold's. Measured errors: ANCF −2.4e-5 … +6.5e-5 (k = 1e-4),
+/// GEBF −6.6e-3 … +6.8e-3 (a floor that scales with the shear stiffness, see the GEBF test);
+/// both −4.2e-3 … −5.7e-3 at k = 1e-2 (the elastic lowering).
 #[test]
 fn fold_mode_of_a_free_flared_hinge_is_sqrt_k_over_j() {
     for k in [1e-4, 1e-2] {
