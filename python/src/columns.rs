@@ -155,6 +155,7 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
     d.set_item("newton_iterations", PyArray1::from_vec(py, it))?;
     let ok: Vec<bool> = p.iter().map(|p| p.error.is_none()).collect();
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
+    d.set_item("drag", f(|p| p.drag))?;
     debug_assert_eq!(d.len(), harness::static_out::HEADER.split(',').count());
     Ok(d)
 }
