@@ -13,6 +13,8 @@ use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate};
 /// A formulation's model as a problem builds it: [`Structure`] plus its construction and its
 /// Newton predictor. A third formulation implements this and adds one line to [`dispatch`].
 pub trait BuildModel: Structure + Send + Sync + Sized {
+    /// The formulation this model is.
+    const FORMULATION: Formulation;
     /// Newton's predictor for this formulation's time steps.
     const PREDICTOR: Predictor;
     /// Build the model of `problem` (its scene and this formulation's options).
@@ -20,23 +22,54 @@ pub trait BuildModel: Structure + Send + Sync + Sized {
     /// # Errors
     /// [`Error::Model`] when the scene does not validate or the model cannot be built.
     fn build(problem: &Problem) -> Result<Self, Error>;
+    /// Build the model of a bare `scene` with this formulation's default options: for work on
+    /// a structure alone (modes, statics, a user's own analysis), without a problem's flow and
+    /// solver settings.
+    ///
+    /// # Errors
+    /// [`Error::Model`] when the scene does not validate or the model cannot be built.
+    fn from_scene(scene: &scene::Scene) -> Result<Self, Error>;
+    /// An upper bound of [`Structure::n_unknowns`] for `elements` beam elements on `bodies`
+    /// bodies and `joints` joints, before the model is built: what a size budget checks. In
+    /// f64, so that a count that cannot fit in memory overflows nothing.
+    fn unknowns_bound(elements: f64, bodies: f64, joints: f64) -> f64;
 }
 
 impl BuildModel for ancf::Model {
+    const FORMULATION: Formulation = Formulation::Ancf;
     /// ANCF's inertia is linear: constant accelerations.
     const PREDICTOR: Predictor = Predictor::ConstantAcceleration;
     fn build(problem: &Problem) -> Result<Self, Error> {
         build_ancf(problem)
     }
+    fn from_scene(scene: &scene::Scene) -> Result<Self, Error> {
+        ancf::Model::from_scene(scene, ancf::Options::default())
+            .map_err(|e| Error::Model { formulation: Self::FORMULATION, msg: e.to_string() })
+    }
+    /// 12 coordinates per node, one node more than elements per body; at most 12 constraint
+    /// rows per joint (a clamp: 12, a hinge: fewer).
+    fn unknowns_bound(elements: f64, bodies: f64, joints: f64) -> f64 {
+        12.0 * (elements + bodies) + 12.0 * joints
+    }
 }
 
 impl BuildModel for gebf::Model {
+    const FORMULATION: Formulation = Formulation::Gebf;
     /// GEBF starts Newton from extrapolated accelerations: its residual is quadratic in the
     /// floating frames' angular velocities (Coriolis and centrifugal terms of the beam in a
     /// frame spinning at up to 30 rad/s in the c = 0.01 case).
     const PREDICTOR: Predictor = Predictor::ExtrapolatedAcceleration;
     fn build(problem: &Problem) -> Result<Self, Error> {
         build_gebf(problem)
+    }
+    fn from_scene(scene: &scene::Scene) -> Result<Self, Error> {
+        gebf::Model::from_scene(scene, gebf::Options::default())
+            .map_err(|e| Error::Model { formulation: Self::FORMULATION, msg: e.to_string() })
+    }
+    /// Three-node elements: 6 unknowns (R, ψ) on each of the 2 nodes an element adds after a
+    /// body's first node, 6 for the body's floating frame, at most 6 constraint rows per joint.
+    fn unknowns_bound(elements: f64, bodies: f64, joints: f64) -> f64 {
+        12.0 * elements + 6.0 * bodies + 6.0 * joints
     }
 }
 
@@ -66,6 +99,18 @@ pub fn predictor(f: Formulation) -> Predictor {
         }
     }
     dispatch(f, Of)
+}
+
+/// [`BuildModel::unknowns_bound`] of formulation `f`.
+pub fn unknowns_bound(f: Formulation, elements: f64, bodies: f64, joints: f64) -> f64 {
+    struct Bound(f64, f64, f64);
+    impl ForModel for Bound {
+        type Output = f64;
+        fn run<M: BuildModel>(self) -> f64 {
+            M::unknowns_bound(self.0, self.1, self.2)
+        }
+    }
+    dispatch(f, Bound(elements, bodies, joints))
 }
 
 /// The integrator parameters, end time and output interval of formulation `f` of a problem.
@@ -101,15 +146,16 @@ pub fn build_ancf(problem: &Problem) -> Result<ancf::Model, Error> {
         AncfPath::Dae => ancf::SolvePath::Dae,
         AncfPath::Ode => ancf::SolvePath::Ode,
     };
-    ancf::Model::from_scene(&problem.scene(Formulation::Ancf), ancf::Options { path, ..Default::default() })
-        .map_err(|e| Error::Model { formulation: Formulation::Ancf, msg: e.to_string() })
+    let f = <ancf::Model as BuildModel>::FORMULATION;
+    ancf::Model::from_scene(&problem.scene(f), ancf::Options { path, ..Default::default() })
+        .map_err(|e| Error::Model { formulation: f, msg: e.to_string() })
 }
 
 /// Build the GEBF model of a problem.
 pub fn build_gebf(problem: &Problem) -> Result<gebf::Model, Error> {
     let options = gebf::Options { stabilization: problem.gebf.stabilization, ..Default::default() };
-    gebf::Model::from_scene(&problem.scene(Formulation::Gebf), options)
-        .map_err(|e| Error::Model { formulation: Formulation::Gebf, msg: e.to_string() })
+    let f = <gebf::Model as BuildModel>::FORMULATION;
+    gebf::Model::from_scene(&problem.scene(f), options).map_err(|e| Error::Model { formulation: f, msg: e.to_string() })
 }
 
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot

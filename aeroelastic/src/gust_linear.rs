@@ -37,11 +37,11 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::{SectionLoad, StationMap, lattice_spec, station_map, stations_at};
+use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::gust::Increments;
 use crate::problem::{Formulation, Problem};
-use crate::stability::{MovedLattice, linear_wake, load_part, lump, mode_step, reduce, zero_loads};
+use crate::stability::{MovedLattice, linear_wake, load_maps, lump, mode_step, reduce, zero_loads};
 
 type C64 = Complex<f64>;
 
@@ -176,41 +176,6 @@ fn flat(l: &[SectionLoad]) -> Vec<f64> {
 /// `(a − b)·k`.
 fn diff(a: &[f64], b: &[f64], k: f64) -> DVector<f64> {
     DVector::from_iterator(a.len(), a.iter().zip(b).map(|(x, y)| (x - y) * k))
-}
-
-/// The lumping `C_l` (6·stations × nodal forces of `la`, about `origins`) and `H = Φᵀ P C_l`,
-/// `P` the generalised load part per unit station load at `q`.
-fn load_maps<S: Structure>(
-    model: &mut S,
-    q: &[f64],
-    phi: &DMatrix<f64>,
-    map: &[StationMap],
-    zero_loads: &[SectionLoad],
-    la: &uvlm::LinearUvlm,
-    origins: &[[f64; 3]],
-) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-    let (nf, ns) = (la.n_force(), map.len());
-    let ref_pos = la.lattice().ring_nodes().to_vec();
-    let mut cl = DMatrix::zeros(6 * ns, nf);
-    let mut unit = vec![0.0; nf];
-    for a in 0..nf {
-        unit.fill(0.0);
-        unit[a] = 1.0;
-        cl.set_column(a, &DVector::from_vec(flat(&lump(map, &ref_pos, origins, &unit))));
-    }
-    let mut p = DMatrix::zeros(model.n_dof(), 6 * ns);
-    for j in 0..6 * ns {
-        let mut l = zero_loads.to_vec();
-        let comp = j % 6;
-        if comp < 3 {
-            l[j / 6].force[comp] = 1.0;
-        } else {
-            l[j / 6].moment[comp - 3] = 1.0;
-        }
-        p.set_column(j, &DVector::from_vec(load_part(model, q, &l, zero_loads)?));
-    }
-    let h = phi.transpose() * &p * &cl;
-    Ok((cl, h))
 }
 
 /// The outputs of [`Increments`] at a state (the lift, linear in the nodal forces, is 0 here):

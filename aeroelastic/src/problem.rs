@@ -543,6 +543,9 @@ pub struct Block<'a> {
     pub form: FormSetting,
     /// Newton settings.
     pub newton: NewtonSettings,
+    /// The solve path, for a formulation that has more than one (ANCF: with multipliers or by
+    /// eliminating the joints); `None` for one with a single path.
+    pub path: Option<AncfPath>,
 }
 
 /// The shared settings of one formulation's block, to change in place.
@@ -558,6 +561,8 @@ pub struct BlockMut<'a> {
     pub form: &'a mut FormSetting,
     /// Newton settings.
     pub newton: &'a mut NewtonSettings,
+    /// The solve path ([`Block::path`]).
+    pub path: Option<&'a mut AncfPath>,
 }
 
 /// The block of formulation `f` of a pair of blocks (a problem's or a case file's).
@@ -569,6 +574,7 @@ pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings
             rho_inf: ancf.rho_inf,
             form: ancf.form,
             newton: ancf.newton,
+            path: Some(ancf.path),
         },
         Formulation::Gebf => Block {
             elements_per_body: &gebf.elements_per_body,
@@ -576,6 +582,7 @@ pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings
             rho_inf: gebf.rho_inf,
             form: gebf.form,
             newton: gebf.newton,
+            path: None,
         },
     }
 }
@@ -589,6 +596,7 @@ pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut 
             rho_inf: &mut ancf.rho_inf,
             form: &mut ancf.form,
             newton: &mut ancf.newton,
+            path: Some(&mut ancf.path),
         },
         Formulation::Gebf => BlockMut {
             elements_per_body: &mut gebf.elements_per_body,
@@ -596,6 +604,7 @@ pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut 
             rho_inf: &mut gebf.rho_inf,
             form: &mut gebf.form,
             newton: &mut gebf.newton,
+            path: None,
         },
     }
 }
@@ -621,11 +630,19 @@ impl Formulation {
     }
     /// Lower-case name used in file names.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Formulation::Ancf => "ancf",
-            Formulation::Gebf => "gebf",
-        }
+        Self::NAMES[self.index()].0
     }
+    /// Upper-case name used in tables and legends.
+    pub fn label(self) -> &'static str {
+        Self::NAMES[self.index()].1
+    }
+    /// Position in [`Formulation::ALL`]: where tables indexed by formulation (plot styles, speed
+    /// targets) keep this formulation's entry.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+    /// File name and label of each formulation, in [`Formulation::ALL`] order.
+    const NAMES: [(&'static str, &'static str); 2] = [("ancf", "ANCF"), ("gebf", "GEBF")];
 }
 
 impl std::fmt::Display for Formulation {
@@ -745,5 +762,22 @@ impl Problem {
             .collect();
         let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);
         scene::Scene { bodies, joints, forces, gravity }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Formulation;
+
+    /// Tables indexed by [`Formulation::index`] rely on it being the position in `ALL`, and the
+    /// command line's names on `from_name` inverting `as_str`.
+    #[test]
+    fn formulation_index_and_names_follow_all() {
+        for (i, f) in Formulation::ALL.into_iter().enumerate() {
+            assert_eq!(f.index(), i);
+            assert_eq!(Formulation::from_name(f.as_str()), Some(f));
+            assert_eq!(f.label(), f.as_str().to_uppercase());
+        }
+        assert_eq!(Formulation::from_name("both"), None);
     }
 }

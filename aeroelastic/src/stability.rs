@@ -663,10 +663,12 @@ fn strip_model<S: Structure>(
     Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset - b) / b, speed: aero.airspeed.unwrap_or(0.0) }
 }
 
-/// `H = Φᵀ P C_l` (basis modes × nodal forces): the generalised (modal) load part per unit nodal
-/// force of the lattice `la` (lumped about `origins`), by the linearity of the load part in the
-/// station loads and of the lumping in the nodal forces.
-fn modal_load_per_nodal_force<S: Structure>(
+/// The load maps of a lattice `la` on `model` at `q`: the lumping `C_l` (6·stations × nodal
+/// forces: a unit force on each lattice node lumped about `origins` into `[F, M]` per station)
+/// and `H = Φᵀ P C_l` (basis modes × nodal forces), `P` the generalised load part per unit
+/// station load. Both rely on the linearity of the load part in the station loads and of the
+/// lumping in the nodal forces. Stability and the linear gust response share it.
+pub(crate) fn load_maps<S: Structure>(
     model: &mut S,
     q: &[f64],
     phi: &DMatrix<f64>,
@@ -674,9 +676,21 @@ fn modal_load_per_nodal_force<S: Structure>(
     zero_loads: &[SectionLoad],
     la: &uvlm::LinearUvlm,
     origins: &[[f64; 3]],
-) -> Result<DMatrix<f64>, String> {
-    let (nb, nf, ns) = (phi.ncols(), la.n_force(), map.len());
+) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+    let (nf, ns) = (la.n_force(), map.len());
     let ref_pos = la.lattice().ring_nodes().to_vec();
+    let mut cl = DMatrix::zeros(6 * ns, nf);
+    let mut unit = vec![0.0; nf];
+    for a in 0..nf {
+        unit.fill(0.0);
+        unit[a] = 1.0;
+        for (j, sl) in lump(map, &ref_pos, origins, &unit).iter().enumerate() {
+            for comp in 0..3 {
+                cl[(6 * j + comp, a)] = sl.force[comp];
+                cl[(6 * j + 3 + comp, a)] = sl.moment[comp];
+            }
+        }
+    }
     let mut p = DMatrix::zeros(model.n_dof(), 6 * ns);
     for j in 0..ns {
         for comp in 0..6 {
@@ -690,30 +704,8 @@ fn modal_load_per_nodal_force<S: Structure>(
             p.column_mut(6 * j + comp).copy_from_slice(&g);
         }
     }
-    let pt = phi.transpose() * &p; // nb × 6ns
-    let mut h = DMatrix::zeros(nb, nf);
-    let mut unit = vec![0.0; nf];
-    for a in 0..nf {
-        unit.fill(0.0);
-        unit[a] = 1.0;
-        let l = lump(map, &ref_pos, origins, &unit);
-        for (j, sl) in l.iter().enumerate() {
-            for comp in 0..3 {
-                let (fv, mv) = (sl.force[comp], sl.moment[comp]);
-                if fv != 0.0 {
-                    for i in 0..nb {
-                        h[(i, a)] += pt[(i, 6 * j + comp)] * fv;
-                    }
-                }
-                if mv != 0.0 {
-                    for i in 0..nb {
-                        h[(i, a)] += pt[(i, 6 * j + 3 + comp)] * mv;
-                    }
-                }
-            }
-        }
-    }
-    Ok(h)
+    let h = phi.transpose() * &p * &cl;
+    Ok((cl, h))
 }
 
 /// The lattice of a linear UVLM moved with the structure, its reference circulations held: the
@@ -921,7 +913,7 @@ pub fn reduce<S: Structure>(
     let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
     let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let h = modal_load_per_nodal_force(&mut model, q, &basis.phi, map, &zero_loads, &la, &origins)?;
+    let (_, h) = load_maps(&mut model, q, &basis.phi, map, &zero_loads, &la, &origins)?;
     let mut moved = MovedLattice::new(&la, map, aero);
     let geo = geometric_terms(&mut model, q, &basis.phi, &mut moved, &zero_loads)?;
     // The wake's nodes follow the trailing edge's past motion, as the time march sheds them:

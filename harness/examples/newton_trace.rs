@@ -11,27 +11,34 @@
 //! body 6 per node from node 1 (R, ψ), then the frame (v_A, ω_A). Cases without aerodynamics
 //! only; overrides as `harness run --set` (e.g. `gebf.newton.broyden=false`).
 use anyhow::{Context, Result, bail};
-use genalpha::{GenAlpha, IterationRecord, LinearSolver};
+use genalpha::{GenAlpha, IterationRecord};
 use harness::case::{CaseFile, Formulation, Override};
-use harness::run::Structure;
-use harness::scene::{build_ancf, build_gebf, settings};
+use harness::scene::{BuildModel, ForModel, dispatch, settings};
 
-fn trace<S: Structure>(sys: &mut S, params: genalpha::IntegratorParams, t_end: f64) -> Result<Vec<IterationRecord>>
-where
-    S::Solver: LinearSolver,
-{
-    let mut ga: GenAlpha<S::Solver> = sys.integrator(params)?;
-    let mut s = sys.initial_state();
-    ga.initialize(sys, &mut s)?;
-    ga.set_trace(true);
-    let n_steps = (t_end / params.dt - 1e-9).ceil() as usize;
-    for k in 1..=n_steps {
-        if let Err(e) = ga.step(sys, &mut s) {
-            eprintln!("step {k}: {e}");
-            break;
+/// One run of a formulation's model with Newton's trace on ([`dispatch`] picks the model type).
+struct Trace {
+    problem: aeroelastic::Problem,
+    run: harness::run::RunSettings,
+}
+
+impl ForModel for Trace {
+    type Output = Result<Vec<IterationRecord>>;
+    fn run<M: BuildModel>(self) -> Self::Output {
+        let sys = &mut M::build(&self.problem)?;
+        let (params, t_end) = (self.run.params, self.run.t_end);
+        let mut ga: GenAlpha<M::Solver> = sys.integrator(params)?;
+        let mut s = sys.initial_state();
+        ga.initialize(sys, &mut s)?;
+        ga.set_trace(true);
+        let n_steps = (t_end / params.dt - 1e-9).ceil() as usize;
+        for k in 1..=n_steps {
+            if let Err(e) = ga.step(sys, &mut s) {
+                eprintln!("step {k}: {e}");
+                break;
+            }
         }
+        Ok(ga.take_trace())
     }
-    Ok(ga.take_trace())
 }
 
 fn main() -> Result<()> {
@@ -42,21 +49,14 @@ fn main() -> Result<()> {
     let overrides = rest.iter().map(|s| s.parse::<Override>()).collect::<Result<Vec<_>, _>>()?;
     let runs = CaseFile::read(file.as_ref())?.expand(&overrides)?;
     let spec = runs.first().context("the case expands into no run")?;
-    let gebf = match formulation.as_str() {
-        "ancf" => false,
-        "gebf" => true,
-        other => bail!("formulation `{other}`: expected ancf or gebf"),
+    let Some(f) = Formulation::from_name(formulation) else {
+        bail!("formulation `{formulation}`: expected one of {:?}", Formulation::ALL.map(Formulation::as_str));
     };
-    let case = if gebf { &spec.gebf } else { &spec.ancf };
+    let case = spec.case(f);
     if case.aero.is_some() {
         bail!("{}: cases with aerodynamics are not traced", spec.name);
     }
-    let run = settings(case, if gebf { Formulation::Gebf } else { Formulation::Ancf });
-    let records = if gebf {
-        trace(&mut build_gebf(case)?, run.params, run.t_end)?
-    } else {
-        trace(&mut build_ancf(case)?, run.params, run.t_end)?
-    };
+    let records = dispatch(f, Trace { problem: case.problem(), run: settings(case, f) })?;
     println!("t,h,iter,factorized,residual_norm,phi_norm,psi_norm,increment_norm,worst_unknown");
     for r in &records {
         println!(

@@ -25,7 +25,8 @@ use crate::scene::run_formulation;
 
 /// Speed targets of the paper's double pendulums (docs/cases.md), ms per 2 s run; the paper's
 /// MATLAB code took ~20 s and SHARPy ~40 s CPU.
-pub const TARGET_MS: [(Formulation, f64); 2] = [(Formulation::Ancf, 50.0), (Formulation::Gebf, 100.0)];
+/// In [`Formulation::ALL`] order: ANCF 50 ms, GEBF 100 ms.
+pub const TARGET_MS: [(Formulation, f64); 2] = [(Formulation::ALL[0], 50.0), (Formulation::ALL[1], 100.0)];
 
 /// One benchmarked configuration.
 #[derive(Debug, Clone, Serialize)]
@@ -72,16 +73,25 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// The configurations of `spec`: ANCF on both paths, then GEBF.
+/// The configurations of `spec`: each formulation on each of its solve paths (ANCF with
+/// multipliers and by eliminating the joints, GEBF on its one), in [`Formulation::ALL`] order.
 fn configurations(spec: &RunSpec) -> Vec<(Formulation, String, crate::case::Case)> {
     let mut out = Vec::new();
-    for path in [AncfPath::Dae, AncfPath::Ode] {
-        let mut c = spec.ancf.clone();
-        c.ancf.path = path;
-        let name = if path == AncfPath::Dae { "dae" } else { "ode" };
-        out.push((Formulation::Ancf, name.to_string(), c));
+    for f in Formulation::ALL {
+        let base = spec.case(f);
+        if base.block(f).path.is_none() {
+            out.push((f, "-".to_string(), base.clone()));
+            continue;
+        }
+        for path in [AncfPath::Dae, AncfPath::Ode] {
+            let mut c = base.clone();
+            if let Some(p) = c.block_mut(f).path {
+                *p = path;
+            }
+            let name = if path == AncfPath::Dae { "dae" } else { "ode" };
+            out.push((f, name.to_string(), c));
+        }
     }
-    out.push((Formulation::Gebf, "-".to_string(), spec.gebf.clone()));
     out
 }
 
@@ -142,9 +152,9 @@ pub fn run(specs: &[RunSpec], repeats: usize, progress: bool) -> Vec<BenchRow> {
 }
 
 fn label(r: &BenchRow) -> String {
-    match r.formulation {
-        Formulation::Ancf => format!("ANCF {}", r.path.to_uppercase()),
-        Formulation::Gebf => "GEBF".to_string(),
+    match r.path.as_str() {
+        "-" => r.formulation.label().to_string(),
+        path => format!("{} {}", r.formulation.label(), path.to_uppercase()),
     }
 }
 

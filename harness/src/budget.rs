@@ -133,10 +133,7 @@ fn unknowns(case: &Case, f: Formulation) -> f64 {
     let nb = case.bodies.len();
     let nj = case.joints.len() as f64;
     let el: f64 = (0..nb).map(|i| elements.for_body(i) as f64).sum();
-    match f {
-        Formulation::Ancf => 12.0 * (el + nb as f64) + 12.0 * nj,
-        Formulation::Gebf => 12.0 * el + 6.0 * nb as f64 + 6.0 * nj,
-    }
+    aeroelastic::factory::unknowns_bound(f, el, nb as f64, nj)
 }
 
 /// Estimate formulation `f` of `case` (validated counts; every product in f64, so nothing
@@ -439,4 +436,44 @@ pub fn describe_analysis(case: &Case, a: Analysis, fs: &[Formulation]) -> String
         })
         .collect();
     parts.join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unknowns;
+    use crate::case::{CaseFile, Formulation};
+    use aeroelastic::factory::{BuildModel, ForModel, dispatch};
+
+    /// The built model's unknowns.
+    struct Count(aeroelastic::Problem);
+    impl ForModel for Count {
+        type Output = usize;
+        fn run<M: BuildModel>(self) -> usize {
+            M::build(&self.0).map_or(0, |m| m.n_unknowns())
+        }
+    }
+
+    /// The budget's count bounds every shipped case's model from above and within 25 %, so that
+    /// it neither lets an oversized case through nor refuses a fitting one.
+    #[test]
+    fn unknowns_bound_every_case_model_closely() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases");
+        let mut checked = 0;
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let path = e.unwrap().path();
+            if path.extension().is_none_or(|x| x != "json") || path.ends_with("case.schema.json") {
+                continue;
+            }
+            let spec = CaseFile::read(&path).unwrap().expand(&[]).unwrap().remove(0);
+            for f in Formulation::ALL {
+                let case = spec.case(f);
+                let (built, bound) = (dispatch(f, Count(case.problem())), unknowns(case, f));
+                assert!(built > 0, "{}: {f} does not build", path.display());
+                let ratio = bound / built as f64;
+                assert!((1.0..=1.25).contains(&ratio), "{} {f}: bound {bound} for {built} unknowns", path.display());
+                checked += 1;
+            }
+        }
+        assert!(checked >= 30, "only {checked} models checked");
+    }
 }

@@ -13,7 +13,7 @@ use crate::Error;
 use crate::case::Formulation;
 use crate::csv::write_file;
 use crate::gust::{GustRun, GustSpec, GustSweepOutput, HingeState};
-use crate::static_out::{Curves, Style, panel};
+use crate::static_out::{Curves, panel, style};
 
 /// Column header of `gust_<f>.csv`.
 pub const HEADER: &str = "hinge,spring_stiffness,gradient_m,frequency_hz,gust_velocity,\
@@ -106,10 +106,13 @@ pub fn summarise(out: GustSweepOutput) -> GustSummary {
         }
     }
     let mut ancf_gebf = Vec::new();
-    for a in runs.iter().filter(ok).filter(|r| r.formulation == Formulation::Ancf) {
-        if let Some(g) = runs.iter().filter(ok).find(|g| {
-            g.formulation == Formulation::Gebf && same_hinge(&g.hinge, &a.hinge) && g.gradient_m == a.gradient_m
-        }) {
+    let [first, second] = Formulation::ALL;
+    for a in runs.iter().filter(ok).filter(|r| r.formulation == first) {
+        if let Some(g) = runs
+            .iter()
+            .filter(ok)
+            .find(|g| g.formulation == second && same_hinge(&g.hinge, &a.hinge) && g.gradient_m == a.gradient_m)
+        {
             let (ma, mg) = (a.peak_delta_root_bending_moment.0, g.peak_delta_root_bending_moment.0);
             ancf_gebf.push(PairDifference {
                 hinge: a.hinge,
@@ -234,13 +237,6 @@ fn hinge_color(hinges: &[HingeState], h: &HingeState) -> RGBColor {
     PALETTE[k % PALETTE.len()]
 }
 
-fn style(f: Formulation) -> Style {
-    match f {
-        Formulation::Ancf => Style::Solid,
-        Formulation::Gebf => Style::Dashed,
-    }
-}
-
 fn hinges_of(s: &GustSummary) -> Vec<HingeState> {
     let mut v: Vec<HingeState> = Vec::new();
     for r in &s.runs {
@@ -300,7 +296,7 @@ fn histories(s: &GustSummary, h_crit: f64, value: impl Fn(&crate::gust::Incremen
                 format!("{} {}", f.as_str().to_uppercase(), hinge_name(&r.hinge)),
                 hinge_color(&hinges, &r.hinge),
                 pts,
-                if f == Formulation::Ancf { Style::Solid } else { Style::Dashed },
+                style(f),
             ));
         }
     }
@@ -394,15 +390,11 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
          <th>ANCF peak ΔM [N·m]</th><th>GEBF peak ΔM [N·m]</th><th>Δ [%]</th>\
          <th>ANCF peak Δθ [°]</th><th>GEBF peak Δθ [°]</th><th>alleviation ANCF [%]</th><th>alleviation GEBF [%]</th></tr>\n",
     );
-    for a in s
-        .runs
-        .iter()
-        .filter(|r| r.formulation == Formulation::Ancf || !s.runs.iter().any(|x| x.formulation == Formulation::Ancf))
-    {
-        let g = s
-            .runs
-            .iter()
-            .find(|g| g.formulation == Formulation::Gebf && g.hinge == a.hinge && g.gradient_m == a.gradient_m);
+    // One row per hinge and gradient: from the first formulation's run, or the second's where the
+    // first did not run.
+    let [first, second] = Formulation::ALL;
+    for a in s.runs.iter().filter(|r| r.formulation == first || !s.runs.iter().any(|x| x.formulation == first)) {
+        let g = s.runs.iter().find(|g| g.formulation == second && g.hinge == a.hinge && g.gradient_m == a.gradient_m);
         let d = s.ancf_gebf.iter().find(|d| d.hinge == a.hinge && d.gradient_m == a.gradient_m);
         let al = |f: Formulation| {
             s.runs
@@ -429,8 +421,8 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
             d.map_or_else(|| "–".into(), |d| format!("{:.3}", d.peak_rbm_percent)),
             peak(Some(a), |r| r.peak_delta_fold_deg.0, 3),
             peak(g, |r| r.peak_delta_fold_deg.0, 3),
-            percent_cell(al(Formulation::Ancf)),
-            percent_cell(al(Formulation::Gebf)),
+            percent_cell(al(first)),
+            percent_cell(al(second)),
         );
     }
     h.push_str("</table>\n");

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 
 use harness::budget::Analysis;
 use harness::case::{CaseFile, Formulation, Override, RunSpec, json_schema};
@@ -72,21 +72,22 @@ struct CaseSource {
     cases: PathBuf,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum Which {
-    Ancf,
-    Gebf,
-    Both,
-}
+/// `--formulation`: one formulation by name, or `both`.
+#[derive(Clone, Debug)]
+struct Which(Vec<Formulation>);
 
 impl Which {
     /// The formulations this choice runs.
-    fn formulations(self) -> Vec<Formulation> {
-        match self {
-            Which::Ancf => vec![Formulation::Ancf],
-            Which::Gebf => vec![Formulation::Gebf],
-            Which::Both => Formulation::ALL.to_vec(),
-        }
+    fn formulations(&self) -> Vec<Formulation> {
+        self.0.clone()
+    }
+    /// The parser of `--formulation`: the formulations' names or `both` (listed in the help and
+    /// in the error of any other value).
+    fn parser() -> impl clap::builder::TypedValueParser<Value = Which> {
+        use clap::builder::TypedValueParser as _;
+        let names = Formulation::ALL.map(Formulation::as_str).into_iter().chain(["both"]);
+        clap::builder::PossibleValuesParser::new(names)
+            .map(|s: String| Which(Formulation::from_name(&s).map_or_else(|| Formulation::ALL.to_vec(), |f| vec![f])))
     }
 }
 
@@ -96,7 +97,7 @@ struct AnalysisArgs {
     /// Case file (with the analysis' block: `static`, `stability` or `gust`).
     case: PathBuf,
     /// Formulation(s) to run.
-    #[arg(long, value_enum, default_value = "both")]
+    #[arg(long, value_parser = Which::parser(), default_value = "both")]
     formulation: Which,
     #[command(flatten)]
     out: OutOpt,
@@ -128,7 +129,7 @@ struct RunArgs {
     /// Case file.
     case: PathBuf,
     /// Formulation(s) to run.
-    #[arg(long, value_enum, default_value = "both")]
+    #[arg(long, value_parser = Which::parser(), default_value = "both")]
     formulation: Which,
     #[command(flatten)]
     out: OutOpt,

@@ -73,6 +73,17 @@ impl Style {
     pub const fn width(self, width: u32) -> Self {
         Self { width, ..self }
     }
+    /// How formulation `f` is drawn in `color` where the formulations appear together: the first
+    /// of [`Formulation::ALL`](crate::case::Formulation::ALL) dashed with circles on top, the
+    /// second solid and wide beneath it, so that either stays visible when the two coincide.
+    pub fn of_formulation(f: crate::case::Formulation, color: RGBColor) -> Self {
+        [Self::solid(color).dash(Dash::Dashed).marker(Marker::Circle), Self::solid(color).width(3)][f.index()]
+    }
+    /// The line pattern of formulation `f` in plots without markers: the first solid, the
+    /// second dashed.
+    pub fn formulation_dash(f: crate::case::Formulation) -> Dash {
+        [Dash::Solid, Dash::Dashed][f.index()]
+    }
     /// The `i`-th of a set of distinct styles (colour, dash and marker all change with `i`), for
     /// series that have no fixed meaning.
     pub fn nth(i: usize) -> Self {
@@ -131,10 +142,7 @@ pub mod colors {
     pub const GEBF: RGBColor = RGBColor(213, 94, 0);
     /// The colour of formulation `f`.
     pub fn of(f: crate::case::Formulation) -> RGBColor {
-        match f {
-            crate::case::Formulation::Ancf => ANCF,
-            crate::case::Formulation::Gebf => GEBF,
-        }
+        [ANCF, GEBF][f.index()]
     }
     /// External references, in order.
     pub const REFS: [RGBColor; 4] =

@@ -60,7 +60,8 @@ impl CaseResult {
             })
             .collect();
         let find = |f: Formulation| runs.iter().find(|r| r.formulation == f && !r.rows.is_empty());
-        let (pair, pair_diff) = match (find(Formulation::Ancf), find(Formulation::Gebf)) {
+        let [first, second] = Formulation::ALL;
+        let (pair, pair_diff) = match (find(first), find(second)) {
             (Some(a), Some(b)) => {
                 let (m, d) = PairMetrics::of(a, b, span);
                 (Some(m), d)
@@ -158,10 +159,7 @@ pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
 /// How each formulation is drawn wherever both appear: GEBF a solid line, ANCF dashed with
 /// circles on top of it, so that either stays visible when the two coincide.
 fn run_style(f: Formulation) -> Style {
-    match f {
-        Formulation::Ancf => Style::solid(colors::ANCF).dash(Dash::Dashed).marker(Marker::Circle),
-        Formulation::Gebf => Style::solid(colors::GEBF).width(3),
-    }
+    Style::of_formulation(f, colors::of(f))
 }
 
 /// How external reference `i` is drawn: its own colour, dash and marker.
@@ -193,10 +191,7 @@ fn style_words(s: &Style) -> String {
 }
 
 fn label(f: Formulation) -> &'static str {
-    match f {
-        Formulation::Ancf => "ANCF",
-        Formulation::Gebf => "GEBF",
-    }
+    f.label()
 }
 
 fn t_end(r: &CaseResult) -> f64 {
@@ -259,11 +254,11 @@ pub fn plots(r: &CaseResult) -> Vec<PlotFile> {
             format!("{l} ({}{shifted})", style_words(&ref_style(i)))
         })
         .collect();
-    let forms = format!(
-        "ANCF ({}), GEBF ({})",
-        style_words(&run_style(Formulation::Ancf)),
-        style_words(&run_style(Formulation::Gebf))
-    );
+    let forms = Formulation::ALL
+        .iter()
+        .map(|&f| format!("{} ({})", f.label(), style_words(&run_style(f))))
+        .collect::<Vec<_>>()
+        .join(", ");
     let mut v = vec![PlotFile {
         file: "tip.svg",
         caption: if refs.is_empty() {
@@ -375,10 +370,7 @@ fn write_tip_difference(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     for (i, (lab, c, shift)) in r.reference_curves.iter().enumerate() {
         let color = [colors::REFS[1], colors::REFS[2], colors::EXTRA[1], colors::EXTRA[2]][i % 4];
         for run in r.runs.iter().filter(|x| !x.rows.is_empty()) {
-            let style = match run.formulation {
-                Formulation::Ancf => Style::solid(color).dash(Dash::Dashed).marker(Marker::Circle),
-                Formulation::Gebf => Style::solid(color).marker(Marker::Square),
-            };
+            let style = Style::of_formulation(run.formulation, color);
             diff.push(Series::new(
                 format!("|{} − {}|", label(run.formulation), lab),
                 style,
@@ -418,10 +410,7 @@ fn write_energy(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     for run in r.runs.iter().rev() {
         let l = label(run.formulation);
         for &(name, get, color) in &components {
-            let style = match run.formulation {
-                Formulation::Ancf => Style::solid(color).dash(Dash::Dashed).marker(Marker::Circle),
-                Formulation::Gebf => Style::solid(color).width(3),
-            };
+            let style = Style::of_formulation(run.formulation, color);
             comp.push(Series::new(format!("{name} ({l})"), style, run.rows.iter().map(|x| (x.t, get(x))).collect()));
         }
         let e0 = run.rows.first().map_or(0.0, |x| x.total);

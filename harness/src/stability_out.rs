@@ -174,7 +174,7 @@ fn plots(dir: &Path, runs: &[StabilityOutput]) -> Result<(), Error> {
         ..Default::default()
     };
     for out in runs {
-        let dash = if out.formulation == Formulation::Ancf { Dash::Solid } else { Dash::Dashed };
+        let dash = Style::formulation_dash(out.formulation);
         for m in 0..n_modes {
             let pick = |f: &dyn Fn(&crate::stability::Root) -> f64| -> Vec<(f64, f64)> {
                 out.points

@@ -488,10 +488,7 @@ const EXP: RGBColor = RGBColor(30, 30, 30);
 const MODEL: RGBColor = RGBColor(44, 160, 44);
 
 fn color(f: Formulation) -> RGBColor {
-    match f {
-        Formulation::Ancf => ANCF,
-        Formulation::Gebf => GEBF,
-    }
+    [ANCF, GEBF][f.index()]
 }
 
 fn range(vals: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -603,11 +600,10 @@ pub(crate) fn panel(path: &Path, title: &str, xl: &str, yl: &str, curves: &Curve
     file.commit()
 }
 
-fn style(f: Formulation) -> Style {
-    match f {
-        Formulation::Ancf => Style::Solid,
-        Formulation::Gebf => Style::Dashed,
-    }
+/// How formulation `f`'s curves are drawn: the first of [`Formulation::ALL`] solid, the second
+/// dashed over it.
+pub(crate) fn style(f: Formulation) -> Style {
+    [Style::Solid, Style::Dashed][f.index()]
 }
 
 fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {

@@ -1,7 +1,7 @@
 //! A catalogue of reference scenes, shared by both formulations' tests and benchmarks and by the
 //! harness (re-exported as `ancf::samples` and `gebf::samples`).
 
-use crate::{BodySpec, JointSpec, Section};
+use crate::{BodySpec, ForceElement, JointSpec, PointMass, Scene, Section};
 use nalgebra::{Matrix3, Vector3};
 
 /// The paper's double-pendulum section (Otsuka, Cheng & Palacios, ICAS 2024, Tables 1–2):
@@ -90,4 +90,72 @@ pub fn cantilever(section: Section, length: f64, n_el: usize) -> (Vec<BodySpec>,
         point_masses: Vec::new(),
     };
     (vec![body], vec![JointSpec::Clamp { body: 0 }])
+}
+
+/// Length of the inner body of [`free_hinge_wing`], m.
+pub const FREE_HINGE_INNER: f64 = 0.75;
+/// Length of the tip of [`free_hinge_wing`], m.
+pub const FREE_HINGE_TIP: f64 = 0.25;
+
+/// The section: Healy's aluminium spar (mass 0.2592 kg/m, EI_yy 12.9 N·m², EI_zz 224 N·m²,
+/// J_xx = J_yy + J_zz so that ANCF's slope inertias are exact), with near-rigid shear.
+pub fn free_hinge_section() -> Section {
+    Section::centred(0.2592, 9.13766e-6, 4.97664e-7, 8.64e-6, 6.72e6, 1e9, 1e9, 18.2753, 12.9024, 224.0)
+}
+
+/// The tip's point mass: 0.061 kg, 12 mm behind the spar (−y), 0.1 m from the hinge.
+pub fn free_hinge_tip_mass() -> PointMass {
+    PointMass {
+        at: 0.1,
+        offset: Vector3::new(0.0, -0.0139, 0.0),
+        mass: 0.061,
+        inertia: Vector3::new(1.89e-5, 1.16e-4, 1.349e-4),
+    }
+}
+
+/// A Healy-like 1 m wing with a free flared hinge (no gravity): a 0.75 m inner body clamped at
+/// the root (12 elements) and a 0.25 m tip (4 elements, a point mass) on a flared hinge of flare
+/// `flare_deg` with a soft spring `k`, N·m/rad (joint 1). Its lowest mode is the tip turning
+/// about the hinge axis at `ω = √(k/J)`, `J` = [`free_hinge_tip_inertia`], while `ω` lies far
+/// below the first bending (5.6 Hz).
+pub fn free_hinge_wing(flare_deg: f64, k: f64) -> Scene {
+    let body = |name: &str, start: f64, length: f64, n_elements: usize, point_masses: Vec<PointMass>| BodySpec {
+        name: name.into(),
+        start: Vector3::new(start, 0.0, 0.0),
+        length,
+        frame: Matrix3::identity(),
+        section: free_hinge_section(),
+        n_elements,
+        point_masses,
+    };
+    Scene {
+        forces: vec![ForceElement::HingeSpring { joint: 1, stiffness: k, damping: 0.0, rest: 0.0 }],
+        ..Scene::new(
+            vec![
+                body("inner", 0.0, FREE_HINGE_INNER, 12, Vec::new()),
+                body("tip", FREE_HINGE_INNER, FREE_HINGE_TIP, 4, vec![free_hinge_tip_mass()]),
+            ],
+            vec![
+                JointSpec::Clamp { body: 0 },
+                JointSpec::FlaredHinge { parent: 0, child: 1, beta: flare_deg.to_radians() },
+            ],
+            Vector3::zeros(),
+        )
+    }
+}
+
+/// The tip's moment of inertia about the hinge axis `a = sin β x + cos β y` through the hinge,
+/// analytically: the line mass `μ` at `s x` (distance `s cos β` from the axis), the sections'
+/// rotary inertias `aᵀ diag(ρI) a`, and the point mass at `r` (`|r|² − (r·a)²`) with its own
+/// inertia.
+pub fn free_hinge_tip_inertia(flare_deg: f64) -> f64 {
+    let (sb, cb) = flare_deg.to_radians().sin_cos();
+    let a = Vector3::new(sb, cb, 0.0);
+    let s = free_hinge_section();
+    let line = s.mass * FREE_HINGE_TIP.powi(3) / 3.0 * cb * cb;
+    let rotary = FREE_HINGE_TIP * (s.rho_ixx * sb * sb + s.rho_iyy * cb * cb);
+    let p = free_hinge_tip_mass();
+    let r = Vector3::new(p.at, 0.0, 0.0) + p.offset;
+    let point = p.mass * (r.norm_squared() - r.dot(&a).powi(2)) + a.dot(&p.inertia.component_mul(&a));
+    line + rotary + point
 }

@@ -4,7 +4,6 @@
 mod bad_input;
 mod common;
 mod energy;
-mod fold_mode;
 mod generic_analysis;
 mod inertia;
 mod invariance;

@@ -3,7 +3,6 @@
 
 mod common;
 mod energy;
-mod fold_mode;
 mod frame_retraction;
 mod generic_analysis;
 mod inertia;
