@@ -85,7 +85,11 @@
 //! blocks of 8 points, compute `P − X` and `|P − X|` once per (point, node), and are compiled for
 //! AVX-512 and AVX2 + FMA with run-time dispatch (portable fallback otherwise). The AIC is rebuilt
 //! and refactorised only when the lattice moved. Evaluations with enough work use rayon
-//! ([`Parallel::Auto`]). No heap allocation happens in a step once the wake buffer is full.
+//! ([`Parallel::Auto`]): their blocks of points are split into chunks, each with its own entry of
+//! a scratch workspace the solver owns (no thread-local or shared mutable state; a threaded
+//! evaluation is bit-identical to the serial one). [`Uvlm`], [`LinearUvlm`] and
+//! [`treecode::Treecode`] are `Send + Sync`. No heap allocation happens in a step once the wake
+//! buffer is full.
 #![warn(missing_docs)]
 // Index loops over x/y/z components and lattice indices mirror the equations they implement.
 #![allow(clippy::needless_range_loop)]
@@ -104,6 +108,7 @@ mod linear;
 mod loads;
 mod params;
 pub mod samples;
+mod scratch;
 mod solver;
 mod station;
 mod stats;

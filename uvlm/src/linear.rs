@@ -46,6 +46,7 @@ use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
 use crate::params::{SteadyWake, UvlmParams};
+use crate::scratch::ScratchPool;
 use crate::solver::Uvlm;
 use crate::wake::Wake;
 
@@ -125,7 +126,8 @@ struct Frozen {
     v_col: Vec<[f64; 3]>,
     u_mid: Vec<[f64; 3]>,
     v_mid: Vec<[f64; 3]>,
-    blk: NodeBlock,
+    /// The Biot–Savart loops' workspace (serial here).
+    blocks: ScratchPool<NodeBlock>,
     loads: Loads,
 }
 
@@ -155,8 +157,8 @@ impl Frozen {
     fn induce(&mut self, sets: &[&Filaments]) {
         self.u_col.resize(self.col.len(), [0.0; 3]);
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
-        induced_velocity_inplace(sets, &self.col, &mut self.u_col, crate::Parallel::Off, &mut self.blk);
-        induced_velocity_inplace(sets, &self.mid, &mut self.u_mid, crate::Parallel::Off, &mut self.blk);
+        induced_velocity_inplace(sets, &self.col, &mut self.u_col, crate::Parallel::Off, &mut self.blocks);
+        induced_velocity_inplace(sets, &self.mid, &mut self.u_mid, crate::Parallel::Off, &mut self.blocks);
     }
 }
 
@@ -302,7 +304,7 @@ impl Uvlm {
         // Unit strengths (the AIC reads the filaments' strengths).
         let mut unit_bs = BoundSystem::default();
         unit_bs.build(&lat, TrailingEdge::Unsteady, &p.bound_core, &p.images);
-        unit_bs.assemble_aic(&fz.col, &nrm_pts, &mut aic_rm, crate::Parallel::Off, &mut fz.blk);
+        unit_bs.assemble_aic(&fz.col, &nrm_pts, &mut aic_rm, crate::Parallel::Off, &mut fz.blocks);
         let aic = DMatrix::from_row_slice(nr, nr, &aic_rm);
 
         // Bilinear load derivative along (δΓ, δu): central difference with a unit step, exact.
@@ -351,7 +353,7 @@ impl Uvlm {
             fz.bs.set_strengths(&unit);
             let mid = std::mem::take(&mut fz.mid);
             fz.u_mid.resize(mid.len(), [0.0; 3]);
-            induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blk);
+            induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blocks);
             fz.mid = mid;
             let du = fz.u_mid.clone();
             load_derivative(&mut fz, Some(r), None, &du, &mut col);

@@ -9,6 +9,7 @@ use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads};
 use crate::params::{Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
+use crate::scratch::ScratchPool;
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
 use crate::treecode::{Treecode, block_order};
@@ -85,7 +86,8 @@ pub struct Uvlm {
     gamma_row: Vec<f64>,
     /// Circulation of the newest wake row, per column (the trailing-edge segment's force).
     te_shed: Vec<f64>,
-    blk: NodeBlock,
+    /// The Biot–Savart loops' workspace (one entry per threaded chunk).
+    blocks: ScratchPool<NodeBlock>,
     loads: Loads,
     stats: Stats,
     pending_dt: Option<f64>,
@@ -138,7 +140,7 @@ impl Uvlm {
             row_buf: vec![[0.0; 3]; n + 1],
             gamma_row: vec![0.0; n],
             te_shed: vec![0.0; n],
-            blk: NodeBlock::default(),
+            blocks: ScratchPool::default(),
             loads: Loads::default(),
             stats: Stats::default(),
             pending_dt: None,
@@ -308,7 +310,7 @@ impl Uvlm {
         self.bound_mode = Some(mode);
         self.load_collocation();
         self.stats.n_pair_evaluations +=
-            self.bound.assemble_aic(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blk);
+            self.bound.assemble_aic(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blocks);
         self.stats.n_aic_builds += 1;
         self.aic_key = None;
         self.lu.factorize_row_major(&self.aic).map_err(|pivot| UvlmError::SingularAic { pivot })?;
@@ -330,7 +332,7 @@ impl Uvlm {
                 tol,
                 &mut self.u_col,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             );
             if self.params.wake_reuse == WakeReuse::Frozen {
                 if !self.far_ready {
@@ -341,7 +343,7 @@ impl Uvlm {
                         tol,
                         &mut self.u_far_col,
                         self.params.parallel,
-                        &mut self.blk,
+                        &mut self.blocks,
                     );
                 }
                 add_to(&mut self.u_col, &self.u_far_col);
@@ -393,7 +395,7 @@ impl Uvlm {
                 &self.mid,
                 &mut self.u_mid,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             );
             bound
                 + self.known_tree.add_velocity(
@@ -402,7 +404,7 @@ impl Uvlm {
                     tol,
                     &mut self.u_mid,
                     self.params.parallel,
-                    &mut self.blk,
+                    &mut self.blocks,
                 )
         } else if with_known_wake {
             induced_velocity_inplace(
@@ -410,7 +412,7 @@ impl Uvlm {
                 &self.mid,
                 &mut self.u_mid,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             )
         } else {
             induced_velocity_inplace(
@@ -418,7 +420,7 @@ impl Uvlm {
                 &self.mid,
                 &mut self.u_mid,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             )
         };
         self.stats.n_pair_evaluations += pairs;
@@ -432,7 +434,7 @@ impl Uvlm {
                     tol,
                     &mut self.u_far_mid,
                     self.params.parallel,
-                    &mut self.blk,
+                    &mut self.blocks,
                 );
             }
             add_to(&mut self.u_mid, &self.u_far_mid);
@@ -551,11 +553,11 @@ impl Uvlm {
                 &self.wpts,
                 &mut self.u_wake,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             );
             for (tree, set) in [(&mut self.known_tree, &self.known), (&mut self.far_tree, &self.far)] {
                 self.stats.n_pair_evaluations +=
-                    tree.add_velocity(set, &self.wpts, tol, &mut self.u_wake, self.params.parallel, &mut self.blk);
+                    tree.add_velocity(set, &self.wpts, tol, &mut self.u_wake, self.params.parallel, &mut self.blocks);
             }
         } else if free {
             self.stats.n_pair_evaluations += induced_velocity_inplace(
@@ -563,7 +565,7 @@ impl Uvlm {
                 &self.wpts,
                 &mut self.u_wake,
                 self.params.parallel,
-                &mut self.blk,
+                &mut self.blocks,
             );
         } else {
             self.u_wake.fill([0.0; 3]);
@@ -718,15 +720,16 @@ impl WakeTree {
         tol: f64,
         out: &mut [[f64; 3]],
         parallel: Parallel,
-        blk: &mut NodeBlock,
+        scratch: &mut ScratchPool<NodeBlock>,
     ) -> u64 {
         if pts.is_empty() || set.n_filaments() == 0 {
             return 0;
         }
         if !self.applies(set) {
             if out.iter().all(|u| *u == [0.0; 3]) {
-                return induced_velocity_inplace(&[set], pts, out, parallel, blk);
+                return induced_velocity_inplace(&[set], pts, out, parallel, scratch);
             }
+            let blk = scratch.first();
             let mut pairs = 0;
             for b in 0..pts.len().div_ceil(crate::biot_savart::LANES) {
                 pairs += add_block_direct(set, pts, b, out, blk);

@@ -36,7 +36,7 @@
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, velocity_block};
 use crate::induce::{Points, use_threads};
 use crate::params::Parallel;
-use rayon::prelude::*;
+use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
@@ -145,20 +145,24 @@ pub struct Treecode {
     legs: Filaments,
     /// Σ |Γ/4π| |B − A| over all segments.
     total_strength: f64,
-    scratch: Scratch,
+    /// The traversals' workspace: one entry per threaded chunk of point blocks (the first
+    /// serves the serial loop).
+    scratch: ScratchPool<Scratch>,
+    /// The threaded loop's velocities and direct pairs per point block, scattered to the points
+    /// after the loop.
+    block_out: Vec<BlockOut>,
 }
 
-/// Per-evaluation scratch of a traversal (one per thread).
+/// The velocities at one block's points and the point–filament pairs summed directly.
+type BlockOut = ([[f64; LANES]; 3], u64);
+
+/// Scratch of a traversal (one per chunk of point blocks).
 #[derive(Debug, Clone, Default)]
 struct Scratch {
     stack: Vec<u32>,
     taylor: Vec<[f64; LANES]>,
     stats: TreeStats,
     blk: NodeBlock,
-}
-
-thread_local! {
-    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 impl Treecode {
@@ -229,15 +233,22 @@ impl Treecode {
         self.order
     }
 
-    /// Counters of the evaluations since the last [`Treecode::build`].
+    /// Counters of the evaluations since the last [`Treecode::build`] (serial and threaded).
     pub fn stats(&self) -> TreeStats {
-        self.scratch.stats
+        let mut t = TreeStats::default();
+        for sc in self.scratch.entries() {
+            t.n_direct_pairs += sc.stats.n_direct_pairs;
+            t.n_expansions += sc.stats.n_expansions;
+        }
+        t
     }
 
     /// Sort the segments of `fil` into the tree and compute every cluster's moments.
     pub fn build(&mut self, fil: &Filaments) {
         let ns = fil.n_segments();
-        self.scratch.stats = TreeStats::default();
+        for sc in self.scratch.entries_mut() {
+            sc.stats = TreeStats::default();
+        }
         self.perm.clear();
         self.perm.extend(0..ns as u32);
         self.mid.clear();
@@ -431,35 +442,41 @@ impl Treecode {
         // Rough work: every point against a leaf's worth of segments per level.
         let work = pts.len() * self.leaf_size * self.clusters.len().max(1).ilog2() as usize * 16;
         if use_threads(parallel, work) && n_blocks > 1 {
-            // Blocks write disjoint points of `out` (through `order`): compute, then scatter.
-            let res: Vec<([[f64; LANES]; 3], u64)> = (0..n_blocks)
-                .into_par_iter()
-                .map(|b| {
-                    SCRATCH.with(|cell| {
-                        let sc = &mut cell.borrow_mut();
-                        let (bx, by, bz) = gather(pts, order, b);
-                        let mut u = [[0.0; LANES]; 3];
-                        let pairs = self.block(&bx, &by, &bz, tol, &mut u, sc);
-                        (u, pairs)
-                    })
-                })
-                .collect();
-            let mut pairs = 0;
-            for (b, (u, p)) in res.iter().enumerate() {
-                scatter(order, b, u, out);
-                pairs += p;
-            }
-            return pairs;
+            return self.add_blocks_threaded(pts, order, tol, out);
         }
         let mut pairs = 0u64;
-        let mut sc = std::mem::take(&mut self.scratch);
+        let mut pool = std::mem::take(&mut self.scratch);
+        let sc = pool.first();
         for b in 0..n_blocks {
             let (bx, by, bz) = gather(pts, order, b);
             let mut u = [[0.0; LANES]; 3];
-            pairs += self.block(&bx, &by, &bz, tol, &mut u, &mut sc);
+            pairs += self.block(&bx, &by, &bz, tol, &mut u, sc);
             scatter(order, b, &u, out);
         }
-        self.scratch = sc;
+        self.scratch = pool;
+        pairs
+    }
+
+    /// The point blocks on rayon, each chunk of blocks with its own scratch entry: the blocks
+    /// write disjoint points of `out` (through `order`), so compute into `block_out`, then
+    /// scatter in block order. Returns the pairs summed directly.
+    fn add_blocks_threaded(&mut self, pts: &Points, order: &[u32], tol: f64, out: &mut [[f64; 3]]) -> u64 {
+        let n_blocks = pts.len().div_ceil(LANES);
+        let (mut pool, mut res) = (std::mem::take(&mut self.scratch), std::mem::take(&mut self.block_out));
+        res.resize(n_blocks, ([[0.0; LANES]; 3], 0));
+        pool.for_each_chunk(&mut res, 1, TREE_CHUNKS_PER_THREAD, |first, chunk, sc| {
+            for (i, (u, pairs)) in chunk.iter_mut().enumerate() {
+                let (bx, by, bz) = gather(pts, order, first + i);
+                *u = [[0.0; LANES]; 3];
+                *pairs = self.block(&bx, &by, &bz, tol, u, sc);
+            }
+        });
+        let mut pairs = 0;
+        for (b, (u, p)) in res.iter().enumerate() {
+            scatter(order, b, u, out);
+            pairs += p;
+        }
+        (self.scratch, self.block_out) = (pool, res);
         pairs
     }
 

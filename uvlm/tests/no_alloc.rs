@@ -1,7 +1,8 @@
 //! The time loop does not allocate: once the wake buffer is full and every work buffer has
-//! reached its size, `update_stations` + `step` perform no heap allocation (counting allocator,
-//! single thread; prescribed and free wake, with a symmetry plane, without and with a disturbance
-//! field).
+//! reached its size, `update_stations` + `step` perform no heap allocation (counting allocator;
+//! prescribed and free wake, with a symmetry plane, without and with a disturbance field; single
+//! thread, and threaded on a rayon pool of two with the wake summed directly and through the
+//! treecode).
 
 use uvlm::samples::FlaredWing;
 use uvlm::*;
@@ -43,5 +44,49 @@ fn step_does_not_allocate() {
             }
         });
         assert_eq!(allocations, 0, "{convection:?}, disturbed {disturbed}: {allocations} allocations in 8 steps");
+    }
+}
+
+/// The threaded evaluations (blocks of points in chunks, each with its own entry of the solver's
+/// workspace) allocate nothing once warm. The counter sees the thread that calls `step` (a
+/// worker of the pool, which also runs chunks); the other worker's chunks only use the same
+/// workspace entries.
+#[test]
+fn threaded_step_does_not_allocate() {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    for (convection, aggregation) in [
+        (WakeConvection::Prescribed, WakeAggregation::off()),
+        (WakeConvection::Free, WakeAggregation::off()),
+        (WakeConvection::Prescribed, WakeAggregation::treecode()),
+        (WakeConvection::Free, WakeAggregation::treecode()),
+    ] {
+        let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+        let stations: Vec<Vec<SpanStation>> = (0..8).map(|k| wing.stations(0.02 * k as f64)).collect();
+        let lat = Lattice::from_stations(wing.spec(), &stations[0]).unwrap();
+        let n_col = lat.n_rings();
+        let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+        p.parallel = Parallel::Auto;
+        p.n_wake_rows = 40;
+        p.wake_convection = convection;
+        p.wake_aggregation = aggregation;
+        p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+        let mut u = Uvlm::new(lat, p).unwrap();
+        let allocations = pool.install(|| {
+            for k in 0..48 {
+                u.update_stations(&stations[k % 8], None).unwrap();
+                u.step(0.01).unwrap();
+            }
+            // The wake (40 rows of 32 rings, mirrored: ≥ 5000 filaments) at the collocation
+            // points alone is above the threaded threshold of two threads.
+            assert!(n_col * 5000 >= 2 * PARALLEL_MIN_PAIRS);
+            let ((), allocations) = alloc_count::count(|| {
+                for k in 0..8 {
+                    u.update_stations(&stations[7 - k], None).unwrap();
+                    u.step(0.01).unwrap();
+                }
+            });
+            allocations
+        });
+        assert_eq!(allocations, 0, "{convection:?}, {aggregation:?}: {allocations} allocations in 8 threaded steps");
     }
 }

@@ -9,6 +9,7 @@ mod linear;
 mod linear_gust;
 mod properties;
 mod reuse;
+mod send_sync;
 mod steady;
 mod steady_finite_wake;
 mod theodorsen;
