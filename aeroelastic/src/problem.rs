@@ -562,42 +562,42 @@ pub struct BlockMut<'a> {
 
 /// The block of formulation `f` of a pair of blocks (a problem's or a case file's).
 pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings) -> Block<'a> {
-    match f {
-        Formulation::Ancf => Block {
+    f.pick(
+        Block {
             elements_per_body: &ancf.elements_per_body,
             dt: ancf.dt,
             rho_inf: ancf.rho_inf,
             form: ancf.form,
             newton: ancf.newton,
         },
-        Formulation::Gebf => Block {
+        Block {
             elements_per_body: &gebf.elements_per_body,
             dt: gebf.dt,
             rho_inf: gebf.rho_inf,
             form: gebf.form,
             newton: gebf.newton,
         },
-    }
+    )
 }
 
 /// [`blocks`], to change in place.
 pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut GebfSettings) -> BlockMut<'a> {
-    match f {
-        Formulation::Ancf => BlockMut {
+    f.pick(
+        BlockMut {
             elements_per_body: &mut ancf.elements_per_body,
             dt: &mut ancf.dt,
             rho_inf: &mut ancf.rho_inf,
             form: &mut ancf.form,
             newton: &mut ancf.newton,
         },
-        Formulation::Gebf => BlockMut {
+        BlockMut {
             elements_per_body: &mut gebf.elements_per_body,
             dt: &mut gebf.dt,
             rho_inf: &mut gebf.rho_inf,
             form: &mut gebf.form,
             newton: &mut gebf.newton,
         },
-    }
+    )
 }
 
 /// The two structural formulations.
@@ -621,9 +621,15 @@ impl Formulation {
     }
     /// Lower-case name used in file names.
     pub fn as_str(self) -> &'static str {
+        self.pick("ancf", "gebf")
+    }
+    /// Of a pair of values kept per formulation in the case file's order (`ancf`, `gebf`: the
+    /// blocks of a problem, the cases of a run), this formulation's: the one place that matches
+    /// on the variants for such pairs.
+    pub fn pick<T>(self, ancf: T, gebf: T) -> T {
         match self {
-            Formulation::Ancf => "ancf",
-            Formulation::Gebf => "gebf",
+            Formulation::Ancf => ancf,
+            Formulation::Gebf => gebf,
         }
     }
 }
