@@ -567,8 +567,8 @@ pub struct BlockMut<'a> {
 
 /// The block of formulation `f` of a pair of blocks (a problem's or a case file's).
 pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings) -> Block<'a> {
-    match f {
-        Formulation::Ancf => Block {
+    f.pick(
+        Block {
             elements_per_body: &ancf.elements_per_body,
             dt: ancf.dt,
             rho_inf: ancf.rho_inf,
@@ -576,7 +576,7 @@ pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings
             newton: ancf.newton,
             path: Some(ancf.path),
         },
-        Formulation::Gebf => Block {
+        Block {
             elements_per_body: &gebf.elements_per_body,
             dt: gebf.dt,
             rho_inf: gebf.rho_inf,
@@ -584,13 +584,13 @@ pub fn blocks<'a>(f: Formulation, ancf: &'a AncfSettings, gebf: &'a GebfSettings
             newton: gebf.newton,
             path: None,
         },
-    }
+    )
 }
 
 /// [`blocks`], to change in place.
 pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut GebfSettings) -> BlockMut<'a> {
-    match f {
-        Formulation::Ancf => BlockMut {
+    f.pick(
+        BlockMut {
             elements_per_body: &mut ancf.elements_per_body,
             dt: &mut ancf.dt,
             rho_inf: &mut ancf.rho_inf,
@@ -598,7 +598,7 @@ pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut 
             newton: &mut ancf.newton,
             path: Some(&mut ancf.path),
         },
-        Formulation::Gebf => BlockMut {
+        BlockMut {
             elements_per_body: &mut gebf.elements_per_body,
             dt: &mut gebf.dt,
             rho_inf: &mut gebf.rho_inf,
@@ -606,7 +606,7 @@ pub fn blocks_mut<'a>(f: Formulation, ancf: &'a mut AncfSettings, gebf: &'a mut 
             newton: &mut gebf.newton,
             path: None,
         },
-    }
+    )
 }
 
 /// The two structural formulations.
@@ -631,6 +631,15 @@ impl Formulation {
     /// Lower-case name used in file names.
     pub fn as_str(self) -> &'static str {
         Self::NAMES[self.index()].0
+    }
+    /// Of a pair of values kept per formulation in the case file's order (`ancf`, `gebf`: the
+    /// blocks of a problem, the cases of a run), this formulation's: the one place that matches
+    /// on the variants for such pairs.
+    pub fn pick<T>(self, ancf: T, gebf: T) -> T {
+        match self {
+            Formulation::Ancf => ancf,
+            Formulation::Gebf => gebf,
+        }
     }
     /// Upper-case name used in tables and legends.
     pub fn label(self) -> &'static str {

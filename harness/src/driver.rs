@@ -31,7 +31,7 @@ pub fn expand_all(files: &[PathBuf], overrides: &[Override]) -> (Vec<RunSpec>, V
     for f in files {
         match CaseFile::read(f).and_then(|c| c.expand(overrides)) {
             Ok(r) => runs.extend(r),
-            Err(e) => errors.push(e),
+            Err(e) => errors.push(e.into()),
         }
     }
     (runs, errors)

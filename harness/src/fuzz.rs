@@ -532,7 +532,7 @@ pub fn check_file(path: &Path, max_steps: usize, limits: &Limits) -> (Class, Str
 
 fn check_parsed(
     input_path: &Path,
-    read: impl FnOnce() -> Result<CaseFile, crate::Error>,
+    read: impl FnOnce() -> Result<CaseFile, crate::case::Error>,
     max_steps: usize,
     limits: &Limits,
 ) -> (Class, String) {
@@ -579,7 +579,7 @@ pub fn check_command(cmd: FuzzCommand, path: &Path, max_steps: usize, limits: &L
         return check_file(path, max_steps, limits);
     }
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let rejected = |e: crate::Error| {
+        let rejected = |e: crate::case::Error| {
             let m = e.to_string();
             let named = m.contains(&path.display().to_string());
             (if named { Class::Rejected } else { Class::RejectedUnnamed }, m)

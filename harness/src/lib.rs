@@ -11,8 +11,6 @@
 
 pub mod atomic;
 pub mod bench;
-pub mod budget;
-pub mod case;
 pub mod converge;
 pub mod csv;
 pub mod driver;
@@ -25,7 +23,6 @@ pub mod metrics;
 pub mod plot;
 pub mod progress;
 pub mod report;
-pub mod scene;
 pub mod shard;
 pub mod signal;
 pub mod stability_out;
@@ -34,8 +31,11 @@ pub mod stress;
 pub mod view3d;
 pub mod vtk;
 
-// The analyses live in the `aeroelastic` library; their modules keep their harness paths.
+// The analyses live in the `aeroelastic` library, the case files in `casefile`; their modules keep
+// their harness paths.
 pub use aeroelastic::{aero, gust, gust_linear, loads, pencil, run, stability, static_hold, statics};
+pub use casefile as case;
+pub use casefile::{budget, scene};
 
 /// Errors of the harness library (the binary adds context with anyhow).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -82,6 +82,18 @@ pub enum Error {
         /// What failed.
         msg: String,
     },
+}
+
+impl From<casefile::Error> for Error {
+    fn from(e: casefile::Error) -> Self {
+        match e {
+            casefile::Error::Case { file, msg } => Error::Case { file, msg },
+            casefile::Error::Override(msg) => Error::Override(msg),
+            casefile::Error::Io(msg) => Error::Io(msg),
+            casefile::Error::Reference { file, msg } => Error::Reference { file, msg },
+            casefile::Error::Model { formulation, msg } => Error::Model { formulation, msg },
+        }
+    }
 }
 
 impl From<aeroelastic::Error> for Error {

@@ -3,29 +3,9 @@
 
 use serde::Serialize;
 
-use crate::csv::Curve;
 use crate::run::{Row, RunOutput};
 
-/// Time history of the tip of a run.
-pub fn tip_curve(rows: &[Row]) -> Curve {
-    let mut c = Curve { t: Vec::with_capacity(rows.len()), tip: Vec::with_capacity(rows.len()) };
-    for r in rows {
-        if c.t.last().is_none_or(|&l| r.t > l) {
-            c.t.push(r.t);
-            c.tip.push(r.tip);
-        }
-    }
-    c
-}
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
-/// The distance d(t) = |a(t) − b(t + shift)| sampled at the times of `a` where `b` is defined.
-pub fn tip_difference(a: &Curve, b: &Curve, shift: f64) -> Vec<(f64, f64)> {
-    a.t.iter().zip(&a.tip).filter_map(|(&t, &p)| b.tip_at(t + shift).map(|q| (t, dist(p, q)))).collect()
-}
+pub use casefile::curve::{tip_curve, tip_difference};
 
 /// Max and RMS of a sampled difference over a window.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

@@ -14,9 +14,8 @@ use crate::csv::write_file;
 use crate::stability::WakeSettings;
 use crate::statics::StaticOutput;
 
-/// Column header of `static_<f>.csv`.
-pub const HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
-root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag";
+pub use casefile::csv::STATIC_HEADER as HEADER;
+pub use casefile::curve::{parse_xy, read_xy};
 
 /// Column header of `static_lift_<f>.csv`.
 pub const LIFT_HEADER: &str = "airspeed,strip,s,x,y,z,lift_per_span,cl";
@@ -881,35 +880,4 @@ pub fn hold_references(spec: &RunSpec, summary: &mut StaticSummary) {
         .par_iter()
         .map(|&(f, u, coast)| aeroelastic::static_hold::hold(&spec.case(f).problem(), f, u, coast))
         .collect();
-}
-
-/// Read a two-column CSV (a header line, then `x,y` rows; `#` comments allowed).
-pub fn read_xy(path: &Path) -> Result<Vec<(f64, f64)>, Error> {
-    let file = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| Error::Reference { file: file.clone(), msg: e.to_string() })?;
-    parse_xy(&text).map_err(|msg| Error::Reference { file, msg })
-}
-
-/// Parse the text of [`read_xy`].
-pub fn parse_xy(text: &str) -> Result<Vec<(f64, f64)>, String> {
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
-    lines.next().ok_or("no header line")?;
-    let mut out = Vec::new();
-    for (n, line) in lines {
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() < 2 {
-            return Err(format!("line {}: two columns expected", n + 1));
-        }
-        let num = |s: &str| s.parse::<f64>().map_err(|e| format!("line {}: {e}", n + 1));
-        let (x, y) = (num(f[0])?, num(f[1])?);
-        if !(x.is_finite() && y.is_finite()) {
-            return Err(format!("line {}: not finite", n + 1));
-        }
-        out.push((x, y));
-    }
-    if out.is_empty() {
-        return Err("no data rows".into());
-    }
-    Ok(out)
 }

@@ -10,22 +10,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
-
 use crate::case::{Case, Formulation, RunSpec};
 use crate::run::{BeamGeometry, Observer, Snapshot};
 
-/// The case file's `vtk` block: write ParaView files for every run of the case, as `--vtk`
-/// does (`harness run` and `harness all`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct VtkOutput {
-    /// Write every N-th output step (≥ 1; default: about 100 frames per run,
-    /// max(1, output rows / 100)). `--vtk-stride` overrides it.
-    #[serde(default)]
-    pub stride: Option<usize>,
-}
+pub use casefile::VtkOutput;
 
 /// The file families, in the order they are written.
 const FAMILIES: [&str; 4] = ["beams", "ribbon", "lattice", "wake"];

@@ -5,9 +5,9 @@ use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use harness::run::Row;
-use harness::stability::StabilityOutput;
-use harness::statics::StaticOutput;
+use aeroelastic::run::Row;
+use aeroelastic::stability::StabilityOutput;
+use aeroelastic::statics::StaticOutput;
 
 /// One column of the time-history CSV: its name and how to read it from a row.
 type Getter = fn(&Row) -> f64;
@@ -37,12 +37,12 @@ const COLUMNS: [(&str, Getter); 18] = [
     ("hinge_moment", |r| r.hinge_moment),
 ];
 
-/// The CSV column names of these rows (`harness::csv::header`: aerodynamic columns when the run
+/// The CSV column names of these rows (`casefile::csv::header`: aerodynamic columns when the run
 /// has them, `spring` and `dissipated` when the model has force elements).
 fn header(rows: &[Row]) -> Vec<String> {
     let aero = rows.iter().any(|r| r.aero_work.is_finite());
     let springs = rows.iter().any(|r| r.spring.is_finite());
-    harness::csv::header(aero, springs).split(',').map(str::to_string).collect()
+    casefile::csv::header(aero, springs).split(',').map(str::to_string).collect()
 }
 
 /// The rows as a dict of NumPy arrays keyed by the CSV's column names (`newton_iterations` as
@@ -131,11 +131,11 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
 }
 
 /// A static sweep as a dict of arrays keyed by the columns of `static_<f>.csv`
-/// (`harness::static_out::HEADER`; `newton_iterations` int64, `converged` bool).
+/// (`casefile::csv::STATIC_HEADER`; `newton_iterations` int64, `converged` bool).
 pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let p = &out.points;
-    let f = |g: fn(&harness::statics::StaticPoint) -> f64| PyArray1::from_vec(py, p.iter().map(g).collect());
+    let f = |g: fn(&aeroelastic::statics::StaticPoint) -> f64| PyArray1::from_vec(py, p.iter().map(g).collect());
     d.set_item("airspeed", f(|p| p.airspeed))?;
     d.set_item("fold_deg", f(|p| p.fold_deg))?;
     d.set_item("tip_x", f(|p| p.tip[0]))?;
@@ -156,7 +156,7 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
     let ok: Vec<bool> = p.iter().map(|p| p.error.is_none()).collect();
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
     d.set_item("drag", f(|p| p.drag))?;
-    debug_assert_eq!(d.len(), harness::static_out::HEADER.split(',').count());
+    debug_assert_eq!(d.len(), casefile::csv::STATIC_HEADER.split(',').count());
     Ok(d)
 }
 
@@ -166,9 +166,9 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
 /// speeds (None when not found in the sweep).
 pub fn stability_columns<'py>(py: Python<'py>, out: &StabilityOutput) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let rows: Vec<(f64, &harness::stability::Root)> =
+    let rows: Vec<(f64, &aeroelastic::stability::Root)> =
         out.points.iter().flat_map(|p| p.roots.iter().map(move |r| (p.airspeed, r))).collect();
-    let f = |g: fn(&(f64, &harness::stability::Root)) -> f64| PyArray1::from_vec(py, rows.iter().map(g).collect());
+    let f = |g: fn(&(f64, &aeroelastic::stability::Root)) -> f64| PyArray1::from_vec(py, rows.iter().map(g).collect());
     d.set_item("airspeed", f(|x| x.0))?;
     let modes: Vec<i64> = rows.iter().map(|x| x.1.mode as i64).collect();
     d.set_item("mode", PyArray1::from_vec(py, modes))?;

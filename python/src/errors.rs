@@ -58,7 +58,7 @@ pub fn field_of(msg: &str) -> Option<String> {
 
 /// A harness error as a Python exception: case and override errors as [`CaseError`] with
 /// `.field` and `.file`, unreadable files as `OSError`.
-pub fn to_py(py: Python<'_>, e: harness::Error) -> PyErr {
+pub fn to_py(py: Python<'_>, e: casefile::Error) -> PyErr {
     let set = |err: PyErr, field: Option<String>, file: Option<String>| -> PyErr {
         let v = err.value(py);
         let r = v.setattr("field", field).and_then(|_| v.setattr("file", file));
@@ -68,15 +68,15 @@ pub fn to_py(py: Python<'_>, e: harness::Error) -> PyErr {
         }
     };
     match e {
-        harness::Error::Case { file, msg } => {
+        casefile::Error::Case { file, msg } => {
             let field = field_of(&msg);
             set(CaseError::new_err(format!("{file}: {msg}")), field, Some(file))
         }
-        harness::Error::Override(msg) => {
+        casefile::Error::Override(msg) => {
             let field = field_of(&msg);
             set(CaseError::new_err(format!("--set: {msg}")), field, None)
         }
-        harness::Error::Io(msg) => PyOSError::new_err(msg),
+        casefile::Error::Io(msg) => PyOSError::new_err(msg),
         other => FlexmbError::new_err(other.to_string()),
     }
 }

@@ -1,17 +1,19 @@
 //! `flexmb._core`: the Rust side of the `flexmb` Python package.
 //!
-//! Every function here goes through the harness library exactly as the `harness` command line
-//! does: [`CaseFile::read`]/[`CaseFile::from_bytes`], [`CaseFile::expand`] with the `--set`
-//! overrides, then [`harness::scene::run_formulation`] per formulation (in parallel, as
-//! `harness run` runs them), [`harness::statics::run_static`] or
-//! [`harness::stability::run_stability`]. The arrays handed to Python are
+//! Every function here goes through the libraries exactly as the `harness` command line does
+//! (the case files of [`casefile`], the analyses of [`aeroelastic`]; not the command line's crate,
+//! so neither clap nor plotters is linked): [`CaseFile::read`]/[`CaseFile::from_bytes`],
+//! [`CaseFile::expand`] with the `--set` overrides, then [`casefile::scene::run_formulation`] per
+//! formulation (in parallel, as
+//! `harness run` runs them), [`aeroelastic::statics::run_static`] or
+//! [`aeroelastic::stability::run_stability`]. The arrays handed to Python are
 //! the `f64`s of the rows the command line formats into its CSV files, column by column, so a
 //! value printed by the CLI is the Python value rounded by that format (`flexmb.to_csv` re-renders
 //! them with the CLI's own writer).
 //!
 //! A run releases the GIL. It runs on rayon's pool while the calling thread waits with the GIL
 //! released and, every 20 ms, takes it back to let Python handle pending signals: a Ctrl-C
-//! (`KeyboardInterrupt`) sets the harness's stop flag ([`harness::signal::request_stop`]), which
+//! (`KeyboardInterrupt`) sets the library's stop flag ([`aeroelastic::interrupt::request_stop`]), which
 //! both time loops read before each step, waits for the run to stop, clears the flag and raises.
 #![warn(missing_docs)]
 
@@ -26,34 +28,31 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
-use harness::case::{CaseFile, Formulation, Override, RunSpec};
-use harness::run::RunOutput;
+use aeroelastic::run::RunOutput;
+use casefile::{CaseFile, Formulation, Override, RunSpec};
 
 use crate::errors::{CaseError, FlexmbError, RunError, to_py};
 
 /// How often a waiting call takes the GIL back to let Python run its signal handlers.
 const POLL: Duration = Duration::from_millis(20);
 
-/// Parse the formulation names (`"ancf"`, `"gebf"`).
+/// Parse the formulation names (`"ancf"`, `"gebf"`: [`Formulation::from_name`]).
 fn formulations(names: &[String]) -> PyResult<Vec<Formulation>> {
-    names
-        .iter()
-        .map(|n| match n.as_str() {
-            "ancf" => Ok(Formulation::Ancf),
-            "gebf" => Ok(Formulation::Gebf),
-            other => {
-                let e =
-                    CaseError::new_err(format!("formulation: `{other}` is not one of \"ancf\", \"gebf\", \"both\""));
-                Python::with_gil(|py| -> PyResult<()> { e.value(py).setattr("field", "formulation") })?;
-                Err(e)
-            }
-        })
-        .collect()
+    names.iter().map(|n| Formulation::from_name(n).ok_or_else(|| unknown_formulation(n))).collect()
+}
+
+/// The [`CaseError`] of a formulation name that is none, its `field` set to `formulation`.
+fn unknown_formulation(name: &str) -> PyErr {
+    let e = CaseError::new_err(format!("formulation: `{name}` is not one of \"ancf\", \"gebf\", \"both\""));
+    match Python::with_gil(|py| e.value(py).setattr("field", "formulation")) {
+        Ok(()) => e,
+        Err(set_failed) => set_failed,
+    }
 }
 
 /// Read a case (a path, or JSON text whose references resolve against `base_dir`), apply the
 /// overrides and expand its sweep.
-fn load(case: &str, from_path: bool, base_dir: &str, overrides: &[String]) -> Result<Vec<RunSpec>, harness::Error> {
+fn load(case: &str, from_path: bool, base_dir: &str, overrides: &[String]) -> Result<Vec<RunSpec>, casefile::Error> {
     let ovs = overrides.iter().map(|s| s.parse::<Override>()).collect::<Result<Vec<_>, _>>()?;
     let file = if from_path {
         CaseFile::read(Path::new(case))
@@ -65,7 +64,7 @@ fn load(case: &str, from_path: bool, base_dir: &str, overrides: &[String]) -> Re
 
 /// Run `work` on rayon's pool with the GIL released, waiting on a channel in slices of [`POLL`];
 /// between slices the caller takes the GIL to let Python run its signal handlers. A Ctrl-C
-/// (`KeyboardInterrupt`) sets the harness's stop flag, which the time loops read before each step,
+/// (`KeyboardInterrupt`) sets the library's stop flag, which the time loops read before each step,
 /// waits for the work to return, clears the flag and raises.
 fn interruptible<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
     let (tx, mut rx) = mpsc::sync_channel(1);
@@ -80,7 +79,7 @@ fn interruptible<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + S
             Ok(r) => {
                 return match interrupt {
                     Some(e) => {
-                        harness::signal::clear_stop();
+                        aeroelastic::interrupt::clear_stop();
                         Err(e)
                     }
                     None => Ok(r),
@@ -90,12 +89,12 @@ fn interruptible<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + S
                 if interrupt.is_none()
                     && let Err(e) = py.check_signals()
                 {
-                    harness::signal::request_stop();
+                    aeroelastic::interrupt::request_stop();
                     interrupt = Some(e);
                 }
             }
             Err(mpsc::RecvTimeoutError::Disconnected) => {
-                harness::signal::clear_stop();
+                aeroelastic::interrupt::clear_stop();
                 return Err(FlexmbError::new_err("the run panicked (a bug: please report the case)"));
             }
         }
@@ -106,7 +105,7 @@ fn interruptible<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + S
 fn run_specs(specs: &[RunSpec], fs: &[Formulation]) -> Vec<Vec<RunOutput>> {
     let jobs: Vec<(usize, Formulation)> = (0..specs.len()).flat_map(|i| fs.iter().map(move |&f| (i, f))).collect();
     let outs: Vec<(usize, RunOutput)> =
-        jobs.par_iter().map(|&(i, f)| (i, harness::scene::run_formulation(specs[i].case(f), f))).collect();
+        jobs.par_iter().map(|&(i, f)| (i, casefile::scene::run_formulation(specs[i].case(f), f))).collect();
     let mut per: Vec<Vec<RunOutput>> = vec![Vec::new(); specs.len()];
     for (i, o) in outs {
         per[i].push(o);
@@ -171,7 +170,9 @@ fn static_sweep<'py>(
             specs
                 .iter()
                 .map(|spec| {
-                    fs.par_iter().map(|&f| harness::statics::run_static(&spec.case(f).problem(), f)).collect::<Vec<_>>()
+                    fs.par_iter()
+                        .map(|&f| aeroelastic::statics::run_static(&spec.case(f).problem(), f))
+                        .collect::<Vec<_>>()
                 })
                 .collect::<Vec<_>>()
         })?
@@ -218,7 +219,7 @@ fn stability<'py>(
                 .iter()
                 .map(|spec| {
                     fs.par_iter()
-                        .map(|&f| harness::stability::run_stability(&spec.case(f).problem(), f))
+                        .map(|&f| aeroelastic::stability::run_stability(&spec.case(f).problem(), f))
                         .collect::<Vec<_>>()
                 })
                 .collect::<Vec<_>>()
@@ -236,20 +237,20 @@ fn stability<'py>(
     Ok(list)
 }
 
-/// The CSV text the CLI writes for a run with these columns (`harness::csv::to_csv`).
+/// The CSV text the CLI writes for a run with these columns (`casefile::csv::to_csv`).
 #[pyfunction]
 fn to_csv(columns: &Bound<'_, PyDict>) -> PyResult<String> {
     let rows = columns::rows_of(columns)?;
-    Ok(harness::csv::to_csv(&rows))
+    Ok(casefile::csv::to_csv(&rows))
 }
 
-/// The ANCF–GEBF tip distance as the CLI computes it (`harness::metrics::tip_difference`, no time
+/// The ANCF–GEBF tip distance as the CLI computes it (`casefile::curve::tip_difference`, no time
 /// shift): `(t, d)` with the maximum being the CLI's "max tip difference".
 #[pyfunction]
 fn tip_difference(a: &Bound<'_, PyDict>, b: &Bound<'_, PyDict>) -> PyResult<(Vec<f64>, Vec<f64>)> {
     let (ra, rb) = (columns::rows_of(a)?, columns::rows_of(b)?);
-    let (ca, cb) = (harness::metrics::tip_curve(&ra), harness::metrics::tip_curve(&rb));
-    Ok(harness::metrics::tip_difference(&ca, &cb, 0.0).into_iter().unzip())
+    let (ca, cb) = (casefile::curve::tip_curve(&ra), casefile::curve::tip_curve(&rb));
+    Ok(casefile::curve::tip_difference(&ca, &cb, 0.0).into_iter().unzip())
 }
 
 /// The benchmark's reference: the same load and runs as [`run`], timed inside Rust with no Python

@@ -1,18 +1,39 @@
-//! Case files: the scene (bodies, joints, gravity), solver settings per formulation, external
-//! references and gate tolerances. JSON deserialises straight into these types; unknown fields
-//! are errors, and [`Case::validate`] names the offending field of every impossible value.
+//! # casefile — flexmb's case files
+//!
+//! The case-file schema (the scene: bodies, joints, gravity; solver settings per formulation;
+//! external references and gate tolerances; the analyses' blocks), read from JSON ([`CaseFile`]),
+//! expanded over its sweep and `--set` overrides into [`RunSpec`]s, validated ([`Case::validate`]
+//! names the offending field of every impossible value; unknown fields are errors), checked
+//! against the cost limits ([`budget`]) and converted in one place to the library's
+//! [`aeroelastic::Problem`] ([`Case::problem`]). [`scene`] runs a case's formulation through
+//! [`aeroelastic::factory`]; [`csv`] and [`curve`] are the file formats the `harness` command
+//! line and the Python package share (the time-history columns, the static sweep's header, the
+//! reference curves a case names).
+//!
+//! This crate is what a front end needs between a case file and the analyses, without the
+//! command line, plots or progress bars. The JSON-schema derives sit behind the `schema` feature
+//! (`json_schema`).
+#![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};
 
+#[cfg(feature = "schema")]
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use crate::Error;
-
+pub mod budget;
+pub mod csv;
+pub mod curve;
+mod error;
+mod json;
 mod polars;
+pub mod scene;
 mod to_lib;
 mod validate;
+
+pub use error::Error;
+pub use json::parse_unique_keys;
 
 pub use aeroelastic::problem::{
     AncfPath, AncfSettings, Block, BlockMut, Body, Elements, FormSetting, Formulation, GebfSettings, Joint,
@@ -24,7 +45,8 @@ fn one() -> f64 {
 }
 
 /// One simulation scene, run with both formulations.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     /// Unique name; outputs go to `reports/<name>/`.
@@ -68,7 +90,7 @@ pub struct Case {
     pub gate: Option<Gate>,
     /// Aerodynamics (UVLM) — omit for a purely structural case.
     #[serde(default)]
-    pub aero: Option<crate::aero::AeroSettings>,
+    pub aero: Option<aeroelastic::aero::AeroSettings>,
     /// `harness all` also runs the refinement ladders of this case (`harness converge`).
     #[serde(default)]
     pub converge: bool,
@@ -79,7 +101,7 @@ pub struct Case {
     /// ParaView files for every run of this case (`harness run` and `harness all`), as `--vtk`
     /// writes them (docs/outputs.md §7); omit for none.
     #[serde(default)]
-    pub vtk: Option<crate::vtk::VtkOutput>,
+    pub vtk: Option<VtkOutput>,
     /// Parameter sweep: each entry maps a `--set`-style path (e.g. `stiffness_scale`,
     /// `joints.1.flare_deg`, `ancf.dt`) to a list of values; the Cartesian product expands into
     /// named runs `<name>__<key>=<value>…`.
@@ -92,15 +114,15 @@ pub struct Case {
     /// Linearised stability (`harness stability`): airspeeds, modes to track, the state to
     /// linearise about. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stability: Option<crate::stability::StabilitySettings>,
+    pub stability: Option<aeroelastic::stability::StabilitySettings>,
     /// Gust sweep (`harness gust`): the gradients (or gust frequencies) of the case's 1-cos
     /// `aero.gust` and the hinge states to fly through them (docs/gust.md). Needs `aero.gust`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gust: Option<crate::gust::GustSweep>,
+    pub gust: Option<aeroelastic::gust::GustSweep>,
     /// The polars of `aero.polars`, read by [`Case::load_polars`] when the case is expanded (not
     /// a case-file field).
     #[serde(skip)]
-    #[schemars(skip)]
+    #[cfg_attr(feature = "schema", schemars(skip))]
     pub polars: Vec<aeroelastic::section_polars::BodyPolar>,
 }
 
@@ -108,8 +130,21 @@ fn is_zero(v: &f64) -> bool {
     *v == 0.0
 }
 
+/// The case file's `vtk` block: write ParaView files for every run of the case, as `--vtk`
+/// does (`harness run` and `harness all`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct VtkOutput {
+    /// Write every N-th output step (≥ 1; default: about 100 frames per run,
+    /// max(1, output rows / 100)). `--vtk-stride` overrides it.
+    #[serde(default)]
+    pub stride: Option<usize>,
+}
+
 /// The static aeroelastic sweep of a case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct StaticSettings {
     /// Airspeeds of the sweep, m/s (positive; the free stream keeps the direction of
@@ -138,11 +173,12 @@ pub struct StaticSettings {
     /// `closure` the semi-infinite legs. Default (absent): semi-infinite legs along the free
     /// stream. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wake: Option<crate::stability::WakeSettings>,
+    pub wake: Option<aeroelastic::stability::WakeSettings>,
 }
 
 /// A curve of equilibrium fold (coast) angle against airspeed.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct StaticReference {
     /// Legend label.
@@ -156,7 +192,8 @@ pub struct StaticReference {
 }
 
 /// One sweep dimension.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SweepAxis {
     /// Dotted path into the case (as for `--set`).
@@ -166,7 +203,8 @@ pub struct SweepAxis {
 }
 
 /// An external reference curve (CSV with a header; `#` lines are comments).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Reference {
     /// Legend label.
@@ -187,7 +225,8 @@ pub struct Reference {
 }
 
 /// Gate tolerances of a case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct Gate {
     /// Why these numbers (refinement study); shown in the reports.
@@ -202,7 +241,8 @@ pub struct Gate {
 }
 
 /// Tip-difference limits over a time window.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct GateWindow {
     /// Window start, s.
@@ -533,7 +573,7 @@ pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
     if READ.lock().is_ok_and(|v| v.contains(&key)) {
         return Ok(());
     }
-    crate::csv::read_curve(&full).map_err(|e| e.to_string())?;
+    crate::curve::read_curve(&full).map_err(|e| e.to_string())?;
     if let Ok(mut v) = READ.lock()
         && v.len() < 1024
     {
@@ -545,7 +585,7 @@ pub fn check_reference(dir: &Path, file: &str) -> Result<(), String> {
 /// Check a static reference as [`check_reference`] does, holding an airspeed–angle curve.
 pub fn check_static_reference(dir: &Path, file: &str) -> Result<(), String> {
     let full = checked_file(dir, file)?;
-    crate::static_out::read_xy(&full).map(|_| ()).map_err(|e| e.to_string())
+    crate::curve::read_xy(&full).map(|_| ()).map_err(|e| e.to_string())
 }
 
 /// `dir/file`, canonical, when it is a regular file of at most [`MAX_REFERENCE_BYTES`] under `dir`.
@@ -566,83 +606,6 @@ fn checked_file(dir: &Path, file: &str) -> Result<PathBuf, String> {
         return Err(format!("{shown}: {} bytes, more than the limit of {MAX_REFERENCE_BYTES}", meta.len()));
     }
     Ok(full)
-}
-
-/// Parse JSON text into a [`Value`], refusing a key repeated within one object anywhere in the
-/// document (`bodies[0]: duplicate key "length"`).
-pub fn parse_unique_keys(text: &str) -> Result<Value, serde_json::Error> {
-    use serde::de::DeserializeSeed;
-    let mut de = serde_json::Deserializer::from_str(text);
-    let v = UniqueKeys(String::new()).deserialize(&mut de)?;
-    de.end()?;
-    Ok(v)
-}
-
-/// Builds a [`Value`] like serde_json's own deserializer but errors on a repeated object key.
-/// Hand-written because serde_json silently keeps the last of repeated keys and has no option to
-/// refuse them (and `Value`'s own `Deserialize` builds its map the same way). The field is the
-/// path of the value being read, in the messages' `bodies[0].section` style.
-struct UniqueKeys(String);
-
-impl<'de> serde::de::DeserializeSeed<'de> for UniqueKeys {
-    type Value = Value;
-    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Value, D::Error> {
-        d.deserialize_any(self)
-    }
-}
-
-impl<'de> serde::de::Visitor<'de> for UniqueKeys {
-    type Value = Value;
-    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("a JSON value")
-    }
-    fn visit_bool<E>(self, v: bool) -> Result<Value, E> {
-        Ok(Value::Bool(v))
-    }
-    fn visit_i64<E>(self, v: i64) -> Result<Value, E> {
-        Ok(v.into())
-    }
-    fn visit_u64<E>(self, v: u64) -> Result<Value, E> {
-        Ok(v.into())
-    }
-    fn visit_f64<E>(self, v: f64) -> Result<Value, E> {
-        Ok(v.into())
-    }
-    fn visit_str<E>(self, v: &str) -> Result<Value, E> {
-        Ok(Value::String(v.to_owned()))
-    }
-    fn visit_string<E>(self, v: String) -> Result<Value, E> {
-        Ok(Value::String(v))
-    }
-    fn visit_unit<E>(self) -> Result<Value, E> {
-        Ok(Value::Null)
-    }
-    fn visit_none<E>(self) -> Result<Value, E> {
-        Ok(Value::Null)
-    }
-    fn visit_some<D: serde::Deserializer<'de>>(self, d: D) -> Result<Value, D::Error> {
-        serde::de::DeserializeSeed::deserialize(self, d)
-    }
-    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Value, A::Error> {
-        let mut v = Vec::new();
-        while let Some(x) = seq.next_element_seed(UniqueKeys(format!("{}[{}]", self.0, v.len())))? {
-            v.push(x);
-        }
-        Ok(Value::Array(v))
-    }
-    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Value, A::Error> {
-        let mut m = serde_json::Map::new();
-        while let Some(k) = map.next_key::<String>()? {
-            if m.contains_key(&k) {
-                let at = if self.0.is_empty() { String::new() } else { format!("{}: ", self.0) };
-                return Err(serde::de::Error::custom(format!("{at}duplicate key \"{k}\"")));
-            }
-            let path = if self.0.is_empty() { k.clone() } else { format!("{}.{k}", self.0) };
-            let v = map.next_value_seed(UniqueKeys(path))?;
-            m.insert(k, v);
-        }
-        Ok(Value::Object(m))
-    }
 }
 
 /// Deserialize with the path of the offending field in the message.
@@ -670,18 +633,12 @@ pub struct RunSpec {
 impl RunSpec {
     /// The case seen by formulation `f`.
     pub fn case(&self, f: Formulation) -> &Case {
-        match f {
-            Formulation::Ancf => &self.ancf,
-            Formulation::Gebf => &self.gebf,
-        }
+        f.pick(&self.ancf, &self.gebf)
     }
 
     /// The case seen by formulation `f`, to change in place.
     pub fn case_mut(&mut self, f: Formulation) -> &mut Case {
-        match f {
-            Formulation::Ancf => &mut self.ancf,
-            Formulation::Gebf => &mut self.gebf,
-        }
+        f.pick(&mut self.ancf, &mut self.gebf)
     }
 }
 
@@ -734,12 +691,13 @@ impl Case {
     }
 
     /// The scene of formulation `f` ([`aeroelastic::Problem::scene`]).
-    pub fn scene(&self, f: Formulation) -> scene::Scene {
+    pub fn scene(&self, f: Formulation) -> ::scene::Scene {
         self.problem().scene(f)
     }
 }
 
 /// The JSON Schema of a case file, generated from these types.
+#[cfg(feature = "schema")]
 pub fn json_schema() -> Value {
     serde_json::to_value(schemars::schema_for!(Case)).unwrap_or(Value::Null)
 }

@@ -2,9 +2,10 @@
 //! naming the field. The checks run in a fixed order (the first failing one is reported), one
 //! group of fields per function.
 
+use aeroelastic::aero::AeroSettings;
+
 use super::{Block, Case, FormSetting, Formulation, Joint, MAX_STATIC_POINTS, StaticSettings, clip};
 use super::{finite3, norm3, whole_steps};
-use crate::aero::AeroSettings;
 use crate::budget::{
     MAX_BODIES, MAX_CHORDWISE, MAX_ELEMENTS_PER_BODY, MAX_LIST, MAX_NEWTON_ITER, MAX_PANELS_PER_BODY,
     MAX_STEP_HALVINGS, MAX_SUB_ITERATIONS, MAX_WAKE_ROWS,
@@ -46,7 +47,7 @@ impl Case {
         }
         // Everything else about the structure, as the formulations will check it (in degrees
         // where the case speaks degrees). The scenes differ only in their element counts.
-        let first = fs.first().copied().unwrap_or(Formulation::Ancf);
+        let first = fs.first().copied().unwrap_or(Formulation::ALL[0]);
         self.scene(first).validate().map_err(|e| e.to_string())?;
         self.check_times(fs)?;
         self.check_references()?;
@@ -300,7 +301,7 @@ impl Case {
             return Err(format!("aero.coupling.relaxation: {} is not in (0, 1]", a.coupling.relaxation));
         }
         positive("aero.coupling.tolerance", a.coupling.tolerance)?;
-        crate::aero::station_map(&self.problem(), a)?;
+        aeroelastic::aero::station_map(&self.problem(), a)?;
         // The lattice's own limit on a hinge column's slant, found here rather than at run time.
         for (i, j) in self.joints.iter().enumerate() {
             if let Joint::FlaredHinge { flare_deg, .. } = j

@@ -3,9 +3,10 @@
 
 pub use aeroelastic::factory::{BuildModel, ForModel, dispatch, predictor};
 
+use aeroelastic::run::{Observer, RunOutput, RunSettings};
+
 use crate::Error;
-use crate::case::{Case, Formulation};
-use crate::run::{Observer, RunOutput, RunSettings};
+use crate::{Case, Formulation};
 
 /// The integrator parameters, end time and output interval of formulation `f` of a case.
 pub fn settings(case: &Case, f: Formulation) -> RunSettings {

@@ -17,8 +17,9 @@
 
 use std::sync::OnceLock;
 
-use crate::case::{Block, Case, Formulation};
-use crate::run::Row;
+use aeroelastic::run::Row;
+
+use crate::{Block, Case, Formulation};
 
 /// Largest `newton.max_iter`.
 pub const MAX_NEWTON_ITER: usize = 200;
@@ -352,8 +353,8 @@ pub fn estimate_analysis(case: &Case, f: Formulation, a: Analysis) -> Estimate {
             // The modal basis: once about the undeformed state, at each equilibrium otherwise.
             let modes = 2e-9 * n * n * n;
             let (per_point, once) = match st.about {
-                crate::stability::About::Equilibrium => (static_point + modes, 0.0),
-                crate::stability::About::Undeformed => (0.0, modes),
+                aeroelastic::stability::About::Equilibrium => (static_point + modes, 0.0),
+                aeroelastic::stability::About::Undeformed => (0.0, modes),
             };
             e.wake_rings = wake;
             e.bytes += lattice + 16.0 * n * n;
@@ -441,7 +442,7 @@ pub fn describe_analysis(case: &Case, a: Analysis, fs: &[Formulation]) -> String
 #[cfg(test)]
 mod tests {
     use super::unknowns;
-    use crate::case::{CaseFile, Formulation};
+    use crate::{CaseFile, Formulation};
     use aeroelastic::factory::{BuildModel, ForModel, dispatch};
 
     /// The built model's unknowns.

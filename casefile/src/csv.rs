@@ -1,0 +1,62 @@
+//! The CSV formats the command line writes and the Python package reproduces: the time-history
+//! columns of a run (docs/outputs.md §2) and the header of a static sweep's `static_<f>.csv`.
+
+use std::fmt::Write as _;
+
+use aeroelastic::run::Row;
+
+/// Column header of a formulation's CSV.
+pub const HEADER: &str =
+    "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,constraint_residual,newton_iterations";
+
+/// Column header with aerodynamics (`aero_work` after `total`, `lift` and the wing loads at the
+/// end).
+pub const HEADER_AERO: &str = "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,\
+newton_iterations,lift,root_bending_moment,root_torque,hinge_moment";
+
+/// The header line (without newline) of a CSV with or without the aerodynamic and the force
+/// element columns.
+pub fn header(aero: bool, springs: bool) -> String {
+    let header = if aero { HEADER_AERO } else { HEADER };
+    if springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() }
+}
+
+/// Append one row (with its newline) in the columns of [`header`]`(aero, springs)`.
+pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool) {
+    let _ = write!(
+        s,
+        "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},",
+        r.t, r.tip[0], r.tip[1], r.tip[2], r.fold, r.kinetic, r.elastic, r.potential,
+    );
+    if springs {
+        let _ = write!(s, "{:.9e},{:.9e},", r.spring, r.dissipated);
+    }
+    let _ = write!(s, "{:.9e},", r.total);
+    if aero {
+        let _ = write!(s, "{:.9e},", r.aero_work);
+    }
+    let _ = write!(s, "{:.3e},{}", r.constraint_residual, r.newton_iterations);
+    if aero {
+        let _ = write!(s, ",{:.6e},{:.6e},{:.6e},{:.6e}", r.lift, r.root_bending_moment, r.root_torque, r.hinge_moment);
+    }
+    s.push('\n');
+}
+
+/// Render rows as CSV text: the aerodynamic columns when the run has them, and `spring` (hinge
+/// spring potential) and `dissipated` (work of the dampers since t = 0) after `potential` when
+/// the model has force elements.
+pub fn to_csv(rows: &[Row]) -> String {
+    let aero = rows.iter().any(|r| r.aero_work.is_finite());
+    let springs = rows.iter().any(|r| r.spring.is_finite());
+    let mut s = String::with_capacity(rows.len() * 220);
+    s.push_str(&header(aero, springs));
+    s.push('\n');
+    for r in rows {
+        push_row(&mut s, r, aero, springs);
+    }
+    s
+}
+
+/// Column header of `static_<f>.csv`.
+pub const STATIC_HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
+root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag";
