@@ -7,6 +7,7 @@ use std::process::{Command, Output};
 
 use harness::case::{CaseFile, Formulation, Override};
 use harness::gust::{HingeState, gust_history, peak};
+use rayon::prelude::*;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -30,11 +31,13 @@ fn max_abs(v: &[f64]) -> f64 {
 /// |Δθ| ≤ 1.9e-9°, |ΔL| ≤ 6.2e-8 N (closed and unclosed alike).
 #[test]
 fn no_gust_stays_at_equilibrium() {
-    for (closure, f, h) in [true, false]
+    let runs: Vec<_> = [true, false]
         .into_iter()
         .flat_map(|c| Formulation::ALL.into_iter().map(move |f| (c, f)))
         .flat_map(|(c, f)| [HingeState::Free, HingeState::Locked].into_iter().map(move |h| (c, f, h)))
-    {
+        .collect();
+    // The eight runs are independent: run them in parallel.
+    runs.into_par_iter().for_each(|(closure, f, h)| {
         let spec = case("wing_gust.json", &["t_end=2", &format!("aero.wake_closure={closure}")]);
         let mut c = h.apply(&spec.case(f).problem()).unwrap();
         c.aero.as_mut().unwrap().gust = None;
@@ -50,7 +53,7 @@ fn no_gust_stays_at_equilibrium() {
         );
         assert!(m < 1e-3, "{f} {} (closure {closure}): the root bending moment drifts by {m} N m", h.label());
         assert!(th < 1e-6, "{f} {} (closure {closure}): the fold drifts by {th} deg", h.label());
-    }
+    });
 }
 
 /// Every gust of a summarised sweep: ANCF and GEBF peak incremental root bending moments within
@@ -171,8 +174,10 @@ fn bad_gust_input_exits_2_naming_the_field() {
 #[test]
 fn small_gust_matches_the_linearised_model() {
     let spec = case("wing_gust.json", &["t_end=4"]);
-    for f in Formulation::ALL {
-        for h in [HingeState::Free, HingeState::Locked] {
+    let runs: Vec<_> =
+        Formulation::ALL.into_iter().flat_map(|f| [HingeState::Free, HingeState::Locked].map(|h| (f, h))).collect();
+    // The four cases are independent: run them in parallel.
+    runs.into_par_iter().for_each(|(f, h)| {
             let mut c = h.apply(&spec.case(f).problem()).unwrap();
             c.aero.as_mut().unwrap().gust = Some(harness::gust::GustSpec::OneMinusCosine {
                 gradient_m: 25.0,
@@ -247,8 +252,7 @@ fn small_gust_matches_the_linearised_model() {
                 100.0 * worst / scale
             );
             assert!(worst < 0.02 * scale, "{f} {}: histories differ by {worst} N m", h.label());
-        }
-    }
+    });
 }
 
 /// Issue 38 (fuzz seed 38, 27 inputs): when every run of a formulation failed, the gust report
