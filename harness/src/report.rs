@@ -190,10 +190,6 @@ fn style_words(s: &Style) -> String {
     format!("{line}{marker}")
 }
 
-fn label(f: Formulation) -> &'static str {
-    f.label()
-}
-
 fn t_end(r: &CaseResult) -> f64 {
     r.runs.iter().filter_map(|x| x.rows.last()).map(|x| x.t).fold(0.0, f64::max)
 }
@@ -345,7 +341,7 @@ fn write_tip(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 .collect();
             series.extend(r.runs.iter().rev().map(|run| {
                 Series::new(
-                    label(run.formulation),
+                    run.formulation.label(),
                     run_style(run.formulation),
                     run.rows.iter().map(|x| (x.t, x.tip[k])).collect(),
                 )
@@ -365,14 +361,14 @@ fn write_tip(dir: &Path, r: &CaseResult) -> Result<(), Error> {
 /// `tip_difference.svg`: the tip distance between the formulations and to each reference.
 fn write_tip_difference(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     // Differences: ANCF–GEBF, and each formulation against each reference (colour: the
-    // reference; dash and marker: the formulation).
+    // reference; dash, marker and width: the formulation, `Style::of_formulation`).
     let mut diff = vec![Series::new("|ANCF − GEBF|", Style::solid(colors::PALETTE[4]).width(2), r.pair_diff.clone())];
     for (i, (lab, c, shift)) in r.reference_curves.iter().enumerate() {
         let color = [colors::REFS[1], colors::REFS[2], colors::EXTRA[1], colors::EXTRA[2]][i % 4];
         for run in r.runs.iter().filter(|x| !x.rows.is_empty()) {
             let style = Style::of_formulation(run.formulation, color);
             diff.push(Series::new(
-                format!("|{} − {}|", label(run.formulation), lab),
+                format!("|{} − {}|", run.formulation.label(), lab),
                 style,
                 tip_difference(&tip_curve(&run.rows), c, *shift),
             ));
@@ -408,7 +404,7 @@ fn write_energy(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     let mut comp = Vec::new();
     let mut drift = Vec::new();
     for run in r.runs.iter().rev() {
-        let l = label(run.formulation);
+        let l = run.formulation.label();
         for &(name, get, color) in &components {
             let style = Style::of_formulation(run.formulation, color);
             comp.push(Series::new(format!("{name} ({l})"), style, run.rows.iter().map(|x| (x.t, get(x))).collect()));
@@ -460,7 +456,7 @@ fn write_per_run(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         r.runs
             .iter()
             .rev()
-            .map(|run| Series::new(label(run.formulation), run_style(run.formulation), get(run)))
+            .map(|run| Series::new(run.formulation.label(), run_style(run.formulation), get(run)))
             .collect()
     };
     panels_svg(
@@ -782,7 +778,7 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
         .filter_map(|f| r.metrics.get(f).map(|m| (f, m)))
         .map(|(f, m)| {
             vec![
-                label(*f).to_string(),
+                f.label().to_string(),
                 if m.error.is_some() { format!("failed at {:.4} s", m.t_reached) } else { "ok".into() },
                 m.n_steps.to_string(),
                 format!("{:.1}", 1e3 * m.wall_s),
@@ -814,8 +810,8 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
     }
     for x in &r.references {
         dist.push(vec![
-            format!("{} − {}", label(x.formulation), x.label),
-            label(x.formulation).into(),
+            format!("{} − {}", x.formulation.label(), x.label),
+            x.formulation.label().into(),
             fixed(Some(1e3 * x.diff.max), 3),
             fixed(Some(1e3 * x.diff.rms), 3),
             "–".into(),
@@ -993,7 +989,7 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
         for f in Formulation::ALL {
             s.push_str(&figure(
                 &format!("stress/stress_{f}.svg"),
-                &format!("Stress matrix, {}: outcome of each cell.", label(f)),
+                &format!("Stress matrix, {}: outcome of each cell.", f.label()),
             ));
         }
         v.push(Section {
