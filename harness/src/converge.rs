@@ -20,6 +20,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::Error;
@@ -188,6 +189,20 @@ fn max_distance(a: &RunOutput, truth: &Curve) -> f64 {
 /// Plan of one study: (formulation, ladder, elements, dt, is_truth).
 type Plan = Vec<(Formulation, Ladder, Elements, f64, bool)>;
 
+/// The rungs' indices by decreasing estimated cost: elements × steps, times the wake rows (∝ 1/dt)
+/// for an aeroelastic case, whose Biot–Savart sums grow with the wake.
+fn costliest_first(plan: &Plan, aero: bool) -> Vec<usize> {
+    let cost = |i: usize| {
+        let (_, _, ref e, dt, _) = plan[i];
+        // Per body: the same factor scales every body's count, so one body's count orders the rungs.
+        let steps = 1.0 / dt;
+        e.for_body(0) as f64 * steps * if aero { steps } else { 1.0 }
+    };
+    let mut order: Vec<usize> = (0..plan.len()).collect();
+    order.sort_by(|&a, &b| cost(b).total_cmp(&cost(a)));
+    order
+}
+
 /// Refinement levels below the case's own settings: 3 for structural cases; 2 for aeroelastic
 /// ones, whose cost per step grows with the wake rows (∝ 1/dt), so a level costs 4× in time.
 fn levels(spec: &RunSpec) -> i32 {
@@ -230,9 +245,16 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
         None => None,
     };
     let bar = if progress { indicatif::ProgressBar::new(plan.len() as u64) } else { indicatif::ProgressBar::hidden() };
-    // One after another on this thread: each rung's CPU time is its own cost.
-    let mut outs: Vec<(usize, RunOutput, f64)> = (0..plan.len())
-        .map(|i| {
+    // Rungs side by side on the rayon threads, costliest first (one task each, so that the long
+    // fine rungs start at once and the short ones fill in). Each rung runs on one thread (its
+    // Biot–Savart sums single-threaded: several runs are registered), so the thread's CPU time
+    // is the rung's own cost.
+    let order = costliest_first(&plan, spec.ancf.aero.is_some());
+    let _runs = aeroelastic::aero_settings::register_runs(plan.len());
+    let mut outs: Vec<(usize, RunOutput, f64)> = order
+        .par_iter()
+        .with_max_len(1)
+        .map(|&i| {
             let (f, _, ref e, dt, _) = plan[i];
             let c0 = crate::bench::thread_cpu_s();
             let out = run_formulation(&rung_spec(spec, f, e.clone(), dt), f);

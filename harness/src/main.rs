@@ -542,11 +542,12 @@ fn run_stress(
 ) -> (Vec<stress::Cell>, Vec<stress::Extra>) {
     let jobs: Vec<stress::Job> =
         stress::jobs(axes).into_iter().filter(|j| runs_here(plan, &stress::job_id(j))).collect();
-    let cells = stress::run_jobs(base, &jobs, true);
-    done.extend(jobs.iter().map(stress::job_id));
     let mine: Vec<_> =
         extras.iter().filter(|(l, _)| runs_here(plan, &harness::merge::extra_unit(l))).cloned().collect();
-    let ex = stress::run_extras(&mine);
+    // The extra runs are long (a 20 s run whose recovery with step control takes minutes): they
+    // start at once beside the matrix, whose short cells fill the other threads meanwhile.
+    let (ex, cells) = rayon::join(|| stress::run_extras(&mine), || stress::run_jobs(base, &jobs, true));
+    done.extend(jobs.iter().map(stress::job_id));
     done.extend(mine.iter().map(|(l, _)| harness::merge::extra_unit(l)));
     (cells, ex)
 }

@@ -1,7 +1,7 @@
 //! Run one paper double-pendulum case and print the tip, fold angle, energy and joint drift
 //! every 0.1 s; optionally write every step to a CSV file.
 //!
-//! `cargo run --release -p gebf --example pendulum -- [c] [beta_deg] [n_el] [dt] [rho_inf] [stabilization 0/1] [out.csv]`
+//! `cargo run --release -p perf --example gebf_pendulum -- [c] [beta_deg] [n_el] [dt] [rho_inf] [stabilization 0/1] [out.csv]`
 use gebf::{Model, Options, samples, simulate};
 use genalpha::IntegratorParams;
 

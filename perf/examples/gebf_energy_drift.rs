@@ -2,7 +2,7 @@
 //! elements: max over 2 s of |E(t) − E(0)| divided by the run's peak kinetic energy
 //! (docs/outputs.md §3), with the largest joint violation of the run.
 //!
-//! `cargo run --release -p gebf --example energy_drift -- [c] [rho_inf] [stabilization 0/1]`
+//! `cargo run --release -p perf --example gebf_energy_drift -- [c] [rho_inf] [stabilization 0/1]`
 use gebf::{Model, Options, samples, simulate};
 use genalpha::IntegratorParams;
 

@@ -2,7 +2,7 @@
 //! settings (5 elements per body, dt = 0.002, 2 s, rho_inf = 0.8): steps, Newton iterations,
 //! factorisations, residual evaluations, step halvings, and the thread CPU time of the run.
 //!
-//! `cargo run --release -p gebf --example paper_work -- [repeats] [dump_dir]`
+//! `cargo run --release -p perf --example gebf_paper_work -- [repeats] [dump_dir]`
 //!
 //! With `dump_dir`, the tip trajectory of each case (t, x, y, z per step, full precision) is
 //! written to `dump_dir/tip_c{c}_beta{beta}.txt`, to compare runs before and after a change.

@@ -1,7 +1,7 @@
 //! CPU time of the calling thread (not wall time) per UVLM step of the paper's wing, useful on
 //! shared machines where criterion's wall time is inflated by other load. With rayon the CPU
 //! figure only counts the main thread: read the wall time there.
-//! Run: `cargo run --release -p uvlm --example cputime`.
+//! Run: `cargo run --release -p perf --example uvlm_cputime`.
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 fn cpu_ns() -> u64 {

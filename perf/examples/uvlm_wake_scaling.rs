@@ -1,9 +1,9 @@
 //! CPU time of the calling thread per UVLM step of the paper's wing against the wake's length
 //! (40 to 320 rows), direct and through the treecode at 1e-6 |V∞| (orders 4, 6, 8), and the
 //! direct kernel's throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
-//! shared machine, where the wall time of `cargo bench -p uvlm --bench wake_scaling` / `--bench
-//! kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full.
-//! Run: `cargo run --release -p uvlm --example wake_scaling`.
+//! shared machine, where the wall time of `cargo bench -p perf --bench uvlm_wake_scaling` / `--bench
+//! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full.
+//! Run: `cargo run --release -p perf --example uvlm_wake_scaling`.
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 

@@ -3,7 +3,7 @@
 //! bordered band factorisation and solve (checked against the dense LU). Each figure is the
 //! minimum over 9 trials of the mean per call, which is robust to other load on the machine.
 //!
-//! `cargo run --release -p gebf --example call_times [-- matrix|residual]`: with an argument,
+//! `cargo run --release -p perf --example gebf_call_times [-- matrix|residual]`: with an argument,
 //! only that kernel runs, 100 000 times (for `perf record`).
 use gebf::{Model, Options, samples, simulate};
 use genalpha::{ConstrainedSystem, DenseLu, DenseMatrix, IntegratorParams, LinearSolver};

@@ -1,7 +1,7 @@
 //! Every Newton iteration of one run: the tool behind the convergence diagnoses in the README
 //! (where a formulation spends its iterations and factorisations, and on which unknown).
 //!
-//! `cargo run --release -p harness --example newton_trace -- <case.json> <ancf|gebf> [path=value ...]`
+//! `cargo run --release -p perf --example newton_trace -- <case.json> <ancf|gebf> [path=value ...]`
 //!
 //! Writes CSV to stdout, one row per Newton solve (failed attempts that were retried in halves
 //! included): `t, h, iter, factorized, residual_norm, phi_norm, psi_norm, increment_norm,
