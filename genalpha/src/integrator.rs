@@ -129,6 +129,15 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     /// (end time, size bits) of the last converged step.
     last_step: Option<(f64, u64)>,
     stats: Stats,
+    /// With local error control: the halvings a step starts at. A run whose error needs short
+    /// steps would otherwise retry every step from its full length and discard the attempts of
+    /// every level above the one it needs; this remembers that level (deeper at once when a
+    /// step needed it, one level shallower after [`GROW_AFTER`] steps that did not).
+    start_depth: usize,
+    /// Steps in a row completed at `start_depth` without a further halving.
+    calm_steps: usize,
+    /// The shallowest depth a sub-step of the current step was accepted at.
+    shallowest: usize,
 }
 
 impl GenAlpha<DenseLu> {
@@ -144,6 +153,11 @@ const MAX_BROYDEN_GAIN: f64 = 10.0;
 
 /// Steps during which the factorisation is refreshed at the predictor after a reused one failed.
 const REFRESH_STEPS: usize = 10;
+
+/// With local error control, steps in a row completed at their starting depth before the next
+/// starts one halving shallower (probing for a longer step costs one rejected attempt per sub-step
+/// every this many steps).
+const GROW_AFTER: usize = 4;
 
 /// After four iterations with a reused matrix, keep it while its contraction predicts at most
 /// this many more iterations to the tolerance (an assembly and factorisation cost about five
@@ -314,6 +328,9 @@ impl<L: LinearSolver> GenAlpha<L> {
             v_dot_n: vec![0.0; n],
             v_dot_previous: vec![0.0; n],
             last_step: None,
+            start_depth: 0,
+            calm_steps: 0,
+            shallowest: 0,
             stats: Stats::default(),
         })
     }
@@ -572,15 +589,64 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// Advance `s` by one step `dt`. If Newton fails, the step is retried as two half steps
     /// (recursively, up to `newton.max_step_halvings` deep). On error `s` is left at the last
     /// iterate (for plotting what was computed); the caller decides whether to stop.
+    ///
+    /// With local error control (`newton.local_error_tol` > 0) a step starts at the halving
+    /// depth the previous steps needed (see `start_depth`); without it every step starts whole.
     pub fn step<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
         let h = self.params.dt;
-        let out = self.advance(sys, s, h, 0);
+        let controlled = self.params.newton.local_error_tol > 0.0;
+        let d0 = if controlled { self.start_depth.min(self.params.newton.max_step_halvings) } else { 0 };
+        self.shallowest = usize::MAX;
+        let out = self.advance_split(sys, s, h, d0);
         if self.c.h != h {
             self.set_step_size(h);
         }
         let st = out?;
+        if controlled {
+            self.remember_depth(d0);
+        }
         self.stats.record(&st);
         Ok(st)
+    }
+
+    /// After a step started at depth `d0`: go deeper at once when every sub-step needed it,
+    /// one level shallower after [`GROW_AFTER`] steps in a row that did not.
+    fn remember_depth(&mut self, d0: usize) {
+        if self.shallowest > d0 && self.shallowest != usize::MAX {
+            self.start_depth = self.shallowest;
+            self.calm_steps = 0;
+        } else {
+            self.start_depth = d0;
+            self.calm_steps += 1;
+            if self.calm_steps >= GROW_AFTER && self.start_depth > 0 {
+                self.start_depth -= 1;
+                self.calm_steps = 0;
+            }
+        }
+    }
+
+    /// The step `h` as `2^depth` sub-steps of `h / 2^depth`, each halved further as
+    /// [`advance`](Self::advance) does; the statistics summed over the sub-steps.
+    fn advance_split<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        s: &mut State,
+        h: f64,
+        depth: usize,
+    ) -> Result<StepStats, Error> {
+        let n = 1usize << depth;
+        let hs = h / n as f64;
+        let mut total = self.advance(sys, s, hs, depth)?;
+        for _ in 1..n {
+            let st = self.advance(sys, s, hs, depth)?;
+            total = StepStats {
+                n_newton_iters: total.n_newton_iters + st.n_newton_iters,
+                n_factorizations: total.n_factorizations + st.n_factorizations,
+                n_substeps: total.n_substeps + st.n_substeps,
+                ..st
+            };
+        }
+        Ok(total)
     }
 
     fn set_step_size(&mut self, h: f64) {
@@ -604,7 +670,10 @@ impl<L: LinearSolver> GenAlpha<L> {
             copy_state(s, &mut self.backup);
         }
         match self.attempt(sys, s) {
-            Ok(st) if !(retry && self.local_error_too_large(s)) => return Ok(st),
+            Ok(st) if !(retry && self.local_error_too_large(s)) => {
+                self.shallowest = self.shallowest.min(depth);
+                return Ok(st);
+            }
             Ok(_) => {} // converged, but the step was too long for its local error: halve it
             Err(e) if !retry || matches!(e, Error::InvalidParameter { .. }) => return Err(e),
             Err(_) => {}

@@ -23,7 +23,7 @@ use harness::{bench, converge, energy, gate, stress};
 #[command(
     name = "harness",
     version,
-    about = "Dual-formulation (ANCF / GEBF) verification harness for flared-hinged wings"
+    about = "flexmb: nonlinear aeroelasticity of flared folding wingtips, two beam formulations (ANCF / GEBF) side by side"
 )]
 struct Cli {
     #[command(subcommand)]
