@@ -30,8 +30,9 @@ pub struct Stats {
     pub n_factorizations: usize,
     /// Residual evaluations.
     pub n_residual_evals: usize,
-    /// Steps that were retried as two half steps after a Newton failure (each halving at any
-    /// depth counts once).
+    /// Splits of a step into two halves, at any depth: after a Newton failure or too large a
+    /// local error, and (with local error control) the splits of a step started at the depth
+    /// the previous steps needed. A step done in `k` sub-steps counts `k − 1`.
     pub n_step_halvings: usize,
 }
 
