@@ -20,6 +20,13 @@ pub struct AeroSettings {
     /// Free-stream speed, m/s: replaces the magnitude of `v_inf` (or flows along −Y without it).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub airspeed: Option<f64>,
+    /// Sideslip angle β, degrees, in the flight-mechanics convention: positive when the relative
+    /// wind comes from the right (starboard). The span runs along +X (starboard) and the flow
+    /// along −Y, so the free stream of `v_inf`/`airspeed` is turned about the vertical axis (+Z)
+    /// by −β: a stream along −Y becomes `−V (sin β, cos β, 0)`, blowing from the tip towards the
+    /// root for β > 0 (docs/case-file.md). Default 0, in (−90, 90).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+    pub sideslip_deg: f64,
     /// Chord, m.
     pub chord: f64,
     /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
@@ -134,6 +141,11 @@ impl Drop for RunsGuard {
     }
 }
 
+#[cfg(feature = "serde")]
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
 fn default_cutoff() -> f64 {
     1e-6
 }
@@ -148,8 +160,18 @@ fn default_true() -> bool {
 
 impl AeroSettings {
     /// The free-stream velocity, m/s: `v_inf`, scaled to `airspeed` when both are given, or
-    /// `airspeed` along −Y. Validated cases have one of them.
+    /// `airspeed` along −Y, turned about +Z by −`sideslip_deg`. Validated cases have one of them.
     pub fn free_stream(&self) -> [f64; 3] {
+        let v = self.stream_without_sideslip();
+        if self.sideslip_deg == 0.0 {
+            return v;
+        }
+        // A rotation about +Z by −β: x' = x cos β + y sin β, y' = −x sin β + y cos β.
+        let (s, c) = self.sideslip_deg.to_radians().sin_cos();
+        [v[0] * c + v[1] * s, -v[0] * s + v[1] * c, v[2]]
+    }
+
+    fn stream_without_sideslip(&self) -> [f64; 3] {
         match (self.v_inf, self.airspeed) {
             (Some(v), None) => v,
             (Some(v), Some(u)) => {

@@ -71,13 +71,33 @@ pub struct StaticSettings {
     pub load_factors: Vec<f64>,
     /// The steady wake of the static solution (none: semi-infinite legs along the free stream).
     pub wake: Option<WakeSettings>,
+    /// Sideslip angles of a sideslip sweep, degrees (at the one airspeed of `airspeeds`); empty:
+    /// the sweep is over `airspeeds` at the aerodynamic settings' own sideslip.
+    pub sideslips_deg: Vec<f64>,
 }
 
 impl StaticSettings {
     /// An aeroelastic sweep over `airspeeds` with the steady wake `wake` (semi-infinite legs
     /// when `None`).
     pub fn at(airspeeds: Vec<f64>, wake: Option<WakeSettings>) -> Self {
-        Self { airspeeds, point_loads: Vec::new(), load_factors: Vec::new(), wake }
+        Self { airspeeds, point_loads: Vec::new(), load_factors: Vec::new(), wake, sideslips_deg: Vec::new() }
+    }
+
+    /// The points of the sweep in the case's order, `(airspeed m/s, sideslip degrees)`: each
+    /// airspeed at the sideslip `sideslip_deg` of the aerodynamic settings, or each of
+    /// `sideslips_deg` at the first airspeed.
+    pub fn points(&self, sideslip_deg: f64) -> Vec<(f64, f64)> {
+        if self.sideslips_deg.is_empty() {
+            self.airspeeds.iter().map(|&u| (u, sideslip_deg)).collect()
+        } else {
+            let u = self.airspeeds.first().copied().unwrap_or(f64::NAN);
+            self.sideslips_deg.iter().map(|&b| (u, b)).collect()
+        }
+    }
+
+    /// Whether the sweep is over sideslip (`sideslips_deg`) rather than airspeed.
+    pub fn is_sideslip_sweep(&self) -> bool {
+        !self.sideslips_deg.is_empty()
     }
 }
 

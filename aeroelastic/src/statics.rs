@@ -249,6 +249,25 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         Ok(())
     }
 
+    /// Change the sideslip angle (the airspeed kept): the lattice is rebuilt at `q`; the
+    /// aerodynamic stiffness is kept (a Newton iteration refreshes it when it stops contracting).
+    pub fn set_sideslip(&mut self, sideslip_deg: f64, q: &[f64]) -> Result<(), String> {
+        self.aero.sideslip_deg = sideslip_deg;
+        let speed = self.aero.airspeed.unwrap_or_else(|| self.airspeed());
+        self.set_airspeed(speed, q)
+    }
+
+    /// Drop the kept aerodynamic stiffness: the next assembly evaluates it afresh (a walk that
+    /// goes back to an earlier equilibrium must not start from the stiffness of a far one).
+    pub fn forget_tangent(&mut self) {
+        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).valid = false;
+    }
+
+    /// The sideslip angle, degrees.
+    pub fn sideslip_deg(&self) -> f64 {
+        self.aero.sideslip_deg
+    }
+
     /// Replace the structural model (same coordinates; e.g. with scaled gravity).
     pub fn set_model(&mut self, model: S) {
         *write(&self.model) = model;
@@ -543,6 +562,8 @@ pub struct Strip {
 pub struct StaticPoint {
     /// Airspeed, m/s.
     pub airspeed: f64,
+    /// Sideslip angle, degrees (`aero.sideslip_deg`, or the point's of a sideslip sweep).
+    pub sideslip_deg: f64,
     /// Fold angle of the fold hinge, degrees (tip up positive; NaN without one).
     pub fold_deg: f64,
     /// Tip position, m.
@@ -577,7 +598,7 @@ pub struct StaticPoint {
 pub struct StaticOutput {
     /// Formulation.
     pub formulation: Formulation,
-    /// One point per airspeed, in the case's order.
+    /// One point per airspeed (or per sideslip angle of a sideslip sweep), in the case's order.
     pub points: Vec<StaticPoint>,
     /// Wall time of the sweep, s.
     pub wall_s: f64,
@@ -633,10 +654,11 @@ pub fn run_static(case: &Problem, f: Formulation) -> StaticOutput {
 }
 
 fn failed_output(case: &Problem, f: Formulation, msg: String) -> StaticOutput {
-    let speeds = case.statics.as_ref().map(|s| s.airspeeds.clone()).unwrap_or_default();
+    let beta = case.aero.as_ref().map_or(0.0, |a| a.sideslip_deg);
+    let at = case.statics.as_ref().map(|s| s.points(beta)).unwrap_or_default();
     StaticOutput {
         formulation: f,
-        points: speeds.iter().map(|&u| failed_point(u, msg.clone())).collect(),
+        points: at.iter().map(|&(u, b)| StaticPoint { sideslip_deg: b, ..failed_point(u, msg.clone()) }).collect(),
         wall_s: 0.0,
         n_aero_solves: 0,
         n_tangents: 0,
@@ -648,6 +670,7 @@ fn failed_output(case: &Problem, f: Formulation, msg: String) -> StaticOutput {
 fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
     StaticPoint {
         airspeed,
+        sideslip_deg: 0.0,
         fold_deg: f64::NAN,
         tip: [f64::NAN; 3],
         loads: WingLoads {
@@ -774,11 +797,13 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
     };
     let q_ref = model.initial_state().q;
     let n_dof = model.n_dof();
-    let mut order: Vec<usize> = (0..st.airspeeds.len()).collect();
-    order.sort_by(|&a, &b| st.airspeeds[b].total_cmp(&st.airspeeds[a]));
-    let top = st.airspeeds[order[0]];
+    let at = st.points(aero.sideslip_deg);
+    let (order, restart) = walk_order(st, &at);
+    let axis = if st.is_sideslip_sweep() { Axis::Sideslip } else { Axis::Airspeed };
+    let (top, beta0) = at[order[0]];
     let mut a0 = aero.clone();
     a0.airspeed = Some(top);
+    a0.sideslip_deg = beta0;
     let wake = st.wake.as_ref().map_or(uvlm::SteadyWake::SemiInfinite, |w| w.steady_wake());
     let mut sys = match AeroStatic::new(model, &q_ref, &map, &a0, wake, case.span()) {
         Ok(s) => s,
@@ -791,27 +816,40 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
     let mut solver = StaticSolver::new(&sys, static_params());
     let mut x = StaticSolution::guess(&sys, &q_ref);
     let loads_model = LoadModel::new(case, f);
-    let mut points: Vec<Option<StaticPoint>> = vec![None; st.airspeeds.len()];
-    // 1. The first equilibrium at the highest airspeed, by load stepping.
+    let mut points: Vec<Option<StaticPoint>> = vec![None; at.len()];
+    // 1. The first equilibrium (the highest airspeed, or the sideslip nearest zero), by load
+    // stepping.
     sys.hold_reynolds_at(Some(top));
     let stepped = load_stepping(case, build, top, &mut sys, &mut solver, &mut x);
     sys.hold_reynolds_at(None);
     if let Err(e) = stepped {
         return failed_output(case, f, e);
     }
+    let first = x.clone();
     let mut iters = x.n_iterations;
-    // 2. Down the airspeeds, bisecting a step that fails.
-    let mut current = top;
-    for &i in &order {
-        let target = st.airspeeds[i];
+    // 2. Along the walk, bisecting a step that fails; a sideslip sweep walks its second branch
+    // from the first equilibrium again.
+    let mut current = axis.value(at[order[0]]);
+    for (k, &i) in order.iter().enumerate() {
+        if Some(k) == restart {
+            x = first.clone();
+            iters = x.n_iterations;
+            current = axis.value(at[order[0]]);
+            if let Err(e) = axis.set(&mut sys, current, &x.q) {
+                return failed_output(case, f, e);
+            }
+            sys.forget_tangent();
+        }
+        let target = axis.value(at[i]);
         let good = x.clone();
-        let last_err = bisect_to(target, &mut current, &mut sys, &mut solver, &mut x);
+        let last_err = bisect_to(axis, target, &mut current, &mut sys, &mut solver, &mut x);
         let n_it = x.n_iterations - iters;
         iters = x.n_iterations;
         points[i] = Some(match last_err {
             Some(e) => {
                 x = good;
-                failed_point(target, format!("no equilibrium at {target} m/s: {e}"))
+                let p = failed_point(at[i].0, format!("no equilibrium at {}: {e}", axis.describe(target)));
+                StaticPoint { sideslip_deg: at[i].1, ..p }
             }
             None => {
                 let mut p = point_at(&sys, &x.q, case, loads_model.as_ref(), &map, aero.rho);
@@ -826,8 +864,10 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
         formulation: f,
         points: points
             .into_iter()
-            .zip(&st.airspeeds)
-            .map(|(p, &u)| p.unwrap_or_else(|| failed_point(u, "not reached".into())))
+            .zip(&at)
+            .map(|(p, &(u, b))| {
+                p.unwrap_or_else(|| StaticPoint { sideslip_deg: b, ..failed_point(u, "not reached".into()) })
+            })
             .collect(),
         wall_s: 0.0,
         n_aero_solves,
@@ -835,6 +875,64 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
         n_dof,
         error: None,
     }
+}
+
+/// The parameter a static sweep walks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Axis {
+    /// The airspeed, m/s.
+    Airspeed,
+    /// The sideslip angle, degrees.
+    Sideslip,
+}
+
+impl Axis {
+    /// The walked value of a point `(airspeed, sideslip)`.
+    fn value(self, at: (f64, f64)) -> f64 {
+        match self {
+            Axis::Airspeed => at.0,
+            Axis::Sideslip => at.1,
+        }
+    }
+
+    /// Move the system to `value` (the lattice rebuilt at `q`).
+    fn set<S: Structure>(self, sys: &mut AeroStatic<'_, S>, value: f64, q: &[f64]) -> Result<(), String> {
+        match self {
+            Axis::Airspeed => sys.set_airspeed(value, q),
+            Axis::Sideslip => sys.set_sideslip(value, q),
+        }
+    }
+
+    /// `12 m/s` or `sideslip 4°`, for messages.
+    fn describe(self, value: f64) -> String {
+        match self {
+            Axis::Airspeed => format!("{value} m/s"),
+            Axis::Sideslip => format!("sideslip {value}°"),
+        }
+    }
+}
+
+/// The order in which a sweep visits its points `at` (indices), and the position in that order
+/// where the walk restarts from the first equilibrium. An airspeed sweep walks down from the
+/// highest airspeed. A sideslip sweep starts at the angle nearest zero (the least deformed
+/// state), walks up through the larger angles, then restarts there and walks down through the
+/// smaller ones, so that each branch follows its equilibrium continuously.
+fn walk_order(st: &crate::problem::StaticSettings, at: &[(f64, f64)]) -> (Vec<usize>, Option<usize>) {
+    let mut order: Vec<usize> = (0..at.len()).collect();
+    if !st.is_sideslip_sweep() {
+        order.sort_by(|&a, &b| at[b].0.total_cmp(&at[a].0));
+        return (order, None);
+    }
+    let start = (0..at.len()).min_by(|&a, &b| at[a].1.abs().total_cmp(&at[b].1.abs())).unwrap_or(0);
+    let b0 = at[start].1;
+    let mut up: Vec<usize> = order.iter().copied().filter(|&i| i != start && at[i].1 >= b0).collect();
+    up.sort_by(|&a, &b| at[a].1.total_cmp(&at[b].1));
+    let mut down: Vec<usize> = order.iter().copied().filter(|&i| i != start && at[i].1 < b0).collect();
+    down.sort_by(|&a, &b| at[b].1.total_cmp(&at[a].1));
+    order = std::iter::once(start).chain(up.iter().copied()).collect();
+    let restart = (!down.is_empty()).then_some(order.len());
+    order.extend(down);
+    (order, restart)
 }
 
 /// Newton on the aeroelastic system from `x`, in rounds of up to [`ROUND_ITERATIONS`]
@@ -911,10 +1009,12 @@ fn load_stepping<S: Structure>(
     Ok(())
 }
 
-/// From the equilibrium `x` at airspeed `current` to the one at `target`, restarting from the
-/// last equilibrium towards the midpoint of a step that fails, at most 6 times; the last error
-/// when it does not get there (`x` and the system's airspeed are then the last equilibrium's).
+/// From the equilibrium `x` at the value `current` of `axis` (airspeed or sideslip) to the one
+/// at `target`, restarting from the last equilibrium towards the midpoint of a step that fails,
+/// at most 6 times; the last error when it does not get there (`x` and the system's value are
+/// then the last equilibrium's).
 fn bisect_to<S: Structure>(
+    axis: Axis,
     target: f64,
     current: &mut f64,
     sys: &mut AeroStatic<'_, S>,
@@ -925,7 +1025,7 @@ fn bisect_to<S: Structure>(
     let mut path = vec![target];
     let mut halvings = 0;
     while let Some(&u) = path.last() {
-        let attempt = sys.set_airspeed(u, &x.q).and_then(|()| solve_rounds(sys, solver, x));
+        let attempt = axis.set(sys, u, &x.q).and_then(|()| solve_rounds(sys, solver, x));
         match attempt {
             Ok(()) => {
                 *current = u;
@@ -933,7 +1033,7 @@ fn bisect_to<S: Structure>(
             }
             Err(e) => {
                 *x = good.clone();
-                let _ = sys.set_airspeed(*current, &x.q);
+                let _ = axis.set(sys, *current, &x.q);
                 if halvings >= 6 {
                     return Some(e);
                 }
@@ -1000,6 +1100,7 @@ fn point_at<S: Structure>(
         .collect();
     StaticPoint {
         airspeed,
+        sideslip_deg: sys.sideslip_deg(),
         fold_deg: fold,
         tip: model.tip(q),
         loads,

@@ -337,7 +337,8 @@ pub fn estimate_analysis(case: &Case, f: Formulation, a: Analysis) -> Estimate {
     match a {
         Analysis::Static => {
             let st = case.statics.as_ref();
-            let points = st.map_or(0, |s| s.airspeeds.len().max(s.load_factors.len())) as f64;
+            let points =
+                st.map_or(0, |s| s.airspeeds.len().max(s.load_factors.len()).max(s.sideslips_deg.len())) as f64;
             e.seconds = points * static_point;
             e.structure_seconds = points * STATIC_ITERATIONS * structure_iter;
         }

@@ -59,4 +59,5 @@ pub fn to_csv(rows: &[Row]) -> String {
 
 /// Column header of `static_<f>.csv`.
 pub const STATIC_HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
-root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag";
+root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag,\
+sideslip_deg";

@@ -163,7 +163,8 @@ pub struct StaticSettings {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub load_factors: Vec<f64>,
     /// Measured or computed coast angles to compare with: CSV files of two columns, airspeed
-    /// (m/s) and fold angle (degrees), relative to the case file's folder.
+    /// (m/s) — or sideslip (degrees) for a sweep in `sideslips_deg` — and fold angle (degrees),
+    /// relative to the case file's folder.
     #[serde(default)]
     pub references: Vec<StaticReference>,
     /// The steady wake of the static solution: `rows` straight rows of `row_length` (m) along
@@ -174,9 +175,15 @@ pub struct StaticSettings {
     /// stream. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wake: Option<aeroelastic::stability::WakeSettings>,
+    /// A sweep in sideslip instead of airspeed: sideslip angles, degrees (the convention of
+    /// `aero.sideslip_deg`), each solved at the one airspeed of `airspeeds`, continued from the
+    /// angle nearest zero outwards in both directions. The references then give the fold angle
+    /// against sideslip (degrees). Default none (a sweep in airspeed at `aero.sideslip_deg`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sideslips_deg: Vec<f64>,
 }
 
-/// A curve of equilibrium fold (coast) angle against airspeed.
+/// A curve of equilibrium fold (coast) angle against airspeed (or sideslip).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(JsonSchema))]
 #[serde(deny_unknown_fields)]

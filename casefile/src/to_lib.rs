@@ -38,6 +38,7 @@ impl StaticSettings {
             point_loads: self.point_loads.clone(),
             load_factors: self.load_factors.clone(),
             wake: self.wake,
+            sideslips_deg: self.sideslips_deg.clone(),
         }
     }
 }

@@ -12,6 +12,15 @@ use crate::budget::{
 };
 
 /// `v` is a finite positive number.
+/// A sideslip angle: finite and inside (−90°, 90°) (at ±90° the stream runs along the span).
+fn sideslip(field: &str, deg: f64) -> Result<(), String> {
+    if deg.is_finite() && deg.abs() < 90.0 {
+        Ok(())
+    } else {
+        Err(format!("{field}: {deg} is not a sideslip angle in (-90, 90) degrees"))
+    }
+}
+
 fn positive(field: &str, v: f64) -> Result<(), String> {
     if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{field}: {v} is not a positive number")) }
 }
@@ -287,6 +296,7 @@ impl Case {
             (_, Some(u)) => positive("aero.airspeed", u)?,
             _ => {}
         }
+        sideslip("aero.sideslip_deg", a.sideslip_deg)?;
         if !a.le_offset.is_finite() {
             return Err("aero.le_offset: not finite".into());
         }
@@ -431,6 +441,26 @@ fn check_aero_static(st: &StaticSettings) -> Result<(), String> {
     }
     for (k, &u) in st.airspeeds.iter().enumerate() {
         positive(&format!("static.airspeeds[{k}]"), u)?;
+    }
+    if !st.sideslips_deg.is_empty() {
+        if st.airspeeds.len() != 1 {
+            return Err(format!(
+                "static.airspeeds: a sideslip sweep (static.sideslips_deg) is at one airspeed, not {}",
+                st.airspeeds.len()
+            ));
+        }
+        if st.sideslips_deg.len() > MAX_STATIC_POINTS {
+            return Err(format!(
+                "static.sideslips_deg: {} points, more than {MAX_STATIC_POINTS}",
+                st.sideslips_deg.len()
+            ));
+        }
+        for (k, &b) in st.sideslips_deg.iter().enumerate() {
+            sideslip(&format!("static.sideslips_deg[{k}]"), b)?;
+            if st.sideslips_deg[..k].contains(&b) {
+                return Err(format!("static.sideslips_deg[{k}]: {b} is given twice"));
+            }
+        }
     }
     for (k, r) in st.references.iter().enumerate() {
         if r.label.is_empty() {

@@ -380,7 +380,7 @@ impl FuzzCommand {
 }
 
 /// The seed text for `cmd`: unchanged for `run`, `list` and `gate`; for an analysis, its sweep
-/// cut to one point (the highest static airspeed or load factor, the first stability airspeed
+/// cut to one point (the highest static airspeed, sideslip or load factor, the first stability airspeed
 /// with at most 4 modes, the first gust gradient and hinge state with `gust.t_end` of
 /// `max_steps` steps), so that a campaign can afford thousands of analyses. The mutations then
 /// apply to the reduced case.
@@ -397,9 +397,9 @@ pub fn reduce_for(cmd: FuzzCommand, text: &str, max_steps: usize) -> String {
     match cmd {
         FuzzCommand::Static => {
             if let Some(st) = v.get_mut("static") {
-                for key in ["airspeeds", "load_factors"] {
+                for key in ["airspeeds", "load_factors", "sideslips_deg"] {
                     if let Some(x) = st.get_mut(key) {
-                        let last = key == "airspeeds";
+                        let last = key != "load_factors";
                         keep_one(x, last);
                     }
                 }

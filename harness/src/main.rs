@@ -571,7 +571,7 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             s.name,
             r.formulation,
             r.points.len(),
-            if structural { "load factors" } else { "airspeeds" },
+            if structural { "load factors" } else { s.abscissa.plural() },
             r.wall_s,
             r.n_aero_solves,
             r.n_tangents,
@@ -589,11 +589,14 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
                 }
                 continue;
             }
+            let at = match s.abscissa {
+                harness::static_out::Abscissa::Airspeed => format!("{:>5} m/s", p.airspeed),
+                harness::static_out::Abscissa::Sideslip => format!("{:>5} deg sideslip", p.sideslip_deg),
+            };
             match &p.error {
-                Some(e) => eprintln!("  {} m/s: FAILED: {e}", p.airspeed),
+                Some(e) => eprintln!("  {at}: FAILED: {e}"),
                 None => println!(
-                    "  {:>5} m/s  fold {:>8.3} deg  RBM {:>9.5} N m  torque {:>9.5} N m  hinge {:>9.2e} N m  lift {:>8.4} N  ({} Newton)",
-                    p.airspeed,
+                    "  {at}  fold {:>8.3} deg  RBM {:>9.5} N m  torque {:>9.5} N m  hinge {:>9.2e} N m  lift {:>8.4} N  ({} Newton)",
                     p.fold_deg,
                     p.loads.root_bending_moment,
                     p.loads.root_torque,
@@ -604,14 +607,15 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             }
         }
     }
+    let band = s.abscissa.band_text();
     for r in &s.references {
         for (f, rms) in &r.rms_deg {
             match rms {
                 Some(rms) => {
-                    println!("static {} {f}: RMS error against {} = {rms:.2} deg (12-33 m/s)", s.name, r.label)
+                    println!("static {} {f}: RMS error against {} = {rms:.2} deg (over {band})", s.name, r.label)
                 }
                 None => println!(
-                    "static {} {f}: no RMS error against {}: no equilibrium at its airspeeds in 12-33 m/s ({f} failed, see below)",
+                    "static {} {f}: no RMS error against {}: no equilibrium at its points in {band} ({f} failed, see below)",
                     s.name, r.label
                 ),
             }
@@ -683,7 +687,7 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
         match (s.max_fold_difference_deg, s.max_rbm_relative_difference) {
             (Some(d), Some(r)) => println!(
                 "static {}: ANCF-GEBF max fold difference {d:.4} deg, max root bending moment difference {:.3} % \
-                 (over the airspeeds both solved)",
+                 (over the points both solved)",
                 s.name,
                 100.0 * r
             ),

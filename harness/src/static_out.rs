@@ -20,7 +20,75 @@ pub use casefile::curve::{parse_xy, read_xy};
 /// Column header of `static_lift_<f>.csv`.
 pub const LIFT_HEADER: &str = "airspeed,strip,s,x,y,z,lift_per_span,cl";
 
-/// The sweep as CSV text (one row per airspeed, NaN where a point failed).
+/// What a static sweep varies: the airspeed, or the sideslip angle at one airspeed
+/// (`static.sideslips_deg`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Abscissa {
+    /// Airspeed, m/s.
+    Airspeed,
+    /// Sideslip angle, degrees.
+    Sideslip,
+}
+
+impl Abscissa {
+    /// The abscissa of `case`'s static sweep.
+    pub fn of(case: &Case) -> Self {
+        if case.statics.as_ref().is_some_and(|s| !s.sideslips_deg.is_empty()) { Self::Sideslip } else { Self::Airspeed }
+    }
+
+    /// A point's abscissa.
+    pub fn x(self, p: &crate::statics::StaticPoint) -> f64 {
+        match self {
+            Self::Airspeed => p.airspeed,
+            Self::Sideslip => p.sideslip_deg,
+        }
+    }
+
+    /// Axis label with its unit.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Airspeed => "airspeed [m/s]",
+            Self::Sideslip => "sideslip [deg]",
+        }
+    }
+
+    /// The points' name in the plural, for failures.
+    pub fn plural(self) -> &'static str {
+        match self {
+            Self::Airspeed => "airspeeds",
+            Self::Sideslip => "sideslip angles",
+        }
+    }
+
+    /// The band the RMS errors against an experiment are taken over: 12–33 m/s (the Healy
+    /// experiment's range, where the flow is attached and the tip free) for an airspeed sweep,
+    /// every point for a sideslip sweep.
+    fn band(self) -> std::ops::RangeInclusive<f64> {
+        match self {
+            Self::Airspeed => 12.0 - 1e-9..=33.0 + 1e-9,
+            Self::Sideslip => -90.0..=90.0,
+        }
+    }
+
+    /// The band in words.
+    pub fn band_text(self) -> &'static str {
+        match self {
+            Self::Airspeed => "12–33 m/s",
+            Self::Sideslip => "the sweep",
+        }
+    }
+
+    /// A point's abscissa with its unit: `12 m/s`, `sideslip 4°`.
+    fn describe(self, x: f64) -> String {
+        match self {
+            Self::Airspeed => format!("{x} m/s"),
+            Self::Sideslip => format!("sideslip {x}°"),
+        }
+    }
+}
+
+/// The sweep as CSV text (one row per airspeed, or sideslip angle, NaN where a point failed).
 pub fn to_csv(out: &StaticOutput) -> String {
     let mut s = String::from(HEADER);
     s.push('\n');
@@ -28,7 +96,7 @@ pub fn to_csv(out: &StaticOutput) -> String {
         let l = &p.loads;
         let _ = writeln!(
             s,
-            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e}",
+            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e},{}",
             p.airspeed,
             p.fold_deg,
             p.tip[0],
@@ -46,7 +114,8 @@ pub fn to_csv(out: &StaticOutput) -> String {
             l.root_moment[2],
             p.newton_iterations,
             u8::from(p.error.is_none()),
-            p.drag
+            p.drag,
+            p.sideslip_deg
         );
     }
     s
@@ -80,7 +149,7 @@ pub struct ReferenceErrors {
     pub file: String,
     /// An experiment (else a model).
     pub experiment: bool,
-    /// The curve: airspeed (m/s), angle (degrees).
+    /// The curve: airspeed (m/s) or sideslip (degrees), angle (degrees).
     pub points: Vec<(f64, f64)>,
     /// Per formulation: the errors at the reference's airspeeds inside the sweep's converged
     /// range.
@@ -98,6 +167,8 @@ pub struct StaticSummary {
     pub name: String,
     /// Case description.
     pub description: String,
+    /// What the sweep varies.
+    pub abscissa: Abscissa,
     /// Each formulation's sweep.
     pub runs: Vec<StaticOutput>,
     /// References and the errors against them.
@@ -157,7 +228,7 @@ impl Failure {
 }
 
 /// The failures of each sweep of `runs` (formulations without a failed point are left out).
-pub fn failures(runs: &[StaticOutput]) -> Vec<Failure> {
+pub fn failures(runs: &[StaticOutput], abscissa: Abscissa) -> Vec<Failure> {
     let mut v = Vec::new();
     for r in runs {
         let structural = r.points.iter().any(|p| p.load_factor.is_some());
@@ -165,12 +236,12 @@ pub fn failures(runs: &[StaticOutput]) -> Vec<Failure> {
             formulation: r.formulation,
             at: Vec::new(),
             of: r.points.len(),
-            unit: if structural { "load factors" } else { "airspeeds" }.into(),
+            unit: if structural { "load factors" } else { abscissa.plural() }.into(),
             reasons: Vec::new(),
         };
         for p in &r.points {
             let Some(e) = &p.error else { continue };
-            let x = p.load_factor.unwrap_or(p.airspeed);
+            let x = p.load_factor.unwrap_or_else(|| abscissa.x(p));
             f.at.push(x);
             if f.reasons.len() < MAX_REASONS && !f.reasons.iter().any(|(_, r)| r == e) {
                 f.reasons.push((x, e.clone()));
@@ -241,7 +312,10 @@ pub fn compare_with_history(summary: &mut StaticSummary, spec: &RunSpec, runs: &
         let Some(aero) = &case.aero else { continue };
         let airspeed = aero.speed();
         let Some(st) = summary.runs.iter().find(|o| o.formulation == run.formulation) else { continue };
-        let Some(p) = st.points.iter().find(|p| (p.airspeed - airspeed).abs() < 1e-9 && p.error.is_none()) else {
+        let at = |p: &&crate::statics::StaticPoint| {
+            (p.airspeed - airspeed).abs() < 1e-9 && (p.sideslip_deg - aero.sideslip_deg).abs() < 1e-9
+        };
+        let Some(p) = st.points.iter().filter(at).find(|p| p.error.is_none()) else {
             continue;
         };
         let (tip_z, fold) = (p.tip[2], p.fold_deg);
@@ -313,30 +387,26 @@ fn interp(pts: &[(f64, f64)], u: f64) -> Option<f64> {
     Some(a.1 + (b.1 - a.1) * (u - a.0) / (b.0 - a.0))
 }
 
-fn curve(out: &StaticOutput, f: impl Fn(&crate::statics::StaticPoint) -> f64) -> Vec<(f64, f64)> {
-    let mut v: Vec<(f64, f64)> = out
-        .points
-        .iter()
-        .filter(|p| p.error.is_none())
-        .map(|p| (p.airspeed, f(p)))
-        .filter(|p| p.1.is_finite())
-        .collect();
+fn curve(out: &StaticOutput, x: Abscissa, f: impl Fn(&crate::statics::StaticPoint) -> f64) -> Vec<(f64, f64)> {
+    let mut v: Vec<(f64, f64)> =
+        out.points.iter().filter(|p| p.error.is_none()).map(|p| (x.x(p), f(p))).filter(|p| p.1.is_finite()).collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
     v
 }
 
 /// Evaluate the sweeps against each other and the case's references.
 pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> StaticSummary {
+    let abscissa = Abscissa::of(case);
     let mut references = Vec::new();
     for r in case.statics.iter().flat_map(|s| &s.references) {
         let points = read_xy(&dir_of_case.join(&r.file)).unwrap_or_default();
         let mut errors = Vec::new();
         let mut rms_deg = Vec::new();
         for out in &runs {
-            let ours = curve(out, |p| p.fold_deg);
+            let ours = curve(out, abscissa, |p| p.fold_deg);
             let e: Vec<(f64, f64, f64, f64)> =
                 points.iter().filter_map(|&(u, a)| interp(&ours, u).map(|c| (u, a, c, c - a))).collect();
-            let band: Vec<f64> = e.iter().filter(|x| (12.0 - 1e-9..=33.0 + 1e-9).contains(&x.0)).map(|x| x.3).collect();
+            let band: Vec<f64> = e.iter().filter(|x| abscissa.band().contains(&x.0)).map(|x| x.3).collect();
             let rms = (!band.is_empty()).then(|| (band.iter().map(|x| x * x).sum::<f64>() / band.len() as f64).sqrt());
             errors.push((out.formulation, e));
             rms_deg.push((out.formulation, rms));
@@ -367,10 +437,11 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
         }
     }
     let n_failed = runs.iter().flat_map(|r| &r.points).filter(|p| p.error.is_some()).count();
-    let failures = failures(&runs);
+    let failures = failures(&runs, abscissa);
     StaticSummary {
         name: case.name.clone(),
         description: case.description.clone(),
+        abscissa,
         runs,
         references,
         max_fold_difference_deg: dfold,
@@ -383,7 +454,8 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
 }
 
 /// RMS error of a model reference against an experiment reference of the same summary (at the
-/// experiment's airspeeds in 12–33 m/s), degrees; None when the curves do not overlap there.
+/// experiment's airspeeds in 12–33 m/s, or at all its sideslip angles), degrees; None when the
+/// curves do not overlap there.
 pub fn model_rms(summary: &StaticSummary) -> Vec<(String, Option<f64>)> {
     let Some(exp) = summary.references.iter().find(|r| r.experiment) else { return Vec::new() };
     summary
@@ -396,7 +468,7 @@ pub fn model_rms(summary: &StaticSummary) -> Vec<(String, Option<f64>)> {
             let e: Vec<f64> = exp
                 .points
                 .iter()
-                .filter(|p| (12.0 - 1e-9..=33.0 + 1e-9).contains(&p.0))
+                .filter(|p| summary.abscissa.band().contains(&p.0))
                 .filter_map(|&(u, a)| interp(&pts, u).map(|c| c - a))
                 .collect();
             let rms = (!e.is_empty()).then(|| (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt());
@@ -613,7 +685,7 @@ fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {
             (
                 format!("{} (UVLM, steady)", o.formulation.as_str().to_uppercase()),
                 color(o.formulation),
-                curve(o, |p| p.fold_deg),
+                curve(o, s.abscissa, |p| p.fold_deg),
                 style(o.formulation),
             )
         })
@@ -622,7 +694,7 @@ fn plot_coast(path: &Path, s: &StaticSummary) -> Result<(), Error> {
         let st = if r.experiment { Style::Points } else { Style::Solid };
         curves.push((r.label.clone(), if r.experiment { EXP } else { MODEL }, r.points.clone(), st));
     }
-    panel(path, &format!("{}: coast angle", s.name), "airspeed [m/s]", "fold angle [deg] (tip up +)", &curves)
+    panel(path, &format!("{}: coast angle", s.name), s.abscissa.label(), "fold angle [deg] (tip up +)", &curves)
 }
 
 fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
@@ -633,12 +705,12 @@ fn plot_rbm(path: &Path, s: &StaticSummary) -> Result<(), Error> {
             (
                 o.formulation.as_str().to_uppercase(),
                 color(o.formulation),
-                curve(o, |p| p.loads.root_bending_moment),
+                curve(o, s.abscissa, |p| p.loads.root_bending_moment),
                 style(o.formulation),
             )
         })
         .collect();
-    panel(path, &format!("{}: root bending moment", s.name), "airspeed [m/s]", "root bending moment [N m]", &curves)
+    panel(path, &format!("{}: root bending moment", s.name), s.abscissa.label(), "root bending moment [N m]", &curves)
 }
 
 fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
@@ -647,7 +719,7 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
     let mut curves: Curves = Vec::new();
     for o in &s.runs {
         let ok: Vec<_> = o.points.iter().filter(|p| p.error.is_none() && !p.strips.is_empty()).collect();
-        let mut speeds: Vec<f64> = ok.iter().map(|p| p.airspeed).collect();
+        let mut speeds: Vec<f64> = ok.iter().map(|p| s.abscissa.x(p)).collect();
         speeds.sort_by(f64::total_cmp);
         let picks: Vec<f64> = match speeds.len() {
             0 => Vec::new(),
@@ -655,9 +727,9 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
             n => vec![speeds[0], speeds[n / 2], speeds[n - 1]],
         };
         for (k, u) in picks.iter().enumerate() {
-            if let Some(p) = ok.iter().find(|p| p.airspeed == *u) {
+            if let Some(p) = ok.iter().find(|p| s.abscissa.x(p) == *u) {
                 curves.push((
-                    format!("{} {u} m/s", o.formulation.as_str().to_uppercase()),
+                    format!("{} {}", o.formulation.as_str().to_uppercase(), s.abscissa.describe(*u)),
                     SPEEDS[k % 3],
                     p.strips.iter().map(|st| (st.s, st.lift_per_span)).collect(),
                     style(o.formulation),
@@ -682,7 +754,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
         (Some(d), Some(r)) => {
             let _ = writeln!(
                 h,
-                "<p>ANCF–GEBF: coast angles within {d:.3}°, root bending moments within {:.3} % over the airspeeds \
+                "<p>ANCF–GEBF: coast angles within {d:.3}°, root bending moments within {:.3} % over the points \
                  both solved; {} point(s) without an equilibrium.</p>",
                 100.0 * r,
                 s.n_failed
@@ -691,7 +763,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
         _ if s.runs.len() == 2 => {
             let _ = writeln!(
                 h,
-                "<p>ANCF–GEBF: no comparison, no airspeed has an equilibrium in both; {} point(s) without an \
+                "<p>ANCF–GEBF: no comparison, no point has an equilibrium in both; {} point(s) without an \
                  equilibrium.</p>",
                 s.n_failed
             );
@@ -701,7 +773,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     for f in &s.failures {
         let _ = writeln!(h, "<p class=\"fail\">FAILED: {}</p>", html_escape(&f.text()));
     }
-    h.push_str("<table><tr><th>airspeed [m/s]</th>");
+    let _ = write!(h, "<table><tr><th>{}</th>", s.abscissa.label());
     for r in &s.runs {
         let f = r.formulation.as_str().to_uppercase();
         let _ = write!(
@@ -720,7 +792,8 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     h.push_str("</tr>\n");
     if let Some(first) = s.runs.first() {
         for (i, p) in first.points.iter().enumerate() {
-            let _ = write!(h, "<tr><td>{}</td>", p.airspeed);
+            let x = s.abscissa.x(p);
+            let _ = write!(h, "<tr><td>{x}</td>");
             for r in &s.runs {
                 let q = &r.points[i];
                 if q.error.is_some() {
@@ -734,7 +807,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
                 }
             }
             for r in &s.references {
-                match r.points.iter().find(|x| (x.0 - p.airspeed).abs() < 1e-9) {
+                match r.points.iter().find(|r| (r.0 - x).abs() < 1e-9) {
                     Some(x) => {
                         let _ = write!(h, "<td>{:.2}</td>", x.1);
                     }
@@ -743,7 +816,7 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
             }
             for r in s.references.iter().filter(|r| r.experiment) {
                 for (_, errors) in &r.errors {
-                    match errors.iter().find(|e| (e.0 - p.airspeed).abs() < 1e-9) {
+                    match errors.iter().find(|e| (e.0 - x).abs() < 1e-9) {
                         Some(e) => {
                             let _ = write!(h, "<td>{:+.2}</td>", e.3);
                         }
@@ -755,16 +828,17 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
         }
     }
     h.push_str("</table>\n<ul>\n");
+    let band = s.abscissa.band_text();
     for r in s.references.iter().filter(|r| r.experiment) {
         for (f, rms) in &r.rms_deg {
             let label = html_escape(&r.label);
             let _ = match rms {
                 Some(rms) => {
-                    writeln!(h, "<li>{f} against {label}: RMS coast-angle error {rms:.2}° over 12–33 m/s</li>")
+                    writeln!(h, "<li>{f} against {label}: RMS coast-angle error {rms:.2}° over {band}</li>")
                 }
                 None => writeln!(
                     h,
-                    "<li>{f} against {label}: no RMS error, no equilibrium at its airspeeds in 12–33 m/s ({})</li>",
+                    "<li>{f} against {label}: no RMS error, no equilibrium at its points in {band} ({})</li>",
                     html_escape(&failure_of(&s.failures, *f, "no converged point in the band"))
                 ),
             };
@@ -773,8 +847,8 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     for (label, rms) in model_rms(s) {
         let label = html_escape(&label);
         let _ = match rms {
-            Some(rms) => writeln!(h, "<li>{label} against the experiment: RMS {rms:.2}° over 12–33 m/s</li>"),
-            None => writeln!(h, "<li>{label} against the experiment: no common airspeed in 12–33 m/s</li>"),
+            Some(rms) => writeln!(h, "<li>{label} against the experiment: RMS {rms:.2}° over {band}</li>"),
+            None => writeln!(h, "<li>{label} against the experiment: no common point in {band}</li>"),
         };
     }
     for c in &s.history {
@@ -813,9 +887,9 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     h.push_str("</ul>\n");
     h.push_str(&held_html(&s.held));
     for (file, alt) in [
-        ("static_coast.svg", "coast angle against airspeed"),
-        ("static_rbm.svg", "root bending moment against airspeed"),
-        ("static_lift.svg", "spanwise lift at three airspeeds"),
+        ("static_coast.svg", "coast angle"),
+        ("static_rbm.svg", "root bending moment"),
+        ("static_lift.svg", "spanwise lift at three points of the sweep"),
     ] {
         let _ = writeln!(h, "<p><img src=\"{}/{file}\" alt=\"{alt}\" width=\"900\"></p>", html_escape(folder));
     }
@@ -867,6 +941,10 @@ fn html_escape(s: &str) -> String {
 /// taken at), in parallel; stored in `summary.held`. Nothing for a case without a free fold
 /// hinge or without an experiment.
 pub fn hold_references(spec: &RunSpec, summary: &mut StaticSummary) {
+    // The held model is defined at the experiment's airspeeds (at the case's sideslip).
+    if summary.abscissa != Abscissa::Airspeed {
+        return;
+    }
     let mut jobs = Vec::new();
     for r in summary.references.iter().filter(|r| r.experiment) {
         for (f, errors) in &r.errors {

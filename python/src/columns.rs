@@ -156,6 +156,7 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
     let ok: Vec<bool> = p.iter().map(|p| p.error.is_none()).collect();
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
     d.set_item("drag", f(|p| p.drag))?;
+    d.set_item("sideslip_deg", f(|p| p.sideslip_deg))?;
     debug_assert_eq!(d.len(), casefile::csv::STATIC_HEADER.split(',').count());
     Ok(d)
 }

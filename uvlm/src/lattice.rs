@@ -83,8 +83,10 @@ impl LatticeSpec {
 }
 
 /// Largest turn between consecutive spanwise grid steps (or between adjacent panel normals)
-/// before the grid counts as folded over, rad (120°): folds up to ±120° are admissible.
-const MAX_TURN_COS: f64 = -0.5;
+/// before the grid counts as folded over, as its cosine (150°): folds up to ±150° are admissible
+/// (wind-tunnel wingtips coast past ±125° in sideslip; the tip then still lies clear of the
+/// inner wing).
+const MAX_TURN_COS: f64 = -0.866_025_403_784_438_6;
 
 /// The lattice: grid, ring nodes, collocation points, normals, areas and node velocities.
 #[derive(Debug, Clone)]

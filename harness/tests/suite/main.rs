@@ -15,6 +15,7 @@ mod polars;
 mod properties;
 mod send_sync;
 mod shard;
+mod sideslip;
 #[cfg(target_os = "linux")]
 mod slurm;
 mod stability;
