@@ -5,6 +5,8 @@
 //! (the harness's case file) builds one. [`Problem::scene`] maps it onto the [`scene::Scene`]
 //! both formulations build their models from.
 
+use nalgebra::Vector3;
+
 use crate::aero_settings::AeroSettings;
 use crate::gust_settings::GustSweep;
 use crate::stability_settings::{StabilitySettings, WakeSettings};
@@ -142,8 +144,10 @@ pub fn fold_joint_index(joints: &[Joint], fold_joint: Option<&str>) -> Option<us
 pub struct Body {
     /// Name joints refer to.
     pub name: String,
-    /// Start point, m (global).
-    pub start: [f64; 3],
+    /// Start point, m (global). Default: the end of its parent (the body a flared hinge hangs
+    /// it from), or the origin for a body without one.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub start: Option<[f64; 3]>,
     /// Length, m.
     pub length: f64,
     /// Beam axis (section x) in global coordinates; normalised. Default +X.
@@ -152,6 +156,18 @@ pub struct Body {
     /// Section y axis in global coordinates; must be perpendicular to `x_axis`. Default +Y.
     #[cfg_attr(feature = "serde", serde(default = "default_y_axis"))]
     pub y_axis: [f64; 3],
+    /// Sweep Λ, degrees, positive aft: the beam axis turned about the reference frame's z axis
+    /// from its x axis towards −y (the trailing edge). The reference frame is the parent's end
+    /// section frame for the child of a flared hinge, else the frame of `x_axis`/`y_axis`.
+    /// Default 0, within ±80°.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+    pub sweep_deg: f64,
+    /// Dihedral Γ, degrees, positive up: the swept beam axis raised towards the reference
+    /// frame's z axis. The body's frame is `F · R_z(−Λ) · R_y(−Γ)`, its beam axis
+    /// `F (cos Γ cos Λ, −cos Γ sin Λ, sin Γ)`, its chord direction `F (sin Λ, cos Λ, 0)`.
+    /// Default 0, within ±80°.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+    pub dihedral_deg: f64,
     /// Section properties per unit length.
     pub section: Section,
     /// Point masses fixed to the body's sections (default none).
@@ -224,6 +240,11 @@ pub struct Section {
     /// The rotary inertias are about it.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero2"))]
     pub cg_offset: [f64; 2],
+}
+
+#[cfg(feature = "serde")]
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn is_zero2(v: &[f64; 2]) -> bool {
@@ -706,20 +727,77 @@ impl Problem {
         self.bodies.iter().map(|b| b.length).sum()
     }
 
+    /// Each body's start point and section axes x (the beam axis) and y in the reference
+    /// configuration before the root pitch: `start` or the parent's end (the origin without a
+    /// parent); the axes of `x_axis`/`y_axis`, or with a sweep or dihedral those of the
+    /// reference frame (the parent's end section frame, or `x_axis`/`y_axis` for a body without
+    /// a parent) turned by `R_z(−Λ) R_y(−Γ)`.
+    pub fn placements(&self) -> Vec<(Vector3<f64>, Vector3<f64>, Vector3<f64>)> {
+        let n = self.bodies.len();
+        let parent: Vec<Option<usize>> = (0..n)
+            .map(|i| {
+                self.joints.iter().find_map(|j| match j {
+                    Joint::FlaredHinge { parent, child, .. } if self.body_index(child) == Some(i) => {
+                        self.body_index(parent).filter(|&p| p != i)
+                    }
+                    _ => None,
+                })
+            })
+            .collect();
+        let mut placed: Vec<Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>)>> = vec![None; n];
+        for i in 0..n {
+            self.place(i, &parent, &mut placed, 0);
+        }
+        placed.into_iter().map(|p| p.unwrap_or((Vector3::zeros(), Vector3::x(), Vector3::y()))).collect()
+    }
+
+    /// [`Problem::placements`] of body `i`, its parents first (a chain longer than the body
+    /// count is a loop, which the scene's validation names; it is cut here).
+    fn place(
+        &self,
+        i: usize,
+        parent: &[Option<usize>],
+        placed: &mut Vec<Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>)>>,
+        depth: usize,
+    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        if let Some(p) = placed[i] {
+            return p;
+        }
+        let b = &self.bodies[i];
+        let unit = |v: [f64; 3]| Vector3::from(v).normalize();
+        let up = parent[i].filter(|_| depth < self.bodies.len()).map(|p| {
+            let (s, x, y) = self.place(p, parent, placed, depth + 1);
+            (s + x * self.bodies[p].length, x, y)
+        });
+        let start = b.start.map(Vector3::from).or(up.map(|u| u.0)).unwrap_or_else(Vector3::zeros);
+        let (x, y) = if b.sweep_deg == 0.0 && b.dihedral_deg == 0.0 {
+            (unit(b.x_axis), unit(b.y_axis))
+        } else {
+            let (x0, y0) = up.map_or_else(|| (unit(b.x_axis), unit(b.y_axis)), |u| (u.1, u.2));
+            let z0 = x0.cross(&y0);
+            let (sl, cl) = b.sweep_deg.to_radians().sin_cos();
+            let (sg, cg) = b.dihedral_deg.to_radians().sin_cos();
+            (x0 * (cg * cl) - y0 * (cg * sl) + z0 * sg, x0 * sl + y0 * cl)
+        };
+        placed[i] = Some((start, x, y));
+        (start, x, y)
+    }
+
     /// The scene of formulation `f`: bodies (stiffnesses scaled by `stiffness_scale`, element
     /// counts of `f`), joints, hinge springs as force elements, gravity. Body names that do not
     /// resolve become an index past the last body, which [`scene::Scene::validate`] rejects.
     pub fn scene(&self, f: Formulation) -> scene::Scene {
         let n_el = self.block(f).elements_per_body;
-        let unit = |v: [f64; 3]| nalgebra::Vector3::from(v).normalize();
         // Nose-up pitch: a rotation about +X takes +Y (the leading edge) towards +Z.
         let pitch = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), self.pitch_deg.to_radians());
+        let placed = self.placements();
         let bodies = self
             .bodies
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let (x, y) = (pitch * unit(b.x_axis), pitch * unit(b.y_axis));
+                let (start, x, y) = placed[i];
+                let (x, y) = (pitch * x, pitch * y);
                 let s = &b.section;
                 let section = scene::Section {
                     cg_offset: s.cg_offset,
@@ -729,7 +807,7 @@ impl Problem {
                 };
                 scene::BodySpec {
                     name: b.name.clone(),
-                    start: pitch * nalgebra::Vector3::from(b.start),
+                    start: pitch * start,
                     length: b.length,
                     frame: nalgebra::Matrix3::from_columns(&[x, y, x.cross(&y)]),
                     section: section.with_stiffness_scale(self.stiffness_scale),

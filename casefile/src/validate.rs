@@ -146,6 +146,27 @@ impl Case {
             if dot.abs() > 1e-9 {
                 return Err(f(&format!("y_axis: not perpendicular to x_axis (cosine {dot:.3e})")));
             }
+            if let Some(s) = b.start
+                && !finite3(&s)
+            {
+                return Err(f("start: not a finite point"));
+            }
+            for (key, deg) in [("sweep_deg", b.sweep_deg), ("dihedral_deg", b.dihedral_deg)] {
+                if !(deg.is_finite() && deg.abs() <= 80.0) {
+                    return Err(f(&format!("{key}: {deg} is outside ±80 degrees")));
+                }
+            }
+            let hangs = self
+                .joints
+                .iter()
+                .any(|j| matches!(j, aeroelastic::problem::Joint::FlaredHinge { child, .. } if *child == b.name));
+            let own_axes = b.x_axis != [1.0, 0.0, 0.0] || b.y_axis != [0.0, 1.0, 0.0];
+            if hangs && own_axes && (b.sweep_deg != 0.0 || b.dihedral_deg != 0.0) {
+                return Err(f(
+                    "x_axis: a body swept or raised relative to its parent takes its axes from the parent's end \
+                     section; give either x_axis/y_axis or sweep_deg/dihedral_deg",
+                ));
+            }
         }
         Ok(())
     }

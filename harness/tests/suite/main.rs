@@ -7,6 +7,7 @@ mod cli;
 mod external;
 mod fuzz;
 mod gate;
+mod geometry;
 mod gust;
 mod honest;
 mod loads_lost;
