@@ -141,9 +141,11 @@ mod tests {
     }
 
     /// Flat wing along +Y, flow along +X, leading edge on x = 0 (x_s = +Y, y_s = −X), `n`
-    /// strips of width 1 and chord `chord(y)`, every station in `flapped` with a flap.
+    /// strips of width 1 and chord `chord(y)`, leading edge swept back by `sweep` (x = y tan(sweep)),
+    /// every station in `flapped` with a flap.
     fn wing(
         n: usize,
+        sweep: f64,
         chord: impl Fn(f64) -> f64,
         flap: StationFlap,
         flapped: RangeInclusive<usize>,
@@ -152,7 +154,7 @@ mod tests {
         (0..=n)
             .map(|j| {
                 let y = j as f64;
-                let mut st = SpanStation::new(Vector3::new(0.0, y, 0.0), frame, chord(y), 0.0);
+                let mut st = SpanStation::new(Vector3::new(y * sweep.tan(), y, 0.0), frame, chord(y), 0.0);
                 st.flap = flapped.contains(&j).then_some(flap);
                 st
             })
@@ -162,8 +164,8 @@ mod tests {
     #[test]
     fn flapped_column_geometry() {
         let d = 10f64.to_radians();
-        let lat =
-            Lattice::from_stations(LatticeSpec::new(4), &wing(2, |_| 1.0, StationFlap::new(0.25, d), 0..=2)).unwrap();
+        let lat = Lattice::from_stations(LatticeSpec::new(4), &wing(2, 0.0, |_| 1.0, StationFlap::new(0.25, d), 0..=2))
+            .unwrap();
         for j in 0..=2 {
             let f = lat.column_flaps()[j].unwrap();
             assert_eq!(f.hinge_row, 3);
@@ -176,21 +178,26 @@ mod tests {
             assert_relative_eq!(g(4)[2], -0.25 * d.sin(), epsilon = 1e-15);
         }
         // M = 1 leaves no room for a hinge.
-        let st = wing(2, |_| 1.0, StationFlap::new(0.25, d), 1..=1);
+        let st = wing(2, 0.0, |_| 1.0, StationFlap::new(0.25, d), 1..=1);
         assert!(matches!(
             Lattice::from_stations(LatticeSpec::new(1), &st),
             Err(UvlmError::FlapTooFewChordwise { station: 1, n_chordwise: 1 })
         ));
     }
 
-    /// On a straight-tapered planform the hinge points at one chord fraction are collinear, so
+    /// On a straight-tapered (here also swept) planform the hinge points at one chord fraction are collinear, so
     /// every column turns about the same line: the deflected flap is one plane.
     #[test]
     fn tapered_flap_stays_planar() {
-        let st = wing(4, |y| 1.0 - 0.15 * y, StationFlap::new(0.3, 15f64.to_radians()), 0..=4);
+        let st = wing(4, 0.5, |y| 1.0 - 0.15 * y, StationFlap::new(0.3, 15f64.to_radians()), 0..=4);
         let lat = Lattice::from_stations(LatticeSpec { spacing: ChordwiseSpacing::Cosine, ..LatticeSpec::new(7) }, &st)
             .unwrap();
         let row = lat.column_flaps()[0].unwrap().hinge_row;
+        // The hinge line x = y tan(0.5) + 0.7 (1 − 0.15 y), not the stations' x_s = +Y.
+        let slope = 0.5f64.tan() - 0.7 * 0.15;
+        for f in lat.column_flaps() {
+            assert_relative_eq!(f.unwrap().hinge_axis[0], slope / (1.0 + slope * slope).sqrt(), epsilon = 1e-14);
+        }
         let g = |i: usize, j: usize| lat.grid_nodes()[lat.node_index(i, j)];
         let (p0, p1, p2) = (g(row, 0), g(row, 4), g(7, 0));
         let nrm = cross(std::array::from_fn(|q| p1[q] - p0[q]), std::array::from_fn(|q| p2[q] - p0[q]));
@@ -209,7 +216,8 @@ mod tests {
     #[test]
     fn flap_rate_gives_node_velocities() {
         let (d, rate, eps) = (0.2, 3.0, 1e-6);
-        let make = |delta: f64| wing(3, |y| 1.0 - 0.1 * y, StationFlap { rate, ..StationFlap::new(0.3, delta) }, 0..=3);
+        let make =
+            |delta: f64| wing(3, 0.0, |y| 1.0 - 0.1 * y, StationFlap { rate, ..StationFlap::new(0.3, delta) }, 0..=3);
         let spec = LatticeSpec::new(6);
         let mut lat = Lattice::from_stations(spec, &make(d)).unwrap();
         lat.update_stations(&make(d), Some(&[StationVelocity::default(); 4][..])).unwrap();
@@ -234,10 +242,10 @@ mod tests {
     #[test]
     fn part_span_flap_edges_and_hinge_moment() {
         // M·E = 1.5 rounds to 2 flap panels: hinge row 3 at η = 0.7 against the plain η = 0.6.
-        let st = wing(6, |_| 1.0, StationFlap::new(0.3, 20f64.to_radians()), 2..=4);
+        let st = wing(6, 0.0, |_| 1.0, StationFlap::new(0.3, 20f64.to_radians()), 2..=4);
         let lat = Lattice::from_stations(LatticeSpec::new(5), &st).unwrap();
         let plain =
-            Lattice::from_stations(LatticeSpec::new(5), &wing(6, |_| 1.0, StationFlap::default(), 7..=7)).unwrap(); // no station flapped
+            Lattice::from_stations(LatticeSpec::new(5), &wing(6, 0.0, |_| 1.0, StationFlap::default(), 7..=7)).unwrap(); // no station flapped
         assert_eq!(lat.column_flaps()[2].unwrap().hinge_row, 3);
         assert_relative_eq!(lat.grid_nodes()[lat.node_index(3, 2)][0], 0.7, epsilon = 1e-15);
         for j in [0, 1, 5, 6] {
