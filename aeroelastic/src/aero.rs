@@ -169,6 +169,7 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
             chord: aero.chord,
             le_offset: aero.le_offset,
             slant: st.slant,
+            flap: None,
         });
         velocities.push(uvlm::StationVelocity { linear: vel, angular: omega });
     }

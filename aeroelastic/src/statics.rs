@@ -122,6 +122,7 @@ fn placeholder_uvlm() -> Result<uvlm::Uvlm, String> {
         chord: 1.0,
         le_offset: 0.5,
         slant: 0.0,
+        flap: None,
     };
     uvlm::Lattice::from_stations(uvlm::LatticeSpec::new(1), &[st(0.0), st(1.0)])
         .and_then(|l| uvlm::Uvlm::new(l, uvlm::UvlmParams::new(1.0, [0.0, -1.0, 0.0])))

@@ -116,6 +116,26 @@ pub enum UvlmError {
         /// Offending value.
         value: f64,
     },
+    /// A hinge moment was asked of a grid column that carries no control surface or does not
+    /// exist.
+    #[error("grid column {column} carries no control surface (the lattice has {n_columns} columns)")]
+    NoFlap {
+        /// The column asked for.
+        column: usize,
+        /// Number of grid columns N + 1.
+        n_columns: usize,
+    },
+    /// A station carries a control surface but the lattice has fewer than 2 chordwise panels
+    /// (the hinge needs a panel on each side).
+    #[error(
+        "span station {station} carries a control surface, which needs at least 2 chordwise panels, got {n_chordwise}"
+    )]
+    FlapTooFewChordwise {
+        /// Station (grid column) index.
+        station: usize,
+        /// Number of chordwise panels of the lattice.
+        n_chordwise: usize,
+    },
     /// The aerodynamic influence matrix is singular.
     #[error("singular aerodynamic influence matrix (zero pivot in row {pivot})")]
     SingularAic {

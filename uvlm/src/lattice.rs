@@ -13,8 +13,12 @@
 //!
 //! A flared hinge is an interior grid column: the rings on both sides reference the same node
 //! entries, so the hinge edge is one filament carrying the net circulation.
+//!
+//! A station's control surface puts a grid row of its column on the hinge and rotates the rows
+//! behind it about the hinge line ([`crate::ColumnFlap`], docs/uvlm.md §15).
 
 use crate::error::{Result, UvlmError};
+use crate::flap::{ColumnFlap, flap_eta, hinge_row, rotate_about};
 use crate::station::{SpanStation, StationVelocity};
 use serde::{Deserialize, Serialize};
 
@@ -104,6 +108,8 @@ pub struct Lattice {
     colloc_vel: Vec<[f64; 3]>,
     normal: Vec<[f64; 3]>,
     area: Vec<f64>,
+    flaps: Vec<Option<ColumnFlap>>,
+    flaps_scratch: Vec<Option<ColumnFlap>>,
     version: u64,
 }
 
@@ -169,6 +175,8 @@ impl Lattice {
             colloc_vel: vec![[0.0; 3]; m * n],
             normal: vec![[0.0; 3]; m * n],
             area: vec![0.0; m * n],
+            flaps: vec![None; n + 1],
+            flaps_scratch: vec![None; n + 1],
             version: 0,
         };
         lat.update_stations(stations, None)?;
@@ -189,6 +197,9 @@ impl Lattice {
         }
         for (j, st) in stations.iter().enumerate() {
             st.validate(j)?;
+            if st.flap.is_some() && self.m < 2 {
+                return Err(UvlmError::FlapTooFewChordwise { station: j, n_chordwise: self.m });
+            }
             if let Some(v) = velocities
                 && !(v[j].linear.iter().chain(v[j].angular.iter()).all(|x| x.is_finite()))
             {
@@ -196,20 +207,21 @@ impl Lattice {
             }
         }
         for (j, st) in stations.iter().enumerate() {
-            let mut st = *st;
-            if let Some(h) = self.spec.hinge
-                && h.column == j
-            {
-                st.slant = h.flare;
-            }
+            let st = column_station(&self.spec, st, j);
+            let flap = st.flap.map(|f| (f.chord_fraction, hinge_row(self.m, f.chord_fraction)));
             for i in 0..=self.m {
-                let arm = st.arm(self.eta[i]);
-                let p = st.origin + arm;
+                let eta = match flap {
+                    Some((e, row)) => flap_eta(self.spec.spacing, i, self.m, row, e),
+                    None => self.eta[i],
+                };
+                let p = st.origin + st.arm(eta);
                 self.scratch[i * nc + j] = [p.x, p.y, p.z];
             }
         }
+        self.deflect_flaps(stations);
         self.validate_grid(&self.scratch)?;
         std::mem::swap(&mut self.grid, &mut self.scratch);
+        std::mem::swap(&mut self.flaps, &mut self.flaps_scratch);
         for (j, st) in stations.iter().enumerate() {
             for i in 0..=self.m {
                 let k = i * nc + j;
@@ -217,8 +229,17 @@ impl Lattice {
                     Some(v) => {
                         let g = self.grid[k];
                         let arm = nalgebra::Vector3::new(g[0], g[1], g[2]) - st.origin;
-                        let u = v[j].at(&arm);
-                        [u.x, u.y, u.z]
+                        let mut u: [f64; 3] = v[j].at(&arm).into();
+                        if let Some(f) = self.flaps[j]
+                            && i > f.hinge_row
+                        {
+                            // The flap's rotation relative to the section: δ̇ t × (x − h).
+                            let w = crate::flap::cross(f.hinge_axis, sub(g, f.hinge_point));
+                            for q in 0..3 {
+                                u[q] += f.rate * w[q];
+                            }
+                        }
+                        u
                     }
                     None => [0.0; 3],
                 };
@@ -242,10 +263,49 @@ impl Lattice {
             return Err(UvlmError::NonFiniteNode { row: k / (self.n + 1), column: k % (self.n + 1) });
         }
         self.validate_grid(positions)?;
+        self.flaps.fill(None);
         self.grid.copy_from_slice(positions);
         self.grid_vel.copy_from_slice(velocities);
         self.derive();
         Ok(())
+    }
+
+    /// Rotate the nodes behind the hinge of every flapped column of `self.scratch` (the
+    /// undeflected grid of `stations`) and record the columns' flaps in `self.flaps_scratch`.
+    /// The hinge line of column `j` runs through its hinge node along the undeflected hinge points
+    /// (same chord fraction) of stations `j − 1` and `j + 1` (one-sided at the ends).
+    fn deflect_flaps(&mut self, stations: &[SpanStation]) {
+        let (m, n) = (self.m, self.n);
+        let nc = n + 1;
+        for j in 0..nc {
+            self.flaps_scratch[j] = None;
+            let Some(f) = stations[j].flap else { continue };
+            let e = f.chord_fraction;
+            let row = hinge_row(m, e);
+            let h = self.scratch[row * nc + j];
+            let hinge_of = |jj: usize| {
+                let st = column_station(&self.spec, &stations[jj], jj);
+                let p = st.origin + st.arm(1.0 - e);
+                [p.x, p.y, p.z]
+            };
+            let a = if j > 0 { hinge_of(j - 1) } else { h };
+            let b = if j < n { hinge_of(j + 1) } else { h };
+            let d = sub(b, a);
+            let len = norm(d);
+            let t = [d[0] / len, d[1] / len, d[2] / len];
+            for i in row + 1..=m {
+                let k = i * nc + j;
+                self.scratch[k] = rotate_about(self.scratch[k], h, t, f.deflection);
+            }
+            self.flaps_scratch[j] = Some(ColumnFlap {
+                hinge_row: row,
+                hinge_point: h,
+                hinge_axis: t,
+                chord_fraction: e,
+                deflection: f.deflection,
+                rate: f.rate,
+            });
+        }
     }
 
     /// Reject non-finite, non-monotone, folded, degenerate or over-skewed grids.
@@ -400,6 +460,12 @@ impl Lattice {
     pub fn hinge_column(&self) -> Option<usize> {
         self.spec.hinge.map(|h| h.column)
     }
+    /// The control surface of every grid column as placed by the last
+    /// [`update_stations`](Self::update_stations) (`None`: no flap; all `None` after
+    /// [`set_grid`](Self::set_grid), which knows no stations).
+    pub fn column_flaps(&self) -> &[Option<ColumnFlap>] {
+        &self.flaps
+    }
     /// Geometric grid nodes, m.
     pub fn grid_nodes(&self) -> &[[f64; 3]] {
         &self.grid
@@ -435,6 +501,14 @@ impl Lattice {
     /// Counter incremented by every geometry update (lets solvers reuse factorisations).
     pub fn version(&self) -> u64 {
         self.version
+    }
+}
+
+/// Station `j` as meshed: a flared hinge column takes the hinge's flare as its slant.
+fn column_station(spec: &LatticeSpec, st: &SpanStation, j: usize) -> SpanStation {
+    match spec.hinge {
+        Some(h) if h.column == j => SpanStation { slant: h.flare, ..*st },
+        _ => *st,
     }
 }
 

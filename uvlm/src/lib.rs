@@ -51,8 +51,10 @@
 //! starts an unsteady run from it instead of impulsively.
 //!
 //! ## Public API at a glance
-//! * Geometry: [`SpanStation`] `{ origin, frame, chord, le_offset, slant }` (section frame columns
-//!   `x_s` span, `y_s` towards the leading edge, `z_s` normal), [`StationVelocity`]
+//! * Geometry: [`SpanStation`] `{ origin, frame, chord, le_offset, slant, flap }` (section frame
+//!   columns `x_s` span, `y_s` towards the leading edge, `z_s` normal; `flap`: an optional
+//!   control surface [`StationFlap`] `{ chord_fraction, deflection, rate }`, placed on the
+//!   lattice as in docs/uvlm.md §15 and reported by [`Lattice::column_flaps`]), [`StationVelocity`]
 //!   `{ linear, angular }`, [`LatticeSpec`] `{ n_chordwise, spacing, hinge: Option<HingeColumn
 //!   { column, flare }>, min_corner_angle_deg }`; [`Lattice::from_stations`],
 //!   [`Lattice::update_stations`], [`Lattice::set_grid`] (arbitrary node motion). The mesher
@@ -71,7 +73,8 @@
 //!   to check them against ([`gust_theory`]: Sears, exact Küssner).
 //! * Loads: [`Loads::nodal`] (per ring node, N), [`Loads::strip`] (per panel column),
 //!   [`Loads::total_force`], [`Loads::moment_about`], [`Loads::lift_drag`],
-//!   [`Loads::column_loads_inplace`] (force + moment about each station origin).
+//!   [`Loads::column_loads_inplace`] (force + moment about each station origin);
+//!   [`Uvlm::hinge_moment`] / [`hinge_moment`] (a control surface's moment about its hinge line).
 //! * Parameters ([`UvlmParams`], serde, unknown fields rejected): `rho`, `v_inf`, `n_wake_rows`,
 //!   `wake_convection` (prescribed / free), `wake_closure`, `bound_core` / `wake_core`
 //!   ([`CoreModel`]: SHARPy cut-off or Scully core sized from the local panel), `images`
@@ -98,6 +101,7 @@ mod aic;
 pub mod biot_savart;
 mod dense_lu;
 mod error;
+mod flap;
 pub mod flow;
 pub mod gust;
 pub mod gust_theory;
@@ -117,6 +121,7 @@ mod wake;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
 pub use error::{Result, UvlmError};
+pub use flap::{ColumnFlap, hinge_moment, hinge_row};
 pub use flow::{Flow, FlowField, Uniform};
 pub use gust::{Convection, OneMinusCosine, SharpEdged, Sinusoidal, VonKarman, VonKarmanParams};
 pub use images::ImagePlane;
@@ -126,7 +131,7 @@ pub use linear::{LinearGust, LinearUvlm, LinearWake, WakeNodeDerivatives, with_w
 pub use loads::{Loads, lift_drag_of, lump_columns};
 pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 pub use solver::Uvlm;
-pub use station::{SpanStation, StationVelocity};
+pub use station::{MAX_FLAP_DEFLECTION_DEG, SpanStation, StationFlap, StationVelocity};
 pub use stats::Stats;
 pub use treecode::{TreeStats, Treecode};
 pub use wake::Wake;

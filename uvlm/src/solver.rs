@@ -174,6 +174,12 @@ impl Uvlm {
     pub fn loads(&self) -> &Loads {
         &self.loads
     }
+    /// Hinge moment of the control surface covering grid columns `columns` (each must carry a
+    /// flap), from the loads of the last solve, N·m, positive trailing edge down: see
+    /// [`crate::hinge_moment`]. Call it after the solve, before the stations move again.
+    pub fn hinge_moment(&self, columns: std::ops::RangeInclusive<usize>) -> Result<f64> {
+        crate::flap::hinge_moment(&self.lattice, &self.loads, columns)
+    }
     /// Work counters.
     pub fn stats(&self) -> &Stats {
         &self.stats

@@ -29,12 +29,40 @@ pub struct SpanStation {
     pub le_offset: f64,
     /// Slant of the grid column in the section x-y plane, rad (|slant| < 80°); 0 = along `y_s`.
     pub slant: f64,
+    /// Control surface (flap) on this station's column, if any (see [`StationFlap`]).
+    pub flap: Option<StationFlap>,
+}
+
+/// Largest control-surface deflection, degrees (exclusive): beyond it the chordwise grid lines
+/// fold back at the hinge.
+pub const MAX_FLAP_DEFLECTION_DEG: f64 = 80.0;
+
+/// A trailing-edge control surface on one span station: the part of the column behind the hinge
+/// at chordwise fraction `η = 1 − chord_fraction` is rotated about the hinge line by
+/// `deflection` (docs/uvlm.md §15).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StationFlap {
+    /// Flap chord over section chord, `E` in (0, 1).
+    pub chord_fraction: f64,
+    /// Deflection δ, rad (|δ| < 80°), positive trailing edge down (towards `−z_s`, more lift):
+    /// a right-handed rotation about the hinge line oriented along increasing column index.
+    pub deflection: f64,
+    /// Deflection rate dδ/dt, rad/s, added to the node velocities behind the hinge when the
+    /// lattice is given station velocities (ignored for a lattice at rest).
+    pub rate: f64,
+}
+
+impl StationFlap {
+    /// A flap of chord fraction `chord_fraction` at a fixed deflection (rad).
+    pub fn new(chord_fraction: f64, deflection: f64) -> Self {
+        Self { chord_fraction, deflection, rate: 0.0 }
+    }
 }
 
 impl SpanStation {
-    /// A station with an unslanted column.
+    /// A station with an unslanted column and no control surface.
     pub fn new(origin: Vector3<f64>, frame: Matrix3<f64>, chord: f64, le_offset: f64) -> Self {
-        Self { origin, frame, chord, le_offset, slant: 0.0 }
+        Self { origin, frame, chord, le_offset, slant: 0.0, flap: None }
     }
 
     /// Position of the column point at chordwise fraction `eta` (0 = leading edge, 1 = trailing
@@ -66,6 +94,17 @@ impl SpanStation {
         }
         if !(self.slant.is_finite() && self.slant.abs() < 80f64.to_radians()) {
             return bad("slant", self.slant);
+        }
+        if let Some(f) = self.flap {
+            if !(f.chord_fraction.is_finite() && f.chord_fraction > 0.0 && f.chord_fraction < 1.0) {
+                return bad("flap.chord_fraction", f.chord_fraction);
+            }
+            if !(f.deflection.is_finite() && f.deflection.abs() < MAX_FLAP_DEFLECTION_DEG.to_radians()) {
+                return bad("flap.deflection", f.deflection);
+            }
+            if !f.rate.is_finite() {
+                return bad("flap.rate", f.rate);
+            }
         }
         Ok(())
     }
@@ -116,5 +155,19 @@ mod tests {
         st.frame = Matrix3::identity();
         st.origin.x = f64::NAN;
         assert!(matches!(st.validate(0), Err(UvlmError::InvalidStation { field: "origin", .. })));
+        st.origin.x = 0.0;
+        for (flap, field) in [
+            (StationFlap::new(1.0, 0.1), "flap.chord_fraction"),
+            (StationFlap::new(0.0, 0.1), "flap.chord_fraction"),
+            (StationFlap::new(0.3, 1.5), "flap.deflection"),
+            (StationFlap { rate: f64::INFINITY, ..StationFlap::new(0.3, 0.1) }, "flap.rate"),
+        ] {
+            st.flap = Some(flap);
+            assert!(
+                matches!(st.validate(2), Err(UvlmError::InvalidStation { station: 2, field: f, .. }) if f == field)
+            );
+        }
+        st.flap = Some(StationFlap::new(0.25, -0.2));
+        assert!(st.validate(2).is_ok());
     }
 }

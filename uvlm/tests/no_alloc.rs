@@ -90,3 +90,42 @@ fn threaded_step_does_not_allocate() {
         assert_eq!(allocations, 0, "{convection:?}, {aggregation:?}: {allocations} allocations in 8 threaded steps");
     }
 }
+
+/// A moving control surface (an aileron on inner stations 16..=22, deflection and rate changing
+/// every step) and its hinge moment allocate nothing either.
+#[test]
+fn flapped_step_does_not_allocate() {
+    let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+    let stations: Vec<Vec<SpanStation>> = (0..8)
+        .map(|k| {
+            let (delta, rate) = (0.1 * (k as f64).sin(), 10.0 * (k as f64).cos());
+            let mut st = wing.stations(0.02 * k as f64);
+            for s in &mut st[16..=22] {
+                s.flap = Some(StationFlap { rate, ..StationFlap::new(0.25, delta) });
+            }
+            st
+        })
+        .collect();
+    let vel = vec![StationVelocity::default(); stations[0].len()];
+    let lat = Lattice::from_stations(wing.spec(), &stations[0]).unwrap();
+    let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+    p.parallel = Parallel::Off;
+    p.n_wake_rows = 6;
+    p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+    let mut u = Uvlm::new(lat, p).unwrap();
+    for st in &stations {
+        u.update_stations(st, Some(&vel)).unwrap();
+        u.step(0.01).unwrap();
+    }
+    let (h, allocations) = alloc_count::count(|| {
+        let mut h = 0.0;
+        for k in 0..8 {
+            u.update_stations(&stations[7 - k], Some(&vel)).unwrap();
+            u.step(0.01).unwrap();
+            h += u.hinge_moment(16..=22).unwrap();
+        }
+        h
+    });
+    assert!(h.is_finite() && h != 0.0);
+    assert_eq!(allocations, 0, "{allocations} allocations in 8 flapped steps");
+}

@@ -2,6 +2,7 @@
 //! link instead of one per file); the allocation tests stay separate binaries because they install a counting global allocator.
 
 mod common;
+mod flap;
 mod flow;
 mod gust;
 mod hinge;

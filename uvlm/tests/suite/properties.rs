@@ -60,12 +60,16 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(12))]
 
     /// Rigidly moving the wing and the free stream together leaves the circulations unchanged and
-    /// rotates the loads (steady solve, then two unsteady steps), for the flared folded wing.
+    /// rotates the loads (steady solve, then two unsteady steps) and leaves the hinge moment
+    /// unchanged, for the flared folded wing with a deflected part-span flap on the inner wing.
     #[test]
-    fn solution_is_objective(axis in v3(), angle in -3.0..3.0f64, t in v3(), fold in -0.5..0.5f64) {
+    fn solution_is_objective(axis in v3(), angle in -3.0..3.0f64, t in v3(), fold in -0.5..0.5f64, delta in -0.4..0.4f64) {
         let q = rot(axis, angle);
         let wing = FlaredWing { aoa: 4f64.to_radians(), n_inner: 6, n_outer: 2, inner_length: 3.0, outer_length: 1.0, ..FlaredWing::default() };
-        let st = wing.stations(fold);
+        let mut st = wing.stations(fold);
+        for s in &mut st[2..=4] {
+            s.flap = Some(StationFlap::new(0.3, delta));
+        }
         let moved: Vec<SpanStation> = st
             .iter()
             .map(|s| SpanStation { origin: q * s.origin + Vector3::from(t), frame: q.matrix() * s.frame, ..*s })
@@ -75,12 +79,14 @@ proptest! {
             let lat = Lattice::from_stations(wing.spec(), stations).unwrap();
             let mut u = Uvlm::new(lat, UvlmParams::new(1.0, v_inf.into())).unwrap();
             let fs = u.solve_steady().unwrap().total_force();
+            let h = u.hinge_moment(2..=4).unwrap();
             u.step(0.01).unwrap();
             let fu = u.step(0.01).unwrap().total_force();
-            (u.gamma().to_vec(), Vector3::from(fs), Vector3::from(fu))
+            (u.gamma().to_vec(), Vector3::from(fs), Vector3::from(fu), h)
         };
-        let (g0, fs0, fu0) = run(&st, v);
-        let (g1, fs1, fu1) = run(&moved, q * v);
+        let (g0, fs0, fu0, h0) = run(&st, v);
+        let (g1, fs1, fu1, h1) = run(&moved, q * v);
+        prop_assert!((h0 - h1).abs() <= 1e-8 * (h0.abs() + 1e-3 * fs0.norm()));
         let gmax = g0.iter().fold(0.0f64, |a, g| a.max(g.abs()));
         for (a, b) in g0.iter().zip(&g1) {
             prop_assert!((a - b).abs() <= 1e-9 * gmax);
