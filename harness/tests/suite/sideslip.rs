@@ -60,6 +60,7 @@ fn a_symmetric_wing_in_sideslip_has_even_lift_and_odd_side_force() {
             chord: 0.25,
             le_offset: 0.0625,
             slant: 0.0,
+            flap: None,
         })
         .collect();
     let spec = case("healy_sideslip_flare20_pitch0.json", &[]);
