@@ -724,6 +724,7 @@ impl Problem {
                             inertia: p.inertia.into(),
                         })
                         .collect(),
+                    twist: scene::Twist::none(),
                 }
             })
             .collect();

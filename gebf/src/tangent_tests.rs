@@ -129,7 +129,7 @@ fn check_element(seed: u64, rot: f64) {
     };
     let elastic = |s: &ElementState, _g: &V3| {
         let mut r = Vec24::zeros();
-        add_elastic(s, le, &sec, 2, &mut r, None);
+        add_elastic(s, le, &sec, 2, None, &mut r, None);
         r
     };
     let gravity = |s: &ElementState, g: &V3| {
@@ -152,7 +152,7 @@ fn check_element(seed: u64, rot: f64) {
     }
     let mut an = Mat24::zeros();
     let mut r = Vec24::zeros();
-    add_elastic(&st, le, &sec, 2, &mut r, Some((&mut an, 1.0)));
+    add_elastic(&st, le, &sec, 2, None, &mut r, Some((&mut an, 1.0)));
     let e = rel_err(&an, &fd_matrix(elastic, &st, &g_a, Slot::Q));
     println!("seed {seed}: elastic rel err {e:.2e}");
     assert!(e < TOL, "elastic tangent (seed {seed}) rel err {e:.2e}");
@@ -305,6 +305,7 @@ fn random_model_full(
         section: sec,
         n_elements: n,
         point_masses: Vec::new(),
+        twist: crate::Twist::none(),
     };
     let mut bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
     if masses {
@@ -580,6 +581,7 @@ fn rescaled_crvs(masses: bool) {
         section: sec,
         n_elements: 2,
         point_masses,
+        twist: crate::Twist::none(),
     };
     let mut model = Model::new(&[body], &[], V3::new(0.3, -0.4, -9.8), Options::default()).unwrap();
     model.set_nodal_load(0, 4, NodalLoad { force: rng.v3(1.0), moment: rng.v3(1.0) }).unwrap();

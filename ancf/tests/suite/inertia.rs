@@ -49,6 +49,7 @@ fn loaded_body() -> BodySpec {
                 inertia: Vector3::new(0.002, 0.004, 0.005),
             },
         ],
+        twist: ancf::Twist::none(),
     }
 }
 

@@ -38,6 +38,7 @@ fn loaded_body() -> BodySpec {
             point_mass(1.4 / 3.0, [0.05, 0.0, 0.0], 0.2, [0.0, 0.0, 0.0]),
             point_mass(1.4, [-0.02, 0.15, 0.3], 1.5, [0.1, 0.06, 0.07]),
         ],
+        twist: gebf::Twist::none(),
     }
 }
 
