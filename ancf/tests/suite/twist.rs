@@ -72,7 +72,7 @@ fn a_twisted_body_at_rest_stays_at_rest() {
     }
     let mut ga = Structure::integrator(&model, IntegratorParams::new(0.8, 1e-3)).unwrap();
     let mut s = model.initial_state();
-    ga.initialize(&mut model, &mut s).unwrap();
+    ga.initialize(&model, &mut s).unwrap();
     for _ in 0..20 {
         ga.step(&mut model, &mut s).unwrap();
     }
