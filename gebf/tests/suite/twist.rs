@@ -4,7 +4,8 @@
 //! natural frequencies agree between ANCF and GEBF.
 use formulation::Structure;
 use gebf::{
-    BodySpec, ForceElement, JointSpec, Model, NodalLoad, Options, PointMass, Scene, StaticOptions, Twist, samples,
+    BodySpec, ForceElement, JointSpec, Model, NodalLoad, Options, PointMass, RigidPose, Scene, StaticOptions, Twist,
+    samples,
 };
 use genalpha::{ConstrainedSystem, IntegratorParams};
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -96,6 +97,27 @@ fn at_rest(scene: &Scene) {
     let drift = s.q.iter().zip(&s0.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     println!("after 20 steps: max |q − q_ref| = {drift:.2e}");
     assert!(drift < 1e-12, "drift {drift}");
+}
+
+/// The flared hinge's axis is fixed in the parent's twisted end section: the tip turned rigidly
+/// by φ about `−a`, `a = F_P(L) (sin β, cos β, 0)` with `F_P(L)` the inner body's twisted end
+/// section frame, keeps every joint (violation below 1e-12) and reads a fold angle of φ
+/// (1e-12), for φ up to ±2 rad.
+#[test]
+fn the_hinge_axis_is_fixed_in_the_parents_twisted_end_section() {
+    let scene = twisted_wing(false, false);
+    let model = Model::from_scene(&scene, Options::default()).unwrap();
+    let (inner, tip) = (&scene.bodies[0], &scene.bodies[1]);
+    let beta: f64 = 0.4;
+    let a = inner.section_frame(inner.length) * Vector3::new(beta.sin(), beta.cos(), 0.0);
+    for phi in [-2.0, -0.3, 0.5, 2.0] {
+        let rotation = Rotation3::from_scaled_axis(-a * phi).into_inner();
+        let pose = RigidPose { rotation, ..RigidPose::at_rest(tip.start) };
+        let q = model.rigid_state(&[RigidPose::at_rest(scene.bodies[0].start), pose]).unwrap().q;
+        let (violation, fold) = (model.constraint_residual(&q), model.fold_angle(&q, 1).unwrap());
+        println!("φ = {phi}: joint violation {violation:.1e}, fold {fold}");
+        assert!(violation < 1e-12 && (fold - phi).abs() < 1e-12, "φ = {phi}: {violation:e}, fold {fold}");
+    }
 }
 
 /// Tip position of a clamped body of `n_el` elements under a tip force, solved statically.
