@@ -822,6 +822,7 @@ impl Problem {
                             inertia: p.inertia.into(),
                         })
                         .collect(),
+                    twist: scene::Twist::none(),
                 }
             })
             .collect();

@@ -62,6 +62,13 @@ impl Element {
         }
     }
 
+    /// The same kernel with the strains' reference values taken from the element coordinates
+    /// `e0` (one element of a twisted body, docs/ancf.md §1): mass, stiffnesses and sampling are
+    /// unchanged.
+    pub fn with_reference(&self, e0: &[f64]) -> Self {
+        Self { plan: self.plan.with_reference(e0), ..self.clone() }
+    }
+
     /// `out += c · M_e · x` for 24-vectors.
     #[inline]
     pub fn add_mass_times(&self, c: f64, x: &[f64], out: &mut [f64]) {

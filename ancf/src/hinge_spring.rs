@@ -128,7 +128,7 @@ impl HingeSpring {
         let (child, gamma, base) = match jt {
             Joint::Ground { body, axis, .. } => {
                 let (n1, n2) = rotation_basis(axis);
-                let f0 = bodies[*body].spec.frame;
+                let f0 = bodies[*body].node_frame(0);
                 (slope_index(*body, 0), f0.transpose() * n1, Base::Ground { u1: n1, u2: n2 })
             }
             Joint::Flared { parent, child, alpha_p, rel0, lock: None, .. } => {

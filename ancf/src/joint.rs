@@ -82,10 +82,12 @@ impl Joint {
             JointSpec::GroundHinge { body, axis } => {
                 let b = &bodies[body];
                 let axis = axis.normalize();
-                Joint::Ground { body, axis, alpha: b.spec.frame.transpose() * axis, r0: b.spec.start }
+                Joint::Ground { body, axis, alpha: b.node_frame(0).transpose() * axis, r0: b.spec.start }
             }
             JointSpec::FlaredHinge { parent, child, beta } | JointSpec::LockedHinge { parent, child, beta } => {
-                let (fp, fc) = (bodies[parent].spec.frame, bodies[child].spec.frame);
+                // the parent's end and the child's start section frames (twisted, docs/ancf.md §5)
+                let (bp, bc) = (&bodies[parent], &bodies[child]);
+                let (fp, fc) = (bp.node_frame(bp.n_nodes - 1), bc.node_frame(0));
                 let alpha_p = Vector3::new(beta.sin(), beta.cos(), 0.0);
                 let alpha_c = fc.transpose() * (fp * alpha_p);
                 let lock = matches!(spec, JointSpec::LockedHinge { .. })
@@ -94,7 +96,7 @@ impl Joint {
             }
             JointSpec::Clamp { body } => {
                 let b = &bodies[body];
-                Joint::Clamp { body, r0: b.spec.start, frame0: b.spec.frame }
+                Joint::Clamp { body, r0: b.spec.start, frame0: b.node_frame(0) }
             }
         }
     }

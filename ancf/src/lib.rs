@@ -79,5 +79,5 @@ pub use modal::{Mode, ModeKind};
 pub use model::Model;
 pub use rigid::RigidPose;
 pub use skyline::SkylineLu;
-pub use spec::{BodySpec, Curvature, ForceElement, JointSpec, Options, PointMass, Scene, Section, SolvePath};
+pub use spec::{BodySpec, Curvature, ForceElement, JointSpec, Options, PointMass, Scene, Section, SolvePath, Twist};
 pub use strain::StrainKind;

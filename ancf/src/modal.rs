@@ -66,7 +66,7 @@ impl Model {
             .flat_map(|body| {
                 (0..body.n_elements()).map(move |el| {
                     let first = body.offset + NODE_DOF * el;
-                    (first, body.element.strain_gradients(&q_full[first..first + ELEMENT_DOF]))
+                    (first, body.kernel(el).strain_gradients(&q_full[first..first + ELEMENT_DOF]))
                 })
             })
             .collect();

@@ -13,6 +13,7 @@ use crate::node_tie::{NodeTie, TieMatrix};
 use crate::point_mass::{PointInertia, point_mass_matrix, point_mass_weights};
 use crate::reduction::Reduction;
 use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
+use crate::strain::twisted_reference_element;
 use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
@@ -27,12 +28,27 @@ pub(crate) struct Body {
     /// First global coordinate of the body.
     pub offset: usize,
     pub n_nodes: usize,
+    /// The kernel of every element (mass, strain plan with the straight reference).
     pub element: Element,
+    /// A twisted body's kernels, one per element, with the twisted reference strains
+    /// (docs/ancf.md §1); empty for an untwisted body, whose elements all use `element`.
+    pub twisted: Vec<Element>,
 }
 
 impl Body {
     pub(crate) fn n_elements(&self) -> usize {
         self.n_nodes - 1
+    }
+
+    /// The elastic kernel of element `k`.
+    #[inline]
+    pub(crate) fn kernel(&self, k: usize) -> &Element {
+        self.twisted.get(k).unwrap_or(&self.element)
+    }
+
+    /// The reference section frame (columns x, y, z, global) at node `n`.
+    pub(crate) fn node_frame(&self, n: usize) -> Matrix3<f64> {
+        self.spec.section_frame(n as f64 * self.element.l)
     }
 }
 
@@ -129,12 +145,16 @@ impl Model {
             .iter()
             .map(|spec| {
                 let l = spec.length / spec.n_elements as f64;
-                let b = Body {
-                    spec: spec.clone(),
-                    offset,
-                    n_nodes: spec.n_elements + 1,
-                    element: Element::new(l, &spec.section, options.curvature, options.penalty_factor),
+                let element = Element::new(l, &spec.section, options.curvature, options.penalty_factor);
+                let twisted = if spec.twist.is_none() {
+                    Vec::new()
+                } else {
+                    let theta = |n: usize| spec.twist.angle(n as f64 * l);
+                    (0..spec.n_elements)
+                        .map(|k| element.with_reference(&twisted_reference_element(l, theta(k), theta(k + 1))))
+                        .collect()
                 };
+                let b = Body { spec: spec.clone(), offset, n_nodes: spec.n_elements + 1, element, twisted };
                 offset += NODE_DOF * b.n_nodes;
                 b
             })
@@ -144,10 +164,10 @@ impl Model {
         let mut q_ref = vec![0.0; n_full];
         let mut weights = vec![1.0; n_full];
         for b in &bodies {
-            let f = b.spec.frame;
             for n in 0..b.n_nodes {
+                let f = b.node_frame(n);
                 let i = b.offset + NODE_DOF * n;
-                let r = b.spec.start + f.column(0) * (n as f64 * b.element.l);
+                let r = b.spec.start + b.spec.frame.column(0) * (n as f64 * b.element.l);
                 for k in 0..3 {
                     q_ref[i + k] = r[k];
                     q_ref[i + 3 + k] = f[(k, 0)];
@@ -467,7 +487,7 @@ impl Model {
                 mv.iter_mut().for_each(|x| *x = 0.0);
                 b.element.add_mass_times(1.0, &vf[range.clone()], &mut mv);
                 e.kinetic += 0.5 * mv.iter().zip(&vf[range.clone()]).map(|(a, b)| a * b).sum::<f64>();
-                e.elastic += b.element.elastic_energy(&qf[range]);
+                e.elastic += b.kernel(k).elastic_energy(&qf[range]);
             }
         }
         for p in &self.point_inertia {
@@ -694,7 +714,8 @@ impl Model {
         for b in &self.bodies {
             let n = b.n_elements();
             let mut k = 0;
-            while k + ELEMENT_LANES <= n {
+            // A twisted body's elements have kernels of their own: one at a time.
+            while b.twisted.is_empty() && k + ELEMENT_LANES <= n {
                 add_element_residuals::<ELEMENT_LANES>(b, k, q, v_dot, r);
                 k += ELEMENT_LANES;
             }
@@ -762,11 +783,11 @@ impl Model {
                 }
                 let e = &q[first..first + ELEMENT_DOF];
                 if at_rest && c_k != 0.0 {
-                    b.element.add_rest_tangent_upper(e, c_k, &mut ke);
+                    b.kernel(el).add_rest_tangent_upper(e, c_k, &mut ke);
                 } else if newton {
-                    b.element.add_newton_tangent_upper(e, c_k, &mut ke);
+                    b.kernel(el).add_newton_tangent_upper(e, c_k, &mut ke);
                 } else if c_k != 0.0 {
-                    b.element.add_elastic_tangent_upper(e, c_k, &mut ke);
+                    b.kernel(el).add_elastic_tangent_upper(e, c_k, &mut ke);
                 }
                 self.scatter_element(first, e_index, &mut ke, k);
                 e_index += 1;
@@ -901,7 +922,7 @@ impl Model {
                         ke[(3 * a + i, 3 * bb + i)] += c_m * m;
                     }
                 }
-                b.element.add_elastic_tangent(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
+                b.kernel(el).add_elastic_tangent(&q[first..first + ELEMENT_DOF], c_k, &mut ke);
                 k.add_block(first, first, &ke);
             }
         }
@@ -948,7 +969,7 @@ impl Model {
         for b in &self.bodies {
             for k in 0..b.n_elements() {
                 let first = b.offset + NODE_DOF * k;
-                for (x, y) in u.iter_mut().zip(b.element.elastic_energy_by_kind(&q[first..first + ELEMENT_DOF])) {
+                for (x, y) in u.iter_mut().zip(b.kernel(k).elastic_energy_by_kind(&q[first..first + ELEMENT_DOF])) {
                     *x += y;
                 }
             }
@@ -965,7 +986,7 @@ fn add_element_residuals<const L: usize>(b: &Body, k0: usize, q: &[f64], v_dot: 
     let first = |l: usize| b.offset + NODE_DOF * (k0 + l);
     let e: [&[f64]; L] = std::array::from_fn(|l| &q[first(l)..first(l) + ELEMENT_DOF]);
     let mut f = [[0.0; ELEMENT_DOF]; L];
-    b.element.elastic_forces(e, &mut f);
+    b.kernel(k0).elastic_forces(e, &mut f);
     for (l, fl) in f.iter().enumerate() {
         let range = first(l)..first(l) + ELEMENT_DOF;
         let out = &mut r[range.clone()];

@@ -87,13 +87,14 @@ impl Model {
             let f = p.rotation * b.spec.frame;
             for node in 0..b.n_nodes {
                 let i = b.offset + NODE_DOF * node;
+                let f_node = if b.twisted.is_empty() { f } else { p.rotation * b.node_frame(node) };
                 let arm = f.column(0) * (node as f64 * b.element.l);
                 let r = p.translation + arm;
                 let rd = p.velocity + p.angular_velocity.cross(&arm);
                 q[i..i + 3].copy_from_slice(r.as_slice());
                 v[i..i + 3].copy_from_slice(rd.as_slice());
                 for k in 0..3 {
-                    let slope: Vector3<f64> = f.column(k).into();
+                    let slope: Vector3<f64> = f_node.column(k).into();
                     let j = i + 3 * (k + 1);
                     q[j..j + 3].copy_from_slice(slope.as_slice());
                     v[j..j + 3].copy_from_slice(p.angular_velocity.cross(&slope).as_slice());

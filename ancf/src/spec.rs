@@ -4,7 +4,7 @@
 use crate::Error;
 use serde::{Deserialize, Serialize};
 
-pub use scene::{BodySpec, ForceElement, JointSpec, PointMass, Scene, Section};
+pub use scene::{BodySpec, ForceElement, JointSpec, PointMass, Scene, Section, Twist};
 
 /// Which form of the equations of motion the model presents to the integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

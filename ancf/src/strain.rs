@@ -236,6 +236,32 @@ fn group_strains(strains: &[SampledStrain]) -> (Vec<StrainGroup>, Vec<f64>) {
     (groups, hessians)
 }
 
+/// Element coordinates of a straight, unstrained element of length `l` along the x axis whose
+/// sections are twisted about it by `theta0` at its first node and `theta1` at its second, rad
+/// (the twisted reference of docs/ancf.md §1; slopes `r_y = R_x(θ) e_y`, `r_z = R_x(θ) e_z`).
+pub fn twisted_reference_element(l: f64, theta0: f64, theta1: f64) -> [f64; 24] {
+    let mut e = reference_element(l);
+    for (n, theta) in [theta0, theta1].into_iter().enumerate() {
+        let (s, c) = theta.sin_cos();
+        e[12 * n + 6..12 * n + 12].copy_from_slice(&[0.0, c, s, 0.0, -s, c]);
+    }
+    e
+}
+
+impl StrainPlan {
+    /// The same plan with every strain's reference value taken from the element coordinates
+    /// `e0` (a twisted reference, [`twisted_reference_element`]): the element is then free of
+    /// stress in the configuration `e0`.
+    pub fn with_reference(&self, e0: &[f64]) -> StrainPlan {
+        let f0: Vec<[f64; 3]> = self.fields.iter().map(|f| f.eval(e0)).collect();
+        let mut plan = self.clone();
+        for s in &mut plan.strains {
+            s.reference = strain_value(s, &f0);
+        }
+        plan
+    }
+}
+
 /// Element coordinates of a straight, unstrained element of length `l` along the global x axis.
 pub fn reference_element(l: f64) -> [f64; 24] {
     let mut e = [0.0; 24];

@@ -40,13 +40,23 @@ pub(crate) struct Body {
     pub cg: V3,
     /// The point masses of each element, at their parametric positions.
     pub point_masses: Vec<Vec<Slice>>,
+    /// A twisted body's reference twist of each node relative to A, φ_i = θ(s_i) − θ(0), rad
+    /// (its reference CRV is `φ_i e_x`); empty for an untwisted body (docs/gebf.md §4).
+    pub twist0: Vec<f64>,
 }
 
 impl Body {
     pub fn new(spec: &BodySpec, dof0: usize, coord0: usize) -> Self {
         // Orthonormalise the frame (it passed a 1e-9 check) so that the quaternion is exact.
-        let quat0 = Quaternion::from_rotation_matrix(&spec.frame);
+        // A follows the start section: twisted by θ(0) for a twisted body.
+        let quat0 = Quaternion::from_rotation_matrix(&spec.section_frame(0.0));
         let le = spec.length / spec.n_elements as f64;
+        let twist0 = if spec.twist.is_none() {
+            Vec::new()
+        } else {
+            let root = spec.twist.angle(0.0);
+            (0..=2 * spec.n_elements).map(|i| spec.twist.angle(0.5 * le * i as f64) - root).collect()
+        };
         let mut point_masses = vec![Vec::new(); spec.n_elements];
         for p in &spec.point_masses {
             // The element holding arclength `at` (the last one for the body's end).
@@ -66,6 +76,24 @@ impl Body {
             coord0,
             cg: V3::new(0.0, spec.section.cg_offset[0], spec.section.cg_offset[1]),
             point_masses,
+            twist0,
+        }
+    }
+    /// Reference CRV of node `i` relative to A (`None`: zero, an untwisted body).
+    #[inline]
+    pub fn node_psi0(&self, i: usize) -> Option<V3> {
+        self.twist0.get(i).map(|&phi| V3::new(phi, 0.0, 0.0))
+    }
+    /// The nodal reference twists of element `e` (`None` for an untwisted body).
+    #[inline]
+    pub fn element_twist(&self, e: usize) -> Option<&[f64; 3]> {
+        self.twist0.get(2 * e..2 * e + 3).map(|w| w.try_into().expect("three nodes"))
+    }
+    /// Reference orientation `C^{GB}_0` of node `i`'s section.
+    pub fn section_frame0(&self, i: usize) -> M3 {
+        match self.node_psi0(i) {
+            None => self.frame,
+            Some(psi0) => self.frame * crate::crv::rotation_matrix(&psi0),
         }
     }
     /// Number of nodes, including the clamped node 0.

@@ -76,8 +76,8 @@ impl FlaredHinge {
         let a_b = V3::new(beta.sin(), beta.cos(), 0.0);
         let z = V3::z();
         let n = [z, a_b.cross(&z), a_b];
-        // Reference: psi_n = 0, so C^{GBn}_0 = C^{GAp}_0.
-        let rel0 = bp.frame.transpose() * bc.frame;
+        // Reference: C^{GBn}_0 = C^{GAp}_0 C^{ApBn}(psi_n0), C^{GAp}_0 itself untwisted (psi_n0 = 0).
+        let rel0 = bp.section_frame0(bp.n_nodes() - 1).transpose() * bc.frame;
         Self { parent, child, a_b, n, n_ang: if locked { 3 } else { 2 }, a_c: rel0.transpose() * a_b, rel0 }
     }
 

@@ -104,7 +104,7 @@ pub use modal::Modes;
 pub use model::Model;
 pub use options::Options;
 pub use rigid::RigidPose;
-pub use scene::{ForceElement, PointMass, Scene};
+pub use scene::{ForceElement, PointMass, Scene, Twist};
 pub use section::Section;
 pub use statics::{StaticOptions, StaticSolution};
 

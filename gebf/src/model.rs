@@ -180,6 +180,9 @@ impl Model {
             for i in 1..b.n_nodes() {
                 let k = b.node_coord(i).expect("i ≥ 1");
                 q[k..k + 3].copy_from_slice(b.node_ref(i).as_slice());
+                if let Some(psi0) = b.node_psi0(i) {
+                    q[k + 3..k + 6].copy_from_slice(psi0.as_slice());
+                }
             }
             let f = b.frame_coord();
             q[f..f + 3].copy_from_slice(b.start.as_slice());
@@ -373,7 +376,15 @@ impl Model {
             for el in 0..b.n_elements {
                 let st = ElementState::gather(b, el, q, Some(v), None);
                 e.kinetic += add_element_inertia(&st, b, el, &mut res, None);
-                e.elastic += add_elastic(&st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, None);
+                e.elastic += add_elastic(
+                    &st,
+                    b.le,
+                    &b.section,
+                    self.options.n_gauss_stiffness,
+                    b.element_twist(el),
+                    &mut res,
+                    None,
+                );
                 e.potential += element_potential(&st, b, el, &self.gravity, &r_a, &c_ga);
             }
         }
@@ -426,7 +437,15 @@ impl Model {
         add_element_inertia(st, b, e, &mut res, Some((&mut m, unit(1.0, 0.0, 0.0))));
         add_element_inertia(st, b, e, &mut scratch, Some((&mut g, unit(0.0, 1.0, 0.0))));
         add_element_inertia(st, b, e, &mut scratch, Some((&mut k, unit(0.0, 0.0, 1.0))));
-        add_elastic(st, b.le, &b.section, self.options.n_gauss_stiffness, &mut res, Some((&mut k, 1.0)));
+        add_elastic(
+            st,
+            b.le,
+            &b.section,
+            self.options.n_gauss_stiffness,
+            b.element_twist(e),
+            &mut res,
+            Some((&mut k, 1.0)),
+        );
         add_element_gravity(st, b, e, g_a, &mut res, Some((&mut k, 1.0)));
         st.map_matrix(&res, &m, &g, &k, c)
     }
@@ -467,14 +486,22 @@ impl Model {
                         add_element_inertia(&st, b, e, &mut res, Some((&mut mat, *coeffs)));
                         // c_k = 0 leaves the stiffness out of the matrix, not out of the residual
                         let k_part = (coeffs.c_k != 0.0).then_some(coeffs.c_k);
-                        add_elastic(&st, b.le, &b.section, ng, &mut res, k_part.map(|c| (&mut mat, c)));
+                        add_elastic(
+                            &st,
+                            b.le,
+                            &b.section,
+                            ng,
+                            b.element_twist(e),
+                            &mut res,
+                            k_part.map(|c| (&mut mat, c)),
+                        );
                         add_element_gravity(&st, b, e, &g_a, &mut res, k_part.map(|c| (&mut mat, c)));
                         false
                     }
                 };
                 if plain_residual {
                     add_element_inertia(&st, b, e, &mut res, None);
-                    add_elastic(&st, b.le, &b.section, ng, &mut res, None);
+                    add_elastic(&st, b.le, &b.section, ng, b.element_twist(e), &mut res, None);
                     add_element_gravity(&st, b, e, &g_a, &mut res, None);
                 }
                 if let Some(r) = r.as_deref_mut() {

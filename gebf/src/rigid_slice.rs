@@ -292,7 +292,14 @@ pub(crate) fn slice_potential(
     let (n, _) = shape(s.xi, body.le);
     let psi = interp(&n, &st.psi);
     let cab = Tangent::new(&psi).rotation();
-    let mut dr = c_ga * (cab * s.offset) - body.frame * s.offset;
+    let ref_offset = match body.element_twist(e) {
+        None => body.frame * s.offset,
+        Some(phi) => {
+            let psi0 = V3::new(n[0] * phi[0] + n[1] * phi[1] + n[2] * phi[2], 0.0, 0.0);
+            body.frame * (Tangent::new(&psi0).rotation() * s.offset)
+        }
+    };
+    let mut dr = c_ga * (cab * s.offset) - ref_offset;
     if axis_part {
         let ref_r = [body.node_ref(2 * e), body.node_ref(2 * e + 1), body.node_ref(2 * e + 2)];
         dr += r_a + c_ga * interp(&n, &st.r) - (body.start + body.frame * interp(&n, &ref_r));

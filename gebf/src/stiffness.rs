@@ -2,7 +2,12 @@
 //!
 //! Strains at a Gauss point (reference straight along the A-frame x axis, `psi_0 = 0`):
 //!
-//! $$ \gamma = C^{BA}(\psi)\,R' - e_x,\qquad \kappa = T(\psi)\,\psi' ,$$
+//! $$ \gamma = C^{BA}(\psi)\,R' - e_x,\qquad \kappa = T(\psi)\,\psi' - \kappa_0 ,$$
+//!
+//! with `κ₀ = 0` for an untwisted body. A twisted body's reference has `psi_0(s) = φ(s) e_x`
+//! (`φ = θ − θ(0)`, the twist relative to the start section, which the frame A follows) and
+//! `κ₀ = T(psi_0) psi_0' = φ' e_x`, evaluated from the nodal twists exactly as `κ` is from the
+//! nodal CRVs, so the reference is free of stress to rounding (docs/gebf.md §4).
 //!
 //! energy `U = ½ ∫ (γᵀ diag(EA, GA_y, GA_z) γ + κᵀ diag(GJ, EI_yy, EI_zz) κ) ds`, integrated
 //! with `n_gauss` points (2 = reduced integration, as SHARPy/xbeam do, which avoids shear
@@ -22,20 +27,31 @@ use crate::section::SectionDiagonals;
 
 /// Add the elastic forces of one element to `res` (and `c_k ×` their tangent to `mat`);
 /// returns the element's elastic energy, J.
+/// `twist` holds the element's nodal reference twists φ (rad, relative to the body frame A),
+/// `None` for an untwisted body.
 pub(crate) fn add_elastic(
     st: &ElementState,
     le: f64,
     sec: &Section,
     n_gauss: usize,
+    twist: Option<&[f64; 3]>,
     res: &mut Vec24,
     mat: Option<(&mut Mat24, f64)>,
 ) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked just above).
-        return unsafe { add_elastic_avx2(st, le, sec, n_gauss, res, mat) };
+        return unsafe { add_elastic_avx2(st, le, sec, n_gauss, twist, res, mat) };
     }
-    add_elastic_generic(st, le, sec, n_gauss, res, mat)
+    add_elastic_generic(st, le, sec, n_gauss, twist, res, mat)
+}
+
+/// The reference curvature `κ₀ = T(psi_0) psi_0'` at shape values `n`, `dn` of the nodal
+/// reference twists `phi` (`psi_0 = φ e_x`).
+#[inline]
+fn reference_curvature(phi: &[f64; 3], n: &[f64; 3], dn: &[f64; 3]) -> V3 {
+    let at = |w: &[f64; 3]| V3::new(w[0] * phi[0] + w[1] * phi[1] + w[2] * phi[2], 0.0, 0.0);
+    Tangent::new(&at(n)).t * at(dn)
 }
 
 /// The same code compiled with AVX2 (wider vectors, no FMA: the same arithmetic, so the same
@@ -47,10 +63,11 @@ fn add_elastic_avx2(
     le: f64,
     sec: &Section,
     n_gauss: usize,
+    twist: Option<&[f64; 3]>,
     res: &mut Vec24,
     mat: Option<(&mut Mat24, f64)>,
 ) -> f64 {
-    add_elastic_generic(st, le, sec, n_gauss, res, mat)
+    add_elastic_generic(st, le, sec, n_gauss, twist, res, mat)
 }
 
 #[inline(always)]
@@ -59,6 +76,7 @@ fn add_elastic_generic(
     le: f64,
     sec: &Section,
     n_gauss: usize,
+    twist: Option<&[f64; 3]>,
     res: &mut Vec24,
     mut mat: Option<(&mut Mat24, f64)>,
 ) -> f64 {
@@ -82,7 +100,10 @@ fn add_elastic_generic(
         let cab = tg.rotation(); // C^{AB}
         let e = cab.tr_mul(&r_p);
         let gamma = e - ex;
-        let kappa = t * psi_p;
+        let kappa = match twist {
+            None => t * psi_p,
+            Some(phi) => t * psi_p - reference_curvature(phi, &n, &dn),
+        };
         let nf = sg.component_mul(&gamma);
         let mo = sk.component_mul(&kappa);
         energy += 0.5 * wt * (gamma.dot(&nf) + kappa.dot(&mo));
@@ -199,12 +220,12 @@ mod tests {
             let q = rotation_matrix(&rot);
             let st = rigidly_moved(le, c, &q);
             let mut res = Vec24::zeros();
-            let u = add_elastic(&st, le, &sec, 2, &mut res, None);
+            let u = add_elastic(&st, le, &sec, 2, None, &mut res, None);
             assert!(u.abs() < 1e-9 * sec.ea * le, "energy {u}");
             assert!(res.amax() < 1e-9 * sec.ea, "force {}", res.amax());
             // Full integration as well.
             let mut res = Vec24::zeros();
-            let u = add_elastic(&st, le, &sec, 3, &mut res, None);
+            let u = add_elastic(&st, le, &sec, 3, None, &mut res, None);
             assert!(u.abs() < 1e-9 * sec.ea * le && res.amax() < 1e-9 * sec.ea);
         }
     }
@@ -224,14 +245,14 @@ mod tests {
             st.psi[k] = V3::new(0.0, 0.0, kappa * s);
         }
         let mut res = Vec24::zeros();
-        let u0 = add_elastic(&st, le, &sec, 2, &mut res, None);
+        let u0 = add_elastic(&st, le, &sec, 2, None, &mut res, None);
         let q = rotation_matrix(&V3::new(0.7, -0.5, 0.9));
         let mut moved = st;
         for k in 0..3 {
             moved.r[k] = q * st.r[k];
             moved.psi[k] = from_rotation_matrix(&(q * rotation_matrix(&st.psi[k])));
         }
-        let u1 = add_elastic(&moved, le, &sec, 2, &mut res, None);
+        let u1 = add_elastic(&moved, le, &sec, 2, None, &mut res, None);
         let rel = (u1 - u0).abs() / u0;
         println!("bent element: energy {u0:.6e}, after a rigid rotation {u1:.6e} (rel change {rel:.2e})");
         assert!(rel < 1e-5, "{rel}");

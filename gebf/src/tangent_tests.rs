@@ -129,7 +129,7 @@ fn check_element(seed: u64, rot: f64) {
     };
     let elastic = |s: &ElementState, _g: &V3| {
         let mut r = Vec24::zeros();
-        add_elastic(s, le, &sec, 2, &mut r, None);
+        add_elastic(s, le, &sec, 2, None, &mut r, None);
         r
     };
     let gravity = |s: &ElementState, g: &V3| {
@@ -152,7 +152,7 @@ fn check_element(seed: u64, rot: f64) {
     }
     let mut an = Mat24::zeros();
     let mut r = Vec24::zeros();
-    add_elastic(&st, le, &sec, 2, &mut r, Some((&mut an, 1.0)));
+    add_elastic(&st, le, &sec, 2, None, &mut r, Some((&mut an, 1.0)));
     let e = rel_err(&an, &fd_matrix(elastic, &st, &g_a, Slot::Q));
     println!("seed {seed}: elastic rel err {e:.2e}");
     assert!(e < TOL, "elastic tangent (seed {seed}) rel err {e:.2e}");
@@ -290,6 +290,19 @@ fn random_model_full(
     springs: bool,
     masses: bool,
 ) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    random_model_twisted(rng, beta, locked, springs, masses, false)
+}
+
+/// [`random_model_full`], optionally with twisted bodies (a linear twist, a table with a
+/// breakpoint inside an element, a constant twist; docs/gebf.md §4).
+fn random_model_twisted(
+    rng: &mut Lcg,
+    beta: f64,
+    locked: bool,
+    springs: bool,
+    masses: bool,
+    twisted: bool,
+) -> (Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let sec = unit_section();
     let f1 = rotation_matrix(&V3::new(0.1, -0.2, 0.3));
     let f2 = rotation_matrix(&V3::new(-0.3, 0.2, 0.4));
@@ -305,6 +318,7 @@ fn random_model_full(
         section: sec,
         n_elements: n,
         point_masses: Vec::new(),
+        twist: crate::Twist::none(),
     };
     let mut bodies = vec![body("a", s1, f1, 1.1, 2), body("b", s2, f2, 0.9, 2), body("c", s3, f3, 0.7, 1)];
     if masses {
@@ -314,6 +328,11 @@ fn random_model_full(
         bodies[1].point_masses = vec![pm(0.45, V3::new(-0.05, 0.1, 0.2), 1.2)];
         bodies[2].section.cg_offset = [-0.1, 0.04];
         bodies[2].point_masses = vec![pm(0.0, V3::new(0.05, 0.1, 0.0), 0.6), pm(0.5, V3::zeros(), 0.4)];
+    }
+    if twisted {
+        bodies[0].twist = crate::Twist::linear(0.3, 1.4, 1.1);
+        bodies[1].twist = crate::Twist::table(vec![(0.0, -0.2), (0.3, 0.5), (0.9, 0.1)]);
+        bodies[2].twist = crate::Twist::table(vec![(0.2, 0.8)]);
     }
     let joints = vec![
         JointSpec::GroundHinge { body: 0, axis: V3::new(0.2, 1.0, 0.1) },
@@ -428,8 +447,12 @@ fn check_model_with(seed: u64, beta: f64, locked: bool, springs: bool) {
 }
 
 fn check_model_full(seed: u64, beta: f64, locked: bool, springs: bool, masses: bool) {
+    check_model_twisted(seed, beta, locked, springs, masses, false);
+}
+
+fn check_model_twisted(seed: u64, beta: f64, locked: bool, springs: bool, masses: bool, twisted: bool) {
     let mut rng = Lcg(seed);
-    let (model, q, v, a, mu) = random_model_full(&mut rng, beta, locked, springs, masses);
+    let (model, q, v, a, mu) = random_model_twisted(&mut rng, beta, locked, springs, masses, twisted);
     let n = model.n_dof();
     let nc = model.n_velocity_constraints();
     check_iteration_matrix(&model, &q, &v, &a, &format!("model iteration matrix (seed {seed})"));
@@ -529,6 +552,14 @@ fn model_tangents_with_point_masses_and_offsets() {
     check_model_full(13, -0.9, true, false, true);
 }
 
+/// Twisted bodies (the reference curvature in the strain, the twisted reference CRVs and the
+/// flared hinges' reference relative rotations), with point masses, offsets and springs.
+#[test]
+fn model_tangents_with_twisted_bodies() {
+    check_model_twisted(4, 0.6, false, true, true, true);
+    check_model_twisted(13, -0.9, true, false, true, true);
+}
+
 /// The locked hinge's sixth (axial) angular row in every tangent.
 #[test]
 fn model_tangents_with_a_locked_hinge() {
@@ -580,6 +611,7 @@ fn rescaled_crvs(masses: bool) {
         section: sec,
         n_elements: 2,
         point_masses,
+        twist: crate::Twist::none(),
     };
     let mut model = Model::new(&[body], &[], V3::new(0.3, -0.4, -9.8), Options::default()).unwrap();
     model.set_nodal_load(0, 4, NodalLoad { force: rng.v3(1.0), moment: rng.v3(1.0) }).unwrap();

@@ -27,6 +27,7 @@ fn main() {
         section,
         n_elements,
         point_masses: Vec::new(),
+        twist: ancf::Twist::none(),
     };
     let bodies = [body("inner", 0.0, 12.0, 12), body("outer", 12.0, 4.0, 4)];
     let joints =

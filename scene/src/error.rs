@@ -155,4 +155,16 @@ pub enum Error {
         /// The inertias given.
         inertia: [f64; 3],
     },
+    /// A twist table whose arclengths do not increase strictly.
+    #[error(
+        "{field}: s = {value} does not exceed the previous point's s = {previous} (the table must increase strictly)"
+    )]
+    TwistNotIncreasing {
+        /// Field path, e.g. `bodies[1].twist[2].s`.
+        field: String,
+        /// The offending arclength, m.
+        value: f64,
+        /// The previous point's arclength, m.
+        previous: f64,
+    },
 }

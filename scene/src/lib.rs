@@ -1,7 +1,8 @@
 //! The scene both beam formulations build from.
 //!
 //! A [`Scene`] is a list of straight beam [`BodySpec`]s in their reference configuration (each
-//! with a cross-[`Section`] and optional [`PointMass`]es), the [`JointSpec`]s that connect them to
+//! with a cross-[`Section`], optional [`PointMass`]es and an optional built-in [`Twist`] of its
+//! sections), the [`JointSpec`]s that connect them to
 //! each other and to ground, the [`ForceElement`]s that act across joints (hinge springs and
 //! dampers), and gravity. Bodies are referred to by index into the body list, joints by index into
 //! the joint list.
@@ -19,6 +20,7 @@ mod force;
 mod joint;
 pub mod samples;
 mod section;
+pub mod twist;
 mod validate;
 
 pub use body::{BodySpec, PointMass, RigidBodyInertia};
@@ -26,6 +28,7 @@ pub use error::Error;
 pub use force::ForceElement;
 pub use joint::JointSpec;
 pub use section::Section;
+pub use twist::Twist;
 
 use nalgebra::Vector3;
 

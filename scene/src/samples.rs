@@ -1,7 +1,7 @@
 //! A catalogue of reference scenes, shared by both formulations' tests and benchmarks and by the
 //! harness (re-exported as `ancf::samples` and `gebf::samples`).
 
-use crate::{BodySpec, ForceElement, JointSpec, PointMass, Scene, Section};
+use crate::{BodySpec, ForceElement, JointSpec, PointMass, Scene, Section, Twist};
 use nalgebra::{Matrix3, Vector3};
 
 /// The paper's double-pendulum section (Otsuka, Cheng & Palacios, ICAS 2024, Tables 1–2):
@@ -35,6 +35,7 @@ fn two_bodies(section: Section, n_el: usize, beta: f64) -> (Vec<BodySpec>, Vec<J
         section,
         n_elements: n_el,
         point_masses: Vec::new(),
+        twist: Twist::none(),
     };
     let bodies = vec![body("body1", 0.0), body("body2", 0.5)];
     let joints = vec![
@@ -88,6 +89,7 @@ pub fn cantilever(section: Section, length: f64, n_el: usize) -> (Vec<BodySpec>,
         section,
         n_elements: n_el,
         point_masses: Vec::new(),
+        twist: Twist::none(),
     };
     (vec![body], vec![JointSpec::Clamp { body: 0 }])
 }
@@ -127,6 +129,7 @@ pub fn free_hinge_wing(flare_deg: f64, k: f64) -> Scene {
         section: free_hinge_section(),
         n_elements,
         point_masses,
+        twist: Twist::none(),
     };
     Scene {
         forces: vec![ForceElement::HingeSpring { joint: 1, stiffness: k, damping: 0.0, rest: 0.0 }],
@@ -158,4 +161,87 @@ pub fn free_hinge_tip_inertia(flare_deg: f64) -> f64 {
     let r = Vector3::new(p.at, 0.0, 0.0) + p.offset;
     let point = p.mass * (r.norm_squared() - r.dot(&a).powi(2)) + a.dot(&p.inertia.component_mul(&a));
     line + rotary + point
+}
+
+/// The section of the pretwisted cantilever ([`pretwisted_cantilever`]): EI_zz = 10 EI_yy
+/// (1 and 10 N·m²), GJ = 2 N·m², near-rigid axial and shear stiffness (EA = GA = 1e7 N), and
+/// J_xx = J_yy + J_zz so that ANCF's slope inertias are exact.
+pub fn pretwisted_section() -> Section {
+    Section::centred(1.0, 4e-4, 1e-4, 3e-4, 1e7, 1e7, 1e7, 2.0, 1.0, 10.0)
+}
+
+/// A cantilever of `length` along +X from the origin, clamped at the origin, with a linear
+/// built-in twist from `root` to `tip` (rad) and `n_el` elements.
+pub fn pretwisted_cantilever(
+    section: Section,
+    length: f64,
+    n_el: usize,
+    root: f64,
+    tip: f64,
+) -> (Vec<BodySpec>, Vec<JointSpec>) {
+    let (mut bodies, joints) = cantilever(section, length, n_el);
+    bodies[0].twist = Twist::linear(root, tip, length);
+    (bodies, joints)
+}
+
+/// The exact linear tip compliance of a body clamped at its start, loaded by a force `F` on the
+/// axis of its end section: tip displacement `u = G F`, m/N (global components),
+///
+/// $$ G = \int_0^L \big[(L-s)^2\,X^T R\,C^{-1} R^T X + R\,S^{-1} R^T\big]\,ds, $$
+///
+/// with `X = [x]×` the skew matrix of the body's axis, `R(s)` its section frame (twisted),
+/// `C = diag(GJ, EI_yy, EI_zz)` and `S = diag(EA, GA_y, GA_z)`: the moment `(L − s) x × F` bends
+/// the section about its own (rotating) principal axes, the curvature integrates to the
+/// rotation and the rotation (with the shear and axial strain) to the tip displacement. It is
+/// Timoshenko's cantilever with the principal axes turning along the span; untwisted it gives
+/// `L³/(3EI) + L/GA` across and `L/EA` along. Integrated by [`Twist::quadrature`], exact to
+/// rounding for a piecewise-linear twist.
+pub fn cantilever_tip_compliance(body: &BodySpec) -> Matrix3<f64> {
+    let sec = &body.section;
+    let c_inv = Matrix3::from_diagonal(&Vector3::new(1.0 / sec.gj, 1.0 / sec.ei_yy, 1.0 / sec.ei_zz));
+    let s_inv = Matrix3::from_diagonal(&Vector3::new(1.0 / sec.ea, 1.0 / sec.ga_y, 1.0 / sec.ga_z));
+    let x = body.frame.column(0).cross_matrix();
+    let l = body.length;
+    body.twist.quadrature(l).into_iter().fold(Matrix3::zeros(), |g, (s, w)| {
+        let r = body.section_frame(s);
+        let arm = (l - s) * (l - s);
+        g + (x.transpose() * r * c_inv * r.transpose() * x * arm + r * s_inv * r.transpose()) * w
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// Untwisted: Timoshenko's cantilever (1e-14). A quarter turn of twist, θ = k s with
+    /// `kL = π/2`, weighs the two bending compliances with `∫ (L−s)² cos²θ`, `∫ (L−s)² sin²θ`
+    /// and couples y and z through `∫ (L−s)² sin θ cos θ`, integrated by parts in closed form
+    /// below (1e-13).
+    #[test]
+    fn the_tip_compliance_has_its_closed_forms() {
+        let sec = pretwisted_section();
+        let l = 1.3;
+        let (b, _) = cantilever(sec, l, 1);
+        let g = cantilever_tip_compliance(&b[0]);
+        assert_relative_eq!(g[(2, 2)], l.powi(3) / (3.0 * sec.ei_yy) + l / sec.ga_z, max_relative = 1e-14);
+        assert_relative_eq!(g[(1, 1)], l.powi(3) / (3.0 * sec.ei_zz) + l / sec.ga_y, max_relative = 1e-14);
+        assert_relative_eq!(g[(0, 0)], l / sec.ea, max_relative = 1e-14);
+        let (b, _) = pretwisted_cantilever(sec, l, 1, 0.0, std::f64::consts::FRAC_PI_2);
+        let g = cantilever_tip_compliance(&b[0]);
+        // ∫ (L−s)² cos²(ks) ds, ∫ (L−s)² sin²(ks) ds, ∫ (L−s)² sin(ks) cos(ks) ds with kL = π/2:
+        // ∫ (L−s)² cos(2ks) ds = [(L−s)² sin 2ks/(2k)] + ∫ (L−s) sin(2ks)/k ds = L/(2k²) − sin(2kL)/(4k³) = L/(2k²)
+        // ∫ (L−s)² sin(2ks) ds = L²/(2k) − ∫ (L−s) cos(2ks)/k ds = L²/(2k) − (1 − cos 2kL)/(4k³) = L²/(2k) − 1/(2k³)
+        let k = std::f64::consts::FRAC_PI_2 / l;
+        let (i0, ic2, is2) = (l.powi(3) / 3.0, l / (2.0 * k * k), l * l / (2.0 * k) - 1.0 / (2.0 * k.powi(3)));
+        let (cc, ss, sc) = (0.5 * (i0 + ic2), 0.5 * (i0 - ic2), 0.5 * is2);
+        // force along z bends about the section's y (EI_yy) where θ = 0, about its z where θ = 90°
+        let gzz = cc / sec.ei_yy + ss / sec.ei_zz + l / sec.ga_z;
+        let gyy = ss / sec.ei_yy + cc / sec.ei_zz + l / sec.ga_y;
+        let gyz = -sc * (1.0 / sec.ei_yy - 1.0 / sec.ei_zz);
+        assert_relative_eq!(g[(2, 2)], gzz, max_relative = 1e-13);
+        assert_relative_eq!(g[(1, 1)], gyy, max_relative = 1e-13);
+        assert_relative_eq!(g[(1, 2)], gyz, max_relative = 1e-13);
+        assert_relative_eq!(g[(2, 1)], gyz, max_relative = 1e-13);
+    }
 }

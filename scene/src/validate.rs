@@ -73,6 +73,7 @@ impl BodySpec {
         if self.n_elements == 0 {
             return Err(Error::ZeroElements { field: format!("{path}.n_elements") });
         }
+        self.validate_twist(&path)?;
         for (k, p) in self.point_masses.iter().enumerate() {
             let pm = format!("{path}.point_masses[{k}]");
             finite(|| format!("{pm}.at"), p.at)?;
@@ -89,6 +90,30 @@ impl BodySpec {
             if i.x > i.y + i.z + slack || i.y > i.x + i.z + slack || i.z > i.x + i.y + slack {
                 return Err(Error::ImpossibleInertia { field: format!("{pm}.inertia"), inertia: i.into() });
             }
+        }
+        Ok(())
+    }
+}
+
+impl BodySpec {
+    /// The twist table: every point finite, `s` strictly increasing and within `[0, length]`
+    /// (1e-12 relative slack). Fields are named `bodies[i].twist[k].s` / `.angle`.
+    fn validate_twist(&self, path: &str) -> Result<(), Error> {
+        let slack = 1e-12 * self.length;
+        let mut previous: Option<f64> = None;
+        for (k, &(s, angle)) in self.twist.points().iter().enumerate() {
+            let field = format!("{path}.twist[{k}]");
+            finite(|| format!("{field}.s"), s)?;
+            finite(|| format!("{field}.angle"), angle)?;
+            if s < -slack || s > self.length + slack {
+                return Err(Error::OutOfRange { field: format!("{field}.s"), value: s, min: 0.0, max: self.length });
+            }
+            if let Some(p) = previous
+                && s <= p
+            {
+                return Err(Error::TwistNotIncreasing { field: format!("{field}.s"), value: s, previous: p });
+            }
+            previous = Some(s);
         }
         Ok(())
     }
@@ -217,6 +242,7 @@ mod tests {
             section,
             n_elements: 2,
             point_masses: Vec::new(),
+            twist: crate::Twist::none(),
         };
         Scene::new(
             vec![body("a", 0.0), body("b", 0.5)],
@@ -269,6 +295,18 @@ mod tests {
         s.joints[1] = JointSpec::LockedHinge { parent: 0, child: 1, beta: 0.5 };
         s.forces[0] = ForceElement::HingeSpring { joint: 1, stiffness: 2.0, damping: 0.0, rest: 0.0 };
         assert_eq!(msg(&s), "joints[1].spring: a hinge spring needs a free ground or flared hinge, not a locked hinge");
+        let mut s = pendulum();
+        s.bodies[1].twist = crate::Twist::table(vec![(0.0, 0.1), (0.3, f64::NAN)]);
+        assert_eq!(msg(&s), "bodies[1].twist[1].angle: NaN is not a finite number");
+        s.bodies[1].twist = crate::Twist::table(vec![(0.0, 0.1), (0.6, 0.2)]);
+        assert_eq!(msg(&s), "bodies[1].twist[1].s: 0.6 is not in [0, 0.5]");
+        s.bodies[1].twist = crate::Twist::table(vec![(0.2, 0.1), (0.2, 0.2)]);
+        assert_eq!(
+            msg(&s),
+            "bodies[1].twist[1].s: s = 0.2 does not exceed the previous point's s = 0.2 (the table must increase strictly)"
+        );
+        s.bodies[1].twist = crate::Twist::linear(0.1, 0.2, 0.5 * (1.0 + 1e-13));
+        s.validate().unwrap();
         let mut s = pendulum();
         s.joints.push(JointSpec::Clamp { body: 1 });
         assert_eq!(msg(&s), "joints[2].body: body 1 is already attached at its start by joints[1]");

@@ -1,9 +1,24 @@
 //! Model-level derivative checks: the iteration matrix the integrator factorises equals central
 //! differences of the residual (both solve paths, with a configuration-dependent moment load),
-//! and the constraint Jacobian equals central differences of Φ.
-use ancf::{Model, Options, PointLoad, SolvePath, samples};
+//! and the constraint Jacobian equals central differences of Φ; each also on twisted bodies
+//! (a linear twist and a table with a breakpoint inside an element, docs/ancf.md §1).
+use ancf::{BodySpec, ForceElement, JointSpec, Model, Options, PointLoad, Scene, SolvePath, Twist, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use nalgebra::Vector3;
+
+/// The paper's double pendulum, its bodies twisted when `twisted` (with a spring on the flared
+/// hinge then, whose reference angle involves the twisted end and start sections).
+fn pendulum(beta: f64, n_el: usize, twisted: bool, options: Options) -> Model {
+    let (mut bodies, joints, g): (Vec<BodySpec>, Vec<JointSpec>, _) = samples::double_pendulum(1.0, beta, n_el);
+    let mut scene = Scene::new(bodies.clone(), joints, g);
+    if twisted {
+        bodies[0].twist = Twist::linear(0.3, 1.1, 0.5);
+        bodies[1].twist = Twist::table(vec![(0.0, -0.2), (0.2, 0.4), (0.5, 0.1)]);
+        scene.bodies = bodies;
+        scene.forces = vec![ForceElement::HingeSpring { joint: 1, stiffness: 0.7, damping: 0.0, rest: 0.2 }];
+    }
+    Model::from_scene(&scene, options).unwrap()
+}
 
 fn deformed_state(model: &Model) -> Vec<f64> {
     let q0 = model.initial_state().q;
@@ -17,9 +32,10 @@ fn max_rel(a: &DenseMatrix, b: &DenseMatrix) -> f64 {
 
 #[test]
 fn iteration_matrix_equals_finite_differences_of_the_residual() {
-    for path in [SolvePath::Dae, SolvePath::Ode] {
-        let (bodies, joints, g) = samples::double_pendulum(1.0, 45.0, 3);
-        let mut model = Model::new(&bodies, &joints, g, Options { path, ..Default::default() }).unwrap();
+    for (path, twisted) in
+        [(SolvePath::Dae, false), (SolvePath::Ode, false), (SolvePath::Dae, true), (SolvePath::Ode, true)]
+    {
+        let mut model = pendulum(45.0, 3, twisted, Options { path, ..Default::default() });
         model
             .set_point_loads(&[
                 PointLoad::moment(1, 0.31, Vector3::new(0.4, -1.2, 0.7)),
@@ -60,17 +76,16 @@ fn iteration_matrix_equals_finite_differences_of_the_residual() {
                 }
             }
             let err = max_rel(&k, &fd);
-            println!("{path:?} c_m {c_m} c_k {c_k}: relative error {err:.2e}");
-            assert!(err < 1e-6, "{path:?}: {err}");
+            println!("{path:?} twisted {twisted} c_m {c_m} c_k {c_k}: relative error {err:.2e}");
+            assert!(err < 1e-6, "{path:?} twisted {twisted}: {err}");
         }
     }
 }
 
 #[test]
 fn constraint_jacobian_equals_finite_differences() {
-    for beta in [0.0, 30.0, 90.0, -60.0] {
-        let (bodies, joints, g) = samples::double_pendulum(1.0, beta, 2);
-        let model = Model::new(&bodies, &joints, g, Options::default()).unwrap();
+    for (beta, twisted) in [(0.0, false), (30.0, false), (90.0, false), (-60.0, false), (30.0, true), (90.0, true)] {
+        let model = pendulum(beta, 2, twisted, Options::default());
         let (n, m) = (model.n_dof(), model.n_holonomic());
         let q = deformed_state(&model);
         let mut j = DenseMatrix::zeros(m, n);
@@ -88,8 +103,8 @@ fn constraint_jacobian_equals_finite_differences() {
             }
         }
         let err = max_rel(&j, &fd);
-        assert!(err < 1e-8, "beta {beta}: {err}");
+        assert!(err < 1e-8, "beta {beta} twisted {twisted}: {err}");
         // rank 12 for every β, including 90° (no division by cos β anywhere)
-        assert_eq!(model.n_reduced_coords(), n - 12, "beta {beta}");
+        assert_eq!(model.n_reduced_coords(), n - 12, "beta {beta} twisted {twisted}");
     }
 }

@@ -16,3 +16,4 @@ mod properties;
 mod rigid_limit;
 mod spring;
 mod statics;
+mod twist;

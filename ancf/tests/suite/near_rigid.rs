@@ -32,6 +32,7 @@ pub fn healy_wing(ga: f64, ea: f64, flare_deg: f64, gravity: Vector3<f64>) -> Sc
         section: section(1.0),
         n_elements: 8,
         point_masses: Vec::new(),
+        twist: ancf::Twist::none(),
     };
     let tip = BodySpec {
         name: "tip".into(),
@@ -46,6 +47,7 @@ pub fn healy_wing(ga: f64, ea: f64, flare_deg: f64, gravity: Vector3<f64>) -> Sc
             mass: 0.061,
             inertia: Vector3::new(1.89e-5, 1.16e-4, 1.349e-4),
         }],
+        twist: ancf::Twist::none(),
     };
     Scene {
         forces: vec![ForceElement::HingeSpring { joint: 1, stiffness: 1e-4, damping: 0.0, rest: 0.0 }],

@@ -99,6 +99,7 @@ fn scene(
         section: samples::paper_section(c),
         n_elements,
         point_masses: Vec::new(),
+        twist: ancf::Twist::none(),
     };
     let bodies = vec![body("p", start, lengths.0, fp, n_el.0), body("c", hinge0, lengths.1, fc, n_el.1)];
     let mut joints = Vec::new();

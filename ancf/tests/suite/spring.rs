@@ -128,6 +128,7 @@ fn stiff_body(length: f64) -> BodySpec {
         section: samples::paper_section(100.0),
         n_elements: 4,
         point_masses: Vec::new(),
+        twist: ancf::Twist::none(),
     }
 }
 

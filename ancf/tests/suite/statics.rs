@@ -222,6 +222,7 @@ fn bend_scene(n: usize) -> ancf::Scene {
                 section,
                 n_elements: 1,
                 point_masses: Vec::new(),
+                twist: ancf::Twist::none(),
             }
         })
         .collect();

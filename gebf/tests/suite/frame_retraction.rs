@@ -20,6 +20,7 @@ fn final_error(dt: f64) -> f64 {
         section: samples::paper_section(1.0),
         n_elements: 2,
         point_masses: Vec::new(),
+        twist: gebf::Twist::none(),
     };
     let mut m = Model::new(&[body], &[], Vector3::zeros(), Options::default()).unwrap();
     let mut s = m.initial_state();

@@ -38,6 +38,7 @@ fn loaded_body() -> BodySpec {
             point_mass(1.4 / 3.0, [0.05, 0.0, 0.0], 0.2, [0.0, 0.0, 0.0]),
             point_mass(1.4, [-0.02, 0.15, 0.3], 1.5, [0.1, 0.06, 0.07]),
         ],
+        twist: gebf::Twist::none(),
     }
 }
 
@@ -86,7 +87,37 @@ fn rigid_body_from(m6: &Matrix6<f64>, start: Vector3<f64>) -> (f64, Vector3<f64>
 /// the body (the offsets turn with the sections).
 #[test]
 fn rigid_body_inertia_from_kinetic_energy_matches_the_reference() {
-    let body = loaded_body();
+    let err = inertia_error(loaded_body());
+    assert!(err < 1e-12, "{err:e}");
+}
+
+/// The same on the loaded body twisted (a table with a breakpoint on a node, −0.2 to 1.2 rad):
+/// the rotated sections' inertia and centre-of-mass offset are integrated by the 3-point rule,
+/// exact for the twisted sections up to its error on `cos 2θ` over an element (`O(Δ⁶)`):
+/// measured 5.9e-10, 9.1e-12, 1.4e-13 at 6, 12 and 24 elements; tolerance 1e-10 from 12
+/// elements on. (A breakpoint inside an element is interpolated quadratically, an `O(h²)` error
+/// there: 7.0e-5, 8.7e-6, 6.5e-6 with the breakpoint at 0.5 m.)
+#[test]
+fn twisted_rigid_body_inertia_converges_to_the_reference() {
+    let errors: Vec<f64> = [6, 12, 24]
+        .into_iter()
+        .map(|n_elements| {
+            let body = BodySpec {
+                n_elements,
+                twist: gebf::Twist::table(vec![(0.0, 0.3), (0.7, 1.2), (1.4, -0.2)]),
+                ..loaded_body()
+            };
+            inertia_error(body)
+        })
+        .collect();
+    println!("twisted body: worst relative errors {errors:?}");
+    assert!(errors[1] < 1e-10 && errors[2] < 1e-10, "{errors:?}");
+}
+
+/// The worst relative error of the model's mass, centre and inertia tensor against
+/// `reference_inertia()`, in the reference and rigidly rotated.
+fn inertia_error(body: BodySpec) -> f64 {
+    let mut worst: f64 = 0.0;
     let reference = body.reference_inertia();
     let m = Model::from_scene(&Scene::new(vec![body.clone()], vec![], Vector3::zeros()), Options::default()).unwrap();
     let rot = Rotation3::from_scaled_axis(Vector3::new(-0.7, 0.4, 1.1)).into_inner();
@@ -103,8 +134,9 @@ fn rigid_body_inertia_from_kinetic_energy_matches_the_reference() {
              inertia rel err {e_inertia:.1e}",
             reference.mass
         );
-        assert!(e_mass < 1e-12 && e_centre < 1e-12 && e_inertia < 1e-12);
+        worst = worst.max(e_mass).max(e_centre).max(e_inertia);
     }
+    worst
 }
 
 /// A 1 m cantilever (10 elements) clamped at the origin along +X with a 1 kg tip mass at

@@ -15,4 +15,5 @@ mod sharpy_regression;
 mod spring;
 mod stabilization;
 mod statics;
+mod twist;
 mod validation;

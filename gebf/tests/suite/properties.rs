@@ -91,6 +91,7 @@ fn free_pair(beta: f64, frame: [f64; 3], kink: [f64; 3], lengths: (f64, f64), n_
         section: samples::paper_section(1.0),
         n_elements,
         point_masses: Vec::new(),
+        twist: gebf::Twist::none(),
     };
     let bodies =
         vec![body("p", V3::zeros(), lengths.0, fp, n_el.0), body("c", fp.column(0) * lengths.0, lengths.1, fc, n_el.1)];

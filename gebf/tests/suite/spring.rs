@@ -21,7 +21,16 @@ fn stiff_section() -> Section {
 }
 
 fn body(name: &str, start: Vector3<f64>, frame: Matrix3<f64>, length: f64, n_elements: usize) -> BodySpec {
-    BodySpec { name: name.into(), start, length, frame, section: stiff_section(), n_elements, point_masses: Vec::new() }
+    BodySpec {
+        name: name.into(),
+        start,
+        length,
+        frame,
+        section: stiff_section(),
+        n_elements,
+        point_masses: Vec::new(),
+        twist: gebf::Twist::none(),
+    }
 }
 
 fn spring(joint: usize, stiffness: f64, damping: f64, rest: f64) -> ForceElement {

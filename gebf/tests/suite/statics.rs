@@ -148,6 +148,7 @@ fn bend_scene(n: usize) -> gebf::Scene {
                 section,
                 n_elements: 1,
                 point_masses: Vec::new(),
+                twist: gebf::Twist::none(),
             }
         })
         .collect();

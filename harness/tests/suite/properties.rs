@@ -127,6 +127,7 @@ impl Scene {
                 section: self.section.ancf(),
                 n_elements: b.n_ancf,
                 point_masses: Vec::new(),
+                twist: scene::Twist::none(),
             })
             .collect();
         let mut joints = Vec::new();
@@ -153,6 +154,7 @@ impl Scene {
                 section: self.section.gebf(),
                 n_elements: b.n_gebf,
                 point_masses: Vec::new(),
+                twist: scene::Twist::none(),
             })
             .collect();
         let mut joints = Vec::new();
