@@ -168,11 +168,75 @@ pub struct Body {
     /// Default 0, within ±80°.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
     pub dihedral_deg: f64,
+    /// Built-in twist of the section frame about the beam axis along the body, degrees,
+    /// right-handed about the axis (for a body along +X: leading edge up, nose up), structural
+    /// and aerodynamic (the lattice follows the sections): `[root, tip]`, linear along the
+    /// body, or a table `[[s (m), deg], …]` increasing in s within the body, linear in between
+    /// and held outside. Default none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub twist_deg: Option<TwistSpec>,
     /// Section properties per unit length.
     pub section: Section,
     /// Point masses fixed to the body's sections (default none).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub point_masses: Vec<PointMass>,
+}
+
+/// A body's placement in the reference configuration before the root pitch: its start point
+/// and its section axes x (the beam axis) and y, before its own twist.
+pub type Placement = (Vector3<f64>, Vector3<f64>, Vector3<f64>);
+
+/// A body's built-in twist (`twist_deg`).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(untagged))]
+pub enum TwistSpec {
+    /// `[root, tip]`, degrees, linear along the body.
+    Linear([f64; 2]),
+    /// `[[s (m), degrees], …]`, increasing in s.
+    Table(Vec<[f64; 2]>),
+}
+
+impl TwistSpec {
+    /// The scene's twist of a body of `length` (radians).
+    pub fn twist(&self, length: f64) -> scene::Twist {
+        match self {
+            TwistSpec::Linear([a, b]) => scene::Twist::linear(a.to_radians(), b.to_radians(), length),
+            TwistSpec::Table(p) => scene::Twist::table(p.iter().map(|x| (x[0], x[1].to_radians())).collect()),
+        }
+    }
+
+    /// Why the twist is not valid on a body of `length` (non-finite, beyond ±90°, a table not
+    /// increasing in s or reaching outside the body), naming the entry below `field`.
+    pub fn check(&self, field: &str, length: f64) -> Result<(), String> {
+        let deg = |f: String, d: f64| {
+            if d.is_finite() && d.abs() <= 90.0 {
+                Ok(())
+            } else {
+                Err(format!("{f}: {d} is not a twist within ±90 degrees"))
+            }
+        };
+        match self {
+            TwistSpec::Linear([a, b]) => deg(format!("{field}[0]"), *a).and(deg(format!("{field}[1]"), *b)),
+            TwistSpec::Table(p) => {
+                if p.is_empty() {
+                    return Err(format!("{field}: an empty table"));
+                }
+                for (k, x) in p.iter().enumerate() {
+                    let inside = x[0].is_finite() && x[0] >= 0.0 && x[0] <= length * (1.0 + 1e-12);
+                    if !inside || (k > 0 && x[0] <= p[k - 1][0]) {
+                        return Err(format!(
+                            "{field}[{k}]: s = {} does not increase within the body (0 to {length} m)",
+                            x[0]
+                        ));
+                    }
+                    deg(format!("{field}[{k}]"), x[1])?;
+                }
+                Ok(())
+            }
+        }
+    }
 }
 
 /// A rigid point mass fixed to a body's section.
@@ -728,11 +792,11 @@ impl Problem {
     }
 
     /// Each body's start point and section axes x (the beam axis) and y in the reference
-    /// configuration before the root pitch: `start` or the parent's end (the origin without a
-    /// parent); the axes of `x_axis`/`y_axis`, or with a sweep or dihedral those of the
-    /// reference frame (the parent's end section frame, or `x_axis`/`y_axis` for a body without
-    /// a parent) turned by `R_z(−Λ) R_y(−Γ)`.
-    pub fn placements(&self) -> Vec<(Vector3<f64>, Vector3<f64>, Vector3<f64>)> {
+    /// configuration before the root pitch and before its own twist: `start` or the parent's end
+    /// (the origin without a parent); the axes of `x_axis`/`y_axis`, or with a sweep or dihedral
+    /// those of the reference frame (the parent's end section frame, its twist included, or
+    /// `x_axis`/`y_axis` for a body without a parent) turned by `R_z(−Λ) R_y(−Γ)`.
+    pub fn placements(&self) -> Vec<Placement> {
         let n = self.bodies.len();
         let parent: Vec<Option<usize>> = (0..n)
             .map(|i| {
@@ -744,7 +808,7 @@ impl Problem {
                 })
             })
             .collect();
-        let mut placed: Vec<Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>)>> = vec![None; n];
+        let mut placed: Vec<Option<Placement>> = vec![None; n];
         for i in 0..n {
             self.place(i, &parent, &mut placed, 0);
         }
@@ -757,9 +821,9 @@ impl Problem {
         &self,
         i: usize,
         parent: &[Option<usize>],
-        placed: &mut Vec<Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>)>>,
+        placed: &mut Vec<Option<Placement>>,
         depth: usize,
-    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    ) -> Placement {
         if let Some(p) = placed[i] {
             return p;
         }
@@ -767,7 +831,11 @@ impl Problem {
         let unit = |v: [f64; 3]| Vector3::from(v).normalize();
         let up = parent[i].filter(|_| depth < self.bodies.len()).map(|p| {
             let (s, x, y) = self.place(p, parent, placed, depth + 1);
-            (s + x * self.bodies[p].length, x, y)
+            let parent = &self.bodies[p];
+            // The parent's end section frame: its axes turned by its twist at the end.
+            let theta = parent.twist_deg.as_ref().map_or(0.0, |t| t.twist(parent.length).angle(parent.length));
+            let (st, ct) = theta.sin_cos();
+            (s + x * parent.length, x, y * ct + x.cross(&y) * st)
         });
         let start = b.start.map(Vector3::from).or(up.map(|u| u.0)).unwrap_or_else(Vector3::zeros);
         let (x, y) = if b.sweep_deg == 0.0 && b.dihedral_deg == 0.0 {
@@ -822,7 +890,7 @@ impl Problem {
                             inertia: p.inertia.into(),
                         })
                         .collect(),
-                    twist: scene::Twist::none(),
+                    twist: b.twist_deg.as_ref().map_or_else(scene::Twist::none, |t| t.twist(b.length)),
                 }
             })
             .collect();

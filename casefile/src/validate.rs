@@ -151,6 +151,9 @@ impl Case {
             {
                 return Err(f("start: not a finite point"));
             }
+            if let Some(t) = &b.twist_deg {
+                t.check(&f("twist_deg"), b.length)?;
+            }
             for (key, deg) in [("sweep_deg", b.sweep_deg), ("dihedral_deg", b.dihedral_deg)] {
                 if !(deg.is_finite() && deg.abs() <= 80.0) {
                     return Err(f(&format!("{key}: {deg} is outside ±80 degrees")));

@@ -104,6 +104,9 @@ fn bad_orientation_exits_2_naming_the_field() {
         ("bodies.1.sweep_deg=85", "bodies[1].sweep_deg"),
         ("bodies.0.dihedral_deg=-80.5", "bodies[0].dihedral_deg"),
         ("bodies.1.dihedral_deg=\"NaN\"", "bodies[1].dihedral_deg"),
+        ("bodies.1.twist_deg=[0,95]", "bodies[1].twist_deg[1]"),
+        ("bodies.1.twist_deg=[[0,0],[0.2,1]]", "bodies[1].twist_deg[1]"),
+        ("bodies.1.twist_deg=[[0.05,0],[0.05,1]]", "bodies[1].twist_deg[1]"),
     ] {
         let o = harness(&["static", c, "--set", set, "--out", std::env::temp_dir().to_str().unwrap()]);
         let err = String::from_utf8_lossy(&o.stderr);
@@ -124,4 +127,32 @@ fn bad_orientation_exits_2_naming_the_field() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("bodies[1].x_axis"), "{err}");
+}
+
+/// Healy's wingtip with the thesis' built-in twist ramp (zero up to 0.425 m from the root, 3°
+/// nose up from 0.45 m): ANCF and GEBF reach one equilibrium (0.01°, with the case's 12 tip
+/// elements), and the washed-in tip rests higher than the untwisted one, by several degrees
+/// (the fold's own incidence change, sin 20° per degree of fold, must make up for the twist).
+#[test]
+fn a_twisted_wingtip_coasts_higher_in_both_formulations() {
+    let path = root().join("cases/healy_sideslip_flare20_pitch0.json");
+    let set = |twist: &str| -> harness::case::RunSpec {
+        let ov: Vec<harness::case::Override> =
+            ["static.sideslips_deg=[0]".to_string(), format!("bodies.1.twist_deg={twist}")]
+                .iter()
+                .map(|s| s.parse().unwrap())
+                .collect();
+        CaseFile::read(&path).unwrap().expand(&ov).unwrap().remove(0)
+    };
+    let fold = |spec: &harness::case::RunSpec, f: Formulation| {
+        let p = run_static(&spec.case(f).problem(), f).points.remove(0);
+        assert!(p.error.is_none(), "{f}: {:?}", p.error);
+        p.fold_deg
+    };
+    let flat = set("[0,0]");
+    let twisted = set("[[0,0],[0.06,0],[0.085,3],[0.135,3]]");
+    let (a, g) = (fold(&twisted, Formulation::Ancf), fold(&twisted, Formulation::Gebf));
+    assert!((a - g).abs() < 0.01, "twisted tip: ANCF {a}° GEBF {g}°");
+    let g0 = fold(&flat, Formulation::Gebf);
+    assert!(g > g0 + 2.0 && g < g0 + 3.0 / 20f64.to_radians().sin(), "twisted {g}° against untwisted {g0}°");
 }
