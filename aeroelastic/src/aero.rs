@@ -36,6 +36,8 @@ pub struct StationMap {
     pub slant: f64,
     /// Whether this is a flared hinge's column.
     pub hinge: bool,
+    /// The control surface on this station (index into `aero.control_surfaces`), if any.
+    pub surface: Option<usize>,
 }
 
 impl StationMap {
@@ -79,11 +81,32 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
             }
         }
         for k in first..=n {
-            out.push(StationMap { body: b, s: body.length * k as f64 / n as f64, slant: 0.0, hinge: false });
+            out.push(StationMap {
+                body: b,
+                s: body.length * k as f64 / n as f64,
+                slant: 0.0,
+                hinge: false,
+                surface: None,
+            });
         }
     }
     grade_slants(case, aero, &mut out);
+    place_control_surfaces(case, aero, &mut out)?;
     Ok(out)
+}
+
+/// Check `aero.control_surfaces` and put each on the stations it covers (the hinge column
+/// belongs to the inner body's end; a surface of the outer body from `s0 = 0` covers it).
+fn place_control_surfaces(case: &Problem, aero: &AeroSettings, map: &mut [StationMap]) -> Result<(), String> {
+    let cs = &aero.control_surfaces;
+    if cs.is_empty() {
+        return Ok(());
+    }
+    crate::control_surface::check(case, cs, &aero.panels_per_body, aero.n_chordwise)?;
+    for m in map.iter_mut() {
+        m.surface = crate::control_surface::surface_at(case, cs, m.body, m.s, m.hinge)?;
+    }
+    crate::control_surface::columns(map, cs.len()).map(|_| ())
 }
 
 /// Blend the columns next to a slanted hinge column towards its slant, so that no panel folds
@@ -147,14 +170,17 @@ pub fn section_state<S: Structure + ?Sized>(
     (p, r, vel, omega)
 }
 
-/// Build the lattice stations (and their velocities) of the current structural state.
-#[allow(clippy::too_many_arguments)] // model, state, map, settings and three reused buffers
+/// Build the lattice stations (and their velocities) of the current structural state, with the
+/// control surfaces' flaps at time `t` (`None`: steady, the deflection at t = 0 and no rate, as
+/// statics, stability and the linear gust use).
+#[allow(clippy::too_many_arguments)] // model, state, map, settings, time and three reused buffers
 pub(crate) fn stations_at<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
     v: &[f64],
     map: &[StationMap],
     aero: &AeroSettings,
+    t: Option<f64>,
     scratch: &mut (Vec<f64>, Vec<f64>, Vec<f64>),
     stations: &mut Vec<uvlm::SpanStation>,
     velocities: &mut Vec<uvlm::StationVelocity>,
@@ -169,7 +195,7 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
             chord: aero.chord,
             le_offset: aero.le_offset,
             slant: st.slant,
-            flap: None,
+            flap: st.surface.map(|i| aero.control_surfaces[i].flap_at(t)),
         });
         velocities.push(uvlm::StationVelocity { linear: vel, angular: omega });
     }
@@ -265,6 +291,7 @@ pub fn simulate_aero_from<S: Structure>(
     let mut r0 = row(model, fold, &s, 0);
     r0.aero_work = 0.0;
     r0.lift = c.lift;
+    r0.control_hinge_moments = c.hinge;
     with_loads(model, &mut r0, &s, &c.loads);
     out.rows.push(r0);
     if let Err(e) = feed.feed(model, &r0, &s.q, Some(&c.uv)) {
@@ -280,13 +307,14 @@ pub fn simulate_aero_from<S: Structure>(
             Err(e) => return fail(out, e),
         };
         // 5. Work of the aerodynamic loads over the step (trapezoidal in the station velocities).
-        c.move_to(model, &s.q, &s.v);
+        c.move_to(model, &s.q, &s.v, s.t);
         work += 0.5 * dt * (power(&c.loads, &c.vel_n) + power(&c.loads, &c.vel));
         dissipation.step(model, &s);
         if k % every == 0 || k == n_steps {
             let mut r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
             r.aero_work = work;
             r.lift = c.lift;
+            r.control_hinge_moments = c.hinge;
             with_loads(model, &mut r, &s, &c.loads);
             out.rows.push(r);
             if let Err(e) = feed.feed(model, &r, &s.q, Some(&c.uv)) {
@@ -326,6 +354,10 @@ struct MarchAero<'a> {
     qp: Vec<f64>,
     dq: Vec<f64>,
     vp: Vec<f64>,
+    /// The grid columns of each control surface.
+    surface_columns: Vec<std::ops::RangeInclusive<usize>>,
+    /// Hinge moment of each control surface at the last solve, N·m (NaN past the surfaces).
+    hinge: [f64; crate::control_surface::MAX_CONTROL_SURFACES],
 }
 
 /// Buffers of the lumping of the lattice's nodal loads to the stations: the stations' origins,
@@ -376,7 +408,10 @@ impl<'a> MarchAero<'a> {
     ) -> Result<Self, String> {
         let mut scratch = (Vec::new(), Vec::new(), Vec::new());
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
-        stations_at(model, &s.q, &s.v, map, aero, &mut scratch, &mut stations, &mut vel);
+        stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
+        let surface_columns = crate::control_surface::columns(map, aero.control_surfaces.len())?;
+        let mut hinge = [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES];
+        hinge.iter_mut().take(surface_columns.len()).for_each(|h| *h = 0.0);
         let spec = lattice_spec(map, aero);
         let mut params = aero.uvlm_params(aero.free_stream());
         if at_equilibrium && !aero.wake_closure {
@@ -407,6 +442,8 @@ impl<'a> MarchAero<'a> {
             qp: vec![0.0; s.q.len()],
             dq: vec![0.0; s.v.len()],
             vp: vec![0.0; s.v.len()],
+            surface_columns,
+            hinge,
         };
         c.uv.set_time(s.t).map_err(|e| format!("aerodynamic clock: {e}"))?;
         if at_equilibrium {
@@ -420,13 +457,23 @@ impl<'a> MarchAero<'a> {
     fn steady_start<S: Structure>(&mut self, model: &mut S) -> Result<(), String> {
         let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics at the equilibrium: {e}"))?;
         self.lift = self.lumping.apply(l, &self.stations, self.aero.free_stream(), &mut self.loads);
+        self.hinge_moments()?;
         self.uv.prefill_wake(self.dt).map_err(|e| format!("steady wake at the equilibrium: {e}"))?;
         model.set_section_loads(&self.loads).map_err(|e| format!("loads at the equilibrium: {e}"))
     }
 
-    /// Move the stations (and their velocities) to the structure at `(q, v)`.
-    fn move_to<S: Structure>(&mut self, model: &S, q: &[f64], v: &[f64]) {
-        stations_at(model, q, v, self.map, self.aero, &mut self.scratch, &mut self.stations, &mut self.vel);
+    /// Move the stations (and their velocities) to the structure at `(q, v)`, the control
+    /// surfaces to their deflections at time `t`.
+    fn move_to<S: Structure>(&mut self, model: &S, q: &[f64], v: &[f64], t: f64) {
+        stations_at(model, q, v, self.map, self.aero, Some(t), &mut self.scratch, &mut self.stations, &mut self.vel);
+    }
+
+    /// The control surfaces' hinge moments of the last solve into `hinge`.
+    fn hinge_moments(&mut self) -> Result<(), String> {
+        for (h, cols) in self.hinge.iter_mut().zip(&self.surface_columns) {
+            *h = self.uv.hinge_moment(cols.clone()).map_err(|e| format!("hinge moment: {e}"))?;
+        }
+        Ok(())
     }
 
     /// Move the lattice to the stations, solve the pending UVLM step and lump its loads into
@@ -435,7 +482,9 @@ impl<'a> MarchAero<'a> {
         self.uv.update_stations(&self.stations, Some(&self.vel)).map_err(|e| e.to_string())?;
         let l = self.uv.solve_step().map_err(|e| e.to_string())?;
         let target = if into_new { &mut self.new_loads } else { &mut self.loads };
-        Ok(self.lumping.apply(l, &self.stations, self.aero.free_stream(), target))
+        let lift = self.lumping.apply(l, &self.stations, self.aero.free_stream(), target);
+        self.hinge_moments()?;
+        Ok(lift)
     }
 
     /// Relax the applied loads towards the sub-iteration's; whether the relative change was
@@ -477,6 +526,7 @@ impl<'a> MarchAero<'a> {
             &self.vp,
             self.map,
             self.aero,
+            Some(t1),
             &mut self.scratch,
             &mut self.stations,
             &mut self.vel,
@@ -491,7 +541,7 @@ impl<'a> MarchAero<'a> {
         let mut st = ga.step(model, s).map_err(|e| format!("step {k}: {e}"))?;
         // 4. Strong coupling.
         for _ in 0..self.aero.coupling.max_sub_iterations {
-            self.move_to(model, &s.q, &s.v);
+            self.move_to(model, &s.q, &s.v, t1);
             self.lift = self.solve(true).map_err(aero_err)?;
             if self.relax() {
                 break;

@@ -116,7 +116,7 @@ fn run<S: Structure>(
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(&model, &q, &zeros, &map, aero, &mut scratch, &mut stations, &mut vel);
+    stations_at(&model, &q, &zeros, &map, aero, None, &mut scratch, &mut stations, &mut vel);
     let lattice = uvlm::Lattice::from_stations(lattice_spec(&map, aero), &stations)
         .map_err(|e| format!("aerodynamic lattice: {e}"))?;
     let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(v_inf)).map_err(|e| format!("UVLM: {e}"))?;

@@ -13,6 +13,7 @@
 pub mod aero;
 pub mod aero_settings;
 pub mod clock;
+pub mod control_surface;
 pub mod factory;
 pub mod gust;
 pub mod gust_field;

@@ -125,6 +125,9 @@ pub struct Row {
     /// Moment about the fold hinge's axis, N·m (fold-up positive; NaN without one or without
     /// aerodynamics).
     pub hinge_moment: f64,
+    /// Hinge moment of each control surface (`aero.control_surfaces`, in order), N·m, trailing
+    /// edge down positive (docs/uvlm.md §15); NaN past the case's surfaces.
+    pub control_hinge_moments: [f64; crate::control_surface::MAX_CONTROL_SURFACES],
 }
 
 /// Solver settings of one run.
@@ -201,6 +204,7 @@ pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &Stat
         root_bending_moment: f64::NAN,
         root_torque: f64::NAN,
         hinge_moment: f64::NAN,
+        control_hinge_moments: [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES],
     }
 }
 

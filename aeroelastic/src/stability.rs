@@ -471,7 +471,7 @@ fn held_load_stiffness<S: Structure>(
     let zeros = vec![0.0; n];
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(&*model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
+    stations_at(&*model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
     let spec = crate::aero::lattice_spec(map, aero);
     let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
     let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
@@ -599,7 +599,7 @@ fn mode_shapes<S: Structure>(
         let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
         model.retract_inplace(q, &dq, &mut qp);
         let (mut st2, mut v2) = (Vec::new(), Vec::new());
-        stations_at(&*model, &qp, &zeros, map, aero, &mut scratch, &mut st2, &mut v2);
+        stations_at(&*model, &qp, &zeros, map, aero, None, &mut scratch, &mut st2, &mut v2);
         let mut d: Vec<[f64; 3]> =
             st2.iter().zip(stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
         let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
@@ -637,7 +637,7 @@ fn strip_model<S: Structure>(
             let dq: Vec<f64> = col.iter().map(|x| sg * eps * x).collect();
             model.retract_inplace(q, &dq, &mut qq);
             let (mut s2, mut v2) = (Vec::new(), Vec::new());
-            stations_at(&*model, &qq, &zeros, map, aero, &mut scratch, &mut s2, &mut v2);
+            stations_at(&*model, &qq, &zeros, map, aero, None, &mut scratch, &mut s2, &mut v2);
             pm.push(s2);
         }
         for j in 0..ns {
@@ -766,7 +766,7 @@ impl<'a> MovedLattice<'a> {
         with_vel: bool,
     ) -> Result<Moved, String> {
         let (mut st, mut ve) = (Vec::new(), Vec::new());
-        stations_at(model, q, v, self.map, self.aero, &mut self.scratch, &mut st, &mut ve);
+        stations_at(model, q, v, self.map, self.aero, None, &mut self.scratch, &mut st, &mut ve);
         self.lat
             .update_stations(&st, if with_vel { Some(&ve) } else { None })
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
@@ -900,7 +900,7 @@ pub fn reduce<S: Structure>(
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = StationScratch::default();
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(&model, q, &zeros, map, aero, &mut scratch, &mut stations, &mut vel);
+    stations_at(&model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
     if let Some((case, out)) = shapes_out {
         out.extend(mode_shapes(&mut model, q, &stations, &basis, (map, aero, case)));
     }

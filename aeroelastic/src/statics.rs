@@ -72,7 +72,7 @@ impl SteadyAero {
             n_solves: 0,
             report: StripReport::default(),
         };
-        stations_at(model, q, &s.zeros, map, aero, &mut s.scratch, &mut s.stations, &mut s.vel);
+        stations_at(model, q, &s.zeros, map, aero, None, &mut s.scratch, &mut s.stations, &mut s.vel);
         let spec = crate::aero::lattice_spec(map, aero);
         let mut params = aero.uvlm_params(v_inf);
         params.steady_wake = wake;
@@ -94,7 +94,7 @@ impl SteadyAero {
         polars: Option<(&StripPolars, f64)>,
         out: &mut [SectionLoad],
     ) -> Result<(), String> {
-        stations_at(model, q, &self.zeros, map, aero, &mut self.scratch, &mut self.stations, &mut self.vel);
+        stations_at(model, q, &self.zeros, map, aero, None, &mut self.scratch, &mut self.stations, &mut self.vel);
         self.uv.update_stations(&self.stations, None).map_err(|e| format!("aerodynamic lattice: {e}"))?;
         let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
         self.n_solves += 1;
@@ -346,6 +346,15 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         Ok((lock(&self.loads).clone(), st.uv.loads().clone(), st.stations.clone()))
     }
 
+    /// The control surfaces' hinge moments (N·m, trailing edge down positive) of the last
+    /// lattice solve (call after [`Self::evaluate_at`]); the lattice's loads, without the section
+    /// polars' correction.
+    pub fn control_hinge_moments(&self, map: &[StationMap]) -> Result<Vec<f64>, String> {
+        let cols = crate::control_surface::columns(map, self.aero.control_surfaces.len())?;
+        let st = lock(&self.aero_state);
+        cols.into_iter().map(|c| st.uv.hinge_moment(c).map_err(|e| format!("hinge moment: {e}"))).collect()
+    }
+
     /// Generalised aerodynamic load `r(q, L) − r(q, 0)` (the residual's load part, with the
     /// minus sign of an external force) of the station loads `loads` at `q`, into `out`.
     fn load_part(&self, t: f64, q: &[f64], loads: &[SectionLoad], zeros: &[f64], scratch: &mut [f64], out: &mut [f64]) {
@@ -576,6 +585,10 @@ pub struct StaticPoint {
     /// Total drag (along the free stream), N: the lattice's induced drag, plus the profile drag
     /// of the section polars when the case has them.
     pub drag: f64,
+    /// Hinge moment of each control surface (`aero.control_surfaces`, in order), N·m, trailing
+    /// edge down positive: the lattice's loads (docs/uvlm.md §15); empty without surfaces.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Vec::is_empty"))]
+    pub control_hinge_moments: Vec<f64>,
     /// Newton iterations spent on this point (its intermediate airspeeds included).
     pub newton_iterations: usize,
     /// Why the point has no equilibrium, if it has none.
@@ -683,6 +696,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
         },
         lift: f64::NAN,
         drag: f64::NAN,
+        control_hinge_moments: Vec::new(),
         newton_iterations: 0,
         error: Some(msg),
         load_factor: None,
@@ -1061,6 +1075,10 @@ fn point_at<S: Structure>(
         Ok(v) => v,
         Err(e) => return failed_point(airspeed, e),
     };
+    let control_hinge_moments = match sys.control_hinge_moments(map) {
+        Ok(v) => v,
+        Err(e) => return failed_point(airspeed, e),
+    };
     let model = sys.model();
     let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(q, j).to_degrees());
     let loads = loads_model.map_or(
@@ -1107,6 +1125,7 @@ fn point_at<S: Structure>(
         loads,
         lift,
         drag,
+        control_hinge_moments,
         newton_iterations: 0,
         error: None,
         load_factor: None,

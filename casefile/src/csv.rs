@@ -15,14 +15,23 @@ pub const HEADER_AERO: &str = "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potentia
 newton_iterations,lift,root_bending_moment,root_torque,hinge_moment";
 
 /// The header line (without newline) of a CSV with or without the aerodynamic and the force
-/// element columns.
-pub fn header(aero: bool, springs: bool) -> String {
+/// element columns; with aerodynamics, a `<name>_hinge_moment` column per control surface
+/// (`surfaces`, the case's `aero.control_surfaces` names in order) at the end.
+pub fn header(aero: bool, springs: bool, surfaces: &[String]) -> String {
     let header = if aero { HEADER_AERO } else { HEADER };
-    if springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() }
+    let mut h =
+        if springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() };
+    if aero {
+        for name in surfaces {
+            let _ = write!(h, ",{name}_hinge_moment");
+        }
+    }
+    h
 }
 
-/// Append one row (with its newline) in the columns of [`header`]`(aero, springs)`.
-pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool) {
+/// Append one row (with its newline) in the columns of [`header`]`(aero, springs, surfaces)`
+/// with `n_surfaces` control surfaces.
+pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool, n_surfaces: usize) {
     let _ = write!(
         s,
         "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},",
@@ -38,21 +47,25 @@ pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool) {
     let _ = write!(s, "{:.3e},{}", r.constraint_residual, r.newton_iterations);
     if aero {
         let _ = write!(s, ",{:.6e},{:.6e},{:.6e},{:.6e}", r.lift, r.root_bending_moment, r.root_torque, r.hinge_moment);
+        for h in r.control_hinge_moments.iter().take(n_surfaces) {
+            let _ = write!(s, ",{h:.6e}");
+        }
     }
     s.push('\n');
 }
 
 /// Render rows as CSV text: the aerodynamic columns when the run has them, and `spring` (hinge
 /// spring potential) and `dissipated` (work of the dampers since t = 0) after `potential` when
-/// the model has force elements.
-pub fn to_csv(rows: &[Row]) -> String {
+/// the model has force elements; the control surfaces' hinge moments (`surfaces`, their names)
+/// at the end of the aerodynamic columns.
+pub fn to_csv(rows: &[Row], surfaces: &[String]) -> String {
     let aero = rows.iter().any(|r| r.aero_work.is_finite());
     let springs = rows.iter().any(|r| r.spring.is_finite());
-    let mut s = String::with_capacity(rows.len() * 220);
-    s.push_str(&header(aero, springs));
+    let mut s = String::with_capacity(rows.len() * (220 + 14 * surfaces.len()));
+    s.push_str(&header(aero, springs, surfaces));
     s.push('\n');
     for r in rows {
-        push_row(&mut s, r, aero, springs);
+        push_row(&mut s, r, aero, springs, surfaces.len());
     }
     s
 }
@@ -61,3 +74,18 @@ pub fn to_csv(rows: &[Row]) -> String {
 pub const STATIC_HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
 root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag,\
 sideslip_deg";
+
+/// The header of `static_<f>.csv` with a `<name>_hinge_moment` column per control surface after
+/// `sideslip_deg`.
+pub fn static_header(surfaces: &[String]) -> String {
+    let mut h = STATIC_HEADER.to_string();
+    for name in surfaces {
+        let _ = write!(h, ",{name}_hinge_moment");
+    }
+    h
+}
+
+/// The control-surface names of a case's aerodynamics (none without `aero`).
+pub fn surface_names(aero: Option<&aeroelastic::aero::AeroSettings>) -> Vec<String> {
+    aero.map(|a| a.control_surfaces.iter().map(|c| c.name.clone()).collect()).unwrap_or_default()
+}

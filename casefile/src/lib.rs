@@ -291,7 +291,8 @@ impl std::str::FromStr for Override {
 }
 
 /// Set `path` (dotted; numbers index arrays) in a JSON value. The path must exist except for
-/// its last key in an object.
+/// its last key in an object. A key that is not a number selects, in an array of objects, the
+/// element whose `"name"` equals it (`aero.control_surfaces.aileron.deflection_deg`).
 pub fn set_path(root: &mut Value, path: &str, value: Value) -> Result<(), Error> {
     let keys: Vec<&str> = path.split('.').collect();
     let mut cur = root;
@@ -309,8 +310,12 @@ pub fn set_path(root: &mut Value, path: &str, value: Value) -> Result<(), Error>
                 map.entry((*key).to_string()).or_insert_with(|| Value::Object(Default::default()))
             }
             Value::Array(arr) => {
-                let idx: usize =
-                    key.parse().map_err(|_| Error::Override(format!("`{here}`: `{key}` is not an array index")))?;
+                let idx = match key.parse::<usize>() {
+                    Ok(i) => i,
+                    Err(_) => arr.iter().position(|x| x.get("name").and_then(Value::as_str) == Some(*key)).ok_or_else(
+                        || Error::Override(format!("`{here}`: no element named `{key}` (nor an array index)")),
+                    )?,
+                };
                 let len = arr.len();
                 let slot = arr
                     .get_mut(idx)
@@ -746,6 +751,10 @@ mod tests {
         assert!(set_path(&mut v, "joints.9.flare_deg", json!(1)).unwrap_err().to_string().contains("joints.9"));
         set_path(&mut v, "ancf.newton.rtol", json!(1e-6)).unwrap();
         assert_eq!(parse_case(&v).unwrap().ancf.newton.rtol, 1e-6);
+        set_path(&mut v, "bodies.outer.length", json!(0.5)).unwrap();
+        assert_eq!(v["bodies"][1]["length"], json!(0.5));
+        let e = set_path(&mut v, "bodies.nose.length", json!(1)).unwrap_err().to_string();
+        assert!(e.contains("bodies.nose") && e.contains("no element named"), "{e}");
         set_path(&mut v, "nope.x", json!(1)).unwrap();
         assert!(parse_case(&v).unwrap_err().contains("nope"));
     }

@@ -21,6 +21,8 @@ pub use casefile::curve::{Curve, parse_curve, read_curve};
 pub struct CsvStream {
     inner: Arc<Mutex<StreamInner>>,
     columns: Option<(bool, bool)>,
+    /// The control surfaces' names: a hinge-moment column each (with aerodynamics).
+    surfaces: Vec<String>,
 }
 
 #[derive(Debug)]
@@ -76,8 +78,9 @@ fn start_flusher() {
 }
 
 impl CsvStream {
-    /// Create (truncate) the file.
-    pub fn create(path: &Path) -> Result<Self, Error> {
+    /// Create (truncate) the file, for a case with the control surfaces `surfaces` (their names,
+    /// in order; empty without).
+    pub fn create(path: &Path, surfaces: Vec<String>) -> Result<Self, Error> {
         if let Some(d) = path.parent() {
             std::fs::create_dir_all(d).map_err(|e| Error::Io(format!("{}: {e}", d.display())))?;
         }
@@ -90,7 +93,7 @@ impl CsvStream {
         }));
         start_flusher();
         STREAMS.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(Arc::downgrade(&inner));
-        Ok(Self { inner, columns: None })
+        Ok(Self { inner, columns: None, surfaces })
     }
 
     /// Append a row; written to the file at once if the last write is [`STREAM_FLUSH`] old.
@@ -98,11 +101,11 @@ impl CsvStream {
         let mut s = self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let (aero, springs) = *self.columns.get_or_insert_with(|| {
             let c = (r.aero_work.is_finite(), r.spring.is_finite());
-            s.buf.push_str(&header(c.0, c.1));
+            s.buf.push_str(&header(c.0, c.1, &self.surfaces));
             s.buf.push('\n');
             c
         });
-        push_row(&mut s.buf, r, aero, springs);
+        push_row(&mut s.buf, r, aero, springs, self.surfaces.len());
         if s.last_flush.elapsed() >= STREAM_FLUSH || s.buf.len() > 1 << 20 {
             s.flush()?;
         }

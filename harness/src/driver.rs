@@ -73,7 +73,12 @@ pub fn run_into(
         .par_iter()
         .map(|&(i, f)| {
             let case = runs[i].case(f);
-            let csv = match dirs.map(|d| CsvStream::create(&d[i].join(format!("{f}.csv")))).transpose() {
+            let csv = match dirs
+                .map(|d| {
+                    CsvStream::create(&d[i].join(format!("{f}.csv")), casefile::csv::surface_names(case.aero.as_ref()))
+                })
+                .transpose()
+            {
                 Ok(c) => c,
                 Err(e) => return (i, RunOutput::failed(f, e.to_string())),
             };

@@ -40,12 +40,13 @@ fn json_err(p: &Path) -> impl Fn(serde_json::Error) -> Error + '_ {
     move |e| Error::Io(format!("{}: {e}", p.display()))
 }
 
-/// A row with every `f64` as its bits (`newton_iterations` as itself).
-type RowBits = [u64; 18];
+/// A row with every `f64` as its bits (`newton_iterations` as itself): the 18 columns, then
+/// the control surfaces' hinge moments (a record of 18 has none: NaN).
+type RowBits = Vec<u64>;
 
 fn row_bits(r: &Row) -> RowBits {
     let b = f64::to_bits;
-    [
+    let mut v = vec![
         b(r.t),
         b(r.tip[0]),
         b(r.tip[1]),
@@ -64,28 +65,32 @@ fn row_bits(r: &Row) -> RowBits {
         b(r.root_bending_moment),
         b(r.root_torque),
         b(r.hinge_moment),
-    ]
+    ];
+    v.extend(r.control_hinge_moments.iter().map(|&h| b(h)));
+    v
 }
 
-fn row_of(x: &RowBits) -> Row {
+fn row_of(x: &[u64]) -> Row {
     let f = f64::from_bits;
+    let g = |i: usize| x.get(i).map_or(f64::NAN, |&v| f(v));
     Row {
-        t: f(x[0]),
-        tip: [f(x[1]), f(x[2]), f(x[3])],
-        fold: f(x[4]),
-        kinetic: f(x[5]),
-        elastic: f(x[6]),
-        potential: f(x[7]),
-        spring: f(x[8]),
-        dissipated: f(x[9]),
-        total: f(x[10]),
-        constraint_residual: f(x[11]),
-        newton_iterations: x[12] as usize,
-        aero_work: f(x[13]),
-        lift: f(x[14]),
-        root_bending_moment: f(x[15]),
-        root_torque: f(x[16]),
-        hinge_moment: f(x[17]),
+        t: g(0),
+        tip: [g(1), g(2), g(3)],
+        fold: g(4),
+        kinetic: g(5),
+        elastic: g(6),
+        potential: g(7),
+        spring: g(8),
+        dissipated: g(9),
+        total: g(10),
+        constraint_residual: g(11),
+        newton_iterations: x.get(12).map_or(0, |&v| v as usize),
+        aero_work: g(13),
+        lift: g(14),
+        root_bending_moment: g(15),
+        root_torque: g(16),
+        hinge_moment: g(17),
+        control_hinge_moments: std::array::from_fn(|i| g(18 + i)),
     }
 }
 
@@ -127,7 +132,7 @@ impl RunRecord {
             self.stats;
         RunOutput {
             formulation: self.formulation,
-            rows: self.rows.iter().map(row_of).collect(),
+            rows: self.rows.iter().map(|r| row_of(r)).collect(),
             wall_s: f64::from_bits(self.wall_s),
             stats: genalpha::Stats {
                 n_steps,

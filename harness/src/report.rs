@@ -44,6 +44,8 @@ pub struct CaseResult {
     pub gate: Option<Gate>,
     /// Gate outcome.
     pub gate_outcome: Option<GateOutcome>,
+    /// The control surfaces' names (`aero.control_surfaces`): the CSV's hinge-moment columns.
+    pub control_surfaces: Vec<String>,
 }
 
 impl CaseResult {
@@ -101,6 +103,7 @@ impl CaseResult {
             reference_errors,
             gate: case.gate.clone(),
             gate_outcome: None,
+            control_surfaces: casefile::csv::surface_names(case.aero.as_ref()),
         };
         res.gate_outcome = gate::evaluate(&res);
         res
@@ -138,7 +141,7 @@ struct Summary<'a> {
 /// Write `<dir>/<formulation>.csv`, `summary.json` and the plots of one case.
 pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     for run in &r.runs {
-        write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows))?;
+        write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows, &r.control_surfaces))?;
     }
     let summary = Summary {
         case: &r.name,

@@ -88,13 +88,14 @@ impl Abscissa {
     }
 }
 
-/// The sweep as CSV text (one row per airspeed, or sideslip angle, NaN where a point failed).
-pub fn to_csv(out: &StaticOutput) -> String {
-    let mut s = String::from(HEADER);
+/// The sweep as CSV text (one row per airspeed, or sideslip angle, NaN where a point failed),
+/// with the hinge moments of the control surfaces `surfaces` (their names) at the end.
+pub fn to_csv(out: &StaticOutput, surfaces: &[String]) -> String {
+    let mut s = casefile::csv::static_header(surfaces);
     s.push('\n');
     for p in &out.points {
         let l = &p.loads;
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e},{}",
             p.airspeed,
@@ -117,6 +118,10 @@ pub fn to_csv(out: &StaticOutput) -> String {
             p.drag,
             p.sideslip_deg
         );
+        for i in 0..surfaces.len() {
+            let _ = write!(s, ",{:.6e}", p.control_hinge_moments.get(i).copied().unwrap_or(f64::NAN));
+        }
+        s.push('\n');
     }
     s
 }
@@ -171,6 +176,9 @@ pub struct StaticSummary {
     pub abscissa: Abscissa,
     /// Each formulation's sweep.
     pub runs: Vec<StaticOutput>,
+    /// The control surfaces' names (`aero.control_surfaces`): the CSV's hinge-moment columns.
+    #[serde(skip)]
+    pub control_surfaces: Vec<String>,
     /// References and the errors against them.
     pub references: Vec<ReferenceErrors>,
     /// Largest |fold_ANCF − fold_GEBF| over the airspeeds both solved, degrees; None (`null`)
@@ -443,6 +451,7 @@ pub fn summarise(case: &Case, dir_of_case: &Path, runs: Vec<StaticOutput>) -> St
         description: case.description.clone(),
         abscissa,
         runs,
+        control_surfaces: casefile::csv::surface_names(case.aero.as_ref()),
         references,
         max_fold_difference_deg: dfold,
         max_rbm_relative_difference: drbm,
@@ -512,7 +521,7 @@ pub fn write(dir: &Path, summary: &StaticSummary) -> Result<(), Error> {
         return write_file(&dir.join("static_summary.json"), &json);
     }
     for out in &summary.runs {
-        write_file(&dir.join(format!("static_{}.csv", out.formulation)), &to_csv(out))?;
+        write_file(&dir.join(format!("static_{}.csv", out.formulation)), &to_csv(out, &summary.control_surfaces))?;
         write_file(&dir.join(format!("static_lift_{}.csv", out.formulation)), &lift_csv(out))?;
     }
     let json = serde_json::to_string_pretty(summary).map_err(|e| Error::Io(e.to_string()))?;

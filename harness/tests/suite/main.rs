@@ -4,6 +4,7 @@
 mod aero;
 mod browser;
 mod cli;
+mod control_surfaces;
 mod external;
 mod fuzz;
 mod gate;
