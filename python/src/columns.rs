@@ -38,18 +38,20 @@ const COLUMNS: [(&str, Getter); 18] = [
 ];
 
 /// The CSV column names of these rows (`casefile::csv::header`: aerodynamic columns when the run
-/// has them, `spring` and `dissipated` when the model has force elements).
-fn header(rows: &[Row]) -> Vec<String> {
+/// has them, `spring` and `dissipated` when the model has force elements, the control surfaces'
+/// `<name>_hinge_moment` last).
+fn header(rows: &[Row], surfaces: &[String]) -> Vec<String> {
     let aero = rows.iter().any(|r| r.aero_work.is_finite());
     let springs = rows.iter().any(|r| r.spring.is_finite());
-    casefile::csv::header(aero, springs).split(',').map(str::to_string).collect()
+    casefile::csv::header(aero, springs, surfaces).split(',').map(str::to_string).collect()
 }
 
 /// The rows as a dict of NumPy arrays keyed by the CSV's column names (`newton_iterations` as
-/// int64, the others float64, each value the row's `f64` unrounded).
-pub fn run_columns<'py>(py: Python<'py>, rows: &[Row]) -> PyResult<Bound<'py, PyDict>> {
+/// int64, the others float64, each value the row's `f64` unrounded), with the hinge moments of
+/// the control surfaces `surfaces` (their names).
+pub fn run_columns<'py>(py: Python<'py>, rows: &[Row], surfaces: &[String]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    for name in header(rows) {
+    for name in header(rows, &[]) {
         let (_, get) = COLUMNS.iter().find(|(n, _)| *n == name).expect("every CSV column has a getter");
         if name == "newton_iterations" {
             let v: Vec<i64> = rows.iter().map(|r| r.newton_iterations as i64).collect();
@@ -58,6 +60,11 @@ pub fn run_columns<'py>(py: Python<'py>, rows: &[Row]) -> PyResult<Bound<'py, Py
             let v: Vec<f64> = rows.iter().map(get).collect();
             d.set_item(name, PyArray1::from_vec(py, v))?;
         }
+    }
+    let aero = rows.iter().any(|r| r.aero_work.is_finite());
+    for (i, name) in surfaces.iter().enumerate().filter(|_| aero) {
+        let v: Vec<f64> = rows.iter().map(|r| r.control_hinge_moments[i]).collect();
+        d.set_item(format!("{name}_hinge_moment"), PyArray1::from_vec(py, v))?;
     }
     Ok(d)
 }
@@ -95,6 +102,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         root_bending_moment: f64::NAN,
         root_torque: f64::NAN,
         hinge_moment: f64::NAN,
+        control_hinge_moments: [f64::NAN; aeroelastic::control_surface::MAX_CONTROL_SURFACES],
     };
     let mut rows = vec![nan; n];
     let setters: [(&str, Setter); 18] = [
@@ -127,12 +135,43 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
             }
         }
     }
+    for (i, name) in surface_names(d)?.iter().enumerate() {
+        let key = format!("{name}_hinge_moment");
+        let v = column(d, &key)?.unwrap_or_default();
+        if v.len() != n {
+            return Err(PyValueError::new_err(format!("column `{key}` has {} values, `t` has {n}", v.len())));
+        }
+        for (r, x) in rows.iter_mut().zip(v) {
+            r.control_hinge_moments[i] = x;
+        }
+    }
     Ok(rows)
 }
 
+/// The control surfaces of a dict of columns: the `<name>_hinge_moment` keys in order (at most
+/// [`MAX_CONTROL_SURFACES`](aeroelastic::control_surface::MAX_CONTROL_SURFACES)).
+pub fn surface_names(d: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
+    let mut names = Vec::new();
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if let Some(name) = k.strip_suffix("_hinge_moment").filter(|n| !n.is_empty()) {
+            names.push(name.to_string());
+        }
+    }
+    if names.len() > aeroelastic::control_surface::MAX_CONTROL_SURFACES {
+        return Err(PyValueError::new_err(format!(
+            "{} control-surface hinge-moment columns, at most {}",
+            names.len(),
+            aeroelastic::control_surface::MAX_CONTROL_SURFACES
+        )));
+    }
+    Ok(names)
+}
+
 /// A static sweep as a dict of arrays keyed by the columns of `static_<f>.csv`
-/// (`casefile::csv::STATIC_HEADER`; `newton_iterations` int64, `converged` bool).
-pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Bound<'py, PyDict>> {
+/// (`casefile::csv::static_header`; `newton_iterations` int64, `converged` bool; the control
+/// surfaces' `<name>_hinge_moment` for `surfaces`, their names).
+pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput, surfaces: &[String]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let p = &out.points;
     let f = |g: fn(&aeroelastic::statics::StaticPoint) -> f64| PyArray1::from_vec(py, p.iter().map(g).collect());
@@ -157,7 +196,11 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput) -> PyResult<Boun
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
     d.set_item("drag", f(|p| p.drag))?;
     d.set_item("sideslip_deg", f(|p| p.sideslip_deg))?;
-    debug_assert_eq!(d.len(), casefile::csv::STATIC_HEADER.split(',').count());
+    for (i, name) in surfaces.iter().enumerate() {
+        let v: Vec<f64> = p.iter().map(|p| p.control_hinge_moments.get(i).copied().unwrap_or(f64::NAN)).collect();
+        d.set_item(format!("{name}_hinge_moment"), PyArray1::from_vec(py, v))?;
+    }
+    debug_assert_eq!(d.len(), casefile::csv::static_header(surfaces).split(',').count());
     Ok(d)
 }
 

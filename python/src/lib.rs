@@ -136,7 +136,8 @@ fn run<'py>(
     for (spec, runs) in specs.iter().zip(outs) {
         let per = PyDict::new(py);
         for out in runs {
-            let cols = columns::run_columns(py, &out.rows)?;
+            let names = casefile::csv::surface_names(spec.case(out.formulation).aero.as_ref());
+            let cols = columns::run_columns(py, &out.rows, &names)?;
             per.set_item(out.formulation.as_str(), (cols, out.error))?;
         }
         list.append((spec.name.as_str(), per))?;
@@ -181,7 +182,8 @@ fn static_sweep<'py>(
     for (spec, runs) in specs.iter().zip(outs) {
         let per = PyDict::new(py);
         for out in runs {
-            let cols = columns::static_columns(py, &out)?;
+            let names = casefile::csv::surface_names(spec.case(out.formulation).aero.as_ref());
+            let cols = columns::static_columns(py, &out, &names)?;
             per.set_item(out.formulation.as_str(), (cols, out.error))?;
         }
         list.append((spec.name.as_str(), per))?;
@@ -241,7 +243,7 @@ fn stability<'py>(
 #[pyfunction]
 fn to_csv(columns: &Bound<'_, PyDict>) -> PyResult<String> {
     let rows = columns::rows_of(columns)?;
-    Ok(casefile::csv::to_csv(&rows))
+    Ok(casefile::csv::to_csv(&rows, &columns::surface_names(columns)?))
 }
 
 /// The ANCF–GEBF tip distance as the CLI computes it (`casefile::curve::tip_difference`, no time
