@@ -104,6 +104,39 @@ fn a_flap_raises_the_static_lift_and_reports_its_hinge_moment() {
     assert!((ha - hg).abs() < 1e-4 * hg.abs(), "hinge moment ANCF {ha} vs GEBF {hg}");
 }
 
+/// The stations a surface covers: its range's panel edges; the flared hinge's column (station
+/// 24, the inner body's end) belongs to a surface ending at the inner body's tip and to one of
+/// the tip body starting at its root.
+#[test]
+fn surfaces_cover_their_panel_edges_and_the_hinge_column() {
+    let columns = |surfaces: &str| {
+        let spec = wing(&[&format!("aero.control_surfaces=[{surfaces}]")]);
+        let case = spec.case(Formulation::Ancf);
+        let aero = case.aero.clone().unwrap();
+        let map = harness::aero::station_map(&case.problem(), &aero).unwrap();
+        assert_eq!(map.len(), 33);
+        assert!(map[24].hinge);
+        (0..aero.control_surfaces.len())
+            .map(|i| {
+                let j: Vec<usize> = (0..map.len()).filter(|&j| map[j].surface == Some(i)).collect();
+                (j[0], *j.last().unwrap(), j.len())
+            })
+            .collect::<Vec<_>>()
+    };
+    let s = |name: &str, body: &str, span: &str| {
+        format!(r#"{{"name":"{name}","body":"{body}","span":{span},"chord_fraction":0.3,"deflection_deg":1}}"#)
+    };
+    // 0.5 m strips on the inner body, 0.5 m on the tip.
+    assert_eq!(columns(&s("a", "inner", "[1,3]")), [(2, 6, 5)]);
+    assert_eq!(columns(&s("a", "inner", "[6,12]")), [(12, 24, 13)]);
+    assert_eq!(columns(&s("a", "outer", "[0,4]")), [(24, 32, 9)]);
+    assert_eq!(columns(&s("a", "outer", "[1,2]")), [(26, 28, 3)]);
+    assert_eq!(
+        columns(&format!("{},{}", s("a", "inner", "[0,11.5]"), s("b", "outer", "[0,4]"))),
+        [(0, 23, 24), (24, 32, 9)]
+    );
+}
+
 fn harness(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_harness")).args(args).current_dir(root()).output().expect("binary runs")
 }
