@@ -25,6 +25,11 @@ use formulation::Structure;
 
 pub use formulation::SectionLoad;
 
+use crate::planform::Sections;
+
+/// Largest angle between a streamwise section and the normal to the beam axis, degrees.
+pub const MAX_STREAMWISE_SLANT_DEG: f64 = 70.0;
+
 /// One span station of the lattice: which body section drives it, and its column slant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StationMap {
@@ -38,6 +43,11 @@ pub struct StationMap {
     pub hinge: bool,
     /// The control surface on this station (index into `aero.control_surfaces`), if any.
     pub surface: Option<usize>,
+    /// Chord measured along the section's y axis, m (`aero.chord` at this station, times the
+    /// cosine of the streamwise slant for streamwise sections).
+    pub chord: f64,
+    /// Distance from the beam axis to the leading edge along the section's y axis, m.
+    pub le_offset: f64,
 }
 
 impl StationMap {
@@ -50,10 +60,14 @@ impl StationMap {
 /// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
 /// body's panels, the hinge column shared (driven by the inner body's end).
 pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap>, String> {
+    aero.chord.check("aero.chord", case.bodies.len(), true)?;
+    aero.le_offset.check("aero.le_offset", case.bodies.len(), false)?;
     let nb = case.bodies.len();
     if aero.panels_per_body.len() != nb {
         return Err(format!("aero.panels_per_body: {} entries for {nb} bodies", aero.panels_per_body.len()));
     }
+    let frames = reference_frames(case);
+    let stream = -Vector3::from(aero.stream_without_sideslip()).normalize();
     let mut out = Vec::new();
     for (b, body) in case.bodies.iter().enumerate() {
         let n = aero.panels_per_body[b];
@@ -74,23 +88,42 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
             let Some(beta) = hinge else {
                 return Err(format!("aero: bodies[{}] and bodies[{b}] are not joined by a flared hinge", b - 1));
             };
+            check_shared_column(aero, b)?;
             if let Some(last) = out.last_mut() {
                 let last: &mut StationMap = last;
                 last.slant = beta;
                 last.hinge = true;
             }
         }
+        let twist = body.twist_deg.as_ref().map(|t| t.twist(body.length));
         for k in first..=n {
-            out.push(StationMap {
-                body: b,
-                s: body.length * k as f64 / n as f64,
-                slant: 0.0,
-                hinge: false,
-                surface: None,
-            });
+            let frac = k as f64 / n as f64;
+            let s = body.length * frac;
+            let (mut chord, mut le_offset) = (aero.chord.at(b, frac), aero.le_offset.at(b, frac));
+            let mut slant = 0.0;
+            if aero.sections == Sections::Streamwise {
+                let frame = frames[b] * twist.as_ref().map_or_else(Matrix3::identity, |t| t.rotation(s));
+                let (along, ahead) = (frame.column(0).dot(&stream), frame.column(1).dot(&stream));
+                if ahead <= 0.0 {
+                    return Err(format!(
+                        "aero.sections: the stream does not reach bodies[{b}] at s = {s} m from its leading edge"
+                    ));
+                }
+                slant = along.atan2(ahead);
+                if slant.abs() >= MAX_STREAMWISE_SLANT_DEG.to_radians() {
+                    return Err(format!(
+                        "aero.sections: bodies[{b}] at s = {s} m lies {:.1}° off the normal to the stream (at most \
+                         {MAX_STREAMWISE_SLANT_DEG}° for streamwise sections)",
+                        slant.to_degrees()
+                    ));
+                }
+                chord *= slant.cos();
+                le_offset *= slant.cos();
+            }
+            out.push(StationMap { body: b, s, slant, hinge: false, surface: None, chord, le_offset });
         }
     }
-    grade_slants(case, aero, &mut out);
+    grade_slants(case, &mut out);
     place_control_surfaces(case, aero, &mut out)?;
     Ok(out)
 }
@@ -111,26 +144,57 @@ fn place_control_surfaces(case: &Problem, aero: &AeroSettings, map: &mut [Statio
 
 /// Blend the columns next to a slanted hinge column towards its slant, so that no panel folds
 /// when the hinge column's ends reach past a neighbouring station (a large flare, a long chord
-/// or narrow panels): a column at arclength distance `d` from the hinge gets
-/// `tan γ = w tan β`, `w = max(0, 1 − d/D)` with `D = 2 max(le, c − le) |tan β|`, which keeps
-/// the leading- and trailing-edge nodes in spanwise order. Only the panel layout changes, not
-/// the planform; columns farther than `D` keep `γ = 0` exactly.
-fn grade_slants(case: &Problem, aero: &AeroSettings, map: &mut [StationMap]) {
+/// or narrow panels): a column of own slant `γ₀` (0 for normal sections) at arclength distance
+/// `d` from the hinge gets `tan γ = tan γ₀ + w (tan β − tan γ₀)`, `w = max(0, 1 − d/D)` with
+/// `D = 2 max(le, c − le) |tan β − tan γ₀|`, which keeps the leading- and trailing-edge nodes in
+/// spanwise order. Only the panel layout changes, not the planform; columns farther than `D`
+/// keep `γ₀` exactly.
+fn grade_slants(case: &Problem, map: &mut [StationMap]) {
     let arc = |m: &StationMap| m.wing_arc(case);
     let hinges: Vec<(f64, f64)> = map.iter().filter(|m| m.hinge).map(|m| (arc(m), m.slant)).collect();
-    let reach = aero.le_offset.abs().max((aero.chord - aero.le_offset).abs());
+    let reach = map.iter().map(|m| m.le_offset.abs().max((m.chord - m.le_offset).abs())).fold(0.0, f64::max);
     for m in map.iter_mut().filter(|m| !m.hinge) {
         let x = arc(m);
-        let mut t = 0.0;
+        let own = m.slant.tan();
+        let (mut t, mut near) = (0.0, false);
         for &(xh, beta) in &hinges {
-            let d_max = 2.0 * reach * beta.tan().abs();
+            let d_max = 2.0 * reach * (beta.tan() - own).abs();
             let w = if d_max > 0.0 { (1.0 - (x - xh).abs() / d_max).max(0.0) } else { 0.0 };
-            t += w * beta.tan();
+            near |= w > 0.0;
+            t += w * (beta.tan() - own);
         }
-        if t != 0.0 {
-            m.slant = t.atan();
+        if near {
+            m.slant = (own + t).atan();
         }
     }
+}
+
+/// A hinge column is shared by the inner body's end and the outer body's root: their chords
+/// and leading-edge offsets must meet there.
+fn check_shared_column(aero: &AeroSettings, b: usize) -> Result<(), String> {
+    for (field, taper) in [("aero.chord", &aero.chord), ("aero.le_offset", &aero.le_offset)] {
+        let (tip, root) = (taper.at(b - 1, 1.0), taper.at(b, 0.0));
+        if (tip - root).abs() > 1e-9 * tip.abs().max(root.abs()).max(1e-3) {
+            return Err(format!(
+                "{field}[{b}][0]: {root} m differs from {field}[{}][1] = {tip} m; the bodies share their hinge column",
+                b - 1
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Each body's section frame in the reference configuration before its own twist, the root
+/// pitch included (the frame the scene builds).
+fn reference_frames(case: &Problem) -> Vec<Matrix3<f64>> {
+    let pitch = nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), case.pitch_deg.to_radians());
+    case.placements()
+        .into_iter()
+        .map(|(_, x, y)| {
+            let (x, y) = (pitch * x, pitch * y);
+            Matrix3::from_columns(&[x, y, x.cross(&y)])
+        })
+        .collect()
 }
 
 /// The lattice layout of a station map: chordwise panels and the hinge column (the station a
@@ -192,8 +256,8 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
         stations.push(uvlm::SpanStation {
             origin: p,
             frame: r,
-            chord: aero.chord,
-            le_offset: aero.le_offset,
+            chord: st.chord,
+            le_offset: st.le_offset,
             slant: st.slant,
             flap: st.surface.map(|i| aero.control_surfaces[i].flap_at(t)),
         });

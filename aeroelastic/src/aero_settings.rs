@@ -4,6 +4,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::gust_settings::GustSpec;
+pub use crate::planform::{Sections, Taper};
 
 /// Aerodynamic settings of a case.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,11 +28,17 @@ pub struct AeroSettings {
     /// root for β > 0 (docs/case-file.md). Default 0, in (−90, 90).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
     pub sideslip_deg: f64,
-    /// Chord, m.
-    pub chord: f64,
+    /// Chord, m: one number for every body, or `[root, tip]` per body (linear taper), in body
+    /// order. A body's root must meet its parent's tip across a shared hinge column.
+    pub chord: Taper,
     /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
-    /// for a mid-chord axis).
-    pub le_offset: f64,
+    /// for a mid-chord axis): one number or `[root, tip]` per body, as `chord`.
+    pub le_offset: Taper,
+    /// How the lattice's grid columns are cut: `"normal"` to the beam axis (default) or
+    /// `"streamwise"` (along the free stream without sideslip; `chord` and `le_offset` are then
+    /// measured along the stream). The same on an unswept wing.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Sections::is_normal"))]
+    pub sections: Sections,
     /// Spanwise panels per body, in body order.
     pub panels_per_body: Vec<usize>,
     /// Chordwise panels.
@@ -175,7 +182,8 @@ impl AeroSettings {
         [v[0] * c + v[1] * s, -v[0] * s + v[1] * c, v[2]]
     }
 
-    fn stream_without_sideslip(&self) -> [f64; 3] {
+    /// The free stream before the sideslip turns it, m/s.
+    pub fn stream_without_sideslip(&self) -> [f64; 3] {
         match (self.v_inf, self.airspeed) {
             (Some(v), None) => v,
             (Some(v), Some(u)) => {

@@ -22,6 +22,7 @@ pub mod gust_settings;
 pub mod interrupt;
 pub mod loads;
 pub mod pencil;
+pub mod planform;
 pub mod polar_correction;
 pub mod problem;
 pub mod run;

@@ -659,8 +659,9 @@ fn strip_model<S: Structure>(
             lo + hi
         })
         .collect();
-    let b = 0.5 * aero.chord;
-    Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset - b) / b, speed: aero.airspeed.unwrap_or(0.0) }
+    // One strip section for the whole wing: the largest chord (every station's with one chord).
+    let b = 0.5 * aero.chord.max();
+    Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset.max() - b) / b, speed: aero.airspeed.unwrap_or(0.0) }
 }
 
 /// The load maps of a lattice `la` on `model` at `q`: the lumping `C_l` (6·stations × nodal
@@ -751,9 +752,9 @@ impl<'a> MovedLattice<'a> {
         self.la
     }
 
-    /// The chord of the lattice, m.
+    /// The largest chord of the lattice, m (the scale of its finite-difference steps).
     pub(crate) fn chord(&self) -> f64 {
-        self.aero.chord
+        self.aero.chord.max()
     }
 
     /// The lattice moved to the stations of `model` at `(q, v)`, their velocities counted when
@@ -799,7 +800,7 @@ fn geometric_terms<S: Structure>(
 ) -> Result<Geometric, String> {
     let (nr, nb) = (moved.la.n_rings(), phi.ncols());
     let zeros = vec![0.0; model.n_dof()];
-    let span = moved.aero.chord.max(1e-3);
+    let span = moved.aero.chord.max().max(1e-3);
     let n_te = 3 * (moved.lat.n_spanwise() + 1);
     let mut g = Geometric {
         rx: DMatrix::zeros(nr, nb),

@@ -1100,7 +1100,9 @@ fn point_at<S: Structure>(
     // Column j of the lattice lies between stations j and j + 1.
     let arc = |m: &StationMap| m.wing_arc(case);
     let qdyn = 0.5 * rho * airspeed * airspeed;
-    let chord = sys.aero.chord;
+    // The section's chord: along the stream for streamwise sections, else along the section's y.
+    let streamwise = sys.aero.sections == crate::planform::Sections::Streamwise;
+    let chord = |m: &StationMap| if streamwise { m.chord / m.slant.cos() } else { m.chord };
     let strips = (0..stations.len().saturating_sub(1))
         .filter_map(|j| {
             let f = Vector3::from(*uv_loads.strip.get(j)?) + report.delta_force.get(j).copied().unwrap_or_default();
@@ -1112,7 +1114,7 @@ fn point_at<S: Structure>(
                 s: 0.5 * (arc(&map[j]) + arc(&map[j + 1])),
                 position: mid.into(),
                 lift_per_span: l,
-                cl: l / (qdyn * chord),
+                cl: l / (qdyn * 0.5 * (chord(&map[j]) + chord(&map[j + 1]))),
                 alpha: report.alpha.get(j).copied().unwrap_or(f64::NAN),
             })
         })

@@ -56,15 +56,18 @@ impl Case {
                 .with_bounds(spec.bounds.aerofoil());
             if let (Some((lo, hi)), ReBound::Error) = (polar.re_range(), spec.bounds.re) {
                 let speeds = aero.airspeed.iter().chain(self.statics.iter().flat_map(|s| s.airspeeds.iter()));
-                for &v in speeds {
-                    let re = v * aero.chord / nu;
+                // The strips' chords: the root and tip of each body of this polar.
+                let chords: Vec<f64> =
+                    spec.bodies.iter().flat_map(|&b| [aero.chord.at(b, 0.0), aero.chord.at(b, 1.0)]).collect();
+                for (v, c) in speeds.flat_map(|&v| chords.iter().map(move |&c| (v, c))) {
+                    let re = v * c / nu;
                     if !(lo..=hi).contains(&re) {
                         return Err(format!(
                             "aero.polars[{i}].file: {}: the free stream's Reynolds number {re:.4e} at {v} m/s \
-                             (aero.chord {} m, aero.kinematic_viscosity {nu} m²/s) is outside the table's range \
+                             (aero.chord {c} m, aero.kinematic_viscosity {nu} m²/s) is outside the table's range \
                              [{lo:.4e}, {hi:.4e}]; give a polar that covers it or set aero.polars[{i}].bounds.re \
                              to \"clamp\"",
-                            spec.file, aero.chord
+                            spec.file
                         ));
                     }
                 }

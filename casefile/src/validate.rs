@@ -311,7 +311,7 @@ impl Case {
             }
         }
         positive("aero.rho", a.rho)?;
-        positive("aero.chord", a.chord)?;
+        a.chord.check("aero.chord", self.bodies.len(), true)?;
         match (a.v_inf, a.airspeed) {
             (None, None) => return Err("aero: give the free stream as `v_inf` or `airspeed`".into()),
             (Some(v), _) if !finite3(&v) || norm3(&v) == 0.0 => {
@@ -321,9 +321,7 @@ impl Case {
             _ => {}
         }
         sideslip("aero.sideslip_deg", a.sideslip_deg)?;
-        if !a.le_offset.is_finite() {
-            return Err("aero.le_offset: not finite".into());
-        }
+        a.le_offset.check("aero.le_offset", self.bodies.len(), false)?;
         if a.n_chordwise == 0 {
             return Err("aero.n_chordwise: must be at least 1".into());
         }

@@ -194,6 +194,17 @@
           g.lineTo(te[k + 1][0], te[k + 1][1]); g.lineTo(te[k][0], te[k][1]); g.closePath(); g.fill();
         }
         self.line(le, rgba(col, 0.9), 1.5); self.line(te, rgba(col, 0.9), 1.5);
+        // Control surfaces: the flap between its hinge line and the deflected trailing edge.
+        (fr.flaps || []).forEach(function (f) {
+          var pts = self.points(f, s), h = pts.slice(0, pts.length / 2), e = pts.slice(pts.length / 2);
+          g.fillStyle = rgba(col, 0.4);
+          for (var k = 0; k + 1 < h.length; k++) {
+            g.beginPath(); g.moveTo(h[k][0], h[k][1]); g.lineTo(h[k + 1][0], h[k + 1][1]);
+            g.lineTo(e[k + 1][0], e[k + 1][1]); g.lineTo(e[k][0], e[k][1]); g.closePath(); g.fill();
+          }
+          self.line(h, rgba(col, 0.9), 1);
+          self.line([h[0], e[0]], rgba(col, 0.9), 1); self.line([h[h.length - 1], e[e.length - 1]], rgba(col, 0.9), 1);
+        });
       }
       // Beams, and the chord direction of each section for structures without a lattice.
       var tick = 0.06 * self.radius;

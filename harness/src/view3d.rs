@@ -42,6 +42,10 @@ pub struct Frame {
     pub le: Vec<i64>,
     /// Trailing-edge points of the lattice.
     pub te: Vec<i64>,
+    /// Per run of neighbouring grid columns carrying a control surface: its hinge-line points,
+    /// then as many trailing-edge points (the deflected flap's edges), x y z flattened.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub flaps: Vec<Vec<i64>>,
     /// Wake nodes, row by row (row 0 the trailing edge), x y z flattened.
     pub wake: Vec<i64>,
     /// Number of wake node rows in `wake`.
@@ -163,6 +167,7 @@ impl Observer for ViewRecorder {
                 quant(l.grid_nodes()[l.node_index(0, j)], &mut f.le);
                 quant(l.grid_nodes()[l.node_index(m, j)], &mut f.te);
             }
+            f.flaps = flap_runs(l, &quant);
             let w = uv.wake();
             let rows = spread(w.n_rows() + 1, MAX_WAKE_ROWS);
             let wcols = spread(w.n_spanwise() + 1, MAX_WAKE_COLUMNS);
@@ -178,6 +183,34 @@ impl Observer for ViewRecorder {
         self.data.frames.push(f);
         Ok(())
     }
+}
+
+/// The control surfaces of lattice `l`: per run of neighbouring flapped grid columns, the hinge
+/// points then the trailing-edge points, quantised by `quant`.
+fn flap_runs(l: &uvlm::Lattice, quant: &impl Fn([f64; 3], &mut Vec<i64>)) -> Vec<Vec<i64>> {
+    let m = l.n_chordwise();
+    let mut runs: Vec<Vec<usize>> = Vec::new();
+    for (j, f) in l.column_flaps().iter().enumerate() {
+        match (f, runs.last_mut()) {
+            (Some(_), Some(run)) if run.last() == Some(&(j - 1)) => run.push(j),
+            (Some(_), _) => runs.push(vec![j]),
+            (None, _) => {}
+        }
+    }
+    runs.into_iter()
+        .filter(|run| run.len() > 1)
+        .map(|run| {
+            let mut out = Vec::with_capacity(6 * run.len());
+            for &j in &run {
+                let hinge = l.column_flaps()[j].map_or([0.0; 3], |f| f.hinge_point);
+                quant(hinge, &mut out);
+            }
+            for &j in &run {
+                quant(l.grid_nodes()[l.node_index(m, j)], &mut out);
+            }
+            out
+        })
+        .collect()
 }
 
 /// The observer of a run of `harness all`: its [`ViewRecorder`], plus the case's ParaView

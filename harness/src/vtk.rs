@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::case::{Case, Formulation, RunSpec};
 use crate::run::{BeamGeometry, Observer, Snapshot};
+use aeroelastic::planform::Taper;
 
 pub use casefile::VtkOutput;
 
@@ -30,7 +31,7 @@ pub struct VtkWriter {
     stride: usize,
     created: bool,
     /// Chord and leading-edge offset of the sections, m, when the case has a lattice.
-    chord: Option<(f64, f64)>,
+    chord: Option<(Taper, Taper)>,
     /// Per family: (time, file name) of each written step.
     steps: [Vec<(f64, String)>; 4],
 }
@@ -44,9 +45,9 @@ impl VtkWriter {
 
     /// Also write each section's chord as a ribbon (`ribbon_<k>.vtp`): `chord` long, its leading
     /// edge `le_offset` ahead of the beam axis along the section's y axis (as the lattice is
-    /// built, docs/uvlm.md).
-    pub fn with_chord(mut self, chord: f64, le_offset: f64) -> Self {
-        self.chord = Some((chord, le_offset));
+    /// built, docs/uvlm.md); each a number or `[root, tip]` per body, as `aero.chord`.
+    pub fn with_chord(mut self, chord: impl Into<Taper>, le_offset: impl Into<Taper>) -> Self {
+        self.chord = Some((chord.into(), le_offset.into()));
         self
     }
 
@@ -100,8 +101,9 @@ impl Observer for VtkWriter {
             self.created = true;
         }
         self.write_family(0, s.index, s.t, &beams_vtp(s.beams))?;
-        if let Some((chord, le)) = self.chord {
-            self.write_family(1, s.index, s.t, &ribbon_vtp(s.beams, chord, le))?;
+        if let Some((chord, le)) = &self.chord {
+            let text = ribbon_vtp(s.beams, chord, le);
+            self.write_family(1, s.index, s.t, &text)?;
         }
         if let Some(uv) = s.aero {
             self.write_family(2, s.index, s.t, &lattice_vtp(uv))?;
@@ -129,7 +131,7 @@ pub fn writer_for(out: &Path, spec: &RunSpec, f: Formulation, cli: Option<Option
     let stride = cli.flatten().or(case.vtk.and_then(|v| v.stride)).unwrap_or_else(|| default_stride(case, f));
     let w = VtkWriter::for_run(out, &spec.name, f, stride);
     Some(match &case.aero {
-        Some(a) => w.with_chord(a.chord, a.le_offset),
+        Some(a) => w.with_chord(a.chord.clone(), a.le_offset.clone()),
         None => w,
     })
 }
@@ -255,13 +257,16 @@ fn beams_vtp(beams: &[BeamGeometry]) -> String {
 /// Each body's sections as a ribbon: at every node a leading-edge point `le` ahead of the axis
 /// along the section's y axis and a trailing-edge point `chord − le` behind it (points 2i and
 /// 2i + 1 of a body's strip), one quad between neighbouring nodes; point data `s` and `body`.
-fn ribbon_vtp(beams: &[BeamGeometry], chord: f64, le: f64) -> String {
+fn ribbon_vtp(beams: &[BeamGeometry], chord: &Taper, le: &Taper) -> String {
     let n: usize = beams.iter().map(|b| b.positions.len()).sum();
     let mut points = Vec::with_capacity(2 * n);
     let mut quads = Vec::new();
-    for b in beams {
+    for (k, b) in beams.iter().enumerate() {
         let base = points.len();
-        for (p, r) in b.positions.iter().zip(&b.frames) {
+        let length = b.arc.last().copied().unwrap_or(0.0);
+        for ((p, r), &s) in b.positions.iter().zip(&b.frames).zip(&b.arc) {
+            let frac = if length > 0.0 { s / length } else { 0.0 };
+            let (chord, le) = (chord.at(k, frac), le.at(k, frac));
             let y = r.column(1);
             points.push(p + y * le);
             points.push(p + y * (le - chord));
@@ -429,7 +434,7 @@ mod tests {
         let w = writer_for(out, &s, Formulation::Gebf, Some(None)).unwrap();
         // 20 s at output_dt 0.01: 2001 rows, about 100 frames.
         assert_eq!(w.stride, 20);
-        assert!(w.chord == Some((1.0, 0.5)));
+        assert!(w.chord == Some((Taper::Uniform(1.0), Taper::Uniform(0.5))));
         v["vtk"] = serde_json::json!({ "stride": 7 });
         let s = spec(&v).unwrap();
         assert_eq!(writer_for(out, &s, Formulation::Ancf, None).unwrap().stride, 7);

@@ -69,14 +69,7 @@ fn rigid_locked_wing_lift_matches_steady_uvlm() {
             let b = &scene.bodies[m.body];
             let frame = b.frame;
             let origin = b.start + frame.column(0) * m.s;
-            uvlm::SpanStation {
-                origin,
-                frame,
-                chord: aero.chord,
-                le_offset: aero.le_offset,
-                slant: m.slant,
-                flap: None,
-            }
+            uvlm::SpanStation { origin, frame, chord: m.chord, le_offset: m.le_offset, slant: m.slant, flap: None }
         })
         .collect();
     let hinge = map.iter().position(|m| m.hinge).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });

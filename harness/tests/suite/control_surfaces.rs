@@ -52,8 +52,8 @@ fn hinge_moment_on_the_lattice(spec: &RunSpec, p: &StaticPoint) -> f64 {
             uvlm::SpanStation {
                 origin,
                 frame,
-                chord: aero.chord,
-                le_offset: aero.le_offset,
+                chord: m.chord,
+                le_offset: m.le_offset,
                 slant: m.slant,
                 flap: m.surface.map(|i| aero.control_surfaces[i].flap_at(None)),
             }

@@ -13,6 +13,7 @@ mod gust;
 mod honest;
 mod loads_lost;
 mod observer;
+mod planform;
 mod polars;
 mod properties;
 mod send_sync;

@@ -1,0 +1,128 @@
+//! The planform of a lifting surface: chord and leading-edge offset per body, linear along each
+//! body (taper), and how the lattice's sections are cut (normal to the beam axis or along the
+//! stream).
+
+/// A length given for every body of a surface at once, or per body as `[root, tip]`, linear
+/// along the body (`aero.chord`, `aero.le_offset`).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(untagged))]
+pub enum Taper {
+    /// One value on every body, m.
+    Uniform(f64),
+    /// `[root, tip]` per body in the surface's body order, m, linear along each body.
+    PerBody(Vec<[f64; 2]>),
+}
+
+impl Default for Taper {
+    fn default() -> Self {
+        Self::Uniform(0.0)
+    }
+}
+
+impl From<f64> for Taper {
+    fn from(v: f64) -> Self {
+        Self::Uniform(v)
+    }
+}
+
+impl Taper {
+    /// The value on body `body` at the fraction `frac` of its length (0 at the root, 1 at the
+    /// tip). A uniform value, or equal root and tip, is returned exactly.
+    pub fn at(&self, body: usize, frac: f64) -> f64 {
+        match self {
+            Self::Uniform(v) => *v,
+            Self::PerBody(v) => match v.get(body) {
+                Some(&[r, t]) if r == t => r,
+                Some(&[r, t]) => r + frac * (t - r),
+                None => f64::NAN,
+            },
+        }
+    }
+
+    /// The uniform value, if it is one number.
+    pub fn uniform(&self) -> Option<f64> {
+        match self {
+            Self::Uniform(v) => Some(*v),
+            Self::PerBody(_) => None,
+        }
+    }
+
+    /// Every root and tip value (the extremes of a linear distribution).
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Self::Uniform(v) => vec![*v],
+            Self::PerBody(v) => v.iter().flatten().copied().collect(),
+        }
+    }
+
+    /// The largest value, m.
+    pub fn max(&self) -> f64 {
+        self.values().into_iter().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The smallest value, m.
+    pub fn min(&self) -> f64 {
+        self.values().into_iter().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The length-weighted mean over bodies of lengths `lengths`, m (the mean geometric chord
+    /// for a chord).
+    pub fn mean(&self, lengths: &[f64]) -> f64 {
+        match self {
+            Self::Uniform(v) => *v,
+            Self::PerBody(v) => {
+                let total: f64 = lengths.iter().sum();
+                let sum: f64 = v.iter().zip(lengths).map(|(rt, l)| 0.5 * (rt[0] + rt[1]) * l).sum();
+                sum / total
+            }
+        }
+    }
+
+    /// Check against `n_bodies` bodies: one entry per body, every value finite and, with
+    /// `positive`, above zero. The error names `field` and the entry.
+    pub fn check(&self, field: &str, n_bodies: usize, positive: bool) -> Result<(), String> {
+        let ok = |v: f64| v.is_finite() && (!positive || v > 0.0);
+        let need = if positive { "a finite length > 0" } else { "finite" };
+        match self {
+            Self::Uniform(v) if !ok(*v) => Err(format!("{field}: {v} is not {need}")),
+            Self::Uniform(_) => Ok(()),
+            Self::PerBody(v) if v.len() != n_bodies => {
+                Err(format!("{field}: {} [root, tip] entries for {n_bodies} bodies", v.len()))
+            }
+            Self::PerBody(v) => v.iter().enumerate().try_for_each(|(b, rt)| {
+                for (k, x) in rt.iter().enumerate() {
+                    if !ok(*x) {
+                        return Err(format!("{field}[{b}][{k}]: {x} is not {need}"));
+                    }
+                }
+                Ok(())
+            }),
+        }
+    }
+}
+
+/// How the lattice's chordwise grid columns are cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Sections {
+    /// Columns along each section's y axis, normal to the beam axis; `chord` and `le_offset` are
+    /// measured along it (the default).
+    #[default]
+    Normal,
+    /// Columns parallel to the free stream (without sideslip) in the reference configuration:
+    /// the stream projected on each section's plane. `chord` and `le_offset` are measured along
+    /// the stream. A swept wing then has streamwise root and tip edges, and its root lies in a
+    /// plane of symmetry along the stream. Columns keep their slant as the structure deforms.
+    Streamwise,
+}
+
+impl Sections {
+    /// Whether these are the default normal sections.
+    pub fn is_normal(&self) -> bool {
+        *self == Self::Normal
+    }
+}
