@@ -116,6 +116,7 @@ mod scratch;
 mod solver;
 mod station;
 mod stats;
+mod surface;
 pub mod treecode;
 mod wake;
 
@@ -133,5 +134,6 @@ pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggre
 pub use solver::Uvlm;
 pub use station::{MAX_FLAP_DEFLECTION_DEG, SpanStation, StationFlap, StationVelocity};
 pub use stats::Stats;
+pub use surface::Surface;
 pub use treecode::{TreeStats, Treecode};
 pub use wake::Wake;
