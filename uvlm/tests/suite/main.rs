@@ -8,6 +8,7 @@ mod gust;
 mod hinge;
 mod linear;
 mod linear_gust;
+mod multi_surface;
 mod multi_surface_baseline;
 mod properties;
 mod reuse;
