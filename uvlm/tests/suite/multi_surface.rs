@@ -189,7 +189,7 @@ fn tail_downwash(ns_wing: usize, nc_wing: usize, x_tail: f64, h: f64) -> (f64, f
 /// behind the wing's quarter chord, 0.1 above the line along the free stream from the root
 /// trailing edge (the wing's trailing legs). ε is the tail's lift loss as an angle,
 /// ε = α (1 − L_t/L_t,alone) (its lift is linear in α); 2 C_L/(π A) takes the isolated wing's C_L.
-/// Measured (docs/uvlm.md §16): −0.3 %, −1.6 %, −1.9 % at x = 8, 16, 32 on this mesh, −0.9 %,
+/// Measured (docs/uvlm.md §16): −0.3 %, −1.6 %, −2.0 % at x = 8, 16, 32 on this mesh, −0.9 %,
 /// −1.3 % at x = 16, 32 with 64 strips. Asserted: within 10 % (the acceptance) at x = 8, 16, 32,
 /// converged in distance (x = 16 and 32 within 1 %), and within 2 % of the downwash that
 /// `velocity_at` gives at the tail's quarter chord in the isolated wing's flow.
