@@ -102,8 +102,9 @@ impl ThreeWings {
 }
 
 /// Two half-wings meeting at the root = one surface across the plane of symmetry = the mirror
-/// image, to 1e-10 of the largest value: steady (semi-infinite legs), then impulsive unsteady
-/// steps with a plunge velocity, prescribed and free wake.
+/// image, to 1e-10 of the largest value: steady (finite and semi-infinite wake), then impulsive
+/// unsteady steps with a plunge velocity, prescribed and free wake (with the trailing-edge
+/// segment force and wake closure).
 ///
 /// Why (b) = (a): at the root the two half-wings' chordwise bound edges (and trailing legs, and
 /// wake legs) coincide node for node and carry Γ_left and −Γ_right; by linearity two coincident
@@ -118,11 +119,17 @@ fn two_half_wings_equal_one_surface_and_the_mirror_image() {
         p.n_wake_rows = 6;
         p.wake_convection = convection;
         p.wake_core = CoreModel::Scully { fraction: 0.1 };
+        // The free-wake run also carries the trailing-edge segment's force and a closed wake.
+        p.te_segment_force = convection == WakeConvection::Free;
+        p.wake_closure = convection == WakeConvection::Free;
         let mut w = three_wings(&p, 8, 4);
-        w.a.solve_steady().unwrap();
-        w.b.solve_steady().unwrap();
-        w.c.solve_steady().unwrap();
-        w.compare(1e-10, "steady");
+        for steady_wake in [SteadyWake::Finite { length: 12.0 }, SteadyWake::SemiInfinite] {
+            for u in [&mut w.a, &mut w.b, &mut w.c] {
+                u.set_steady_wake(steady_wake).unwrap();
+                u.solve_steady().unwrap();
+            }
+            w.compare(1e-10, &format!("steady {steady_wake:?}"));
+        }
         let nh = w.n_half;
         let plunge = |n: usize| vec![StationVelocity { linear: [0.0, 0.0, -0.5].into(), ..Default::default() }; n];
         let full = w.full.clone();
