@@ -220,7 +220,8 @@ fn tail_in_the_wing_downwash_matches_the_far_field_estimate() {
 }
 
 /// A run through every phase with two surfaces in one system (wing with an aileron, tail with
-/// an elevator; free wake with a core, disturbance, closure, frozen far wake, sub-iterations):
+/// an elevator; free wake with a core, disturbance, closure, frozen far wake, treecode,
+/// sub-iterations):
 /// the sub-iterated step equals the plain step bit for bit, the per-surface loads add up to the
 /// total, each surface's column loads take its own station origins, hinge moments are per
 /// surface, and the steady state is a fixed point of the unsteady step.
@@ -268,16 +269,19 @@ fn two_surfaces_through_every_phase() {
     p.wake_convection = WakeConvection::Free;
     p.wake_core = CoreModel::Scully { fraction: 0.1 };
     let pf = UvlmParams { wake_reuse: WakeReuse::Frozen, ..p.clone() };
+    let pt =
+        UvlmParams { wake_aggregation: WakeAggregation { leaf_size: 8, ..WakeAggregation::treecode() }, ..p.clone() };
     let mut a = Uvlm::with_surfaces(lats(), p.clone()).unwrap();
     let mut b = Uvlm::with_surfaces(lats(), p).unwrap();
     let mut c = Uvlm::with_surfaces(lats(), pf).unwrap();
-    for u in [&mut a, &mut b, &mut c] {
+    let mut t = Uvlm::with_surfaces(lats(), pt).unwrap();
+    for u in [&mut a, &mut b, &mut c, &mut t] {
         u.set_disturbance(Some(Box::new(|x: [f64; 3], t: f64| [0.0, 0.0, 0.3 * (x[0] - 10.0 * t).sin()])));
     }
     let vel = |n: usize| vec![StationVelocity { linear: [0.0, 0.0, 0.2].into(), ..Default::default() }; n];
     for k in 1..=5 {
         let d = 0.05 + 0.01 * k as f64;
-        for u in [&mut a, &mut c] {
+        for u in [&mut a, &mut c, &mut t] {
             u.update_stations_of(0, &wing(d), Some(&vel(9))).unwrap();
             u.update_stations_of(1, &tail(-d), Some(&vel(5))).unwrap();
             u.step(0.02).unwrap();
@@ -292,6 +296,9 @@ fn two_surfaces_through_every_phase() {
         assert_eq!(a.gamma(), b.gamma(), "step {k}");
         assert_eq!(a.loads().nodal, b.loads().nodal, "step {k}");
         assert!(rel_diff(a.gamma(), c.gamma()) < 1e-12, "step {k}: frozen {:.2e}", rel_diff(a.gamma(), c.gamma()));
+        // The treecode over both wakes: within its bound (1e-6 |V∞| per point) of the direct sum.
+        assert!(rel_diff(a.gamma(), t.gamma()) < 1e-5, "step {k}: treecode {:.2e}", rel_diff(a.gamma(), t.gamma()));
+        assert!(t.stats().n_pair_evaluations < a.stats().n_pair_evaluations || k < 3);
     }
     let total = a.loads().total_force();
     let (fw, ft) = (a.surface(0).unwrap().loads().total_force(), a.surface(1).unwrap().loads().total_force());
