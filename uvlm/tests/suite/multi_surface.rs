@@ -98,6 +98,11 @@ impl ThreeWings {
             rel_diff(&flat(sc), &flat(sr))
         );
         println!("{what}: Γ (a)-(b) {:.1e}, (a)-(c) {:.1e}", rel_diff(ga, &gb), rel_diff(ga, &gc));
+        println!(
+            "{what}: root strip side force / lift: (a) {:.2e}, (b) right half {:.2e}",
+            self.a.loads().strip[nh][1] / self.a.loads().strip[nh][2],
+            sr[0][1] / sr[0][2]
+        );
     }
 }
 
