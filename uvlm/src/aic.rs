@@ -48,46 +48,103 @@ pub(crate) enum TrailingEdge {
     },
 }
 
-/// Unit-strength bound filaments with incidences.
+/// Where one surface's filaments and unknowns sit in a [`BoundSystem`] of several surfaces.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct SurfaceRange {
+    /// Index of the surface's first segment: its lattice segments are
+    /// `seg0 .. seg0 + n_lattice_seg` (spanwise rows, chordwise columns, then the trailing-edge
+    /// edge in unsteady mode), followed by its finite steady wake if any.
+    pub(crate) seg0: usize,
+    /// Number of its lattice segments (they carry loads).
+    pub(crate) n_lattice_seg: usize,
+    /// The last `n_te_seg` of its lattice segments are the trailing-edge edge (unsteady mode only).
+    pub(crate) n_te_seg: usize,
+    /// Index of its first node in the filament set (its ring nodes, in the lattice's order).
+    pub(crate) node0: usize,
+}
+
+/// Unit-strength bound filaments with incidences, of one or several surfaces (lattices) in one
+/// global numbering: surface `k`'s rings are the unknowns `ring0 .. ring0 + n_rings` (surface
+/// after surface), its nodes and segments one contiguous block each ([`SurfaceRange`]); the legs
+/// of all surfaces follow all segments, and the image copies follow everything.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct BoundSystem {
     /// Filaments (image copies appended); strengths are unit × copy sign until
     /// [`BoundSystem::set_strengths`] is called.
     pub(crate) fil: Filaments,
+    /// Ring incidences of the base segments, then (`inc_leg`) of the base legs.
     inc: Vec<[(u32, f64); 2]>,
+    inc_leg: Vec<[(u32, f64); 2]>,
     n_base_seg: usize,
     n_base_leg: usize,
-    /// The first `n_lattice_seg` base segments are lattice edges (they carry loads).
-    pub(crate) n_lattice_seg: usize,
-    /// The last `n_te_seg` lattice segments are the trailing-edge edge (unsteady mode only).
-    pub(crate) n_te_seg: usize,
+    /// Per surface: where its filaments and rings are.
+    surfaces: Vec<SurfaceRange>,
     n_copies: usize,
     n_planes: usize,
     base_gamma: Vec<f64>,
 }
 
 impl BoundSystem {
-    /// Rebuild for the current lattice geometry. Does not allocate once warm.
+    /// Rebuild for the current geometry of one lattice. Does not allocate once warm.
     pub(crate) fn build(&mut self, lat: &Lattice, te: TrailingEdge, core: &CoreModel, planes: &[ImagePlane]) {
+        self.build_surfaces(std::iter::once(lat), te, core, planes);
+    }
+
+    /// Rebuild for the current geometry of several lattices (surfaces), numbered in the order
+    /// given. One lattice gives exactly the filaments of [`BoundSystem::build`]. Does not
+    /// allocate once warm.
+    pub(crate) fn build_surfaces<'a>(
+        &mut self,
+        lats: impl Iterator<Item = &'a Lattice>,
+        te: TrailingEdge,
+        core: &CoreModel,
+        planes: &[ImagePlane],
+    ) {
+        self.fil.clear();
+        self.inc.clear();
+        self.inc_leg.clear();
+        self.surfaces.clear();
+        let mut ring0 = 0;
+        for lat in lats {
+            let range = self.push_surface(lat, ring0, te, core);
+            self.surfaces.push(range);
+            ring0 += lat.n_rings();
+        }
+        self.n_base_seg = self.fil.n_segments();
+        self.n_base_leg = self.fil.n_legs();
+        self.n_planes = planes.len();
+        self.n_copies = copy_signs(planes.len()).len();
+        append_images(&mut self.fil, planes);
+    }
+
+    /// Where surface `k`'s filaments and rings are.
+    pub(crate) fn surface(&self, k: usize) -> &SurfaceRange {
+        &self.surfaces[k]
+    }
+
+    /// Append one lattice's nodes, segments and legs, its rings numbered from `ring0`.
+    fn push_surface(&mut self, lat: &Lattice, ring0: usize, te: TrailingEdge, core: &CoreModel) -> SurfaceRange {
         let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
         let nc = n + 1;
         let fil = &mut self.fil;
-        fil.clear();
-        self.inc.clear();
+        let node0 = fil.n_nodes();
+        let seg0 = fil.n_segments();
         for p in lat.ring_nodes() {
             fil.push_node(*p);
         }
-        let ring = |i: usize, j: usize| (i * n + j) as u32;
-        let node = |i: usize, j: usize| (i * nc + j) as u32;
+        let ring = |i: usize, j: usize| (ring0 + i * n + j) as u32;
+        let node = |i: usize, j: usize| (node0 + i * nc + j) as u32;
         let nodes = lat.ring_nodes();
-        let dist = |a: u32, b: u32| {
-            let (p, q) = (nodes[a as usize], nodes[b as usize]);
+        // Distance of two lattice nodes given by their local indices.
+        let dist = |a: usize, b: usize| {
+            let (p, q) = (nodes[a], nodes[b]);
             ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
         };
+        let local = |i: usize, j: usize| i * nc + j;
         // Local chordwise panel length of a spanwise edge at node row i, column j..j+1.
         let chord_scale = |i: usize, j: usize| {
             let (r0, r1) = if i < m { (i, i + 1) } else { (i - 1, i) };
-            0.5 * (dist(node(r0, j), node(r1, j)) + dist(node(r0, j + 1), node(r1, j + 1)))
+            0.5 * (dist(local(r0, j), local(r1, j)) + dist(local(r0, j + 1), local(r1, j + 1)))
         };
         // Spanwise lattice edges, rows 0..M−1.
         for i in 0..m {
@@ -106,9 +163,14 @@ impl BoundSystem {
                 self.inc.push([right, left]);
             }
         }
-        self.n_lattice_seg = fil.n_segments();
-        self.n_te_seg = 0;
+        let mut range = SurfaceRange { seg0, n_lattice_seg: fil.n_segments() - seg0, n_te_seg: 0, node0 };
         let te_ring = |j: usize| ring(m - 1, j);
+        // Incidences of a trailing leg from trailing-edge node j.
+        let leg_inc = |j: usize| {
+            let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
+            let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
+            [right, left]
+        };
         match te {
             TrailingEdge::Unsteady => {
                 // Trailing-edge edge (M, j)→(M, j+1): −Γ_TE (the shed row's +Γ_w0 is in the known wake).
@@ -116,37 +178,30 @@ impl BoundSystem {
                     fil.push_segment_scaled(node(m, j), node(m, j + 1), 1.0, core, chord_scale(m, j));
                     self.inc.push([(te_ring(j), -1.0), (NONE, 0.0)]);
                 }
-                self.n_lattice_seg = fil.n_segments();
-                self.n_te_seg = n;
+                range.n_lattice_seg = fil.n_segments() - seg0;
+                range.n_te_seg = n;
             }
             TrailingEdge::Steady(dir) => {
                 for j in 0..nc {
-                    let len = {
-                        let (a, b) = (lat.ring_nodes()[node(m - 1, j) as usize], lat.ring_nodes()[node(m, j) as usize]);
-                        ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
-                    };
+                    let len = dist(local(m - 1, j), local(m, j));
                     fil.push_leg(node(m, j), dir, 1.0, core, len);
-                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
-                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
-                    self.inc.push([right, left]);
+                    self.inc_leg.push(leg_inc(j));
                 }
             }
             TrailingEdge::SteadyFinite { dir, length } => {
                 // Far ends of the legs: node (m, j) + length·dir, after the lattice's nodes.
                 let far0 = fil.n_nodes() as u32;
                 for j in 0..nc {
-                    let p = nodes[node(m, j) as usize];
+                    let p = nodes[local(m, j)];
                     fil.push_node([p[0] + length * dir[0], p[1] + length * dir[1], p[2] + length * dir[2]]);
                 }
                 let far = |j: usize| far0 + j as u32;
                 // Legs (m, j) → far(j), with the incidences and core of the semi-infinite legs
                 // (sized by the trailing-edge panel's chordwise length).
                 for j in 0..nc {
-                    let len = dist(node(m - 1, j), node(m, j));
+                    let len = dist(local(m - 1, j), local(m, j));
                     fil.push_segment_scaled(node(m, j), far(j), 1.0, core, len);
-                    let right = if j < n { (te_ring(j), -1.0) } else { (NONE, 0.0) };
-                    let left = if j > 0 { (te_ring(j - 1), 1.0) } else { (NONE, 0.0) };
-                    self.inc.push([right, left]);
+                    self.inc.push(leg_inc(j));
                 }
                 // Closing spanwise segments far(j) → far(j+1): the downstream edge of strip j's
                 // wake ring, −Γ_TE(j).
@@ -156,11 +211,7 @@ impl BoundSystem {
                 }
             }
         }
-        self.n_base_seg = fil.n_segments();
-        self.n_base_leg = fil.n_legs();
-        self.n_planes = planes.len();
-        self.n_copies = copy_signs(planes.len()).len();
-        append_images(fil, planes);
+        range
     }
 
     /// Total number of filaments (with images).
@@ -180,13 +231,19 @@ impl BoundSystem {
         }
     }
 
+    /// Ring incidences of base filament `b` (segments first, then legs).
+    #[inline]
+    fn incidences(&self, b: usize) -> &[(u32, f64); 2] {
+        if b < self.n_base_seg { &self.inc[b] } else { &self.inc_leg[b - self.n_base_seg] }
+    }
+
     /// Net strength of base filament `b` for ring circulations `gamma`.
     #[inline]
     fn net(&self, b: usize, gamma: &[f64]) -> f64 {
-        self.inc[b].iter().filter(|(r, _)| *r != NONE).map(|(r, s)| s * gamma[*r as usize]).sum()
+        self.incidences(b).iter().filter(|(r, _)| *r != NONE).map(|(r, s)| s * gamma[*r as usize]).sum()
     }
 
-    /// Net circulation of lattice segment `s` (`s < n_lattice_seg`).
+    /// Net circulation of base segment `s` (a lattice segment: see [`SurfaceRange`]).
     pub(crate) fn lattice_segment_gamma(&self, s: usize) -> f64 {
         self.base_gamma[s]
     }
@@ -251,7 +308,7 @@ impl BoundSystem {
             for f in 0..nf {
                 let (b, _) = self.base_of(f);
                 let v = &blk.infl[f];
-                for &(r, s) in &self.inc[b] {
+                for &(r, s) in self.incidences(b) {
                     if r == NONE {
                         continue;
                     }
@@ -309,6 +366,21 @@ pub(crate) fn build_known_wake(
     part: WakePart,
 ) {
     fil.clear();
+    append_known_wake(fil, te, wake, closure_dir, core, te_core, part);
+    append_images(fil, planes);
+}
+
+/// Append one surface's known wake (as [`build_known_wake`], without images) to `fil`, after
+/// what it holds: the wakes of several surfaces go into one set, then the images of all.
+pub(crate) fn append_known_wake(
+    fil: &mut Filaments,
+    te: &[[f64; 3]],
+    wake: &Wake,
+    closure_dir: Option<[f64; 3]>,
+    core: &CoreModel,
+    te_core: &CoreModel,
+    part: WakePart,
+) {
     let len = wake.n_rows();
     let n = wake.n_spanwise();
     let nc = n + 1;
@@ -323,12 +395,13 @@ pub(crate) fn build_known_wake(
     };
     // Position of node (k, j): 0 = trailing edge, k ≥ 1 = detached row k − 1.
     let pos = |k: usize, j: usize| if k == 0 { te[j] } else { wake.node(k - 1, j) };
+    let node0 = fil.n_nodes();
     for k in k_first..=k_last {
         for j in 0..nc {
             fil.push_node(pos(k, j));
         }
     }
-    let node = |k: usize, j: usize| ((k - k_first) * nc + j) as u32;
+    let node = |k: usize, j: usize| (node0 + (k - k_first) * nc + j) as u32;
     let dist = |a: (usize, usize), b: (usize, usize)| {
         let (p, q) = (pos(a.0, a.1), pos(b.0, b.1));
         ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -384,7 +457,6 @@ pub(crate) fn build_known_wake(
             }
         }
     }
-    append_images(fil, planes);
 }
 
 #[cfg(test)]

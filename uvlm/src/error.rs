@@ -156,7 +156,42 @@ pub enum UvlmError {
         /// Step counter when it happened.
         step: usize,
     },
+    /// A solver was asked for with no lifting surface.
+    #[error("a solver needs at least one lifting surface, got none")]
+    NoSurfaces,
+    /// A surface index beyond the solver's surfaces.
+    #[error("surface {surface} does not exist (the solver has {n_surfaces} surfaces)")]
+    UnknownSurface {
+        /// The surface asked for.
+        surface: usize,
+        /// Number of surfaces.
+        n_surfaces: usize,
+    },
+    /// A call that means the only surface (`update_stations`, `set_grid`, `hinge_moment`,
+    /// `linearise`) on a solver with several: use its per-surface form (`…_of`).
+    #[error("`{call}` needs a solver with one surface, this one has {n_surfaces}: use the per-surface call")]
+    SeveralSurfaces {
+        /// The offending call.
+        call: &'static str,
+        /// Number of surfaces.
+        n_surfaces: usize,
+    },
+    /// An error of one surface's lattice or loads, naming the surface.
+    #[error("surface {surface}: {source}")]
+    InSurface {
+        /// The surface.
+        surface: usize,
+        /// What went wrong on it.
+        source: Box<UvlmError>,
+    },
 }
 
 /// Result alias of the crate.
 pub type Result<T> = std::result::Result<T, UvlmError>;
+
+impl UvlmError {
+    /// This error, naming surface `surface`.
+    pub fn in_surface(self, surface: usize) -> Self {
+        UvlmError::InSurface { surface, source: Box::new(self) }
+    }
+}

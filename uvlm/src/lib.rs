@@ -4,7 +4,8 @@
 //! circulations and loads.
 //!
 //! ## Model
-//! A lifting surface is a structured lattice of vortex rings (see [`lattice`]): grid column `j`
+//! A lifting surface is a structured lattice of vortex rings (see [`lattice`]; a solver may hold
+//! several, [`Surface`], in one influence system): grid column `j`
 //! is generated from a [`SpanStation`] (section frame + chord), the rings are the grid panels
 //! shifted a quarter panel downstream along the grid lines, collocation points sit at the ring
 //! centroids. The non-penetration condition at every collocation point `c` with normal `n`,
@@ -66,6 +67,14 @@
 //!   often as needed, then [`Uvlm::commit_step`] — [`Uvlm::prefill_wake`],
 //!   accessors [`Uvlm::gamma`], [`Uvlm::gamma_dot`], [`Uvlm::wake`], [`Uvlm::loads`],
 //!   [`Uvlm::stats`], [`Uvlm::velocity_at`]; the clock [`Uvlm::time`] / [`Uvlm::set_time`].
+//! * Several lifting surfaces in one influence system (docs/uvlm.md §16):
+//!   [`Uvlm::with_surfaces`]`(Vec<Lattice>, params)`, each [`Surface`] with its own lattice and
+//!   wake ([`Surface::lattice`], [`Surface::wake`], [`Surface::loads`], [`Surface::rings`]: its
+//!   unknowns in the global numbering); [`Uvlm::n_surfaces`], [`Uvlm::surface`],
+//!   [`Uvlm::surfaces`], [`Uvlm::update_stations_of`], [`Uvlm::set_grid_of`],
+//!   [`Uvlm::hinge_moment_of`]. [`Uvlm::loads`] is then all surfaces' loads concatenated; the
+//!   one-surface calls (`update_stations`, `set_grid`, `hinge_moment`, `linearise`) return
+//!   [`UvlmError::SeveralSurfaces`].
 //! * External flow ([`flow`]): [`FlowField`] (`velocity(x, t)`, batch `add_velocity_inplace`),
 //!   [`Uniform`], [`Flow`] (free stream + optional disturbance); attach a gust with
 //!   [`Uvlm::set_disturbance`]. Gusts ([`gust`]): [`OneMinusCosine`], [`SharpEdged`],
@@ -116,6 +125,7 @@ mod scratch;
 mod solver;
 mod station;
 mod stats;
+mod surface;
 pub mod treecode;
 mod wake;
 
@@ -133,5 +143,6 @@ pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggre
 pub use solver::Uvlm;
 pub use station::{MAX_FLAP_DEFLECTION_DEG, SpanStation, StationFlap, StationVelocity};
 pub use stats::Stats;
+pub use surface::Surface;
 pub use treecode::{TreeStats, Treecode};
 pub use wake::Wake;

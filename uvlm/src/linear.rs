@@ -144,7 +144,8 @@ impl Frozen {
             self.col.push(*c);
         }
         self.mid.clear();
-        let n_mid = if p.te_segment_force { self.bs.n_lattice_seg } else { self.bs.n_lattice_seg - self.bs.n_te_seg };
+        let r = self.bs.surface(0);
+        let n_mid = if p.te_segment_force { r.n_lattice_seg } else { r.n_lattice_seg - r.n_te_seg };
         for s in 0..n_mid {
             let (a, b) = self.bs.fil.segment_nodes(s);
             let (pa, pb) = (self.bs.fil.node(a as usize), self.bs.fil.node(b as usize));
@@ -218,9 +219,12 @@ impl Uvlm {
     /// about it with the frozen wake `wake` (see the module docs).
     ///
     /// # Errors
-    /// An invalid wake, a lattice that moves, or a failed steady solve.
+    /// An invalid wake, a lattice that moves, a solver of several surfaces
+    /// ([`UvlmError::SeveralSurfaces`]), or a failed steady solve.
     pub fn linearise(&mut self, wake: &LinearWake) -> Result<LinearUvlm> {
         wake.validate()?;
+        // The linear model is of one surface (docs/uvlm.md §16).
+        self.only_surface("linearise")?;
         if self.lattice().grid_velocities().iter().flatten().any(|v| *v != 0.0) {
             return Err(UvlmError::InvalidParameter { field: "lattice velocity", value: 1.0 });
         }
@@ -291,7 +295,7 @@ impl Uvlm {
             (0..nr).map(|r| (0..3).map(|q| (fz.v_col[r][q] + u_col0[r][q]) * nrm[r][q]).sum()).collect();
         // The trailing-edge segment (`te_segment_force`) carries Γ_w0 − Γ_TE: zero in the
         // reference state, whose newest wake row holds the trailing-edge circulation.
-        compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_mid0, None, Some(&g_te), &p);
+        compute_loads(&mut fz.loads, &lat, &fz.bs, 0, &v_mid0, &u_mid0, None, Some(&g_te), &p);
         let mut reference_forces = vec![0.0; 3 * nn];
         stack(&fz.loads, &mut reference_forces);
 
@@ -332,7 +336,7 @@ impl Uvlm {
                             u[q] = u_mid0[s][q] + sgn * du[s][q];
                         }
                     }
-                    compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &u_pm, None, Some(&shed_pm), &p);
+                    compute_loads(&mut fz.loads, &lat, &fz.bs, 0, &v_mid0, &u_pm, None, Some(&shed_pm), &p);
                     stack(&fz.loads, buf);
                 }
                 for k in 0..out.len() {
@@ -359,7 +363,7 @@ impl Uvlm {
             load_derivative(&mut fz, Some(r), None, &du, &mut col);
             force_gamma.column_mut(r).copy_from_slice(&col);
             fz.bs.set_strengths(&zero_gamma);
-            compute_loads(&mut fz.loads, &lat, &fz.bs, &v_mid0, &zeros_mid, Some(&unit), None, &p);
+            compute_loads(&mut fz.loads, &lat, &fz.bs, 0, &v_mid0, &zeros_mid, Some(&unit), None, &p);
             stack(&fz.loads, &mut col);
             force_gamma_dot.column_mut(r).copy_from_slice(&col);
         }
@@ -466,7 +470,7 @@ impl LinearUvlm {
             .map(|r| (0..3).map(|q| (fz.v_col[r][q] - cv[r][q] + fz.u_col[r][q]) * nrm[r][q]).sum())
             .collect();
         let shed = self.reference_shed();
-        compute_loads(&mut fz.loads, lattice, &fz.bs, &fz.v_mid, &fz.u_mid, None, Some(&shed), &self.params);
+        compute_loads(&mut fz.loads, lattice, &fz.bs, 0, &fz.v_mid, &fz.u_mid, None, Some(&shed), &self.params);
         let mut forces = vec![0.0; self.n_force()];
         stack(&fz.loads, &mut forces);
         Ok((residual, forces))
@@ -583,7 +587,7 @@ impl LinearUvlm {
         for m in 0..n_mid {
             for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
                 v_pm[m] = [v_mid0[m][0] + sgn * d[0], v_mid0[m][1] + sgn * d[1], v_mid0[m][2] + sgn * d[2]];
-                compute_loads(&mut fz.loads, lat, &fz.bs, &v_pm, &fz.u_mid, None, Some(&shed), &self.params);
+                compute_loads(&mut fz.loads, lat, &fz.bs, 0, &v_pm, &fz.u_mid, None, Some(&shed), &self.params);
                 stack(&fz.loads, buf);
             }
             v_pm[m] = v_mid0[m];
@@ -701,7 +705,7 @@ impl LinearUvlm {
                                 u[q] = u_mid0[s][q] + sgn * du_mid[s][q];
                             }
                         }
-                        compute_loads(&mut fz.loads, lat, &fz.bs, &v_mid0, &u_pm, None, Some(&shed), p);
+                        compute_loads(&mut fz.loads, lat, &fz.bs, 0, &v_mid0, &u_pm, None, Some(&shed), p);
                         stack(&fz.loads, buf);
                     }
                     for i in 0..nf {

@@ -75,6 +75,27 @@ impl Loads {
     }
 }
 
+/// The loads of several surfaces as one [`Loads`]: nodal forces, positions and strips
+/// concatenated in surface order (the global node and strip numbering), totals summed. Does not
+/// allocate once `out` has its size.
+pub(crate) fn concatenate_loads<'a>(out: &mut Loads, parts: impl Iterator<Item = &'a Loads>) {
+    out.nodal.clear();
+    out.strip.clear();
+    out.positions.clear();
+    let (mut ts, mut tu) = ([0.0; 3], [0.0; 3]);
+    for l in parts {
+        out.nodal.extend_from_slice(&l.nodal);
+        out.strip.extend_from_slice(&l.strip);
+        out.positions.extend_from_slice(&l.positions);
+        for q in 0..3 {
+            ts[q] += l.total_steady[q];
+            tu[q] += l.total_unsteady[q];
+        }
+    }
+    out.total_steady = ts;
+    out.total_unsteady = tu;
+}
+
 /// Lump nodal forces `nodal[k]` at `positions[k]` (grid node `k`, column `k mod origins.len()`)
 /// to the point `origins[j]` of every grid column `j`: force and moment about that point (the
 /// rigid-arm, virtual-work consistent transfer). Does not allocate. [`Loads::column_loads_inplace`]
@@ -123,16 +144,18 @@ pub fn lift_drag_of(f: [f64; 3], v_inf: [f64; 3], span_dir: [f64; 3]) -> (f64, f
     (lift, drag)
 }
 
-/// Fill `loads` from the solved bound system. `v_mid[s]` and `u_mid[s]` are the external flow and
-/// the induced velocity at the midpoint of lattice segment `s`; `gamma_dot` the ring circulation
-/// rates (None: steady); `te_shed[j]` the circulation Γ_w0 of the newest wake ring of column `j`,
-/// which the trailing-edge segment carries besides the bound −Γ_TE (used with
-/// `te_segment_force`; None: no shed row).
+/// Fill `loads` of surface `k` (lattice `lat`) from the solved bound system. `v_mid[s]` and
+/// `u_mid[s]` are the external flow and the induced velocity at the midpoint of the surface's
+/// lattice segment `s` (local numbering); `gamma_dot` the surface's ring circulation rates (None:
+/// steady); `te_shed[j]` the circulation Γ_w0 of the newest wake ring of column `j`, which the
+/// trailing-edge segment carries besides the bound −Γ_TE (used with `te_segment_force`; None: no
+/// shed row).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn compute_loads(
     loads: &mut Loads,
     lat: &Lattice,
     bs: &BoundSystem,
+    k: usize,
     v_mid: &[[f64; 3]],
     u_mid: &[[f64; 3]],
     gamma_dot: Option<&[f64]>,
@@ -144,6 +167,7 @@ pub(crate) fn compute_loads(
     let nc = n + 1;
     let nodes = lat.ring_nodes();
     let vel = lat.ring_velocities();
+    let range = bs.surface(k);
     loads.nodal.clear();
     loads.nodal.resize(nodes.len(), [0.0; 3]);
     loads.strip.clear();
@@ -151,12 +175,12 @@ pub(crate) fn compute_loads(
     loads.positions.clear();
     loads.positions.extend_from_slice(nodes);
     let mut tot = [0.0; 3];
-    for s in 0..bs.n_lattice_seg {
+    for s in 0..range.n_lattice_seg {
         let te_row = s >= m * n + m * nc;
         if te_row && !te_segment_force {
             continue;
         }
-        let mut g = bs.lattice_segment_gamma(s);
+        let mut g = bs.lattice_segment_gamma(range.seg0 + s);
         if let (true, Some(w)) = (te_row, te_shed) {
             // Net strength of the trailing-edge segment: the shed row's +Γ_w0 with the bound −Γ_TE.
             g += w[(s - (m * n + m * nc)) % n];
@@ -164,8 +188,8 @@ pub(crate) fn compute_loads(
         if g == 0.0 {
             continue;
         }
-        let (a, b) = bs.fil.segment_nodes(s);
-        let (a, b) = (a as usize, b as usize);
+        let (a, b) = bs.fil.segment_nodes(range.seg0 + s);
+        let (a, b) = (a as usize - range.node0, b as usize - range.node0);
         let dl = [nodes[b][0] - nodes[a][0], nodes[b][1] - nodes[a][1], nodes[b][2] - nodes[a][2]];
         let mut v = [0.0; 3];
         for q in 0..3 {

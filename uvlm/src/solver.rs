@@ -1,17 +1,20 @@
-//! The UVLM solver: steady solve and unsteady time steps on one lattice with its wake.
+//! The UVLM solver: steady solve and unsteady time steps on one or several lattices (surfaces),
+//! each with its wake, in one influence system.
 
-use crate::aic::{BoundSystem, TrailingEdge, WakePart, build_known_wake};
+use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
 use crate::flow::{Flow, FlowField};
+use crate::images::append_images;
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
-use crate::loads::{Loads, compute_loads};
+use crate::loads::{Loads, compute_loads, concatenate_loads};
 use crate::params::{Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 use crate::scratch::ScratchPool;
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
+use crate::surface::Surface;
 use crate::treecode::{Treecode, block_order};
 use crate::wake::Wake;
 use std::time::Instant;
@@ -23,7 +26,9 @@ enum Mode {
     Unsteady,
 }
 
-/// A UVLM solver owning its lattice, wake, circulations, work buffers and loads.
+/// A UVLM solver owning its lattices (surfaces, [`Surface`]), their wakes, the circulations, work
+/// buffers and loads. [`Uvlm::new`] makes a solver of one surface, [`Uvlm::with_surfaces`] of
+/// several in one influence system (docs/uvlm.md §16).
 ///
 /// The solver keeps the time `t` of its committed solution ([`Uvlm::time`], 0 at construction,
 /// see [`Uvlm::set_time`]); the external flow `V_ext(x, t) = V∞ + u_dist(x, t)` ([`Flow`]) is
@@ -44,14 +49,13 @@ pub struct Uvlm {
     params: UvlmParams,
     flow: Flow,
     time: f64,
-    lattice: Lattice,
-    wake: Wake,
+    /// The surfaces; their rings are numbered surface after surface.
+    pub(crate) surfaces: Vec<Surface>,
     gamma: Vec<f64>,
     gamma_prev: Vec<f64>,
     gamma_prev2: Vec<f64>,
     gamma_dot: Vec<f64>,
     n_history: usize,
-    prev_te: Vec<[f64; 3]>,
     bound: BoundSystem,
     bound_mode: Option<Mode>,
     has_solution: bool,
@@ -71,7 +75,9 @@ pub struct Uvlm {
     lu: DenseLu,
     aic: Vec<f64>,
     rhs: Vec<f64>,
-    aic_key: Option<(Mode, u64)>,
+    /// The mode the current influence matrix was built and factorised for (with the lattice
+    /// versions of [`Surface::aic_version`]); `None` when it must be rebuilt.
+    aic_mode: Option<Mode>,
     col: Points,
     nrm: Points,
     mid: Points,
@@ -82,12 +88,10 @@ pub struct Uvlm {
     v_col: Vec<[f64; 3]>,
     v_mid: Vec<[f64; 3]>,
     v_wake: Vec<[f64; 3]>,
-    row_buf: Vec<[f64; 3]>,
-    gamma_row: Vec<f64>,
-    /// Circulation of the newest wake row, per column (the trailing-edge segment's force).
-    te_shed: Vec<f64>,
     /// The Biot–Savart loops' workspace (one entry per threaded chunk).
     blocks: ScratchPool<NodeBlock>,
+    /// The loads of all surfaces together (filled with several surfaces only; one surface's
+    /// loads are its own).
     loads: Loads,
     stats: Stats,
     pending_dt: Option<f64>,
@@ -95,24 +99,33 @@ pub struct Uvlm {
 }
 
 impl Uvlm {
-    /// A solver for `lattice` with an empty wake (impulsive start).
+    /// A solver for one lifting surface, `lattice`, with an empty wake (impulsive start).
     pub fn new(lattice: Lattice, params: UvlmParams) -> Result<Self> {
+        Self::from_lattices(vec![lattice], params)
+    }
+
+    /// A solver for the surfaces `lattices` (rings numbered surface after surface).
+    pub(crate) fn from_lattices(lattices: Vec<Lattice>, params: UvlmParams) -> Result<Self> {
         params.validate()?;
-        let nr = lattice.n_rings();
-        let n = lattice.n_spanwise();
-        let m = lattice.n_chordwise();
-        let wake = Wake::new(n, params.n_wake_rows);
-        let prev_te = (0..=n).map(|j| lattice.ring_nodes()[lattice.node_index(m, j)]).collect();
+        if lattices.is_empty() {
+            return Err(UvlmError::NoSurfaces);
+        }
+        let mut surfaces = Vec::with_capacity(lattices.len());
+        let mut nr = 0;
+        for lattice in lattices {
+            let n = lattice.n_rings();
+            surfaces.push(Surface::new(lattice, nr, params.n_wake_rows));
+            nr += n;
+        }
         Ok(Self {
             flow: Flow::new(params.v_inf),
             time: 0.0,
-            wake,
+            surfaces,
             gamma: vec![0.0; nr],
             gamma_prev: vec![0.0; nr],
             gamma_prev2: vec![0.0; nr],
             gamma_dot: vec![0.0; nr],
             n_history: 0,
-            prev_te,
             bound: BoundSystem::default(),
             bound_mode: None,
             has_solution: false,
@@ -126,7 +139,7 @@ impl Uvlm {
             lu: DenseLu::new(nr),
             aic: vec![0.0; nr * nr],
             rhs: vec![0.0; nr],
-            aic_key: None,
+            aic_mode: None,
             col: Points::default(),
             nrm: Points::default(),
             mid: Points::default(),
@@ -137,15 +150,11 @@ impl Uvlm {
             v_col: vec![[0.0; 3]; nr],
             v_mid: Vec::new(),
             v_wake: Vec::new(),
-            row_buf: vec![[0.0; 3]; n + 1],
-            gamma_row: vec![0.0; n],
-            te_shed: vec![0.0; n],
             blocks: ScratchPool::default(),
             loads: Loads::default(),
             stats: Stats::default(),
             pending_dt: None,
             solved_pending: false,
-            lattice,
             params,
         })
     }
@@ -154,15 +163,17 @@ impl Uvlm {
     pub fn params(&self) -> &UvlmParams {
         &self.params
     }
-    /// The lattice (current geometry).
+    /// The lattice (current geometry) of the first surface: the only one of a solver built by
+    /// [`Uvlm::new`]. See [`Uvlm::surface`] for the others.
     pub fn lattice(&self) -> &Lattice {
-        &self.lattice
+        &self.surfaces[0].lattice
     }
-    /// The wake.
+    /// The wake of the first surface (see [`Uvlm::lattice`]).
     pub fn wake(&self) -> &Wake {
-        &self.wake
+        &self.surfaces[0].wake
     }
-    /// Bound ring circulations Γ (index `i·N + j`), m²/s.
+    /// Bound ring circulations Γ of all surfaces, m²/s: surface after surface
+    /// ([`Surface::rings`]), index `i·N + j` within a surface.
     pub fn gamma(&self) -> &[f64] {
         &self.gamma
     }
@@ -170,15 +181,22 @@ impl Uvlm {
     pub fn gamma_dot(&self) -> &[f64] {
         &self.gamma_dot
     }
-    /// Loads of the last solve.
+    /// Loads of the last solve. With several surfaces: all of them, nodal forces, positions and
+    /// strips concatenated in surface order, totals summed (lump each surface's own
+    /// [`Surface::loads`] to its stations: its nodal loads follow its grid).
     pub fn loads(&self) -> &Loads {
-        &self.loads
+        match self.surfaces.as_slice() {
+            [s] => &s.loads,
+            _ => &self.loads,
+        }
     }
     /// Hinge moment of the control surface covering grid columns `columns` (each must carry a
     /// flap), from the loads of the last solve, N·m, positive trailing edge down: see
-    /// [`crate::hinge_moment`]. Call it after the solve, before the stations move again.
+    /// [`crate::hinge_moment`]. Call it after the solve, before the stations move again. One
+    /// surface only ([`UvlmError::SeveralSurfaces`] otherwise): see [`Uvlm::hinge_moment_of`].
     pub fn hinge_moment(&self, columns: std::ops::RangeInclusive<usize>) -> Result<f64> {
-        crate::flap::hinge_moment(&self.lattice, &self.loads, columns)
+        let s = self.only_surface("hinge_moment")?;
+        crate::flap::hinge_moment(&s.lattice, &s.loads, columns)
     }
     /// Work counters.
     pub fn stats(&self) -> &Stats {
@@ -199,7 +217,7 @@ impl Uvlm {
         p.validate()?;
         if self.params.steady_wake != wake {
             self.params.steady_wake = wake;
-            self.aic_key = None;
+            self.aic_mode = None;
         }
         Ok(())
     }
@@ -261,13 +279,16 @@ impl Uvlm {
     }
 
     /// Move the lattice to new station frames and velocities (see [`Lattice::update_stations`]).
+    /// One surface only ([`UvlmError::SeveralSurfaces`] otherwise): see
+    /// [`Uvlm::update_stations_of`].
     pub fn update_stations(&mut self, stations: &[SpanStation], velocities: Option<&[StationVelocity]>) -> Result<()> {
-        self.lattice.update_stations(stations, velocities)
+        self.only_surface_mut("update_stations")?.lattice.update_stations(stations, velocities)
     }
 
-    /// Set the grid nodes and velocities directly (see [`Lattice::set_grid`]).
+    /// Set the grid nodes and velocities directly (see [`Lattice::set_grid`]). One surface only:
+    /// see [`Uvlm::set_grid_of`].
     pub fn set_grid(&mut self, positions: &[[f64; 3]], velocities: &[[f64; 3]]) -> Result<()> {
-        self.lattice.set_grid(positions, velocities)
+        self.only_surface_mut("set_grid")?.lattice.set_grid(positions, velocities)
     }
 
     /// Unit free-stream direction (error if the free stream is zero). A direction, not a
@@ -289,20 +310,24 @@ impl Uvlm {
         self.params.wake_aggregation.tolerance * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
     }
 
-    /// Collocation points and normals into SoA buffers.
+    /// Collocation points and normals of every surface (global ring order) into SoA buffers.
     fn load_collocation(&mut self) {
         self.col.clear();
         self.nrm.clear();
-        for (c, n) in self.lattice.collocation().iter().zip(self.lattice.normals()) {
-            self.col.push(*c);
-            self.nrm.push(*n);
+        for s in &self.surfaces {
+            for (c, n) in s.lattice.collocation().iter().zip(s.lattice.normals()) {
+                self.col.push(*c);
+                self.nrm.push(*n);
+            }
         }
     }
 
     /// Build (if needed) and factorise the AIC for `mode`.
     fn prepare_aic(&mut self, mode: Mode) -> Result<()> {
-        let key = (mode, self.lattice.version());
-        if self.aic_key == Some(key) && self.bound_mode == Some(mode) {
+        let current = self.aic_mode == Some(mode)
+            && self.bound_mode == Some(mode)
+            && self.surfaces.iter().all(|s| s.aic_version == Some(s.lattice.version()));
+        if current {
             return Ok(());
         }
         let te = match mode {
@@ -312,23 +337,30 @@ impl Uvlm {
             },
             Mode::Unsteady => TrailingEdge::Unsteady,
         };
-        self.bound.build(&self.lattice, te, &self.params.bound_core, &self.params.images);
+        self.bound.build_surfaces(
+            self.surfaces.iter().map(|s| &s.lattice),
+            te,
+            &self.params.bound_core,
+            &self.params.images,
+        );
         self.bound_mode = Some(mode);
         self.load_collocation();
         self.stats.n_pair_evaluations +=
             self.bound.assemble_aic(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blocks);
         self.stats.n_aic_builds += 1;
-        self.aic_key = None;
+        self.aic_mode = None;
         self.lu.factorize_row_major(&self.aic).map_err(|pivot| UvlmError::SingularAic { pivot })?;
         self.stats.n_factorizations += 1;
-        self.aic_key = Some(key);
+        self.aic_mode = Some(mode);
+        for s in &mut self.surfaces {
+            s.aic_version = Some(s.lattice.version());
+        }
         Ok(())
     }
 
     /// Solve for Γ with the current AIC at time `t`: rhs = −(V_ext(c, t) − ẋ_c + u_known(c))·n.
     fn solve_gamma(&mut self, with_known_wake: bool, t: f64) -> Result<()> {
         self.load_collocation();
-        let nr = self.lattice.n_rings();
         if with_known_wake {
             let tol = self.aggregation_tolerance();
             self.u_col.fill([0.0; 3]);
@@ -358,15 +390,17 @@ impl Uvlm {
             self.u_col.fill([0.0; 3]);
         }
         self.flow.velocity_inplace(&self.col, t, &mut self.v_col);
-        let cv = self.lattice.collocation_velocities();
-        let nrm = self.lattice.normals();
-        for r in 0..nr {
-            let v = self.v_col[r];
-            let mut s = 0.0;
-            for q in 0..3 {
-                s += (v[q] - cv[r][q] + self.u_col[r][q]) * nrm[r][q];
+        for surf in &self.surfaces {
+            let cv = surf.lattice.collocation_velocities();
+            let nrm = surf.lattice.normals();
+            for (r, rg) in surf.rings.clone().enumerate() {
+                let v = self.v_col[rg];
+                let mut s = 0.0;
+                for q in 0..3 {
+                    s += (v[q] - cv[r][q] + self.u_col[rg][q]) * nrm[r][q];
+                }
+                self.rhs[rg] = -s;
             }
-            self.rhs[r] = -s;
         }
         self.gamma.copy_from_slice(&self.rhs);
         self.lu.solve_in_place(&mut self.gamma);
@@ -382,16 +416,13 @@ impl Uvlm {
     /// + known wake) and the loads.
     fn update_loads(&mut self, with_known_wake: bool, unsteady: bool, t: f64) {
         self.mid.clear();
-        // Trailing-edge segments carry no force unless asked for: skip their midpoints.
-        let n_mid = if self.params.te_segment_force {
-            self.bound.n_lattice_seg
-        } else {
-            self.bound.n_lattice_seg - self.bound.n_te_seg
-        };
-        for s in 0..n_mid {
-            let (a, b) = self.bound.fil.segment_nodes(s);
-            let (pa, pb) = (self.bound.fil.node(a as usize), self.bound.fil.node(b as usize));
-            self.mid.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])]);
+        for k in 0..self.surfaces.len() {
+            let range = self.bound.surface(k);
+            for s in range.seg0..range.seg0 + self.n_load_segments(k) {
+                let (a, b) = self.bound.fil.segment_nodes(s);
+                let (pa, pb) = (self.bound.fil.node(a as usize), self.bound.fil.node(b as usize));
+                self.mid.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])]);
+            }
         }
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
         let tol = self.aggregation_tolerance();
@@ -447,15 +478,33 @@ impl Uvlm {
         }
         self.v_mid.resize(self.mid.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
-        let gd = if unsteady && self.params.unsteady_term { Some(&self.gamma_dot[..]) } else { None };
-        let shed = with_known_wake && self.params.te_segment_force && self.wake.n_rows() > 0;
-        if shed {
-            for j in 0..self.te_shed.len() {
-                self.te_shed[j] = self.wake.gamma(0, j);
+        let gd = unsteady && self.params.unsteady_term;
+        let mut m0 = 0;
+        for k in 0..self.surfaces.len() {
+            let m1 = m0 + self.n_load_segments(k);
+            let surf = &mut self.surfaces[k];
+            let shed = with_known_wake && self.params.te_segment_force && surf.wake.n_rows() > 0;
+            if shed {
+                for j in 0..surf.te_shed.len() {
+                    surf.te_shed[j] = surf.wake.gamma(0, j);
+                }
             }
+            let te_shed = if shed { Some(&surf.te_shed[..]) } else { None };
+            let gd = if gd { Some(&self.gamma_dot[surf.rings.clone()]) } else { None };
+            let (v, u) = (&self.v_mid[m0..m1], &self.u_mid[m0..m1]);
+            compute_loads(&mut surf.loads, &surf.lattice, &self.bound, k, v, u, gd, te_shed, &self.params);
+            m0 = m1;
         }
-        let te_shed = if shed { Some(&self.te_shed[..]) } else { None };
-        compute_loads(&mut self.loads, &self.lattice, &self.bound, &self.v_mid, &self.u_mid, gd, te_shed, &self.params);
+        if self.surfaces.len() > 1 {
+            concatenate_loads(&mut self.loads, self.surfaces.iter().map(|s| &s.loads));
+        }
+    }
+
+    /// Number of surface `k`'s lattice segments that carry loads: the trailing-edge segments are
+    /// skipped unless asked for.
+    fn n_load_segments(&self, k: usize) -> usize {
+        let range = self.bound.surface(k);
+        if self.params.te_segment_force { range.n_lattice_seg } else { range.n_lattice_seg - range.n_te_seg }
     }
 
     /// Steady solution with the wake of [`UvlmParams::steady_wake`] along the free stream:
@@ -473,7 +522,7 @@ impl Uvlm {
         self.update_loads(false, false, self.time);
         self.stats.n_steady_solves += 1;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
-        Ok(&self.loads)
+        Ok(self.loads())
     }
 
     /// Replace the wake by the steady wake of the current Γ for time step `dt`: `n_wake_rows`
@@ -488,42 +537,47 @@ impl Uvlm {
         if self.pending_dt.is_some() {
             return Err(UvlmError::StepOrder { call: "prefill_wake", expected: "commit_step" });
         }
-        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         let v = self.flow.free_stream();
-        for j in 0..=n {
-            self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
-        }
-        for j in 0..n {
-            self.gamma_row[j] = self.gamma[self.lattice.ring_index(m - 1, j)];
-        }
-        self.wake.clear();
-        for r in (0..self.wake.capacity()).rev() {
-            let k = (r + 1) as f64 * dt;
+        for s in &mut self.surfaces {
+            let (lat, ring0) = (&s.lattice, s.rings.start);
+            let (m, n) = (lat.n_chordwise(), lat.n_spanwise());
             for j in 0..=n {
-                let p = self.prev_te[j];
-                self.row_buf[j] = [p[0] + k * v[0], p[1] + k * v[1], p[2] + k * v[2]];
+                s.prev_te[j] = lat.ring_nodes()[lat.node_index(m, j)];
             }
-            self.wake.push_front(&self.row_buf, &self.gamma_row);
+            for j in 0..n {
+                s.gamma_row[j] = self.gamma[ring0 + lat.ring_index(m - 1, j)];
+            }
+            s.wake.clear();
+            for r in (0..s.wake.capacity()).rev() {
+                let k = (r + 1) as f64 * dt;
+                for j in 0..=n {
+                    let p = s.prev_te[j];
+                    s.row_buf[j] = [p[0] + k * v[0], p[1] + k * v[1], p[2] + k * v[2]];
+                }
+                s.wake.push_front(&s.row_buf, &s.gamma_row);
+            }
         }
         self.gamma_prev.copy_from_slice(&self.gamma);
         self.gamma_prev2.copy_from_slice(&self.gamma);
         self.n_history = 2;
         self.bound_mode = None;
-        self.aic_key = None;
+        self.aic_mode = None;
         Ok(())
     }
 
-    /// Wake nodes (row by row) then the previous trailing-edge row into `wpts`.
+    /// Per surface: its wake nodes (row by row) then its previous trailing-edge row, into `wpts`.
     fn load_wake_points(&mut self) {
-        let n = self.lattice.n_spanwise();
         self.wpts.clear();
-        for r in 0..self.wake.n_rows() {
-            for j in 0..=n {
-                self.wpts.push(self.wake.node(r, j));
+        for s in &self.surfaces {
+            let n = s.wake.n_spanwise();
+            for r in 0..s.wake.n_rows() {
+                for j in 0..=n {
+                    self.wpts.push(s.wake.node(r, j));
+                }
             }
-        }
-        for p in &self.prev_te {
-            self.wpts.push(*p);
+            for p in &s.prev_te {
+                self.wpts.push(*p);
+            }
         }
     }
 
@@ -539,15 +593,16 @@ impl Uvlm {
             // The same displacement V∞·dt for every node.
             let v = self.flow.free_stream();
             let d = [v[0] * dt, v[1] * dt, v[2] * dt];
-            self.wake.translate(d);
-            for p in &mut self.prev_te {
-                for q in 0..3 {
-                    p[q] += d[q];
+            for s in &mut self.surfaces {
+                s.wake.translate(d);
+                for p in &mut s.prev_te {
+                    for q in 0..3 {
+                        p[q] += d[q];
+                    }
                 }
             }
             return;
         }
-        let n = self.lattice.n_spanwise();
         self.load_wake_points();
         self.v_wake.resize(self.wpts.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.wpts, t, &mut self.v_wake);
@@ -577,19 +632,22 @@ impl Uvlm {
             self.u_wake.fill([0.0; 3]);
         }
         let mut k = 0;
-        for r in 0..self.wake.n_rows() {
-            for j in 0..=n {
+        for s in &mut self.surfaces {
+            let n = s.wake.n_spanwise();
+            for r in 0..s.wake.n_rows() {
+                for j in 0..=n {
+                    let (v, u) = (self.v_wake[k], self.u_wake[k]);
+                    s.wake.displace(r, j, [(v[0] + u[0]) * dt, (v[1] + u[1]) * dt, (v[2] + u[2]) * dt]);
+                    k += 1;
+                }
+            }
+            for p in &mut s.prev_te {
                 let (v, u) = (self.v_wake[k], self.u_wake[k]);
-                self.wake.displace(r, j, [(v[0] + u[0]) * dt, (v[1] + u[1]) * dt, (v[2] + u[2]) * dt]);
+                for q in 0..3 {
+                    p[q] += (v[q] + u[q]) * dt;
+                }
                 k += 1;
             }
-        }
-        for p in &mut self.prev_te {
-            let (v, u) = (self.v_wake[k], self.u_wake[k]);
-            for q in 0..3 {
-                p[q] += (v[q] + u[q]) * dt;
-            }
-            k += 1;
         }
     }
 
@@ -599,7 +657,7 @@ impl Uvlm {
         self.advance_wake(dt)?;
         self.solve_step()?;
         self.commit_step()?;
-        Ok(&self.loads)
+        Ok(self.loads())
     }
 
     /// First phase of a step: convect the wake over `dt` (s) and shed the trailing-edge row of
@@ -614,21 +672,20 @@ impl Uvlm {
             return Err(UvlmError::StepOrder { call: "advance_wake", expected: "commit_step" });
         }
         let t0 = Instant::now();
-        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         self.convect(dt);
-        for j in 0..n {
-            self.gamma_row[j] = self.gamma_prev_te(m, j);
+        for s in &mut self.surfaces {
+            let (lat, ring0) = (&s.lattice, s.rings.start);
+            let m = lat.n_chordwise();
+            // The trailing-edge circulations of the last committed solve.
+            for j in 0..lat.n_spanwise() {
+                s.gamma_row[j] = self.gamma[ring0 + lat.ring_index(m - 1, j)];
+            }
+            s.wake.push_front(&s.prev_te, &s.gamma_row);
         }
-        self.wake.push_front(&self.prev_te, &self.gamma_row);
         self.far_ready = false;
         self.pending_dt = Some(dt);
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(())
-    }
-
-    /// Circulation of trailing-edge ring `j` at the last committed solve.
-    fn gamma_prev_te(&self, m: usize, j: usize) -> f64 {
-        self.gamma[self.lattice.ring_index(m - 1, j)]
     }
 
     /// Second phase: solve the current step for the lattice as it is now (AIC if it moved, known
@@ -639,17 +696,14 @@ impl Uvlm {
             return Err(UvlmError::StepOrder { call: "solve_step", expected: "advance_wake" });
         };
         let t0 = Instant::now();
-        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         self.prepare_aic(Mode::Unsteady)?;
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
-        let te = &self.lattice.ring_nodes()[m * (n + 1)..];
         let frozen = self.params.wake_reuse == WakeReuse::Frozen;
-        let (p, wake) = (&self.params, &self.wake);
         let part = if frozen { WakePart::Near } else { WakePart::All };
-        build_known_wake(&mut self.known, te, wake, closure, &p.wake_core, &p.bound_core, &p.images, part);
+        build_wakes(&mut self.known, &self.surfaces, closure, &self.params, part);
         self.known_tree.invalidate();
         if frozen && !self.far_ready {
-            build_known_wake(&mut self.far, te, wake, closure, &p.wake_core, &p.bound_core, &p.images, WakePart::Far);
+            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far);
             self.far_tree.invalidate();
         }
         let t = self.time + dt;
@@ -665,7 +719,7 @@ impl Uvlm {
         self.far_ready = frozen;
         self.solved_pending = true;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
-        Ok(&self.loads)
+        Ok(self.loads())
     }
 
     /// Third phase: accept the last [`Uvlm::solve_step`] as the state at the new time (history
@@ -674,12 +728,14 @@ impl Uvlm {
         if self.pending_dt.is_none() || !self.solved_pending {
             return Err(UvlmError::StepOrder { call: "commit_step", expected: "solve_step" });
         }
-        let (m, n) = (self.lattice.n_chordwise(), self.lattice.n_spanwise());
         std::mem::swap(&mut self.gamma_prev2, &mut self.gamma_prev);
         self.gamma_prev.copy_from_slice(&self.gamma);
         self.n_history += 1;
-        for j in 0..=n {
-            self.prev_te[j] = self.lattice.ring_nodes()[self.lattice.node_index(m, j)];
+        for s in &mut self.surfaces {
+            let (lat, m) = (&s.lattice, s.lattice.n_chordwise());
+            for j in 0..=lat.n_spanwise() {
+                s.prev_te[j] = lat.ring_nodes()[lat.node_index(m, j)];
+            }
         }
         if let Some(dt) = self.pending_dt.take() {
             self.time += dt;
@@ -688,6 +744,19 @@ impl Uvlm {
         self.stats.n_steps += 1;
         Ok(())
     }
+}
+
+/// The known wake of every surface into `fil` (surface after surface, each from its own trailing
+/// edge; `part` as in [`WakePart`]), then the images of all. One surface gives exactly
+/// [`crate::aic::build_known_wake`]'s set.
+fn build_wakes(fil: &mut Filaments, surfaces: &[Surface], closure: Option<[f64; 3]>, p: &UvlmParams, part: WakePart) {
+    fil.clear();
+    for s in surfaces {
+        let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
+        let te = &s.lattice.ring_nodes()[m * (n + 1)..];
+        append_known_wake(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part);
+    }
+    append_images(fil, &p.images);
 }
 
 /// A wake filament set's induction: direct, or through a treecode built once per set.

@@ -129,3 +129,52 @@ fn flapped_step_does_not_allocate() {
     assert!(h.is_finite() && h != 0.0);
     assert_eq!(allocations, 0, "{allocations} allocations in 8 flapped steps");
 }
+
+/// Two surfaces in one system (the paper's wing and a tail behind it with an elevator), free
+/// wake, disturbance, sub-iterated steps with `update_stations_of`, per-surface hinge moments:
+/// no allocation once warm.
+#[test]
+fn two_surface_step_does_not_allocate() {
+    let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
+    let tail = |k: usize| -> Vec<SpanStation> {
+        (0..=4)
+            .map(|j| {
+                let mut s = wing.stations(0.0)[j];
+                s.origin += nalgebra::Vector3::new(0.0, -5.0, 0.5);
+                s.flap = Some(StationFlap::new(0.3, 0.05 * (k as f64).sin()));
+                s
+            })
+            .collect()
+    };
+    let stations: Vec<Vec<SpanStation>> = (0..8).map(|k| wing.stations(0.02 * k as f64)).collect();
+    let tails: Vec<Vec<SpanStation>> = (0..8).map(tail).collect();
+    let (vw, vt) = (vec![StationVelocity::default(); stations[0].len()], vec![StationVelocity::default(); 5]);
+    let lats = vec![
+        Lattice::from_stations(wing.spec(), &stations[0]).unwrap(),
+        Lattice::from_stations(LatticeSpec::new(4), &tails[0]).unwrap(),
+    ];
+    let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
+    p.parallel = Parallel::Off;
+    p.n_wake_rows = 6;
+    p.wake_convection = WakeConvection::Free;
+    p.wake_core = CoreModel::Scully { fraction: 0.1 };
+    p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+    let mut u = Uvlm::with_surfaces(lats, p).unwrap();
+    u.set_disturbance(Some(Box::new(|x: [f64; 3], t: f64| [0.0, 0.0, (x[1] + 25.0 * t).sin()])));
+    let run = |u: &mut Uvlm, k: usize| {
+        u.advance_wake(0.01).unwrap();
+        for _ in 0..2 {
+            u.update_stations_of(0, &stations[k], Some(&vw)).unwrap();
+            u.update_stations_of(1, &tails[k], Some(&vt)).unwrap();
+            u.solve_step().unwrap();
+        }
+        u.commit_step().unwrap();
+        u.hinge_moment_of(1, 0..=4).unwrap()
+    };
+    for k in 0..8 {
+        run(&mut u, k);
+    }
+    let (h, allocations) = alloc_count::count(|| (0..8).map(|k| run(&mut u, 7 - k)).sum::<f64>());
+    assert!(h.is_finite());
+    assert_eq!(allocations, 0, "{allocations} allocations in 8 two-surface steps");
+}

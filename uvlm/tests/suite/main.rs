@@ -8,6 +8,8 @@ mod gust;
 mod hinge;
 mod linear;
 mod linear_gust;
+mod multi_surface;
+mod multi_surface_baseline;
 mod properties;
 mod reuse;
 mod send_sync;

@@ -8,6 +8,7 @@ fn assert_send_sync<T: Send + Sync>() {}
 #[test]
 fn solver_types_are_send_and_sync() {
     assert_send_sync::<Uvlm>();
+    assert_send_sync::<Surface>();
     assert_send_sync::<LinearUvlm>();
     assert_send_sync::<LinearGust>();
     assert_send_sync::<Treecode>();
