@@ -481,7 +481,13 @@ impl Strips {
             let (w, b, a) = (self.width[j], self.b[j], self.a[j]);
             let u = self.speed * ratio * self.cos_sweep[j];
             let p = s * b / u;
-            let c = C64::new(1.0, 0.0) - 0.165 * p / (p + 0.0455) - 0.335 * p / (p + 0.3);
+            // Without normal flow (`U_n = 0`, a strip along the stream) the circulatory terms
+            // vanish with `U_n`; `C` is then only kept finite.
+            let c = if u != 0.0 {
+                C64::new(1.0, 0.0) - 0.165 * p / (p + 0.0455) - 0.335 * p / (p + 0.3)
+            } else {
+                C64::new(1.0, 0.0)
+            };
             for k in 0..nb {
                 let h = C64::from(-self.z[(j, k)]);
                 let th = C64::from(self.theta[(j, k)]);
@@ -727,7 +733,10 @@ fn strip_model<S: Structure>(
             theta[(j, i)] = rot.dot(axis);
             // The streamwise angle of attack `rot · e_lat` (torsion cos Λ and bending slope
             // −w′ sin Λ) over cos Λ: the normal section's `θ − w′ tan Λ`.
-            alpha[(j, i)] = rot.dot(lateral) / lateral.norm_squared();
+            // A section whose axis lies along the stream sees no normal flow (cos Λ = 0) and no
+            // incidence.
+            let cos2 = lateral.norm_squared();
+            alpha[(j, i)] = if cos2 > 0.0 { rot.dot(lateral) / cos2 } else { 0.0 };
         }
     }
     let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();

@@ -1,5 +1,5 @@
 //! Static aeroelastic divergence of a uniform swept cantilever wing under strip theory
-//! (`cases/divergence_swept.json`) against the exact solution of Diederich & Budiansky's
+//! (`cases/stability/divergence_swept.json`) against the exact solution of Diederich & Budiansky's
 //! bending–torsion divergence equations (NACA TN 1680, 1948), as Hodges & Pierce set them out
 //! ("Introduction to Structural Dynamics and Aeroelasticity", 2nd ed. 2011, §4.3: the straight
 //! wing's Eq. 4.55, the swept wing's parameters τ and β of Eq. 4.103, their linear interaction
@@ -98,7 +98,7 @@ fn first_zero(f: impl Fn(f64) -> f64, hi: f64, n: usize) -> Option<f64> {
 
 /// The wing of the case file: (GJ, EI flap, chord, e, length, ρ).
 fn wing() -> (f64, f64, f64, f64, f64, f64) {
-    let text = std::fs::read_to_string(root().join("cases/divergence_swept.json")).unwrap();
+    let text = std::fs::read_to_string(root().join("cases/stability/divergence_swept.json")).unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let (body, aero) = (&v["bodies"][0], &v["aero"]);
     let num = |x: &serde_json::Value| x.as_f64().unwrap();
@@ -120,7 +120,8 @@ fn reference_speed(sweep_deg: f64) -> f64 {
 
 fn both(sweep_deg: f64) -> (StabilityOutput, StabilityOutput) {
     let ov: Vec<Override> = vec![format!("bodies.0.sweep_deg={sweep_deg}").parse().unwrap()];
-    let spec = CaseFile::read(&root().join("cases/divergence_swept.json")).unwrap().expand(&ov).unwrap().remove(0);
+    let spec =
+        CaseFile::read(&root().join("cases/stability/divergence_swept.json")).unwrap().expand(&ov).unwrap().remove(0);
     let (a, g) = rayon::join(
         || run_stability(&spec.ancf.problem(), Formulation::Ancf),
         || run_stability(&spec.gebf.problem(), Formulation::Gebf),
