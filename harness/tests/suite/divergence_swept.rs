@@ -3,7 +3,7 @@
 //! bending–torsion divergence equations (NACA TN 1680, 1948), as Hodges & Pierce set them out
 //! ("Introduction to Structural Dynamics and Aeroelasticity", 2nd ed. 2011, §4.3: the straight
 //! wing's Eq. 4.55, the swept wing's parameters τ and β of Eq. 4.103, their linear interaction
-//! Eq. 4.113; docs/stability.md §4.1).
+//! Eq. 4.113, numbered as AeroBeams.jl's tests cite them; docs/stability.md §4.1).
 //!
 //! With `y` along the elastic axis (length `l`), `θ` the torsion (nose up), `w` the bending
 //! deflection (up), `c` the chord normal to the axis, `e` the distance of the axis behind the
