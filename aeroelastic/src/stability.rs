@@ -25,8 +25,8 @@
 //!    Newton's method on `(η, s)` (the p-method; no reduced-frequency approximation), continued
 //!    over the airspeeds from the structural modes.
 //! 5. **Flutter** where a root's real part changes sign (interpolated linearly between airspeeds);
-//!    **divergence** where the smallest real eigenvalue of `M⁻¹D(0)` (the static aeroelastic
-//!    stiffness) changes sign.
+//!    **divergence** where `det D(0)` (the static aeroelastic stiffness) changes sign: a real
+//!    eigenvalue of `M⁻¹D(0)` passes through zero (located by bisection on the model).
 
 use std::time::Instant;
 
@@ -80,7 +80,9 @@ pub struct StabilityPoint {
     pub fold_deg: f64,
     /// Tracked roots, one per mode.
     pub roots: Vec<Root>,
-    /// Smallest real eigenvalue of `M⁻¹ D(0)` (rad²/s²): negative past divergence.
+    /// Smallest real eigenvalue of `M⁻¹ D(0)` (rad²/s²): negative past divergence, and also
+    /// where a complex pair of the non-symmetric static stiffness has split into two negative
+    /// real eigenvalues without a static divergence (a swept-back wing, docs/stability.md §3).
     pub static_stiffness_min: f64,
     /// Structural natural frequencies about this equilibrium (no aerodynamics), rad/s.
     pub structural_rad_s: Vec<f64>,
@@ -299,6 +301,49 @@ impl Reduced {
         ev.iter().filter(|x| x.im.abs() <= 1e-9 * scale).map(|x| x.re).fold(f64::INFINITY, f64::min)
     }
 
+    /// Sign of `det D(0)` (the static aeroelastic stiffness; `det M > 0`): +1 while every real
+    /// eigenvalue of `M⁻¹D(0)` crossed zero an even number of times (a complex pair's product is
+    /// positive), −1 past a static divergence, 0 when singular or not finite. From the LU
+    /// factors' signs, which neither overflow nor underflow.
+    pub fn static_sign(&self) -> f64 {
+        let d0 = self.d(C64::new(0.0, 0.0)).map(|x| x.re);
+        if !d0.iter().all(|x| x.is_finite()) {
+            return 0.0;
+        }
+        let lu = d0.lu();
+        let mut sign: f64 = lu.p().determinant();
+        for x in lu.lu_internal().diagonal().iter() {
+            if *x == 0.0 {
+                return 0.0;
+            }
+            sign *= x.signum();
+        }
+        sign
+    }
+
+    /// The static divergence between the speed ratios `lo` and `hi` of this model, where
+    /// `det D(0)` changes sign from positive to negative: bisection to 1e-12 of the ratio. About
+    /// a fixed state `D(0) = K + r² B` exactly; about an equilibrium the geometry is this model's.
+    /// `None` when `det D(0)` does not change sign from `lo` to `hi` on this model. The model is
+    /// left at `hi`.
+    pub fn static_crossing(&mut self, lo: f64, hi: f64) -> Option<f64> {
+        self.at_speed_ratio(lo);
+        let s_lo = self.static_sign();
+        self.at_speed_ratio(hi);
+        let s_hi = self.static_sign();
+        if !(s_lo > 0.0 && s_hi < 0.0) {
+            return None;
+        }
+        let (mut a, mut b) = (lo, hi);
+        while b - a > 1e-12 * hi {
+            let m = 0.5 * (a + b);
+            self.at_speed_ratio(m);
+            if self.static_sign() > 0.0 { a = m } else { b = m }
+        }
+        self.at_speed_ratio(hi);
+        Some(0.5 * (a + b))
+    }
+
     /// Mode `m` followed up from low speed: from its structural start at an eighth of the speed
     /// ratio `target` to `target` in eight equal steps, Newton at each; the roots (upper half
     /// plane) of the steps that converged, in order, ending at `target` when all did. The model
@@ -386,53 +431,81 @@ impl Reduced {
 }
 
 /// Two-dimensional Theodorsen strips at the lattice's stations (Bisplinghoff, Ashley & Halfman
-/// §5-6): per unit span, with `h` the plunge (down), `α` the pitch (nose up) about the axis at
-/// `a` semichords aft of mid-chord,
+/// §5-6), normal to the beam axis (docs/stability.md §4): per unit length of the axis, with `h`
+/// the plunge (down), `θ` the section's pitch (nose up, about its own spanwise axis: torsion on a
+/// swept wing) about the axis at `a` semichords aft of mid-chord, `b` the station's semichord
+/// (normal to the axis), `U_n = U cos Λ` the free stream's component normal to the axis and
+/// `α_n` the effective angle of attack in the normal plane (torsion and bending slope,
+/// `α_n = θ − w′ tan Λ`),
 ///
-/// `L = πρb²(ḧ + Uα̇ − baα̈) + 2πρUb C (ḣ + Uα + b(½ − a)α̇)`,
-/// `M = πρb²(baḧ − Ub(½ − a)α̇ − b²(⅛ + a²)α̈) + 2πρUb²(a + ½) C (ḣ + Uα + b(½ − a)α̇)`,
+/// `L = πρb²(ḧ + U_n α̇_n − baθ̈) + 2πρU_n b C W`,
+/// `M = πρb²(baḧ + baU_n α̇_n − ½U_n b θ̇ − b²(⅛ + a²)θ̈) + 2πρU_n b²(a + ½) C W`,
+/// `W = ḣ + U_n α_n + b(½ − a)θ̇`
 ///
-/// with R. T. Jones' approximation `C(p) = 1 − 0.165 p/(p + 0.0455) − 0.335 p/(p + 0.3)`,
-/// `p = s b / U`, valid for complex `s`. No tip loss, no sweep: strip theory.
+/// (Theodorsen's with the downwash `ḣ + U_n α_n + (x − ba)θ̇` of a swept section, Barmby,
+/// Cunningham & Garrick's without the spanwise derivatives of the twist and of the potential;
+/// its static part is Diederich & Budiansky's `L = q c a cos²Λ (θ − w′ tan Λ)`), with R. T.
+/// Jones' approximation `C(p) = 1 − 0.165 p/(p + 0.0455) − 0.335 p/(p + 0.3)`, `p = s b / U_n`,
+/// valid for complex `s`. At Λ = 0, `α_n = θ` and `U_n = U`: Theodorsen's section. No tip loss.
 pub struct Strips {
     /// Upward displacement of each station's axis along the lift direction per modal
     /// coordinate (stations × modes).
     z: DMatrix<f64>,
-    /// Nose-up rotation of each station per modal coordinate (stations × modes).
+    /// Nose-up rotation `θ` of each station about its section's spanwise axis per modal
+    /// coordinate (stations × modes): the pitch of the section, work-conjugate to `M`.
+    theta: DMatrix<f64>,
+    /// Effective angle of attack `α_n` of each station per modal coordinate (stations × modes):
+    /// the rotation about the lateral axis (perpendicular to the stream, in the wing's plane)
+    /// over `cos Λ`.
     alpha: DMatrix<f64>,
-    /// Span width of each strip, m.
+    /// Span width of each strip along the axis, m.
     width: Vec<f64>,
+    /// Semichord of each strip, m.
+    b: Vec<f64>,
+    /// Axis position of each strip, semichords aft of mid-chord.
+    a: Vec<f64>,
+    /// `cos Λ` of each strip (1 unswept).
+    cos_sweep: Vec<f64>,
     rho: f64,
-    b: f64,
-    a: f64,
     speed: f64,
 }
 
 impl Strips {
     /// Generalised aerodynamic force (modes × modes) at `s`, airspeed `ratio` × the built one.
     fn generalised_force(&self, s: C64, ratio: f64) -> DMatrix<C64> {
-        let (rho, b, a, u) = (self.rho, self.b, self.a, self.speed * ratio);
+        let rho = self.rho;
         let pi = std::f64::consts::PI;
-        let p = s * b / u;
-        let c = C64::new(1.0, 0.0) - 0.165 * p / (p + 0.0455) - 0.335 * p / (p + 0.3);
         let nb = self.z.ncols();
         let mut q = DMatrix::zeros(nb, nb);
         for j in 0..self.width.len() {
-            let w = self.width[j];
+            let (w, b, a) = (self.width[j], self.b[j], self.a[j]);
+            let u = self.speed * ratio * self.cos_sweep[j];
+            let p = s * b / u;
+            // Without normal flow (`U_n = 0`, a strip along the stream) the circulatory terms
+            // vanish with `U_n`; `C` is then only kept finite.
+            let c = if u != 0.0 {
+                C64::new(1.0, 0.0) - 0.165 * p / (p + 0.0455) - 0.335 * p / (p + 0.3)
+            } else {
+                C64::new(1.0, 0.0)
+            };
             for k in 0..nb {
                 let h = C64::from(-self.z[(j, k)]);
+                let th = C64::from(self.theta[(j, k)]);
                 let al = C64::from(self.alpha[(j, k)]);
-                let circ = c * (s * h + u * al + b * (0.5 - a) * s * al);
+                let circ = c * (s * h + u * al + b * (0.5 - a) * s * th);
                 let l =
-                    pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * al) + 2.0 * pi * rho * u * b * circ;
+                    pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * th) + 2.0 * pi * rho * u * b * circ;
+                // `baU_n α̇_n − ½U_n b θ̇` written as Theodorsen's `−U_n b(½ − a)θ̇` plus the
+                // bending slope's part `baU_n(α̇_n − θ̇)`, which vanishes unswept.
                 let m = pi
                     * rho
                     * b
                     * b
-                    * (b * a * s * s * h - u * b * (0.5 - a) * s * al - b * b * (0.125 + a * a) * s * s * al)
+                    * (b * a * s * s * h - u * b * (0.5 - a) * s * th + b * a * u * s * (al - th)
+                        - b * b * (0.125 + a * a) * s * s * th)
                     + 2.0 * pi * rho * u * b * b * (a + 0.5) * circ;
                 for i in 0..nb {
-                    q[(i, k)] += w * (l * self.z[(j, i)] + m * self.alpha[(j, i)]);
+                    q[(i, k)] += w * (l * self.z[(j, i)] + m * self.theta[(j, i)]);
                 }
             }
         }
@@ -613,8 +686,9 @@ fn mode_shapes<S: Structure>(
     out
 }
 
-/// Theodorsen strips at the stations: each station's plunge and pitch along each basis mode
-/// (central differences of the stations), and each strip's width.
+/// Theodorsen strips at the stations: each station's plunge, pitch and effective angle of attack
+/// along each basis mode (central differences of the stations), and each strip's width, semichord,
+/// axis position and sweep.
 fn strip_model<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -625,9 +699,20 @@ fn strip_model<S: Structure>(
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = StationScratch::default();
     let nb = phi.ncols();
+    let stream = Vector3::from(aero.free_stream()).normalize();
     let lift = crate::statics::lift_direction(aero.free_stream());
     let ns = map.len();
-    let (mut z, mut alpha) = (DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb));
+    // Per station: the section's nose-up axis (the leading-edge direction turned towards the
+    // lift: the beam axis of a planar wing) and its part perpendicular to the stream, the lateral
+    // axis scaled by cos Λ (Λ the angle between the two, positive aft).
+    let axes: Vec<(Vector3<f64>, Vector3<f64>)> = stations
+        .iter()
+        .map(|st| {
+            let axis = st.frame.column(1).cross(&lift).normalize();
+            (axis, axis - stream * axis.dot(&stream))
+        })
+        .collect();
+    let (mut z, mut theta, mut alpha) = (DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb), DMatrix::zeros(ns, nb));
     let span_len = case.span().max(1e-3);
     for i in 0..nb {
         let (col, eps) = mode_step(phi, i, span_len);
@@ -640,15 +725,18 @@ fn strip_model<S: Structure>(
             stations_at(&*model, &qq, &zeros, map, aero, None, &mut scratch, &mut s2, &mut v2);
             pm.push(s2);
         }
-        for j in 0..ns {
+        for (j, (axis, lateral)) in axes.iter().enumerate() {
             let d = (pm[0][j].origin - pm[1][j].origin) / (2.0 * eps);
             let w = (pm[0][j].frame - pm[1][j].frame) * stations[j].frame.transpose() / (2.0 * eps);
             let rot = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
-            // Nose-up axis: the leading-edge direction turned towards the lift.
-            let le = stations[j].frame.column(1).into_owned();
-            let axis = le.cross(&lift).normalize();
             z[(j, i)] = d.dot(&lift);
-            alpha[(j, i)] = rot.dot(&axis);
+            theta[(j, i)] = rot.dot(axis);
+            // The streamwise angle of attack `rot · e_lat` (torsion cos Λ and bending slope
+            // −w′ sin Λ) over cos Λ: the normal section's `θ − w′ tan Λ`.
+            // A section whose axis lies along the stream sees no normal flow (cos Λ = 0) and no
+            // incidence.
+            let cos2 = lateral.norm_squared();
+            alpha[(j, i)] = if cos2 > 0.0 { rot.dot(lateral) / cos2 } else { 0.0 };
         }
     }
     let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();
@@ -659,9 +747,10 @@ fn strip_model<S: Structure>(
             lo + hi
         })
         .collect();
-    // One strip section for the whole wing: the largest chord (every station's with one chord).
-    let b = 0.5 * aero.chord.max();
-    Strips { z, alpha, width, rho: aero.rho, b, a: (aero.le_offset.max() - b) / b, speed: aero.airspeed.unwrap_or(0.0) }
+    let b: Vec<f64> = stations.iter().map(|st| 0.5 * st.chord).collect();
+    let a = stations.iter().zip(&b).map(|(st, b)| (st.le_offset - b) / b).collect();
+    let cos_sweep = axes.iter().map(|(_, lateral)| lateral.norm()).collect();
+    Strips { z, theta, alpha, width, b, a, cos_sweep, rho: aero.rho, speed: aero.airspeed.unwrap_or(0.0) }
 }
 
 /// The load maps of a lattice `la` on `model` at `q`: the lumping `C_l` (6·stations × nodal
@@ -1053,6 +1142,8 @@ fn sweep<S: Structure>(
     let mut cache: Option<(f64, Reduced)> = None;
     let mut tracked: Option<Vec<(C64, DVector<C64>)>> = None;
     let mut prev: Option<Vec<(C64, DVector<C64>)>> = None;
+    // The last analysed airspeed, its static stiffness and the sign of `det D(0)` there.
+    let mut last_static: Option<(f64, f64, f64)> = None;
     for (i, &u) in st.airspeeds.iter().enumerate() {
         let mut a = aero.clone();
         a.airspeed = Some(u);
@@ -1116,14 +1207,38 @@ fn sweep<S: Structure>(
             next.push((s, e));
         }
         let smin = red.static_stiffness_min();
+        let sign = red.static_sign();
+        if let Some((u_a, smin_a, sign_a)) = last_static
+            && out.divergence_speed.is_none()
+            && sign_a > 0.0
+            && sign < 0.0
+        {
+            out.divergence_speed = Some(divergence_in(red, *u0, (u_a, smin_a), (u, smin)));
+        }
+        last_static = Some((u, smin, sign));
         out.solve_s += cpu_now() - ts;
         prev = tracked.take();
         tracked = Some(next);
         let omega = red.omega.iter().take(nb_req).copied().collect();
         out.points.push(point(roots, smin, omega, fold, None));
     }
-    flutter_and_divergence(&mut out);
+    flutter_speed(&mut out);
     out
+}
+
+/// The divergence speed between two analysed airspeeds `a` and `b` (with their smallest real
+/// static eigenvalues) where `det D(0)` changed sign from positive to negative: the crossing on
+/// `red`, the model of `b` built at `u0` (exact about a fixed state); failing that, where the
+/// smallest real eigenvalue of `M⁻¹D(0)` changes sign, interpolated linearly; failing that, the
+/// bracket's middle.
+fn divergence_in(red: &mut Reduced, u0: f64, (ua, smin_a): (f64, f64), (ub, smin_b): (f64, f64)) -> f64 {
+    if let Some(r) = red.static_crossing(ua / u0, ub / u0) {
+        return u0 * r;
+    }
+    if smin_a > 0.0 && smin_b <= 0.0 {
+        return ua + smin_a / (smin_a - smin_b) * (ub - ua);
+    }
+    0.5 * (ua + ub)
 }
 
 /// The states a sweep linearises about, one per airspeed of `st`: the undeformed state, or the
@@ -1289,10 +1404,9 @@ fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], t
     }
 }
 
-/// The flutter speed, frequency and mode (the first sign change of a converged root's real part
-/// from negative to positive, interpolated linearly) and the divergence speed (the first sign
-/// change of the static stiffness) of a sweep's points.
-fn flutter_and_divergence(out: &mut StabilityOutput) {
+/// The flutter speed, frequency and mode of a sweep's points: the first sign change of a
+/// converged root's real part from negative to positive, interpolated linearly.
+fn flutter_speed(out: &mut StabilityOutput) {
     // Flutter: the first sign change of a root's real part from negative to positive.
     for w in out.points.windows(2) {
         let (a, b) = (&w[0], &w[1]);
@@ -1314,14 +1428,6 @@ fn flutter_and_divergence(out: &mut StabilityOutput) {
             out.flutter_speed = Some(v);
             out.flutter_frequency_rad_s = Some(om);
             out.flutter_mode = Some(m);
-        }
-    }
-    for w in out.points.windows(2) {
-        let (a, b) = (w[0].static_stiffness_min, w[1].static_stiffness_min);
-        if a > 0.0 && b <= 0.0 {
-            let t = a / (a - b);
-            out.divergence_speed = Some(w[0].airspeed + t * (w[1].airspeed - w[0].airspeed));
-            break;
         }
     }
 }

@@ -5,6 +5,7 @@ mod aero;
 mod browser;
 mod cli;
 mod control_surfaces;
+mod divergence_swept;
 mod external;
 mod fuzz;
 mod gate;

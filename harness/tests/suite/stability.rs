@@ -68,7 +68,7 @@ fn hale_structural_modes_match_beam_theory() {
 
 /// HALE wing: with Theodorsen strips (the aerodynamics of Patil, Hodges & Cesnik) the flutter
 /// speed and frequency and the divergence speed are within 5 % of their 32.21 m/s, 22.61 rad/s
-/// and 37.29 m/s (measured +1.3 %, −2.3 %, −0.5 %); with the 3-D lattice (tip relief) flutter and
+/// and 37.29 m/s (measured +1.3 %, −2.3 %, −0.4 %); with the 3-D lattice (tip relief) flutter and
 /// divergence move up (measured 36.5 m/s at 20.6 rad/s, divergence 40.0 m/s); ANCF and GEBF
 /// flutter speeds within 0.5 % of each other in both (measured 0.003 %).
 #[test]
