@@ -755,6 +755,41 @@ fn plot_lift(path: &Path, s: &StaticSummary) -> Result<(), Error> {
     )
 }
 
+/// A table of each experiment's points that the sweep did not compute (a sideslip sweep's
+/// angles rarely coincide with the experiment's): the experiment, and each formulation's model
+/// interpolated there with its error.
+fn errors_at_reference_points(h: &mut String, s: &StaticSummary) {
+    let computed: Vec<f64> = s.runs.iter().flat_map(|r| r.points.iter().map(|p| s.abscissa.x(p))).collect();
+    for r in s.references.iter().filter(|r| r.experiment) {
+        let off_grid = r.errors.iter().flat_map(|(_, e)| e).any(|e| !computed.iter().any(|x| (x - e.0).abs() < 1e-9));
+        if !off_grid {
+            continue;
+        }
+        let label = html_escape(&r.label);
+        let _ = write!(h, "<p>At the points of {label} (the model interpolated linearly between its own):</p>\n");
+        let _ = write!(h, "<table><tr><th>{}</th><th>{label} [°]</th>", s.abscissa.label());
+        for (f, _) in &r.errors {
+            let f = f.as_str().to_uppercase();
+            let _ = write!(h, "<th>{f} [°]</th><th>{f} − {label} [°]</th>");
+        }
+        h.push_str("</tr>\n");
+        let Some((_, first)) = r.errors.first() else { continue };
+        for e in first {
+            let _ = write!(h, "<tr><td>{}</td><td>{:.2}</td>", e.0, e.1);
+            for (_, errors) in &r.errors {
+                match errors.iter().find(|x| (x.0 - e.0).abs() < 1e-9) {
+                    Some(x) => {
+                        let _ = write!(h, "<td>{:.2}</td><td>{:+.2}</td>", x.2, x.3);
+                    }
+                    None => h.push_str("<td></td><td></td>"),
+                }
+            }
+            h.push_str("</tr>\n");
+        }
+        h.push_str("</table>\n");
+    }
+}
+
 /// The report's section for a static sweep (HTML fragment; links relative to the report root).
 pub fn section_html(s: &StaticSummary, folder: &str) -> String {
     let mut h = String::new();
@@ -836,7 +871,9 @@ pub fn section_html(s: &StaticSummary, folder: &str) -> String {
             h.push_str("</tr>\n");
         }
     }
-    h.push_str("</table>\n<ul>\n");
+    h.push_str("</table>\n");
+    errors_at_reference_points(&mut h, s);
+    h.push_str("<ul>\n");
     let band = s.abscissa.band_text();
     for r in s.references.iter().filter(|r| r.experiment) {
         for (f, rms) in &r.rms_deg {
