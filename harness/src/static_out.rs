@@ -766,7 +766,7 @@ fn errors_at_reference_points(h: &mut String, s: &StaticSummary) {
             continue;
         }
         let label = html_escape(&r.label);
-        let _ = write!(h, "<p>At the points of {label} (the model interpolated linearly between its own):</p>\n");
+        let _ = writeln!(h, "<p>At the points of {label} (the model interpolated linearly between its own):</p>");
         let _ = write!(h, "<table><tr><th>{}</th><th>{label} [°]</th>", s.abscissa.label());
         for (f, _) in &r.errors {
             let f = f.as_str().to_uppercase();
