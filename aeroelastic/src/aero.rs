@@ -106,7 +106,7 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
                 let (along, ahead) = (frame.column(0).dot(&stream), frame.column(1).dot(&stream));
                 if ahead <= 0.0 {
                     return Err(format!(
-                        "aero.sections: the stream does not reach bodies[{b}] at s = {s} m from its leading edge"
+                        "aero.sections: the stream comes from behind bodies[{b}]'s leading edge at s = {s} m"
                     ));
                 }
                 slant = along.atan2(ahead);

@@ -15,12 +15,6 @@ pub enum Taper {
     PerBody(Vec<[f64; 2]>),
 }
 
-impl Default for Taper {
-    fn default() -> Self {
-        Self::Uniform(0.0)
-    }
-}
-
 impl From<f64> for Taper {
     fn from(v: f64) -> Self {
         Self::Uniform(v)
@@ -29,23 +23,11 @@ impl From<f64> for Taper {
 
 impl Taper {
     /// The value on body `body` at the fraction `frac` of its length (0 at the root, 1 at the
-    /// tip). A uniform value, or equal root and tip, is returned exactly.
+    /// tip). A uniform value, or equal root and tip, is returned exactly (`r + frac · 0`).
     pub fn at(&self, body: usize, frac: f64) -> f64 {
         match self {
             Self::Uniform(v) => *v,
-            Self::PerBody(v) => match v.get(body) {
-                Some(&[r, t]) if r == t => r,
-                Some(&[r, t]) => r + frac * (t - r),
-                None => f64::NAN,
-            },
-        }
-    }
-
-    /// The uniform value, if it is one number.
-    pub fn uniform(&self) -> Option<f64> {
-        match self {
-            Self::Uniform(v) => Some(*v),
-            Self::PerBody(_) => None,
+            Self::PerBody(v) => v.get(body).map_or(f64::NAN, |&[r, t]| r + frac * (t - r)),
         }
     }
 
@@ -65,19 +47,6 @@ impl Taper {
     /// The smallest value, m.
     pub fn min(&self) -> f64 {
         self.values().into_iter().fold(f64::INFINITY, f64::min)
-    }
-
-    /// The length-weighted mean over bodies of lengths `lengths`, m (the mean geometric chord
-    /// for a chord).
-    pub fn mean(&self, lengths: &[f64]) -> f64 {
-        match self {
-            Self::Uniform(v) => *v,
-            Self::PerBody(v) => {
-                let total: f64 = lengths.iter().sum();
-                let sum: f64 = v.iter().zip(lengths).map(|(rt, l)| 0.5 * (rt[0] + rt[1]) * l).sum();
-                sum / total
-            }
-        }
     }
 
     /// Check against `n_bodies` bodies: one entry per body, every value finite and, with

@@ -1100,9 +1100,9 @@ fn point_at<S: Structure>(
     // Column j of the lattice lies between stations j and j + 1.
     let arc = |m: &StationMap| m.wing_arc(case);
     let qdyn = 0.5 * rho * airspeed * airspeed;
-    // The section's chord: along the stream for streamwise sections, else along the section's y.
-    let streamwise = sys.aero.sections == crate::planform::Sections::Streamwise;
-    let chord = |m: &StationMap| if streamwise { m.chord / m.slant.cos() } else { m.chord };
+    // The planform's chord at the station (along the stream for streamwise sections, also at a
+    // hinge column, whose slant is the flare's).
+    let chord = |m: &StationMap| sys.aero.chord.at(m.body, m.s / case.bodies[m.body].length);
     let strips = (0..stations.len().saturating_sub(1))
         .filter_map(|j| {
             let f = Vector3::from(*uv_loads.strip.get(j)?) + report.delta_force.get(j).copied().unwrap_or_default();
