@@ -42,19 +42,17 @@ pub struct StationMap {
     /// Whether this is a flared hinge's column.
     pub hinge: bool,
     /// The control surface on this station (index into `aero.control_surfaces`), if any.
-    pub surface: Option<usize>,
+    pub control: Option<usize>,
+    /// The lifting surface this station belongs to (0 with one surface).
+    pub lifting: usize,
+    /// Arclength of the station along its lifting surface from the surface's root, the
+    /// surface's bodies laid end to end, m.
+    pub arc: f64,
     /// Chord measured along the section's y axis, m (`aero.chord` at this station, times the
     /// cosine of the streamwise slant for streamwise sections).
     pub chord: f64,
     /// Distance from the beam axis to the leading edge along the section's y axis, m.
     pub le_offset: f64,
-}
-
-impl StationMap {
-    /// Arclength of the station along the wing, the bodies laid end to end, m.
-    pub fn wing_arc(&self, case: &Problem) -> f64 {
-        case.bodies.iter().take(self.body).map(|b| b.length).sum::<f64>() + self.s
-    }
 }
 
 /// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
@@ -96,6 +94,8 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
             }
         }
         let twist = body.twist_deg.as_ref().map(|t| t.twist(body.length));
+        // The surface's earlier bodies laid end to end.
+        let before: f64 = case.bodies[..b].iter().map(|x| x.length).sum();
         for k in first..=n {
             let frac = k as f64 / n as f64;
             let s = body.length * frac;
@@ -120,10 +120,11 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
                 chord *= slant.cos();
                 le_offset *= slant.cos();
             }
-            out.push(StationMap { body: b, s, slant, hinge: false, surface: None, chord, le_offset });
+            let arc = before + s;
+            out.push(StationMap { body: b, s, slant, hinge: false, control: None, lifting: 0, arc, chord, le_offset });
         }
     }
-    grade_slants(case, &mut out);
+    grade_slants(&mut out);
     place_control_surfaces(case, aero, &mut out)?;
     Ok(out)
 }
@@ -137,7 +138,7 @@ fn place_control_surfaces(case: &Problem, aero: &AeroSettings, map: &mut [Statio
     }
     crate::control_surface::check(case, cs, &aero.panels_per_body, aero.n_chordwise)?;
     for m in map.iter_mut() {
-        m.surface = crate::control_surface::surface_at(case, cs, m.body, m.s, m.hinge)?;
+        m.control = crate::control_surface::surface_at(case, cs, m.body, m.s, m.hinge)?;
     }
     crate::control_surface::columns(map, cs.len()).map(|_| ())
 }
@@ -149,8 +150,8 @@ fn place_control_surfaces(case: &Problem, aero: &AeroSettings, map: &mut [Statio
 /// `D = 2 max(le, c − le) |tan β − tan γ₀|`, which keeps the leading- and trailing-edge nodes in
 /// spanwise order. Only the panel layout changes, not the planform; columns farther than `D`
 /// keep `γ₀` exactly.
-fn grade_slants(case: &Problem, map: &mut [StationMap]) {
-    let arc = |m: &StationMap| m.wing_arc(case);
+fn grade_slants(map: &mut [StationMap]) {
+    let arc = |m: &StationMap| m.arc;
     let hinges: Vec<(f64, f64)> = map.iter().filter(|m| m.hinge).map(|m| (arc(m), m.slant)).collect();
     let reach = map.iter().map(|m| m.le_offset.abs().max((m.chord - m.le_offset).abs())).fold(0.0, f64::max);
     for m in map.iter_mut().filter(|m| !m.hinge) {
@@ -259,7 +260,7 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
             chord: st.chord,
             le_offset: st.le_offset,
             slant: st.slant,
-            flap: st.surface.map(|i| aero.control_surfaces[i].flap_at(t)),
+            flap: st.control.map(|i| aero.control_surfaces[i].flap_at(t)),
         });
         velocities.push(uvlm::StationVelocity { linear: vel, angular: omega });
     }

@@ -183,7 +183,7 @@ pub(crate) fn columns(
 ) -> Result<Vec<std::ops::RangeInclusive<usize>>, String> {
     let mut out = Vec::with_capacity(n_surfaces);
     for i in 0..n_surfaces {
-        let mut js = map.iter().enumerate().filter(|(_, m)| m.surface == Some(i)).map(|(j, _)| j);
+        let mut js = map.iter().enumerate().filter(|(_, m)| m.control == Some(i)).map(|(j, _)| j);
         let first = js.next().ok_or_else(|| format!("aero.control_surfaces[{i}].span: covers no lattice station"))?;
         let last = js.next_back().unwrap_or(first);
         out.push(first..=last);

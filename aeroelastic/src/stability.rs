@@ -677,11 +677,7 @@ fn mode_shapes<S: Structure>(
             st2.iter().zip(stations).map(|(a, b)| ((a.origin - b.origin) / eps).into()).collect();
         let dm = d.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
         d.iter_mut().flatten().for_each(|x| *x /= dm);
-        out.push(ModeShape {
-            omega: basis.omega[i],
-            s: map.iter().map(|x| x.wing_arc(case)).collect(),
-            displacement: d,
-        });
+        out.push(ModeShape { omega: basis.omega[i], s: map.iter().map(|x| x.arc).collect(), displacement: d });
     }
     out
 }
@@ -739,7 +735,7 @@ fn strip_model<S: Structure>(
             alpha[(j, i)] = if cos2 > 0.0 { rot.dot(lateral) / cos2 } else { 0.0 };
         }
     }
-    let arcs: Vec<f64> = map.iter().map(|m| m.wing_arc(case)).collect();
+    let arcs: Vec<f64> = map.iter().map(|m| m.arc).collect();
     let width = (0..ns)
         .map(|j| {
             let lo = if j > 0 { 0.5 * (arcs[j] - arcs[j - 1]) } else { 0.0 };

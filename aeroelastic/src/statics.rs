@@ -1098,7 +1098,7 @@ fn point_at<S: Structure>(
     let lift = total.dot(&lift_dir);
     let drag = total.dot(&Vector3::from(v_inf).normalize());
     // Column j of the lattice lies between stations j and j + 1.
-    let arc = |m: &StationMap| m.wing_arc(case);
+    let arc = |m: &StationMap| m.arc;
     let qdyn = 0.5 * rho * airspeed * airspeed;
     // The planform's chord at the station (along the stream for streamwise sections, also at a
     // hinge column, whose slant is the flare's).

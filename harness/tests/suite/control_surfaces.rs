@@ -55,12 +55,12 @@ fn hinge_moment_on_the_lattice(spec: &RunSpec, p: &StaticPoint) -> f64 {
                 chord: m.chord,
                 le_offset: m.le_offset,
                 slant: m.slant,
-                flap: m.surface.map(|i| aero.control_surfaces[i].flap_at(None)),
+                flap: m.control.map(|i| aero.control_surfaces[i].flap_at(None)),
             }
         })
         .collect();
-    let first = map.iter().position(|m| m.surface == Some(0)).unwrap();
-    let last = map.iter().rposition(|m| m.surface == Some(0)).unwrap();
+    let first = map.iter().position(|m| m.control == Some(0)).unwrap();
+    let last = map.iter().rposition(|m| m.control == Some(0)).unwrap();
     // The inner body's 24 strips: stations 0..=24, the hinge column (24) included.
     assert_eq!((first, last), (0, 24));
     let lattice = uvlm::Lattice::from_stations(harness::aero::lattice_spec(&map, &aero), &stations).unwrap();
@@ -118,7 +118,7 @@ fn surfaces_cover_their_panel_edges_and_the_hinge_column() {
         assert!(map[24].hinge);
         (0..aero.control_surfaces.len())
             .map(|i| {
-                let j: Vec<usize> = (0..map.len()).filter(|&j| map[j].surface == Some(i)).collect();
+                let j: Vec<usize> = (0..map.len()).filter(|&j| map[j].control == Some(i)).collect();
                 (j[0], *j.last().unwrap(), j.len())
             })
             .collect::<Vec<_>>()
