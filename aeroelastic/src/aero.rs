@@ -25,7 +25,7 @@ use formulation::Structure;
 
 pub use formulation::SectionLoad;
 
-use crate::planform::Sections;
+use crate::planform::{Sections, SurfacePlan};
 
 /// Largest angle between a streamwise section and the normal to the beam axis, degrees.
 pub const MAX_STREAMWISE_SLANT_DEG: f64 = 70.0;
@@ -53,40 +53,64 @@ pub struct StationMap {
     pub chord: f64,
     /// Distance from the beam axis to the leading edge along the section's y axis, m.
     pub le_offset: f64,
+    /// Chord as the planform gives it (measured along the stream for streamwise sections), m.
+    pub planform_chord: f64,
 }
 
-/// Span stations of a chain of bodies `0 → 1 → …` joined end to start by flared hinges: each
-/// body's panels, the hinge column shared (driven by the inner body's end).
+/// Span stations of every lifting surface (`aero.surfaces`, or the one-surface shorthand of
+/// every body), surface after surface: each a chain of bodies joined end to start by flared
+/// hinges, each body's panels, the hinge column shared (driven by the inner body's end).
 pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap>, String> {
-    aero.chord.check("aero.chord", case.bodies.len(), true)?;
-    aero.le_offset.check("aero.le_offset", case.bodies.len(), false)?;
-    let nb = case.bodies.len();
-    if aero.panels_per_body.len() != nb {
-        return Err(format!("aero.panels_per_body: {} entries for {nb} bodies", aero.panels_per_body.len()));
-    }
+    let plans = aero.surface_plans(case)?;
     let frames = reference_frames(case);
     let stream = -Vector3::from(aero.stream_without_sideslip()).normalize();
     let mut out = Vec::new();
-    for (b, body) in case.bodies.iter().enumerate() {
-        let n = aero.panels_per_body[b];
-        if n == 0 {
-            return Err(format!("aero.panels_per_body[{b}]: must be at least 1"));
-        }
-        let first = if b == 0 { 0 } else { 1 };
-        if b > 0 {
+    for (k, plan) in plans.iter().enumerate() {
+        let start = out.len();
+        surface_stations(case, plan, k, &frames, &stream, &mut out)?;
+        grade_slants(&mut out[start..]);
+    }
+    if plans.len() > 1 {
+        check_roots(case, &plans)?;
+    }
+    place_control_surfaces(case, aero, &plans, &mut out)?;
+    Ok(out)
+}
+
+/// The stations of lifting surface `k` (`plan`) appended to `out`.
+fn surface_stations(
+    case: &Problem,
+    plan: &SurfacePlan,
+    k: usize,
+    frames: &[Matrix3<f64>],
+    stream: &Vector3<f64>,
+    out: &mut Vec<StationMap>,
+) -> Result<(), String> {
+    let field = &plan.field;
+    let mut before = 0.0;
+    for (i, &b) in plan.bodies.iter().enumerate() {
+        let body = &case.bodies[b];
+        let n = plan.panels[i];
+        if i > 0 {
             // The previous body's end column is the hinge column: find the flared hinge.
+            let inner = plan.bodies[i - 1];
             let hinge = case.joints.iter().find_map(|j| match j {
                 Joint::FlaredHinge { parent, child, flare_deg, .. }
-                    if case.body_index(parent) == Some(b - 1) && case.body_index(child) == Some(b) =>
+                    if case.body_index(parent) == Some(inner) && case.body_index(child) == Some(b) =>
                 {
                     Some(flare_deg.to_radians())
                 }
                 _ => None,
             });
             let Some(beta) = hinge else {
-                return Err(format!("aero: bodies[{}] and bodies[{b}] are not joined by a flared hinge", b - 1));
+                return Err(format!(
+                    "{}: bodies `{}` and `{}` are not joined by a flared hinge (parent then child)",
+                    if plan.field == "aero" { "aero".to_string() } else { format!("{field}.bodies[{i}]") },
+                    case.bodies[inner].name,
+                    body.name
+                ));
             };
-            check_shared_column(aero, b)?;
+            check_shared_column(plan, i)?;
             if let Some(last) = out.last_mut() {
                 let last: &mut StationMap = last;
                 last.slant = beta;
@@ -94,26 +118,25 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
             }
         }
         let twist = body.twist_deg.as_ref().map(|t| t.twist(body.length));
-        // The surface's earlier bodies laid end to end.
-        let before: f64 = case.bodies[..b].iter().map(|x| x.length).sum();
-        for k in first..=n {
-            let frac = k as f64 / n as f64;
+        for j in usize::from(i > 0)..=n {
+            let frac = j as f64 / n as f64;
             let s = body.length * frac;
-            let (mut chord, mut le_offset) = (aero.chord.at(b, frac), aero.le_offset.at(b, frac));
+            let (planform_chord, mut le_offset) = (plan.chord.at(i, frac), plan.le_offset.at(i, frac));
+            let mut chord = planform_chord;
             let mut slant = 0.0;
-            if aero.sections == Sections::Streamwise {
+            if plan.sections == Sections::Streamwise {
                 let frame = frames[b] * twist.as_ref().map_or_else(Matrix3::identity, |t| t.rotation(s));
-                let (along, ahead) = (frame.column(0).dot(&stream), frame.column(1).dot(&stream));
+                let (along, ahead) = (frame.column(0).dot(stream), frame.column(1).dot(stream));
                 if ahead <= 0.0 {
                     return Err(format!(
-                        "aero.sections: the stream comes from behind bodies[{b}]'s leading edge at s = {s} m"
+                        "{field}.sections: the stream comes from behind bodies[{b}]'s leading edge at s = {s} m"
                     ));
                 }
                 slant = along.atan2(ahead);
                 if slant.abs() >= MAX_STREAMWISE_SLANT_DEG.to_radians() {
                     return Err(format!(
-                        "aero.sections: bodies[{b}] at s = {s} m lies {:.1}° off the normal to the stream (at most \
-                         {MAX_STREAMWISE_SLANT_DEG}° for streamwise sections)",
+                        "{field}.sections: bodies[{b}] at s = {s} m lies {:.1}° off the normal to the stream (at \
+                         most {MAX_STREAMWISE_SLANT_DEG}° for streamwise sections)",
                         slant.to_degrees()
                     ));
                 }
@@ -121,24 +144,75 @@ pub fn station_map(case: &Problem, aero: &AeroSettings) -> Result<Vec<StationMap
                 le_offset *= slant.cos();
             }
             let arc = before + s;
-            out.push(StationMap { body: b, s, slant, hinge: false, control: None, lifting: 0, arc, chord, le_offset });
+            out.push(StationMap {
+                body: b,
+                s,
+                slant,
+                hinge: false,
+                control: None,
+                lifting: k,
+                arc,
+                chord,
+                le_offset,
+                planform_chord,
+            });
+        }
+        before += body.length;
+    }
+    Ok(())
+}
+
+/// Surfaces that meet must share their root station exactly (two half-wings at the plane of
+/// symmetry): a gap smaller than a panel between two trailing legs makes their induced velocity
+/// blow up (docs/uvlm.md §16). Roots closer than 1e-9 m count as shared; farther apart they
+/// must be at least a panel width apart (the smaller root strip of the two).
+fn check_roots(case: &Problem, plans: &[SurfacePlan]) -> Result<(), String> {
+    let placements = case.placements();
+    // Root point and root panel width of each surface.
+    let roots: Vec<(Vector3<f64>, f64)> = plans
+        .iter()
+        .map(|p| (placements[p.bodies[0]].0, case.bodies[p.bodies[0]].length / p.panels[0] as f64))
+        .collect();
+    for (k, &(rk, wk)) in roots.iter().enumerate() {
+        for (i, &(ri, wi)) in roots[..k].iter().enumerate() {
+            let d = (rk - ri).norm();
+            if d > 1e-9 && d < wk.min(wi) {
+                return Err(format!(
+                    "aero.surfaces[{k}].bodies[0]: its root is {d:.3e} m from aero.surfaces[{i}]'s root; surfaces \
+                     that meet must share their root point exactly, others keep at least a root panel ({:.3e} m) \
+                     apart",
+                    wk.min(wi)
+                ));
+            }
         }
     }
-    grade_slants(&mut out);
-    place_control_surfaces(case, aero, &mut out)?;
-    Ok(out)
+    Ok(())
 }
 
 /// Check `aero.control_surfaces` and put each on the stations it covers (the hinge column
 /// belongs to the inner body's end; a surface of the outer body from `s0 = 0` covers it).
-fn place_control_surfaces(case: &Problem, aero: &AeroSettings, map: &mut [StationMap]) -> Result<(), String> {
+fn place_control_surfaces(
+    case: &Problem,
+    aero: &AeroSettings,
+    plans: &[SurfacePlan],
+    map: &mut [StationMap],
+) -> Result<(), String> {
     let cs = &aero.control_surfaces;
     if cs.is_empty() {
         return Ok(());
     }
-    crate::control_surface::check(case, cs, &aero.panels_per_body, aero.n_chordwise)?;
-    for m in map.iter_mut() {
-        m.control = crate::control_surface::surface_at(case, cs, m.body, m.s, m.hinge)?;
+    // Each body's lattice: spanwise and chordwise panels of its surface.
+    let mut lattice = vec![None; case.bodies.len()];
+    for p in plans {
+        for (i, &b) in p.bodies.iter().enumerate() {
+            lattice[b] = Some((p.panels[i], p.n_chordwise));
+        }
+    }
+    crate::control_surface::check(case, cs, &lattice)?;
+    for j in 0..map.len() {
+        // A hinge column also belongs to the root of the surface's next body.
+        let next = map[j].hinge.then(|| map.get(j + 1).map(|m| m.body)).flatten();
+        map[j].control = crate::control_surface::surface_at(case, cs, map[j].body, map[j].s, next)?;
     }
     crate::control_surface::columns(map, cs.len()).map(|_| ())
 }
@@ -172,8 +246,9 @@ fn grade_slants(map: &mut [StationMap]) {
 
 /// A hinge column is shared by the inner body's end and the outer body's root: their chords
 /// and leading-edge offsets must meet there.
-fn check_shared_column(aero: &AeroSettings, b: usize) -> Result<(), String> {
-    for (field, taper) in [("aero.chord", &aero.chord), ("aero.le_offset", &aero.le_offset)] {
+fn check_shared_column(plan: &SurfacePlan, b: usize) -> Result<(), String> {
+    for (name, taper) in [("chord", &plan.chord), ("le_offset", &plan.le_offset)] {
+        let field = format!("{}.{name}", plan.field);
         let (tip, root) = (taper.at(b - 1, 1.0), taper.at(b, 0.0));
         if (tip - root).abs() > 1e-9 * tip.abs().max(root.abs()).max(1e-3) {
             return Err(format!(
@@ -196,13 +271,6 @@ fn reference_frames(case: &Problem) -> Vec<Matrix3<f64>> {
             Matrix3::from_columns(&[x, y, x.cross(&y)])
         })
         .collect()
-}
-
-/// The lattice layout of a station map: chordwise panels and the hinge column (the station a
-/// flared hinge drives).
-pub fn lattice_spec(map: &[StationMap], aero: &AeroSettings) -> uvlm::LatticeSpec {
-    let hinge = map.iter().position(|m| m.hinge).map(|j| uvlm::HingeColumn { column: j, flare: map[j].slant });
-    uvlm::LatticeSpec { hinge, ..uvlm::LatticeSpec::new(aero.n_chordwise) }
 }
 
 /// Pose and velocity of a section by central differences along the retraction.
@@ -415,6 +483,8 @@ struct MarchAero<'a> {
     /// Lift of the last solve, N.
     lift: f64,
     lumping: Lumping,
+    /// The stations of each lifting surface.
+    ranges: Vec<std::ops::Range<usize>>,
     /// Predictor: coordinates, increment and velocity at `t_{n+1}`.
     qp: Vec<f64>,
     dq: Vec<f64>,
@@ -439,18 +509,21 @@ impl Lumping {
         Self { origins: Vec::with_capacity(n), force: vec![[0.0; 3]; n], moment: vec![[0.0; 3]; n] }
     }
 
-    /// Lump the nodal loads `l` to `stations` (about their origins) into `target`; return the
-    /// lift, ⊥ the free stream `v_inf` (a direction: a disturbance would not turn it).
+    /// Lump the last solve's nodal loads of `uv` (surfaces on `ranges` of the stations) to
+    /// `stations` (about their origins) into `target`; return the lift, ⊥ the free stream `v_inf`
+    /// (a direction: a disturbance would not turn it).
     fn apply(
         &mut self,
-        l: &uvlm::Loads,
+        uv: &uvlm::Uvlm,
+        ranges: &[std::ops::Range<usize>],
         stations: &[uvlm::SpanStation],
         v_inf: [f64; 3],
         target: &mut [SectionLoad],
     ) -> f64 {
+        let l = uv.loads();
         self.origins.clear();
         self.origins.extend(stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
-        l.column_loads_inplace(&self.origins, &mut self.force, &mut self.moment);
+        crate::lifting::lump_into(uv, ranges, &self.origins, &mut self.force, &mut self.moment);
         for (j, t) in target.iter_mut().enumerate() {
             t.force = Vector3::from(self.force[j]);
             t.moment = Vector3::from(self.moment[j]);
@@ -477,15 +550,13 @@ impl<'a> MarchAero<'a> {
         let surface_columns = crate::control_surface::columns(map, aero.control_surfaces.len())?;
         let mut hinge = [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES];
         hinge.iter_mut().take(surface_columns.len()).for_each(|h| *h = 0.0);
-        let spec = lattice_spec(map, aero);
         let mut params = aero.uvlm_params(aero.free_stream());
         if at_equilibrium && !aero.wake_closure {
             // The equilibrium's steady solution with the march's own unclosed wake (its rows
             // prefilled below), so that without a disturbance the run stays there.
             params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * aero.speed() * dt };
         }
-        let uv = uvlm::Lattice::from_stations(spec, &stations)
-            .and_then(|l| uvlm::Uvlm::new(l, params))
+        let uv = crate::lifting::new_uvlm(map, aero, &stations, params)
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
         let loads: Vec<SectionLoad> = map
             .iter()
@@ -504,6 +575,7 @@ impl<'a> MarchAero<'a> {
             loads,
             lift: 0.0,
             lumping: Lumping::new(map.len()),
+            ranges: crate::lifting::surface_ranges(map),
             qp: vec![0.0; s.q.len()],
             dq: vec![0.0; s.v.len()],
             vp: vec![0.0; s.v.len()],
@@ -520,8 +592,9 @@ impl<'a> MarchAero<'a> {
     /// The steady solution on the equilibrium's lattice, its wake laid out as the unsteady solver
     /// would have shed it, its loads applied to `model` before the initial accelerations.
     fn steady_start<S: Structure>(&mut self, model: &mut S) -> Result<(), String> {
-        let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics at the equilibrium: {e}"))?;
-        self.lift = self.lumping.apply(l, &self.stations, self.aero.free_stream(), &mut self.loads);
+        self.uv.solve_steady().map_err(|e| format!("steady aerodynamics at the equilibrium: {e}"))?;
+        self.lift =
+            self.lumping.apply(&self.uv, &self.ranges, &self.stations, self.aero.free_stream(), &mut self.loads);
         self.hinge_moments()?;
         self.uv.prefill_wake(self.dt).map_err(|e| format!("steady wake at the equilibrium: {e}"))?;
         model.set_section_loads(&self.loads).map_err(|e| format!("loads at the equilibrium: {e}"))
@@ -536,7 +609,8 @@ impl<'a> MarchAero<'a> {
     /// The control surfaces' hinge moments of the last solve into `hinge`.
     fn hinge_moments(&mut self) -> Result<(), String> {
         for (h, cols) in self.hinge.iter_mut().zip(&self.surface_columns) {
-            *h = self.uv.hinge_moment(cols.clone()).map_err(|e| format!("hinge moment: {e}"))?;
+            *h = crate::lifting::hinge_moment(&self.uv, &self.ranges, cols.clone())
+                .map_err(|e| format!("hinge moment: {e}"))?;
         }
         Ok(())
     }
@@ -544,10 +618,11 @@ impl<'a> MarchAero<'a> {
     /// Move the lattice to the stations, solve the pending UVLM step and lump its loads into
     /// `loads` (`into_new`: `new_loads`); the lift of the solve.
     fn solve(&mut self, into_new: bool) -> Result<f64, String> {
-        self.uv.update_stations(&self.stations, Some(&self.vel)).map_err(|e| e.to_string())?;
-        let l = self.uv.solve_step().map_err(|e| e.to_string())?;
+        crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, Some(&self.vel))
+            .map_err(|e| e.to_string())?;
+        self.uv.solve_step().map_err(|e| e.to_string())?;
         let target = if into_new { &mut self.new_loads } else { &mut self.loads };
-        let lift = self.lumping.apply(l, &self.stations, self.aero.free_stream(), target);
+        let lift = self.lumping.apply(&self.uv, &self.ranges, &self.stations, self.aero.free_stream(), target);
         self.hinge_moments()?;
         Ok(lift)
     }

@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::gust_settings::GustSpec;
-pub use crate::planform::{Sections, Taper};
+pub use crate::planform::{LiftingSurface, Sections, SurfacePlan, Taper};
 
 /// Aerodynamic settings of a case.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,18 +29,27 @@ pub struct AeroSettings {
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
     pub sideslip_deg: f64,
     /// Chord, m: one number for every body, or `[root, tip]` per body (linear taper), in body
-    /// order. A body's root must meet its parent's tip across a shared hinge column.
-    pub chord: Taper,
+    /// order. A body's root must meet its parent's tip across a shared hinge column. The
+    /// one-surface shorthand (every body, in order): required without `surfaces`, refused with it.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub chord: Option<Taper>,
     /// Distance from the beam axis to the leading edge along the section y axis, m (0.5·chord
     /// for a mid-chord axis): one number or `[root, tip]` per body, as `chord`.
-    pub le_offset: Taper,
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub le_offset: Option<Taper>,
     /// How the lattice's grid columns are cut: `"normal"` to the beam axis (default) or
     /// `"streamwise"` (along the free stream without sideslip; `chord` and `le_offset` are then
-    /// measured along the stream). The same on an unswept wing.
+    /// measured along the stream). The same on an unswept wing. Shorthand, as `chord`.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Sections::is_normal"))]
     pub sections: Sections,
-    /// Spanwise panels per body, in body order.
+    /// Spanwise panels per body, in body order (shorthand, as `chord`).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub panels_per_body: Vec<usize>,
+    /// Several lifting surfaces, each a chain of bodies with its own planform, panels and wake,
+    /// solved in one influence system; bodies on no surface carry no aerodynamics. Without it,
+    /// `chord`, `le_offset`, `sections` and `panels_per_body` make one surface of every body.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
+    pub surfaces: Vec<LiftingSurface>,
     /// Chordwise panels.
     pub n_chordwise: usize,
     /// Wake rows kept (truncation).
@@ -223,5 +232,108 @@ pub struct Coupling {
 impl Default for Coupling {
     fn default() -> Self {
         Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0, reuse_wake: true }
+    }
+}
+
+impl AeroSettings {
+    /// The lifting surfaces resolved against `case`'s bodies: `surfaces`, or the one-surface
+    /// shorthand of every body in order. Checks the names, the lists against the bodies, that no
+    /// body is on two surfaces and that the shorthand and `surfaces` are not mixed; the errors
+    /// name the field. (That consecutive bodies are joined by a flared hinge is checked where
+    /// the stations are laid out, [`crate::aero::station_map`].)
+    pub fn surface_plans(&self, case: &crate::problem::Problem) -> Result<Vec<SurfacePlan>, String> {
+        if self.surfaces.is_empty() {
+            let (Some(chord), Some(le_offset)) = (&self.chord, &self.le_offset) else {
+                let missing = if self.chord.is_none() { "aero.chord" } else { "aero.le_offset" };
+                return Err(format!("{missing}: missing (give `chord`, `le_offset` and `panels_per_body`, or `surfaces`)"));
+            };
+            let plan = SurfacePlan {
+                name: "wing".into(),
+                field: "aero".into(),
+                bodies: (0..case.bodies.len()).collect(),
+                chord: chord.clone(),
+                le_offset: le_offset.clone(),
+                panels: self.panels_per_body.clone(),
+                sections: self.sections,
+                n_chordwise: self.n_chordwise,
+            };
+            plan.check()?;
+            return Ok(vec![plan]);
+        }
+        let shorthand = [
+            ("aero.chord", self.chord.is_some()),
+            ("aero.le_offset", self.le_offset.is_some()),
+            ("aero.panels_per_body", !self.panels_per_body.is_empty()),
+            ("aero.sections", !self.sections.is_normal()),
+        ];
+        if let Some((field, _)) = shorthand.iter().find(|x| x.1) {
+            return Err(format!("{field}: give it per surface in `aero.surfaces`, not beside it"));
+        }
+        let mut out: Vec<SurfacePlan> = Vec::with_capacity(self.surfaces.len());
+        for (k, s) in self.surfaces.iter().enumerate() {
+            let field = format!("aero.surfaces[{k}]");
+            if s.name.is_empty() || self.surfaces[..k].iter().any(|o| o.name == s.name) {
+                return Err(format!("{field}.name: `{}` is empty or names another surface too", s.name));
+            }
+            if s.bodies.is_empty() {
+                return Err(format!("{field}.bodies: a surface needs at least one body"));
+            }
+            let mut bodies = Vec::with_capacity(s.bodies.len());
+            for (i, name) in s.bodies.iter().enumerate() {
+                let b = case.body_index(name).ok_or_else(|| format!("{field}.bodies[{i}]: no body named `{name}`"))?;
+                if bodies.contains(&b) {
+                    return Err(format!("{field}.bodies[{i}]: `{name}` is already on this surface"));
+                }
+                if let Some(o) = out.iter().position(|p| p.bodies.contains(&b)) {
+                    return Err(format!("{field}.bodies[{i}]: `{name}` is already on aero.surfaces[{o}]"));
+                }
+                bodies.push(b);
+            }
+            let plan = SurfacePlan {
+                name: s.name.clone(),
+                bodies,
+                chord: s.chord.clone(),
+                le_offset: s.le_offset.clone(),
+                panels: s.panels_per_body.clone(),
+                sections: s.sections,
+                n_chordwise: s.n_chordwise.unwrap_or(self.n_chordwise),
+                field,
+            };
+            plan.check()?;
+            out.push(plan);
+        }
+        Ok(out)
+    }
+
+    /// The size of the lattice: its grid columns (stations) and bound rings over every surface.
+    pub fn lattice_size(&self) -> (f64, f64) {
+        let columns = |p: &[usize]| p.iter().map(|&x| x as f64).sum::<f64>() + 1.0;
+        if self.surfaces.is_empty() {
+            let c = columns(&self.panels_per_body);
+            return (c, c * self.n_chordwise as f64);
+        }
+        self.surfaces.iter().fold((0.0, 0.0), |(c, r), s| {
+            let cs = columns(&s.panels_per_body);
+            (c + cs, r + cs * s.n_chordwise.unwrap_or(self.n_chordwise) as f64)
+        })
+    }
+
+    /// The smallest and largest chord of every surface, m (root and tip values).
+    pub fn chord_extremes(&self) -> (f64, f64) {
+        let all = self.chord.iter().chain(self.surfaces.iter().map(|s| &s.chord)).flat_map(Taper::values);
+        all.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
+    }
+
+    /// Chord and leading-edge offset per body of `case` (`[root, tip]` each) from the surfaces;
+    /// `None` for a body on no surface.
+    pub fn body_planforms(&self, case: &crate::problem::Problem) -> Result<Vec<Option<[[f64; 2]; 2]>>, String> {
+        let mut out = vec![None; case.bodies.len()];
+        for plan in self.surface_plans(case)? {
+            for (i, &b) in plan.bodies.iter().enumerate() {
+                let ends = |t: &Taper| [t.at(i, 0.0), t.at(i, 1.0)];
+                out[b] = Some([ends(&plan.chord), ends(&plan.le_offset)]);
+            }
+        }
+        Ok(out)
     }
 }

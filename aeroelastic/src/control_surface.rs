@@ -93,17 +93,15 @@ impl ControlSurface {
 
 /// The control surface covering the station at arclength `s` of body `body` (index into
 /// `surfaces`); a hinge column (the inner body's end) is covered too by a surface of the next
-/// body that starts at its root. Two surfaces on one station column are an error.
+/// body (`next`, the hinge column's outer body) that starts at its root. Two surfaces on one station column are an error.
 pub(crate) fn surface_at(
     case: &Problem,
     surfaces: &[ControlSurface],
     body: usize,
     s: f64,
-    hinge: bool,
+    next: Option<usize>,
 ) -> Result<Option<usize>, String> {
-    let on = |c: &ControlSurface| {
-        c.covers(case, body, s) || (hinge && body + 1 < case.bodies.len() && c.covers(case, body + 1, 0.0))
-    };
+    let on = |c: &ControlSurface| c.covers(case, body, s) || next.is_some_and(|n| c.covers(case, n, 0.0));
     let mut found = surfaces.iter().enumerate().filter(|(_, c)| on(c)).map(|(i, _)| i);
     match (found.next(), found.next()) {
         (Some(a), Some(b)) => Err(format!(
@@ -116,21 +114,12 @@ pub(crate) fn surface_at(
     }
 }
 
-/// Check the control surfaces against the bodies and their lattice strips (`panels_per_body`,
-/// `n_chordwise`); the messages name the field (`aero.control_surfaces[1].span`).
-pub fn check(
-    case: &Problem,
-    surfaces: &[ControlSurface],
-    panels_per_body: &[usize],
-    n_chordwise: usize,
-) -> Result<(), String> {
+/// Check the control surfaces against the bodies and their lattice strips (`lattice[b]`: body
+/// `b`'s spanwise and chordwise panels, `None` on no lifting surface); the messages name the
+/// field (`aero.control_surfaces[1].span`).
+pub fn check(case: &Problem, surfaces: &[ControlSurface], lattice: &[Option<(usize, usize)>]) -> Result<(), String> {
     if surfaces.len() > MAX_CONTROL_SURFACES {
         return Err(format!("aero.control_surfaces: {} surfaces, at most {MAX_CONTROL_SURFACES}", surfaces.len()));
-    }
-    if !surfaces.is_empty() && n_chordwise < 2 {
-        return Err(format!(
-            "aero.n_chordwise: {n_chordwise}; a control surface needs at least 2 chordwise panels (one on each side of its hinge)"
-        ));
     }
     let max = uvlm::MAX_FLAP_DEFLECTION_DEG;
     for (i, c) in surfaces.iter().enumerate() {
@@ -141,13 +130,22 @@ pub fn check(
         let Some(b) = case.body_index(&c.body) else {
             return Err(format!("{at}.body: no body named `{}`", c.body));
         };
+        let Some((n, n_chordwise)) = lattice.get(b).copied().flatten() else {
+            return Err(format!("{at}.body: `{}` is on no lifting surface", c.body));
+        };
+        if n_chordwise < 2 {
+            return Err(format!(
+                "aero.n_chordwise: {n_chordwise} on `{}`'s surface; a control surface needs at least 2 chordwise panels \
+                 (one on each side of its hinge)",
+                c.body
+            ));
+        }
         let len = case.bodies[b].length;
         let [s0, s1] = c.span;
         if !(s0.is_finite() && s1.is_finite() && 0.0 <= s0 && s0 < s1 && s1 <= len * (1.0 + 1e-9)) {
             return Err(format!("{at}.span: [{s0}, {s1}] is not a range 0 ≤ s0 < s1 ≤ {len} (the body's length)"));
         }
-        let n = panels_per_body.get(b).copied().unwrap_or(1).max(1);
-        let h = len / n as f64;
+        let h = len / n.max(1) as f64;
         for s in [s0, s1] {
             if (s / h - (s / h).round()).abs() * h > 1e-9 * len {
                 return Err(format!(

@@ -58,8 +58,8 @@ pub fn disturbance(
                 length_scale: *length_scale_m,
                 seed: seed.ok_or("seed: von Kármán turbulence needs a seed")?,
                 n_modes: *n_modes,
-                min_wavelength: min_wavelength_m.unwrap_or(aero.chord.min()),
-                table_length: u * (t_end - t0).max(0.0) + x0 + 4.0 * aero.chord.max(),
+                min_wavelength: min_wavelength_m.unwrap_or(aero.chord_extremes().0),
+                table_length: u * (t_end - t0).max(0.0) + x0 + 4.0 * aero.chord_extremes().1,
             };
             Box::new(uvlm::VonKarman::new(conv, params, *direction).map_err(e)?)
         }

@@ -37,7 +37,7 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::{SectionLoad, lattice_spec, station_map, stations_at};
+use crate::aero::{SectionLoad, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::gust::Increments;
 use crate::problem::{Formulation, Problem};
@@ -117,9 +117,8 @@ fn run<S: Structure>(
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(&model, &q, &zeros, &map, aero, None, &mut scratch, &mut stations, &mut vel);
-    let lattice = uvlm::Lattice::from_stations(lattice_spec(&map, aero), &stations)
+    let mut uv = crate::lifting::new_uvlm(&map, aero, &stations, aero.uvlm_params(v_inf))
         .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(v_inf)).map_err(|e| format!("UVLM: {e}"))?;
     let la = uv.linearise(&wake).map_err(|e| format!("linear UVLM: {e}"))?;
     let front = crate::gust::gust_front(spec, aero, &stations)?;
     let gust_dir = Vector3::from(spec.direction()).normalize();
@@ -127,9 +126,9 @@ fn run<S: Structure>(
     let steady = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
     let f0: Vec<f64> = steady.nodal.iter().flatten().copied().collect();
-    let l0 = lump(&map, &steady.positions, &origins, &f0);
+    let l0 = lump(&map, aero, &steady.positions, &origins, &f0);
 
-    let (cl, h) = load_maps(&mut model, &q, &red.phi, &map, &zero_loads, &la, &origins)?;
+    let (cl, h) = load_maps(&mut model, &q, &red.phi, (&map, aero), &zero_loads, &la, &origins)?;
     let mut outputs = Outputs { lm: settings.loads.as_ref(), fold: settings.fold_joint, ls: Default::default() };
     let mut moved = MovedLattice::new(&la, &map, aero);
     let d = mode_derivatives(&model, &q, &red.phi, &mut moved, &mut outputs, &l0)?;

@@ -20,6 +20,7 @@ pub mod gust_field;
 pub mod gust_linear;
 pub mod gust_settings;
 pub mod interrupt;
+pub mod lifting;
 pub mod loads;
 pub mod pencil;
 pub mod planform;

@@ -95,3 +95,76 @@ impl Sections {
         *self == Self::Normal
     }
 }
+
+/// One lifting surface of `aero.surfaces`: a chain of bodies with its own planform, panels and
+/// wake. Every surface sheds its own wake; all surfaces are solved in one influence system.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct LiftingSurface {
+    /// Name (unique among the surfaces).
+    pub name: String,
+    /// Its bodies from root to tip, by name: each after the first the child of the one before
+    /// through a flared hinge at that body's end.
+    pub bodies: Vec<String>,
+    /// Chord, m: one number, or `[root, tip]` per body of this surface, in its body order.
+    pub chord: Taper,
+    /// Distance from the beam axis to the leading edge along the section y axis, m, as `chord`.
+    pub le_offset: Taper,
+    /// Spanwise panels per body of this surface, in its body order.
+    pub panels_per_body: Vec<usize>,
+    /// How its grid columns are cut (as `aero.sections`); default normal.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Sections::is_normal"))]
+    pub sections: Sections,
+    /// Chordwise panels; default `aero.n_chordwise`.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub n_chordwise: Option<usize>,
+}
+
+/// A lifting surface resolved against the problem's bodies: body indices from root to tip, the
+/// planform per body of the surface (index `i` of `chord`/`le_offset` is `bodies[i]`), and the
+/// field that names it in messages (`aero` for the one-surface shorthand, `aero.surfaces[k]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfacePlan {
+    /// Name (`wing` for the shorthand).
+    pub name: String,
+    /// The case-file field of its planform, for messages.
+    pub field: String,
+    /// Body indices from root to tip.
+    pub bodies: Vec<usize>,
+    /// Chord per body of the surface.
+    pub chord: Taper,
+    /// Leading-edge offset per body of the surface.
+    pub le_offset: Taper,
+    /// Spanwise panels per body of the surface.
+    pub panels: Vec<usize>,
+    /// How its grid columns are cut.
+    pub sections: Sections,
+    /// Chordwise panels.
+    pub n_chordwise: usize,
+}
+
+impl SurfacePlan {
+    /// Check the planform's lists against the surface's bodies and its panels (at least 1 each).
+    pub fn check(&self) -> Result<(), String> {
+        let n = self.bodies.len();
+        self.chord.check(&format!("{}.chord", self.field), n, true)?;
+        self.le_offset.check(&format!("{}.le_offset", self.field), n, false)?;
+        if self.panels.len() != n {
+            return Err(format!("{}.panels_per_body: {} entries for {n} bodies", self.field, self.panels.len()));
+        }
+        if let Some(i) = self.panels.iter().position(|&p| p == 0) {
+            return Err(format!("{}.panels_per_body[{i}]: must be at least 1", self.field));
+        }
+        if self.n_chordwise == 0 {
+            return Err(format!("{}.n_chordwise: must be at least 1", self.field));
+        }
+        Ok(())
+    }
+
+    /// Position of body `b` in this surface, if it is one of its bodies.
+    pub fn position(&self, b: usize) -> Option<usize> {
+        self.bodies.iter().position(|&x| x == b)
+    }
+}

@@ -93,6 +93,12 @@ impl StripPolars {
         report.total_delta = Vector3::zeros();
         report.profile_drag = 0.0;
         for j in 0..n {
+            // Stations j and j + 1 bound a strip when they are on one lifting surface; the
+            // lattice's strips run surface after surface, one fewer than stations on each.
+            if map[j].lifting != map[j + 1].lifting {
+                continue;
+            }
+            let i = j - map[j].lifting;
             let body = map[j + 1].body;
             let Some(polar) = self.by_body.get(body).and_then(Option::as_ref) else { continue };
             let (a, b) = (&stations[j], &stations[j + 1]);
@@ -109,7 +115,7 @@ impl StripPolars {
                 quarter_chord: Vector3::zeros(),
             };
             let inviscid = aerofoil::StripLoads {
-                force: frame.transpose() * Vector3::from(loads.strip[j]),
+                force: frame.transpose() * Vector3::from(loads.strip[i]),
                 moment: Vector3::zeros(),
             };
             let c = aerofoil::correct_strip(polar, &aerofoil::LatticeSection::THIN_PLATE, &strip, &inviscid)

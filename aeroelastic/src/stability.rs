@@ -545,16 +545,15 @@ fn held_load_stiffness<S: Structure>(
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(&*model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
-    let spec = crate::aero::lattice_spec(map, aero);
-    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
+    let mut uv = crate::lifting::new_uvlm(map, aero, &stations, aero.uvlm_params(aero.free_stream()))
+        .map_err(|e| format!("aerodynamic lattice: {e}"))?;
     let loads = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
     if loads.nodal.iter().flatten().all(|x| *x == 0.0) {
         return Ok(None);
     }
     let f: Vec<f64> = loads.nodal.iter().flatten().copied().collect();
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let l0 = lump(map, &loads.positions, &origins, &f);
+    let l0 = lump(map, aero, &loads.positions, &origins, &f);
     let mut k = DMatrix::zeros(n, n);
     let mut qq = vec![0.0; q.len()];
     let mut dq = vec![0.0; n];
@@ -575,12 +574,30 @@ fn held_load_stiffness<S: Structure>(
 }
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
-/// lattice's own lumping, [`uvlm::lump_columns`]).
-pub(crate) fn lump(map: &[StationMap], positions: &[[f64; 3]], origins: &[[f64; 3]], f: &[f64]) -> Vec<SectionLoad> {
+/// lattice's own lumping, [`uvlm::lump_columns`]), surface by surface: the nodes of the
+/// surfaces' grids follow each other in surface order.
+pub(crate) fn lump(
+    map: &[StationMap],
+    aero: &AeroSettings,
+    positions: &[[f64; 3]],
+    origins: &[[f64; 3]],
+    f: &[f64],
+) -> Vec<SectionLoad> {
     let nodal: Vec<[f64; 3]> = f.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mut force = vec![[0.0; 3]; origins.len()];
     let mut moment = vec![[0.0; 3]; origins.len()];
-    uvlm::lump_columns(positions, &nodal, origins, &mut force, &mut moment);
+    let ranges = crate::lifting::surface_ranges(map);
+    if let [_] = ranges.as_slice() {
+        uvlm::lump_columns(positions, &nodal, origins, &mut force, &mut moment);
+    } else {
+        let mut node0 = 0;
+        for (k, r) in ranges.into_iter().enumerate() {
+            let nodes = node0..node0 + (crate::lifting::n_chordwise_of(aero, k) + 1) * r.len();
+            let (pos, nod) = (&positions[nodes.clone()], &nodal[nodes.clone()]);
+            uvlm::lump_columns(pos, nod, &origins[r.clone()], &mut force[r.clone()], &mut moment[r]);
+            node0 = nodes.end;
+        }
+    }
     map.iter()
         .zip(force.iter().zip(&moment))
         .map(|(m, (f, mo))| SectionLoad { body: m.body, s: m.s, force: Vector3::from(*f), moment: Vector3::from(*mo) })
@@ -758,7 +775,7 @@ pub(crate) fn load_maps<S: Structure>(
     model: &mut S,
     q: &[f64],
     phi: &DMatrix<f64>,
-    map: &[StationMap],
+    (map, aero): (&[StationMap], &AeroSettings),
     zero_loads: &[SectionLoad],
     la: &uvlm::LinearUvlm,
     origins: &[[f64; 3]],
@@ -770,7 +787,7 @@ pub(crate) fn load_maps<S: Structure>(
     for a in 0..nf {
         unit.fill(0.0);
         unit[a] = 1.0;
-        for (j, sl) in lump(map, &ref_pos, origins, &unit).iter().enumerate() {
+        for (j, sl) in lump(map, aero, &ref_pos, origins, &unit).iter().enumerate() {
             for comp in 0..3 {
                 cl[(6 * j + comp, a)] = sl.force[comp];
                 cl[(6 * j + 3 + comp, a)] = sl.moment[comp];
@@ -839,7 +856,7 @@ impl<'a> MovedLattice<'a> {
 
     /// The largest chord of the lattice, m (the scale of its finite-difference steps).
     pub(crate) fn chord(&self) -> f64 {
-        self.aero.chord.max()
+        self.aero.chord_extremes().1
     }
 
     /// The lattice moved to the stations of `model` at `(q, v)`, their velocities counted when
@@ -858,7 +875,7 @@ impl<'a> MovedLattice<'a> {
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
         let (residual, forces) = self.la.evaluate(&self.lat).map_err(|e| e.to_string())?;
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
-        let loads = lump(self.map, self.lat.ring_nodes(), &org, &forces);
+        let loads = lump(self.map, self.aero, self.lat.ring_nodes(), &org, &forces);
         let te = self.lat.ring_nodes()[self.te_start..].iter().flatten().copied().collect();
         Ok(Moved { residual, forces, loads, te })
     }
@@ -885,7 +902,7 @@ fn geometric_terms<S: Structure>(
 ) -> Result<Geometric, String> {
     let (nr, nb) = (moved.la.n_rings(), phi.ncols());
     let zeros = vec![0.0; model.n_dof()];
-    let span = moved.aero.chord.max().max(1e-3);
+    let span = moved.aero.chord_extremes().1.max(1e-3);
     let n_te = 3 * (moved.lat.n_spanwise() + 1);
     let mut g = Geometric {
         rx: DMatrix::zeros(nr, nb),
@@ -994,12 +1011,11 @@ pub fn reduce<S: Structure>(
         let strips = strip_model(&mut model, q, &stations, &basis.phi, (map, aero, case));
         return Ok(Reduced::of_strips(basis, strips));
     }
-    let spec = crate::aero::lattice_spec(map, aero);
-    let lattice = uvlm::Lattice::from_stations(spec, &stations).map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let mut uv = uvlm::Uvlm::new(lattice, aero.uvlm_params(aero.free_stream())).map_err(|e| format!("UVLM: {e}"))?;
+    let mut uv = crate::lifting::new_uvlm(map, aero, &stations, aero.uvlm_params(aero.free_stream()))
+        .map_err(|e| format!("aerodynamic lattice: {e}"))?;
     let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let (_, h) = load_maps(&mut model, q, &basis.phi, map, &zero_loads, &la, &origins)?;
+    let (_, h) = load_maps(&mut model, q, &basis.phi, (map, aero), &zero_loads, &la, &origins)?;
     let mut moved = MovedLattice::new(&la, map, aero);
     let geo = geometric_terms(&mut model, q, &basis.phi, &mut moved, &zero_loads)?;
     // The wake's nodes follow the trailing edge's past motion, as the time march sheds them:

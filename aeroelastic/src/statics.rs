@@ -37,6 +37,8 @@ use crate::problem::{Formulation, Problem};
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
     uv: uvlm::Uvlm,
+    /// The stations of each lifting surface.
+    ranges: Vec<std::ops::Range<usize>>,
     stations: Vec<uvlm::SpanStation>,
     vel: Vec<uvlm::StationVelocity>,
     scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
@@ -62,6 +64,7 @@ impl SteadyAero {
     ) -> Result<Self, String> {
         let mut s = Self {
             uv: placeholder_uvlm()?,
+            ranges: Vec::new(),
             stations: Vec::new(),
             vel: Vec::new(),
             scratch: (Vec::new(), Vec::new(), Vec::new()),
@@ -73,12 +76,11 @@ impl SteadyAero {
             report: StripReport::default(),
         };
         stations_at(model, q, &s.zeros, map, aero, None, &mut s.scratch, &mut s.stations, &mut s.vel);
-        let spec = crate::aero::lattice_spec(map, aero);
         let mut params = aero.uvlm_params(v_inf);
         params.steady_wake = wake;
-        s.uv = uvlm::Lattice::from_stations(spec, &s.stations)
-            .and_then(|l| uvlm::Uvlm::new(l, params))
+        s.uv = crate::lifting::new_uvlm(map, aero, &s.stations, params)
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        s.ranges = crate::lifting::surface_ranges(map);
         Ok(s)
     }
 
@@ -95,12 +97,13 @@ impl SteadyAero {
         out: &mut [SectionLoad],
     ) -> Result<(), String> {
         stations_at(model, q, &self.zeros, map, aero, None, &mut self.scratch, &mut self.stations, &mut self.vel);
-        self.uv.update_stations(&self.stations, None).map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        let l = self.uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
+        crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, None)
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        self.uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
         self.n_solves += 1;
         self.origins.clear();
         self.origins.extend(self.stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
-        l.column_loads_inplace(&self.origins, &mut self.fbuf, &mut self.mbuf);
+        crate::lifting::lump_into(&self.uv, &self.ranges, &self.origins, &mut self.fbuf, &mut self.mbuf);
         for (j, t) in out.iter_mut().enumerate() {
             t.force = Vector3::from(self.fbuf[j]);
             t.moment = Vector3::from(self.mbuf[j]);
@@ -352,7 +355,10 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     pub fn control_hinge_moments(&self, map: &[StationMap]) -> Result<Vec<f64>, String> {
         let cols = crate::control_surface::columns(map, self.aero.control_surfaces.len())?;
         let st = lock(&self.aero_state);
-        cols.into_iter().map(|c| st.uv.hinge_moment(c).map_err(|e| format!("hinge moment: {e}"))).collect()
+        let ranges = crate::lifting::surface_ranges(map);
+        cols.into_iter()
+            .map(|c| crate::lifting::hinge_moment(&st.uv, &ranges, c).map_err(|e| format!("hinge moment: {e}")))
+            .collect()
     }
 
     /// Generalised aerodynamic load `r(q, L) − r(q, 0)` (the residual's load part, with the
@@ -1102,10 +1108,13 @@ fn point_at<S: Structure>(
     let qdyn = 0.5 * rho * airspeed * airspeed;
     // The planform's chord at the station (along the stream for streamwise sections, also at a
     // hinge column, whose slant is the flare's).
-    let chord = |m: &StationMap| sys.aero.chord.at(m.body, m.s / case.bodies[m.body].length);
+    let chord = |m: &StationMap| m.planform_chord;
+    // The lattice's strips run surface after surface, one fewer than the surface's stations.
     let strips = (0..stations.len().saturating_sub(1))
+        .filter(|&j| map[j].lifting == map[j + 1].lifting)
         .filter_map(|j| {
-            let f = Vector3::from(*uv_loads.strip.get(j)?) + report.delta_force.get(j).copied().unwrap_or_default();
+            let i = j - map[j].lifting;
+            let f = Vector3::from(*uv_loads.strip.get(i)?) + report.delta_force.get(j).copied().unwrap_or_default();
             let (a, b) = (stations[j].origin, stations[j + 1].origin);
             let width = (b - a).norm();
             let l = f.dot(&lift_dir) / width;

@@ -155,8 +155,8 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
         + rows * std::mem::size_of::<Row>() as f64;
     let (mut bound, mut wake, mut aero_bytes, mut aero_step, mut sub) = (0.0, 0.0, 0.0, 0.0, 1.0);
     if let Some(a) = &case.aero {
-        let span: f64 = a.panels_per_body.iter().map(|&p| p as f64).sum::<f64>() + 1.0;
-        bound = span * a.n_chordwise as f64;
+        let (span, rings) = a.lattice_size();
+        bound = rings;
         wake = span * a.n_wake_rows as f64;
         aero_bytes = 16.0 * bound * bound + 100.0 * (bound + wake);
         aero_step = 2e-8 * bound * bound + 1e-9 * bound * bound * bound / 3.0 + 3e-8 * bound * wake;
@@ -314,8 +314,7 @@ pub fn estimate_analysis(case: &Case, f: Formulation, a: Analysis) -> Estimate {
     let structure_bytes = 3.0 * 8.0 * n * n + 8.0 * n * 600.0;
     let (mut bound, mut span) = (0.0, 0.0);
     if let Some(a) = &case.aero {
-        span = a.panels_per_body.iter().map(|&p| p as f64).sum::<f64>() + 1.0;
-        bound = span * a.n_chordwise as f64;
+        (span, bound) = a.lattice_size();
     }
     let (solve_s, solve_bytes) = steady_solve(bound, 2.0 * span);
     let static_point = if case.aero.is_some() {

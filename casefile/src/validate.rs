@@ -311,7 +311,7 @@ impl Case {
             }
         }
         positive("aero.rho", a.rho)?;
-        a.chord.check("aero.chord", self.bodies.len(), true)?;
+        a.surface_plans(&self.problem())?;
         match (a.v_inf, a.airspeed) {
             (None, None) => return Err("aero: give the free stream as `v_inf` or `airspeed`".into()),
             (Some(v), _) if !finite3(&v) || norm3(&v) == 0.0 => {
@@ -321,7 +321,6 @@ impl Case {
             _ => {}
         }
         sideslip("aero.sideslip_deg", a.sideslip_deg)?;
-        a.le_offset.check("aero.le_offset", self.bodies.len(), false)?;
         if a.n_chordwise == 0 {
             return Err("aero.n_chordwise: must be at least 1".into());
         }

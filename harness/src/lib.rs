@@ -33,7 +33,7 @@ pub mod vtk;
 
 // The analyses live in the `aeroelastic` library, the case files in `casefile`; their modules keep
 // their harness paths.
-pub use aeroelastic::{aero, gust, gust_linear, loads, pencil, run, stability, static_hold, statics};
+pub use aeroelastic::{aero, gust, gust_linear, lifting, loads, pencil, run, stability, static_hold, statics};
 pub use casefile as case;
 pub use casefile::{budget, scene};
 

@@ -130,10 +130,14 @@ pub fn writer_for(out: &Path, spec: &RunSpec, f: Formulation, cli: Option<Option
     }
     let stride = cli.flatten().or(case.vtk.and_then(|v| v.stride)).unwrap_or_else(|| default_stride(case, f));
     let w = VtkWriter::for_run(out, &spec.name, f, stride);
-    Some(match &case.aero {
-        Some(a) => w.with_chord(a.chord.clone(), a.le_offset.clone()),
-        None => w,
-    })
+    let Some(a) = &case.aero else { return Some(w) };
+    if let (Some(c), Some(le)) = (&a.chord, &a.le_offset) {
+        return Some(w.with_chord(c.clone(), le.clone()));
+    }
+    // Several surfaces: each body's planform; a body on no surface has a ribbon of zero chord.
+    let per_body = a.body_planforms(&case.problem()).unwrap_or_default();
+    let ends = |i: usize| -> Taper { Taper::PerBody(per_body.iter().map(|p| p.map_or([0.0; 2], |x| x[i])).collect()) };
+    Some(w.with_chord(ends(0), ends(1)))
 }
 
 /// Several observers fed the same snapshots, in order (the first error stops the run).

@@ -63,7 +63,7 @@ fn hinge_moment_on_the_lattice(spec: &RunSpec, p: &StaticPoint) -> f64 {
     let last = map.iter().rposition(|m| m.control == Some(0)).unwrap();
     // The inner body's 24 strips: stations 0..=24, the hinge column (24) included.
     assert_eq!((first, last), (0, 24));
-    let lattice = uvlm::Lattice::from_stations(harness::aero::lattice_spec(&map, &aero), &stations).unwrap();
+    let lattice = uvlm::Lattice::from_stations(harness::lifting::lattice_spec(&map, &aero, 0), &stations).unwrap();
     let mut params = aero.uvlm_params(aero.free_stream());
     params.steady_wake = uvlm::SteadyWake::SemiInfinite;
     let mut u = uvlm::Uvlm::new(lattice, params).unwrap();

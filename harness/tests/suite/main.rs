@@ -25,6 +25,7 @@ mod slurm;
 mod stability;
 mod statics;
 mod statics_bend;
+mod surfaces;
 #[cfg(target_os = "linux")]
 mod streamed;
 mod vtk;

@@ -55,7 +55,7 @@ fn steady_strips(spec: &RunSpec) -> (Vec<(f64, f64)>, f64) {
             st
         })
         .collect();
-    let lattice = uvlm::Lattice::from_stations(harness::aero::lattice_spec(&map, &aero), &stations).unwrap();
+    let lattice = uvlm::Lattice::from_stations(harness::lifting::lattice_spec(&map, &aero, 0), &stations).unwrap();
     let v = aero.free_stream();
     let mut u = uvlm::Uvlm::new(lattice, aero.uvlm_params(v)).unwrap();
     let loads = u.solve_steady().unwrap();
