@@ -556,8 +556,8 @@ impl<'a> MarchAero<'a> {
             // prefilled below), so that without a disturbance the run stays there.
             params.steady_wake = uvlm::SteadyWake::Finite { length: aero.n_wake_rows as f64 * aero.speed() * dt };
         }
-        let uv = crate::lifting::new_uvlm(map, aero, &stations, params)
-            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let uv =
+            crate::lifting::new_uvlm(map, aero, &stations, params).map_err(|e| format!("aerodynamic lattice: {e}"))?;
         let loads: Vec<SectionLoad> = map
             .iter()
             .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })

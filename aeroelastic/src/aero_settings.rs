@@ -245,7 +245,9 @@ impl AeroSettings {
         if self.surfaces.is_empty() {
             let (Some(chord), Some(le_offset)) = (&self.chord, &self.le_offset) else {
                 let missing = if self.chord.is_none() { "aero.chord" } else { "aero.le_offset" };
-                return Err(format!("{missing}: missing (give `chord`, `le_offset` and `panels_per_body`, or `surfaces`)"));
+                return Err(format!(
+                    "{missing}: missing (give `chord`, `le_offset` and `panels_per_body`, or `surfaces`)"
+                ));
             };
             let plan = SurfacePlan {
                 name: "wing".into(),

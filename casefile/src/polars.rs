@@ -58,8 +58,12 @@ impl Case {
                 let speeds = aero.airspeed.iter().chain(self.statics.iter().flat_map(|s| s.airspeeds.iter()));
                 // The strips' chords: the root and tip of each body of this polar.
                 let planforms = aero.body_planforms(&self.problem())?;
-                let chords: Vec<f64> =
-                    spec.bodies.iter().filter_map(|&b| planforms.get(b).copied().flatten()).flat_map(|p| p[0]).collect();
+                let chords: Vec<f64> = spec
+                    .bodies
+                    .iter()
+                    .filter_map(|&b| planforms.get(b).copied().flatten())
+                    .flat_map(|p| p[0])
+                    .collect();
                 for (v, c) in speeds.flat_map(|&v| chords.iter().map(move |&c| (v, c))) {
                     let re = v * c / nu;
                     if !(lo..=hi).contains(&re) {

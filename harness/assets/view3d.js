@@ -39,7 +39,7 @@
             for (var k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], a[i + k] * s); hi[k] = Math.max(hi[k], a[i + k] * s); }
           }
         };
-        fr.beams.forEach(grow); grow(fr.le); grow(fr.te);
+        fr.beams.forEach(grow); surfacesOf(fr).forEach(function (sf) { grow(sf.le); grow(sf.te); });
       });
     });
     if (!isFinite(this.t0)) { this.t0 = 0; this.t1 = 1; }
@@ -119,6 +119,11 @@
   };
 
   // The last frame at or before t.
+  // The lifting surfaces of a frame: the first one's fields sit on the frame itself.
+  function surfacesOf(fr) {
+    return [fr].concat(fr.more_surfaces || []);
+  }
+
   function frameAt(frames, t) {
     var lo = 0, hi = frames.length - 1;
     if (t <= frames[0].t) { return frames[0]; }
@@ -175,37 +180,39 @@
     this.runs.forEach(function (r) {
       if (!self.show[r.f]) { return; }
       var fr = frameAt(r.d.frames, self.t), s = r.d.scale, col = COLORS[r.f] || [0, 0, 0];
-      // Wake: a grid of lines.
-      if (fr.wake_rows > 0) {
-        var w = self.points(fr.wake, s), nr = fr.wake_rows, nc = fr.wake_cols, i, j, row;
-        for (i = 0; i < nr; i++) { self.line(w.slice(i * nc, (i + 1) * nc), rgba(col, 0.35), 1); }
-        for (j = 0; j < nc; j++) {
-          row = [];
-          for (i = 0; i < nr; i++) { row.push(w[i * nc + j]); }
-          self.line(row, rgba(col, 0.35), 1);
-        }
-      }
-      // Wing: translucent panels between leading and trailing edge, and both edges.
-      if (fr.le.length > 0) {
-        var le = self.points(fr.le, s), te = self.points(fr.te, s);
-        g.fillStyle = rgba(col, 0.18);
-        for (var k = 0; k + 1 < le.length; k++) {
-          g.beginPath(); g.moveTo(le[k][0], le[k][1]); g.lineTo(le[k + 1][0], le[k + 1][1]);
-          g.lineTo(te[k + 1][0], te[k + 1][1]); g.lineTo(te[k][0], te[k][1]); g.closePath(); g.fill();
-        }
-        self.line(le, rgba(col, 0.9), 1.5); self.line(te, rgba(col, 0.9), 1.5);
-        // Control surfaces: the flap between its hinge line and the deflected trailing edge.
-        (fr.flaps || []).forEach(function (f) {
-          var pts = self.points(f, s), h = pts.slice(0, pts.length / 2), e = pts.slice(pts.length / 2);
-          g.fillStyle = rgba(col, 0.4);
-          for (var k = 0; k + 1 < h.length; k++) {
-            g.beginPath(); g.moveTo(h[k][0], h[k][1]); g.lineTo(h[k + 1][0], h[k + 1][1]);
-            g.lineTo(e[k + 1][0], e[k + 1][1]); g.lineTo(e[k][0], e[k][1]); g.closePath(); g.fill();
+      surfacesOf(fr).forEach(function (sf) {
+        // Wake: a grid of lines.
+        if (sf.wake_rows > 0) {
+          var w = self.points(sf.wake, s), nr = sf.wake_rows, nc = sf.wake_cols, i, j, row;
+          for (i = 0; i < nr; i++) { self.line(w.slice(i * nc, (i + 1) * nc), rgba(col, 0.35), 1); }
+          for (j = 0; j < nc; j++) {
+            row = [];
+            for (i = 0; i < nr; i++) { row.push(w[i * nc + j]); }
+            self.line(row, rgba(col, 0.35), 1);
           }
-          self.line(h, rgba(col, 0.9), 1);
-          self.line([h[0], e[0]], rgba(col, 0.9), 1); self.line([h[h.length - 1], e[e.length - 1]], rgba(col, 0.9), 1);
-        });
-      }
+        }
+        // Wing: translucent panels between leading and trailing edge, and both edges.
+        if (sf.le.length > 0) {
+          var le = self.points(sf.le, s), te = self.points(sf.te, s);
+          g.fillStyle = rgba(col, 0.18);
+          for (var k = 0; k + 1 < le.length; k++) {
+            g.beginPath(); g.moveTo(le[k][0], le[k][1]); g.lineTo(le[k + 1][0], le[k + 1][1]);
+            g.lineTo(te[k + 1][0], te[k + 1][1]); g.lineTo(te[k][0], te[k][1]); g.closePath(); g.fill();
+          }
+          self.line(le, rgba(col, 0.9), 1.5); self.line(te, rgba(col, 0.9), 1.5);
+          // Control surfaces: the flap between its hinge line and the deflected trailing edge.
+          (sf.flaps || []).forEach(function (f) {
+            var pts = self.points(f, s), h = pts.slice(0, pts.length / 2), e = pts.slice(pts.length / 2);
+            g.fillStyle = rgba(col, 0.4);
+            for (var k = 0; k + 1 < h.length; k++) {
+              g.beginPath(); g.moveTo(h[k][0], h[k][1]); g.lineTo(h[k + 1][0], h[k + 1][1]);
+              g.lineTo(e[k + 1][0], e[k + 1][1]); g.lineTo(e[k][0], e[k][1]); g.closePath(); g.fill();
+            }
+            self.line(h, rgba(col, 0.9), 1);
+            self.line([h[0], e[0]], rgba(col, 0.9), 1); self.line([h[h.length - 1], e[e.length - 1]], rgba(col, 0.9), 1);
+          });
+        }
+      });
       // Beams, and the chord direction of each section for structures without a lattice.
       var tick = 0.06 * self.radius;
       fr.beams.forEach(function (b, bi) {

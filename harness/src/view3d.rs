@@ -38,7 +38,18 @@ pub struct Frame {
     pub beams: Vec<Vec<i64>>,
     /// Per body: the section's y axis (chord direction) at each kept node, in hundredths.
     pub e2: Vec<Vec<i64>>,
-    /// Leading-edge points of the lattice, x y z flattened (empty without aerodynamics).
+    /// The lattice's first lifting surface and its wake (empty without aerodynamics).
+    #[serde(flatten)]
+    pub surface: SurfaceFrame,
+    /// The lattice's further lifting surfaces, each drawn as the first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub more_surfaces: Vec<SurfaceFrame>,
+}
+
+/// One lifting surface of a frame: its edges, control surfaces and wake.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SurfaceFrame {
+    /// Leading-edge points of the lattice, x y z flattened.
     pub le: Vec<i64>,
     /// Trailing-edge points of the lattice.
     pub te: Vec<i64>,
@@ -155,34 +166,46 @@ impl Observer for ViewRecorder {
             f.e2.push(e2);
         }
         if let Some(uv) = s.aero {
-            let l = uv.lattice();
-            let (m, n) = (l.n_chordwise(), l.n_spanwise());
-            let mut cols = spread(n + 1, MAX_EDGE_COLUMNS);
-            if let Some(h) = l.hinge_column() {
-                cols.push(h);
-                cols.sort_unstable();
-                cols.dedup();
-            }
-            for &j in &cols {
-                quant(l.grid_nodes()[l.node_index(0, j)], &mut f.le);
-                quant(l.grid_nodes()[l.node_index(m, j)], &mut f.te);
-            }
-            f.flaps = flap_runs(l, &quant);
-            let w = uv.wake();
-            let rows = spread(w.n_rows() + 1, MAX_WAKE_ROWS);
-            let wcols = spread(w.n_spanwise() + 1, MAX_WAKE_COLUMNS);
-            for &r in &rows {
-                for &j in &wcols {
-                    let p = if r == 0 { l.ring_nodes()[l.node_index(m, j)] } else { w.node(r - 1, j) };
-                    quant(p, &mut f.wake);
+            for (k, su) in uv.surfaces().iter().enumerate() {
+                let sf = surface_frame(su.lattice(), su.wake(), &quant);
+                if k == 0 {
+                    f.surface = sf;
+                } else {
+                    f.more_surfaces.push(sf);
                 }
             }
-            f.wake_rows = rows.len();
-            f.wake_cols = wcols.len();
         }
         self.data.frames.push(f);
         Ok(())
     }
+}
+
+/// The frame of one lifting surface: lattice `l` and its wake `w`, quantised by `quant`.
+fn surface_frame(l: &uvlm::Lattice, w: &uvlm::Wake, quant: &impl Fn([f64; 3], &mut Vec<i64>)) -> SurfaceFrame {
+    let mut f = SurfaceFrame::default();
+    let (m, n) = (l.n_chordwise(), l.n_spanwise());
+    let mut cols = spread(n + 1, MAX_EDGE_COLUMNS);
+    if let Some(h) = l.hinge_column() {
+        cols.push(h);
+        cols.sort_unstable();
+        cols.dedup();
+    }
+    for &j in &cols {
+        quant(l.grid_nodes()[l.node_index(0, j)], &mut f.le);
+        quant(l.grid_nodes()[l.node_index(m, j)], &mut f.te);
+    }
+    f.flaps = flap_runs(l, quant);
+    let rows = spread(w.n_rows() + 1, MAX_WAKE_ROWS);
+    let wcols = spread(w.n_spanwise() + 1, MAX_WAKE_COLUMNS);
+    for &r in &rows {
+        for &j in &wcols {
+            let p = if r == 0 { l.ring_nodes()[l.node_index(m, j)] } else { w.node(r - 1, j) };
+            quant(p, &mut f.wake);
+        }
+    }
+    f.wake_rows = rows.len();
+    f.wake_cols = wcols.len();
+    f
 }
 
 /// The control surfaces of lattice `l`: per run of neighbouring flapped grid columns, the hinge

@@ -314,32 +314,41 @@ fn quads_vtp(points: &[[f64; 3]], quads: &[Vec<usize>], gamma: &[f64], delta_p: 
     x
 }
 
-/// The bound vortex rings (corners: the ring nodes), circulation `gamma` and pressure jump
-/// `delta_p`.
+/// The bound vortex rings of every lifting surface (corners: the ring nodes), circulation
+/// `gamma` and pressure jump `delta_p`, surface after surface in one polydata.
 fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
-    let l = uv.lattice();
-    let (m, n) = (l.n_chordwise(), l.n_spanwise());
-    let mut quads = Vec::with_capacity(m * n);
-    let mut gamma = Vec::with_capacity(m * n);
-    for i in 0..m {
-        for j in 0..n {
-            quads.push(l.ring_corners(i, j).to_vec());
-            gamma.push(uv.gamma()[l.ring_index(i, j)]);
+    let (mut points, mut quads, mut gamma, mut dp) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for su in uv.surfaces() {
+        let l = su.lattice();
+        let g = &uv.gamma()[su.rings()];
+        let o = points.len();
+        for i in 0..l.n_chordwise() {
+            for j in 0..l.n_spanwise() {
+                quads.push(l.ring_corners(i, j).iter().map(|c| c + o).collect());
+                gamma.push(g[l.ring_index(i, j)]);
+            }
         }
+        points.extend_from_slice(l.ring_nodes());
+        dp.extend(surface_pressure_jump(l, su.loads()));
     }
-    let dp = pressure_jump(uv);
-    quads_vtp(l.ring_nodes(), &quads, &gamma, Some(&dp))
+    quads_vtp(&points, &quads, &gamma, Some(&dp))
 }
 
-/// Pressure jump across each bound ring, Pa (positive: the ring's normal side is pushed):
-/// `Δp = F · n / A`, with the ring's force `F` taken as an equal share of the loads on its four
-/// corner nodes among the rings meeting there (the nodal loads of the last solve, steady and
-/// unsteady parts). The shares sum to the nodal loads, so `Σ Δp A n` is the total normal force;
-/// it is a smoothed panel pressure, not a separate solve. Zero before the first solve.
+/// Pressure jump across each bound ring of every lifting surface, Pa, surface after surface
+/// (see [`surface_pressure_jump`]). Zero before the first solve.
 pub fn pressure_jump(uv: &uvlm::Uvlm) -> Vec<f64> {
-    let l = uv.lattice();
+    uv.surfaces().iter().flat_map(|su| surface_pressure_jump(su.lattice(), su.loads())).collect()
+}
+
+/// Pressure jump across each bound ring of lattice `l`, Pa (positive: the ring's normal side is
+/// pushed): `Δp = F · n / A`, with the ring's force `F` taken as an equal share of the loads
+/// `loads` on its four corner nodes among the rings meeting there (the nodal loads of the last
+/// solve, steady and unsteady parts). The shares sum to the nodal loads, so `Σ Δp A n` is the
+/// total normal force; it is a smoothed panel pressure, not a separate solve. Zero before the
+/// first solve.
+fn surface_pressure_jump(l: &uvlm::Lattice, loads: &uvlm::Loads) -> Vec<f64> {
     let (m, n) = (l.n_chordwise(), l.n_spanwise());
-    let nodal = &uv.loads().nodal;
+    let nodal = &loads.nodal;
     let mut dp = vec![0.0; m * n];
     if nodal.len() != l.n_nodes() {
         return dp;
@@ -369,24 +378,26 @@ pub fn pressure_jump(uv: &uvlm::Uvlm) -> Vec<f64> {
     dp
 }
 
-/// The wake rings: node row 0 is the lattice's trailing-edge ring row, node row r + 1 the wake's
-/// detached row r; circulation `gamma`.
+/// The wake rings of every lifting surface, surface after surface: per surface, node row 0 is
+/// the lattice's trailing-edge ring row, node row r + 1 the wake's detached row r; circulation
+/// `gamma`.
 fn wake_vtp(uv: &uvlm::Uvlm) -> String {
-    let l = uv.lattice();
-    let w = uv.wake();
-    let (n, rows) = (w.n_spanwise(), w.n_rows());
-    let nc = n + 1;
-    let te = l.n_chordwise();
-    let mut points: Vec<[f64; 3]> = (0..nc).map(|j| l.ring_nodes()[l.node_index(te, j)]).collect();
-    for r in 0..rows {
-        points.extend((0..nc).map(|j| w.node(r, j)));
-    }
-    let mut quads = Vec::with_capacity(rows * n);
-    let mut gamma = Vec::with_capacity(rows * n);
-    for r in 0..rows {
-        for j in 0..n {
-            quads.push(vec![r * nc + j, r * nc + j + 1, (r + 1) * nc + j + 1, (r + 1) * nc + j]);
-            gamma.push(w.gamma(r, j));
+    let (mut points, mut quads, mut gamma) = (Vec::new(), Vec::new(), Vec::new());
+    for su in uv.surfaces() {
+        let (l, w) = (su.lattice(), su.wake());
+        let (n, rows) = (w.n_spanwise(), w.n_rows());
+        let nc = n + 1;
+        let te = l.n_chordwise();
+        let o = points.len();
+        points.extend((0..nc).map(|j| l.ring_nodes()[l.node_index(te, j)]));
+        for r in 0..rows {
+            points.extend((0..nc).map(|j| w.node(r, j)));
+        }
+        for r in 0..rows {
+            for j in 0..n {
+                quads.push(vec![o + r * nc + j, o + r * nc + j + 1, o + (r + 1) * nc + j + 1, o + (r + 1) * nc + j]);
+                gamma.push(w.gamma(r, j));
+            }
         }
     }
     quads_vtp(&points, &quads, &gamma, None)

@@ -25,8 +25,8 @@ mod slurm;
 mod stability;
 mod statics;
 mod statics_bend;
-mod surfaces;
 #[cfg(target_os = "linux")]
 mod streamed;
+mod surfaces;
 mod vtk;
 mod vtk_parse;

@@ -30,8 +30,10 @@ fn body(name: &str, start: [f64; 3], x_axis: [f64; 3], length: f64, twist: f64, 
 /// A case of `bodies` (each clamped at its root) with the `aero` block `aero`, a static point
 /// at 10 m/s along −Y in air of density 1.
 fn case(name: &str, bodies: Vec<Value>, aero: Value) -> Value {
-    let joints: Vec<Value> =
-        bodies.iter().map(|b| json!({ "type": "clamp", "name": format!("root_{}", b["name"].as_str().unwrap()), "body": b["name"] })).collect();
+    let joints: Vec<Value> = bodies
+        .iter()
+        .map(|b| json!({ "type": "clamp", "name": format!("root_{}", b["name"].as_str().unwrap()), "body": b["name"] }))
+        .collect();
     let n = bodies.len();
     let mut a = json!({ "rho": 1.0, "airspeed": 10.0, "n_chordwise": 4, "n_wake_rows": 20 });
     for (k, v) in aero.as_object().unwrap() {
@@ -75,7 +77,10 @@ fn two_half_wings_equal_one_surface_across_and_the_mirror_image() {
     let panels = 16;
     let halves = case(
         "halves",
-        vec![body("right", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 6.0, 1e9), body("left", [0.0; 3], [-1.0, 0.0, 0.0], 4.0, -6.0, 1e9)],
+        vec![
+            body("right", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 6.0, 1e9),
+            body("left", [0.0; 3], [-1.0, 0.0, 0.0], 4.0, -6.0, 1e9),
+        ],
         json!({ "surfaces": [
             { "name": "right", "bodies": ["right"], "chord": 1.0, "le_offset": 0.25, "panels_per_body": [panels] },
             { "name": "left", "bodies": ["left"], "chord": 1.0, "le_offset": 0.25, "panels_per_body": [panels] } ] }),
@@ -91,7 +96,8 @@ fn two_half_wings_equal_one_surface_across_and_the_mirror_image() {
         json!({ "chord": 1.0, "le_offset": 0.25, "panels_per_body": [panels],
             "images": [{ "point": [0, 0, 0], "normal": [1, 0, 0] }] }),
     );
-    let (h, a, m) = (spec(&halves, "halves").unwrap(), spec(&across, "across").unwrap(), spec(&mirror, "mirror").unwrap());
+    let (h, a, m) =
+        (spec(&halves, "halves").unwrap(), spec(&across, "across").unwrap(), spec(&mirror, "mirror").unwrap());
     let (ph, pa, pm) = (solve(&h, Formulation::Gebf), solve(&a, Formulation::Gebf), solve(&m, Formulation::Gebf));
     let (sh, sa, sm) = (strips_by_x(&ph), strips_by_x(&pa), strips_by_x(&pm));
     assert_eq!((sh.len(), sa.len(), sm.len()), (2 * panels, 2 * panels, panels));
@@ -128,7 +134,10 @@ fn wing_and_tail(with_wing: bool, panels: usize) -> Value {
     let surfaces = if with_wing { vec![wing, tail] } else { vec![tail] };
     case(
         if with_wing { "wing_tail" } else { "tail_alone" },
-        vec![body("wing", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 4.0, 1e9), body("tail", [0.0, y_tail, 0.1], [1.0, 0.0, 0.0], 1.0, 2.0, 1e9)],
+        vec![
+            body("wing", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 4.0, 1e9),
+            body("tail", [0.0, y_tail, 0.1], [1.0, 0.0, 0.0], 1.0, 2.0, 1e9),
+        ],
         json!({ "surfaces": surfaces, "images": [{ "point": [0, 0, 0], "normal": [1, 0, 0] }] }),
     )
 }
@@ -196,7 +205,10 @@ fn a_flexible_wing_and_tail_agree_in_both_formulations() {
 fn two_half_wings_march_as_the_mirror_image() {
     let halves = case(
         "halves_march",
-        vec![body("right", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 6.0, 1e3), body("left", [0.0; 3], [-1.0, 0.0, 0.0], 4.0, -6.0, 1e3)],
+        vec![
+            body("right", [0.0; 3], [1.0, 0.0, 0.0], 4.0, 6.0, 1e3),
+            body("left", [0.0; 3], [-1.0, 0.0, 0.0], 4.0, -6.0, 1e3),
+        ],
         json!({ "surfaces": [
             { "name": "right", "bodies": ["right"], "chord": 1.0, "le_offset": 0.25, "panels_per_body": [8] },
             { "name": "left", "bodies": ["left"], "chord": 1.0, "le_offset": 0.25, "panels_per_body": [8] } ] }),
@@ -219,7 +231,12 @@ fn two_half_wings_march_as_the_mirror_image() {
         assert!(oh.error.is_none() && om.error.is_none(), "{f:?}: {:?} {:?}", oh.error, om.error);
         assert_eq!(oh.rows.len(), 11);
         let scale = om.rows.iter().fold(0.0_f64, |a, r| a.max(r.lift.abs()));
-        let d = oh.rows.iter().zip(&om.rows).map(|(a, b)| (a.lift - 2.0 * b.lift).abs() / (2.0 * scale)).fold(0.0, f64::max);
+        let d = oh
+            .rows
+            .iter()
+            .zip(&om.rows)
+            .map(|(a, b)| (a.lift - 2.0 * b.lift).abs() / (2.0 * scale))
+            .fold(0.0, f64::max);
         println!("{f:?}: two half-wings against the mirror image over 10 steps: lift within {d:.2e}");
         assert!(scale > 1.0 && d < 1e-9);
     }
