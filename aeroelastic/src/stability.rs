@@ -752,11 +752,13 @@ fn strip_model<S: Structure>(
             alpha[(j, i)] = if cos2 > 0.0 { rot.dot(lateral) / cos2 } else { 0.0 };
         }
     }
-    let arcs: Vec<f64> = map.iter().map(|m| m.arc).collect();
+    // Each station's share of its lifting surface's span: half the way to each neighbour on the
+    // same surface.
+    let same = |j: usize, k: usize| map[j].lifting == map[k].lifting;
     let width = (0..ns)
         .map(|j| {
-            let lo = if j > 0 { 0.5 * (arcs[j] - arcs[j - 1]) } else { 0.0 };
-            let hi = if j + 1 < ns { 0.5 * (arcs[j + 1] - arcs[j]) } else { 0.0 };
+            let lo = if j > 0 && same(j, j - 1) { 0.5 * (map[j].arc - map[j - 1].arc) } else { 0.0 };
+            let hi = if j + 1 < ns && same(j, j + 1) { 0.5 * (map[j + 1].arc - map[j].arc) } else { 0.0 };
             lo + hi
         })
         .collect();

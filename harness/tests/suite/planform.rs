@@ -184,8 +184,15 @@ fn swept_lift_slope(half: f64, sweep: f64, n_span: usize, n_chord: usize) -> f64
 ///   The same lattice (4 × 1 rings) gives it within 0.1 %.
 /// * Converged (96 × 16 panels per half), the 45° wing is within 3 % of Weber & Brebner's
 ///   measured slope (ARC R&M 2882, 1958, table 4B: CL 0.238 at 4.2°, 3.25 per rad).
-/// * Sweep lowers the slope: 0° > 30° > 45°. (The 0° and 30° figures against the
-///   Helmbold–DATCOM estimate are in docs/validation.md §2.2.)
+/// * Converged, the unswept wing is within 3 % of Tuck's lifting-surface solution for flat
+///   rectangular wings (E. O. Tuck, J. Austral. Math. Soc. Ser. B 35, 127–144, 1993), his fit
+///   CLα = 2π − (π/A)(ln A + 2.5620) + (1.404/A²)(ln A + 3.645): 3.957 per rad at A = 5.
+/// * Converged, the 30° wing is within 3 % of ESDU 70011 (lifting-surface carpets of CLα/A
+///   against βA and A tan Λ½; ESDU, 1970, Amendment I 1996), read through the public
+///   digitisation `finSubsonic.csv` of github.com/icl-rocketry/Flight-Simulator (commit
+///   9a8a379a): at taper 1 and βA = 5, CLα/A = 0.761 at A tan Λ½ = 2 and 0.686 at 4, linear in
+///   between to A tan 30° = 2.887: 3.639 per rad (its 0° value 5 × 0.791 = 3.955 is Tuck's).
+/// * Sweep lowers the slope: 0° > 30° > 45°.
 #[test]
 fn swept_wing_lift_slopes_match_published_values() {
     let bertin = swept_lift_slope(2.5, 45.0, 4, 1);
@@ -201,6 +208,15 @@ fn swept_wing_lift_slopes_match_published_values() {
         .collect();
     let measured = 0.238 / 4.2f64.to_radians();
     assert!((slopes[2] / measured - 1.0).abs() < 0.03, "45°: CLα {} vs measured {measured}", slopes[2]);
+    let a = 5.0_f64;
+    let pi = std::f64::consts::PI;
+    let tuck = 2.0 * pi - pi / a * (a.ln() + 2.5620) + 1.404 / (a * a) * (a.ln() + 3.645);
+    println!("Λ = 0°: Tuck's lifting surface {tuck:.4} per rad ({:+.2} %)", 100.0 * (slopes[0] / tuck - 1.0));
+    assert!((slopes[0] / tuck - 1.0).abs() < 0.03, "0°: CLα {} vs Tuck {tuck}", slopes[0]);
+    let x = a * 30f64.to_radians().tan();
+    let esdu = a * (0.761 + (x - 2.0) / 2.0 * (0.686 - 0.761));
+    println!("Λ = 30°: ESDU 70011 {esdu:.4} per rad ({:+.2} %)", 100.0 * (slopes[1] / esdu - 1.0));
+    assert!((slopes[1] / esdu - 1.0).abs() < 0.03, "30°: CLα {} vs ESDU 70011 {esdu}", slopes[1]);
     assert!(slopes[0] > slopes[1] && slopes[1] > slopes[2], "{slopes:?}");
 }
 
