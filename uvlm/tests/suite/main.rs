@@ -7,6 +7,7 @@ mod flow;
 mod gust;
 mod hinge;
 mod linear;
+mod linear_baseline;
 mod linear_gust;
 mod multi_surface;
 mod multi_surface_baseline;
