@@ -73,8 +73,14 @@
 //!   unknowns in the global numbering); [`Uvlm::n_surfaces`], [`Uvlm::surface`],
 //!   [`Uvlm::surfaces`], [`Uvlm::update_stations_of`], [`Uvlm::set_grid_of`],
 //!   [`Uvlm::hinge_moment_of`]. [`Uvlm::loads`] is then all surfaces' loads concatenated; the
-//!   one-surface calls (`update_stations`, `set_grid`, `hinge_moment`, `linearise`) return
+//!   one-surface calls (`update_stations`, `set_grid`, `hinge_moment`) return
 //!   [`UvlmError::SeveralSurfaces`].
+//! * The linearised UVLM (docs/uvlm.md §13): [`Uvlm::linearise`]`(&`[`LinearWake`]`)` →
+//!   [`LinearUvlm`], of one or several surfaces over the stacked numbering ([`SurfaceBlock`]:
+//!   each surface's rings, ring nodes, trailing-edge columns and nodes, load midpoints);
+//!   [`LinearUvlm::evaluate_surfaces`] (moved lattices, circulations held), the transfer
+//!   matrices [`LinearUvlm::normalwash_matrix`] / [`LinearUvlm::force_matrix`], the gust input
+//!   [`LinearUvlm::gust`] → [`LinearGust`], [`LinearUvlm::wake_node_derivatives`].
 //! * External flow ([`flow`]): [`FlowField`] (`velocity(x, t)`, batch `add_velocity_inplace`),
 //!   [`Uniform`], [`Flow`] (free stream + optional disturbance); attach a gust with
 //!   [`Uvlm::set_disturbance`]. Gusts ([`gust`]): [`OneMinusCosine`], [`SharpEdged`],

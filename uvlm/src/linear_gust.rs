@@ -72,6 +72,7 @@ impl LinearUvlm {
         fz.induce_all();
         fz.external(v);
         let n_mid = fz.mid.len();
+        debug_assert_eq!(n_mid, self.blocks.last().map_or(0, |b| b.midpoints.end));
         let midpoint_delays = (0..n_mid).map(|k| delay([fz.mid.x[k], fz.mid.y[k], fz.mid.z[k]])).collect();
         let nf = self.n_force();
         let mut force = DMatrix::zeros(nf, n_mid);

@@ -190,6 +190,7 @@ fn two_half_wings_linearise_to_one_surface() {
 /// parameters.
 struct WingTail {
     wing: Vec<SpanStation>,
+    tail: Vec<SpanStation>,
     lats: Vec<Lattice>,
     params: UvlmParams,
 }
@@ -217,7 +218,7 @@ fn wing_tail_at(rows: usize, te_segment_force: bool, alpha_deg: f64, h: f64) -> 
     params.images = vec![ImagePlane::through_origin([0.0, 1.0, 0.0])];
     params.n_wake_rows = rows;
     params.te_segment_force = te_segment_force;
-    WingTail { wing, lats, params }
+    WingTail { wing, tail, lats, params }
 }
 
 /// The linear model's lift (z force) of each surface per unit pitch of the wing about its
@@ -354,4 +355,65 @@ fn wing_and_tail_with(te_segment_force: bool) {
             }
         }
     }
+}
+
+/// The stacked numbering of a wing and a tail: each surface's block, the global trailing-edge
+/// rings, the reference state as `evaluate_surfaces` of the reference lattices (bit for bit: the
+/// same sets, points and sums), the blocks of the transfer and gust matrices; and the errors as
+/// values (an unknown surface, the one-surface `evaluate` on two, a wrong number or shape of
+/// lattices, a moving lattice of either surface).
+#[test]
+fn stacked_numbering_and_errors() {
+    let wt = wing_tail(6, true);
+    let mut u = Uvlm::with_surfaces(wt.lats.clone(), wt.params.clone()).unwrap();
+    let lin = u.linearise(&LinearWake::uniform(6, 0.25, false)).unwrap();
+    // Wing 8 × 4 rings, 9 × 5 nodes; tail 4 × 4 rings, 5 × 5 nodes; load segments per surface
+    // M·N + M·(N + 1) + N (the trailing-edge segments carry loads here).
+    let expect = [
+        SurfaceBlock { rings: 0..32, nodes: 0..45, te_columns: 0..8, te_nodes: 0..9, midpoints: 0..76 },
+        SurfaceBlock { rings: 32..48, nodes: 45..70, te_columns: 8..12, te_nodes: 9..14, midpoints: 76..116 },
+    ];
+    assert_eq!(lin.blocks(), &expect);
+    assert_eq!(lin.block(1).unwrap(), &expect[1]);
+    assert_eq!(lin.block(2).unwrap_err(), UvlmError::UnknownSurface { surface: 2, n_surfaces: 2 });
+    assert_eq!(expect[1].forces(), 135..210);
+    assert_eq!((lin.n_surfaces(), lin.n_rings(), lin.n_force(), lin.n_te_nodes()), (2, 48, 210, 14));
+    for (b, s) in lin.blocks().iter().zip(u.surfaces()) {
+        assert_eq!(b.rings, s.rings());
+    }
+    let te: Vec<usize> = (0..8).map(|j| 24 + j).chain((0..4).map(|j| 32 + 12 + j)).collect();
+    assert_eq!(lin.te_rings, te);
+    assert_eq!(lin.gamma0(), u.gamma());
+    let (r, f) = lin.evaluate_surfaces(lin.lattices()).unwrap();
+    assert_eq!((r, f), (lin.reference_residual.clone(), lin.reference_forces.clone()));
+    let s = C::new(0.1, 1.0);
+    assert_eq!(lin.normalwash_matrix(s).shape(), (48, 48));
+    assert_eq!(lin.force_matrix(s).shape(), (210, 48));
+    assert!(lin.row_normalwash.iter().chain(&lin.force_row).all(|m| m.ncols() == 12));
+    let g = lin.gust([0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]).unwrap();
+    assert_eq!((g.force.shape(), g.midpoint_delays.len(), g.normalwash.len()), ((210, 116), 116, 48));
+    // A tail midpoint loads the tail only.
+    assert!(g.force.view((0, 76), (135, 40)).iter().all(|x| *x == 0.0));
+    assert!(g.force.view((135, 76), (75, 40)).iter().any(|x| *x != 0.0));
+    let wd = lin.wake_node_derivatives();
+    assert_eq!((wd.residual.len(), wd.residual[0].shape(), wd.force[0].shape()), (6, (48, 42), (210, 42)));
+    // Errors.
+    let wing_lat = lin.lattice().clone();
+    assert_eq!(lin.evaluate(&wing_lat).unwrap_err(), UvlmError::SeveralSurfaces { call: "evaluate", n_surfaces: 2 });
+    assert_eq!(
+        lin.evaluate_surfaces(std::slice::from_ref(&wing_lat)).unwrap_err(),
+        UvlmError::LengthMismatch { what: "lattices", expected: 2, got: 1 }
+    );
+    assert_eq!(
+        lin.evaluate_surfaces(&[wing_lat.clone(), wing_lat]).unwrap_err(),
+        UvlmError::InSurface {
+            surface: 1,
+            source: Box::new(UvlmError::LengthMismatch { what: "lattice rings", expected: 16, got: 32 })
+        }
+    );
+    // The tail (the second surface) moving.
+    let vel = vec![StationVelocity { linear: [0.0, 0.0, 0.1].into(), ..Default::default() }; 5];
+    u.update_stations_of(1, &wt.tail, Some(&vel)).unwrap();
+    let moving = u.linearise(&LinearWake::uniform(6, 0.25, false)).unwrap_err();
+    assert_eq!(moving, UvlmError::InvalidParameter { field: "lattice velocity", value: 1.0 });
 }
