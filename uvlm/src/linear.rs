@@ -44,7 +44,8 @@
 //! [`LinearUvlm::te_rings`]). Every surface sheds its own frozen wake from its own trailing edge
 //! along the free stream, row `k` of every surface with the same delay `τ_k`; all bound rings and
 //! all wakes induce on all collocation and load points (a tail in the wing's wake). Where each
-//! surface sits: [`LinearUvlm::blocks`] ([`SurfaceBlock`]). One surface is bit for bit the
+//! surface sits: [`LinearUvlm::blocks`] ([`SurfaceBlock`]); [`LinearUvlm::move_lattices`] and
+//! [`LinearUvlm::evaluate_surfaces`] move and evaluate all surfaces. One surface is bit for bit the
 //! one-surface model (test `one_surface_linear_is_bitwise_main`).
 
 use nalgebra::{Complex, DMatrix};
@@ -53,6 +54,7 @@ use crate::error::{Result, UvlmError};
 use crate::lattice::Lattice;
 use crate::linear_stack::{Frozen, SurfaceBlock, stacked_loads};
 use crate::params::UvlmParams;
+use crate::station::{SpanStation, StationVelocity};
 use crate::wake::Wake;
 
 /// The frozen wake of the linear model: straight ring rows along the free stream from the
@@ -143,16 +145,16 @@ impl LinearUvlm {
         &self.lattices[0]
     }
     /// The reference lattices of all surfaces, in their numbering. To move them with a
-    /// structure whose stations are one flat list split into per-surface ranges, clone them
-    /// once and update each from its range, then evaluate all together:
+    /// structure whose stations are one flat list, surface after surface, clone them once,
+    /// move them all and evaluate them together (or update each lattice from its own range of
+    /// stations, [`Lattice::update_stations`]):
     ///
     /// ```text
     /// let mut lats = lin.lattices().to_vec();
-    /// for (lat, r) in lats.iter_mut().zip(&ranges) {
-    ///     lat.update_stations(&stations[r.clone()], Some(&velocities[r.clone()]))?;
-    /// }
+    /// lin.move_lattices(&mut lats, &stations, Some(&velocities))?;
     /// let (residual, forces) = lin.evaluate_surfaces(&lats)?;
     /// let of_k = &forces[lin.blocks()[k].forces()]; // surface k's nodal forces, its grid's order
+    /// let te: Vec<[f64; 3]> = lats.iter().flat_map(|l| l.trailing_edge_nodes()).copied().collect();
     /// ```
     pub fn lattices(&self) -> &[Lattice] {
         &self.lattices
@@ -211,6 +213,45 @@ impl LinearUvlm {
             return Err(UvlmError::SeveralSurfaces { call: "evaluate", n_surfaces: self.lattices.len() });
         }
         self.evaluate_surfaces(std::slice::from_ref(lattice))
+    }
+
+    /// Move `lattices` (the reference lattices, [`LinearUvlm::lattices`], or copies of them
+    /// moved before) to `stations` (with `velocities`; `None` = at rest): one flat list of every
+    /// surface's stations, surface after surface, surface k's being
+    /// [`SurfaceBlock::te_nodes`] (its `N_k + 1` stations; a station where two surfaces meet
+    /// comes once per surface). Then [`LinearUvlm::evaluate_surfaces`] evaluates them. Does not
+    /// allocate.
+    ///
+    /// # Errors
+    /// Another number of lattices than surfaces ([`UvlmError::LengthMismatch`] of
+    /// `"lattices"`), of stations or velocities than `Σ (N_k + 1)` (of `"stations"`,
+    /// `"station velocities"`), or a lattice's own error (in [`UvlmError::InSurface`] with
+    /// several surfaces); the lattices before the failing one are moved.
+    pub fn move_lattices(
+        &self,
+        lattices: &mut [Lattice],
+        stations: &[SpanStation],
+        velocities: Option<&[StationVelocity]>,
+    ) -> Result<()> {
+        let n_surfaces = self.lattices.len();
+        if lattices.len() != n_surfaces {
+            return Err(UvlmError::LengthMismatch { what: "lattices", expected: n_surfaces, got: lattices.len() });
+        }
+        let n = self.n_te_nodes();
+        if stations.len() != n {
+            return Err(UvlmError::LengthMismatch { what: "stations", expected: n, got: stations.len() });
+        }
+        if let Some(v) = velocities
+            && v.len() != n
+        {
+            return Err(UvlmError::LengthMismatch { what: "station velocities", expected: n, got: v.len() });
+        }
+        for (k, (lat, b)) in lattices.iter_mut().zip(&self.blocks).enumerate() {
+            let r = b.te_nodes.clone();
+            let moved = lat.update_stations(&stations[r.clone()], velocities.map(|v| &v[r]));
+            moved.map_err(|e| if n_surfaces == 1 { e } else { e.in_surface(k) })?;
+        }
+        Ok(())
     }
 
     /// [`LinearUvlm::evaluate`] for every surface at once: `lattices` are the reference lattices

@@ -38,7 +38,9 @@ pub struct SurfaceBlock {
     pub te_columns: Range<usize>,
     /// Its trailing-edge nodes (`N_k + 1`, [`Lattice::trailing_edge_nodes`] order), where its
     /// wake's node columns start: node `t` is column `3t + axis` of
-    /// [`WakeNodeDerivatives`](crate::WakeNodeDerivatives).
+    /// [`WakeNodeDerivatives`](crate::WakeNodeDerivatives). One per grid column, so also its
+    /// stations in a flat list of every surface's stations
+    /// ([`LinearUvlm::move_lattices`](crate::LinearUvlm::move_lattices)).
     pub te_nodes: Range<usize>,
     /// Its load segments' midpoints (columns of [`LinearGust::force`](crate::LinearGust::force),
     /// entries of its `midpoint_delays`).

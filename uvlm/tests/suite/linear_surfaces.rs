@@ -166,10 +166,10 @@ fn two_half_wings_linearise_to_one_surface() {
         let mut la = a.lattice().clone();
         la.update_stations(&st, Some(&vel)).unwrap();
         let (ra, fa) = a.evaluate(&la).unwrap();
+        // (b)'s stations: the left half's, then the right half's (the root station twice).
         let mut lb = b.lattices().to_vec();
-        for (l, r) in lb.iter_mut().zip([0..nh + 1, nh..2 * nh + 1]) {
-            l.update_stations(&st[r.clone()], Some(&vel[r])).unwrap();
-        }
+        let (st_b, vel_b) = ([&st[..=nh], &st[nh..]].concat(), [&vel[..=nh], &vel[nh..]].concat());
+        b.move_lattices(&mut lb, &st_b, Some(&vel_b)).unwrap();
         let (rb, fb) = b.evaluate_surfaces(&lb).unwrap();
         check(rel(&column(&ra), &(&pt * column(&rb))), 1e-10, "moved residual");
         check(rel(&column(&fa), &(&m.p * column(&fb))), 1e-10, "moved forces");
@@ -411,6 +411,21 @@ fn stacked_numbering_and_errors() {
             source: Box::new(UvlmError::LengthMismatch { what: "lattice rings", expected: 16, got: 32 })
         }
     );
+    let mut lats = lin.lattices().to_vec();
+    let both = [wt.wing.clone(), wt.tail.clone()].concat();
+    assert_eq!(
+        lin.move_lattices(&mut lats, &both[1..], None).unwrap_err(),
+        UvlmError::LengthMismatch { what: "stations", expected: 14, got: 13 }
+    );
+    assert_eq!(
+        lin.move_lattices(&mut lats, &both, Some(&[StationVelocity::default(); 9])).unwrap_err(),
+        UvlmError::LengthMismatch { what: "station velocities", expected: 14, got: 9 }
+    );
+    let mut bad = both.clone();
+    bad[11].chord = -1.0;
+    assert!(matches!(lin.move_lattices(&mut lats, &bad, None), Err(UvlmError::InSurface { surface: 1, .. })));
+    lin.move_lattices(&mut lats, &both, None).unwrap();
+    assert_eq!(lin.evaluate_surfaces(&lats).unwrap().1, lin.reference_forces);
     // The tail (the second surface) moving.
     let vel = vec![StationVelocity { linear: [0.0, 0.0, 0.1].into(), ..Default::default() }; 5];
     u.update_stations_of(1, &wt.tail, Some(&vel)).unwrap();
