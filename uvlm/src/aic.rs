@@ -85,7 +85,9 @@ pub(crate) struct BoundSystem {
 }
 
 impl BoundSystem {
-    /// Rebuild for the current geometry of one lattice. Does not allocate once warm.
+    /// Rebuild for the current geometry of one lattice (the tests' shorthand of
+    /// [`BoundSystem::build_surfaces`]).
+    #[cfg(test)]
     pub(crate) fn build(&mut self, lat: &Lattice, te: TrailingEdge, core: &CoreModel, planes: &[ImagePlane]) {
         self.build_surfaces(std::iter::once(lat), te, core, planes);
     }
@@ -354,6 +356,7 @@ pub(crate) enum WakePart {
 /// the bound core `te_core`, so that the two cancel exactly at steady state. `part` selects the
 /// whole wake or its near / far part (the two together hold the filaments of `All`, each with
 /// only the nodes it uses).
+#[cfg(test)] // the solver and the linear model append the wakes of all surfaces, then the images
 #[allow(clippy::too_many_arguments)] // the wake, its two cores, closure, images and the part
 pub(crate) fn build_known_wake(
     fil: &mut Filaments,

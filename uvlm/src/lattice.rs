@@ -478,6 +478,11 @@ impl Lattice {
     pub fn ring_nodes(&self) -> &[[f64; 3]] {
         &self.ring
     }
+    /// The trailing-edge row of the vortex-ring nodes (node row `M`, `N + 1` nodes), m: where
+    /// the wake is shed.
+    pub fn trailing_edge_nodes(&self) -> &[[f64; 3]] {
+        &self.ring[self.m * (self.n + 1)..]
+    }
     /// Vortex-ring node velocities, m/s.
     pub fn ring_velocities(&self) -> &[[f64; 3]] {
         &self.ring_vel

@@ -73,8 +73,14 @@
 //!   unknowns in the global numbering); [`Uvlm::n_surfaces`], [`Uvlm::surface`],
 //!   [`Uvlm::surfaces`], [`Uvlm::update_stations_of`], [`Uvlm::set_grid_of`],
 //!   [`Uvlm::hinge_moment_of`]. [`Uvlm::loads`] is then all surfaces' loads concatenated; the
-//!   one-surface calls (`update_stations`, `set_grid`, `hinge_moment`, `linearise`) return
+//!   one-surface calls (`update_stations`, `set_grid`, `hinge_moment`) return
 //!   [`UvlmError::SeveralSurfaces`].
+//! * The linearised UVLM (docs/uvlm.md §13): [`Uvlm::linearise`]`(&`[`LinearWake`]`)` →
+//!   [`LinearUvlm`], of one or several surfaces over the stacked numbering ([`SurfaceBlock`]:
+//!   each surface's rings, ring nodes, trailing-edge columns and nodes, load midpoints);
+//!   [`LinearUvlm::evaluate_surfaces`] (moved lattices, circulations held), the transfer
+//!   matrices [`LinearUvlm::normalwash_matrix`] / [`LinearUvlm::force_matrix`], the gust input
+//!   [`LinearUvlm::gust`] → [`LinearGust`], [`LinearUvlm::wake_node_derivatives`].
 //! * External flow ([`flow`]): [`FlowField`] (`velocity(x, t)`, batch `add_velocity_inplace`),
 //!   [`Uniform`], [`Flow`] (free stream + optional disturbance); attach a gust with
 //!   [`Uvlm::set_disturbance`]. Gusts ([`gust`]): [`OneMinusCosine`], [`SharpEdged`],
@@ -118,6 +124,9 @@ pub mod images;
 mod induce;
 pub mod lattice;
 mod linear;
+mod linear_gust;
+mod linear_stack;
+mod linearise;
 mod loads;
 mod params;
 pub mod samples;
@@ -128,6 +137,7 @@ mod stats;
 mod surface;
 pub mod treecode;
 mod wake;
+mod wake_nodes;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
 pub use error::{Result, UvlmError};
@@ -137,7 +147,9 @@ pub use gust::{Convection, OneMinusCosine, SharpEdged, Sinusoidal, VonKarman, Vo
 pub use images::ImagePlane;
 pub use induce::{Points, induced_velocity};
 pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
-pub use linear::{LinearGust, LinearUvlm, LinearWake, WakeNodeDerivatives, with_wake};
+pub use linear::{LinearUvlm, LinearWake, with_wake};
+pub use linear_gust::LinearGust;
+pub use linear_stack::SurfaceBlock;
 pub use loads::{Loads, lift_drag_of, lump_columns};
 pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 pub use solver::Uvlm;
@@ -146,3 +158,4 @@ pub use stats::Stats;
 pub use surface::Surface;
 pub use treecode::{TreeStats, Treecode};
 pub use wake::Wake;
+pub use wake_nodes::WakeNodeDerivatives;

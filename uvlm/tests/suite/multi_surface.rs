@@ -361,10 +361,13 @@ fn multi_surface_errors_are_values() {
         ("update_stations", u.update_stations(&st, None)),
         ("set_grid", u.set_grid(&[[0.0; 3]; 15], &[[0.0; 3]; 15])),
         ("hinge_moment", u.hinge_moment(0..=1).map(|_| ())),
-        ("linearise", u.linearise(&LinearWake::uniform(4, 0.5, false)).map(|_| ())),
     ] {
         assert_eq!(r.unwrap_err(), UvlmError::SeveralSurfaces { call, n_surfaces: 2 });
     }
+    // The linear model takes several surfaces; its one-surface call does not.
+    let lin = u.linearise(&LinearWake::uniform(4, 0.5, false)).unwrap();
+    let r = lin.evaluate(&lat(&st));
+    assert_eq!(r.unwrap_err(), UvlmError::SeveralSurfaces { call: "evaluate", n_surfaces: 2 });
     // A hinge moment of columns without a flap names the surface.
     u.update_stations_of(0, &st, None).unwrap();
     u.solve_steady().unwrap();
