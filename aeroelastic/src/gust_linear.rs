@@ -132,7 +132,6 @@ fn run<S: Structure>(
     let mut outputs = Outputs { lm: settings.loads.as_ref(), fold: settings.fold_joint, ls: Default::default() };
     let mut moved = MovedLattice::new(&la, &map, aero);
     let d = mode_derivatives(&model, &q, &red.phi, &mut moved, &mut outputs, &l0)?;
-    let te_start = moved.te_start();
     let yl = output_per_station_load(&model, &q, &mut outputs, &l0);
     let (nr, nf) = (la.n_rings(), la.n_force());
     let mut parts = Parts {
@@ -157,7 +156,7 @@ fn run<S: Structure>(
         drift_f: DMatrix::zeros(nf, 0),
     };
     if wake_motion {
-        add_wake_motion(&mut parts, &la, &d.xte, (v_inf, u), front, gust_dir, te_start);
+        add_wake_motion(&mut parts, &la, &d.xte, (v_inf, u), front, gust_dir);
     }
     parts.lift = lift_row(nf, v_inf).map(C64::from);
     let field = crate::gust::disturbance(spec, aero, &stations, 2.0 * settings.t_end, 0.0)?;
@@ -232,7 +231,7 @@ fn mode_derivatives<S: Structure>(
 ) -> Result<ModeDerivatives, String> {
     let (la, chord) = (moved.linear(), moved.chord());
     let (nr, nf, ns, nb) = (la.n_rings(), la.n_force(), l0.len(), phi.ncols());
-    let n_te = la.te_rings.len() + 1;
+    let n_te = la.n_te_nodes();
     let zeros = vec![0.0; model.n_dof()];
     let mut d = ModeDerivatives {
         rx: DMatrix::zeros(nr, nb),
@@ -311,7 +310,7 @@ fn output_per_station_load<S: Structure>(
 
 /// The wake's nodes in [`Parts`]: where the trailing edge was (the structure's motion, `xte`
 /// along each mode), drifted by the gust (direction `gust_dir`, front `front`) in the free
-/// stream `(v_inf, u)`; `te_start` is the first trailing-edge node of the lattice.
+/// stream `(v_inf, u)`; the trailing-edge nodes of every surface, stacked.
 fn add_wake_motion(
     parts: &mut Parts,
     la: &uvlm::LinearUvlm,
@@ -319,12 +318,11 @@ fn add_wake_motion(
     (v_inf, u): ([f64; 3], f64),
     front: [f64; 3],
     gust_dir: Vector3<f64>,
-    te_start: usize,
 ) {
     let (nr, nf) = (la.n_rings(), la.n_force());
-    let n_te = la.te_rings.len() + 1;
+    let n_te = la.n_te_nodes();
     let wd = la.wake_node_derivatives();
-    let te_nodes = &la.lattice().ring_nodes()[te_start..];
+    let te_nodes: Vec<[f64; 3]> = la.lattices().iter().flat_map(|l| l.trailing_edge_nodes().iter().copied()).collect();
     let vh = Vector3::from(v_inf) / u;
     let te_delay: Vec<f64> = te_nodes.iter().map(|x| vh.dot(&(Vector3::from(*x) - Vector3::from(front))) / u).collect();
     let n_rows = wd.residual.len();

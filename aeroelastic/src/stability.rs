@@ -783,7 +783,7 @@ pub(crate) fn load_maps<S: Structure>(
     origins: &[[f64; 3]],
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
     let (nf, ns) = (la.n_force(), map.len());
-    let ref_pos = la.lattice().ring_nodes().to_vec();
+    let ref_pos: Vec<[f64; 3]> = la.lattices().iter().flat_map(|l| l.ring_nodes().iter().copied()).collect();
     let mut cl = DMatrix::zeros(6 * ns, nf);
     let mut unit = vec![0.0; nf];
     for a in 0..nf {
@@ -818,11 +818,10 @@ pub(crate) fn load_maps<S: Structure>(
 /// terms of the stability reduction and of the linear gust response).
 pub(crate) struct MovedLattice<'a> {
     la: &'a uvlm::LinearUvlm,
-    lat: uvlm::Lattice,
+    /// The lattice of each surface.
+    lats: Vec<uvlm::Lattice>,
     map: &'a [StationMap],
     aero: &'a AeroSettings,
-    /// First trailing-edge node of the lattice.
-    te_start: usize,
     scratch: StationScratch,
 }
 
@@ -834,21 +833,19 @@ pub(crate) struct Moved {
     pub forces: Vec<f64>,
     /// The nodal forces lumped to station loads.
     pub loads: Vec<SectionLoad>,
-    /// Stacked trailing-edge node positions.
+    /// Stacked trailing-edge node positions, surface after surface.
     pub te: Vec<f64>,
 }
 
 impl<'a> MovedLattice<'a> {
     /// The lattice of `la` on the stations of `map`.
     pub(crate) fn new(la: &'a uvlm::LinearUvlm, map: &'a [StationMap], aero: &'a AeroSettings) -> Self {
-        let lat = la.lattice().clone();
-        let te_start = lat.n_chordwise() * (lat.n_spanwise() + 1);
-        Self { la, lat, map, aero, te_start, scratch: StationScratch::default() }
+        Self { la, lats: la.lattices().to_vec(), map, aero, scratch: StationScratch::default() }
     }
 
-    /// First trailing-edge node of the lattice.
-    pub(crate) fn te_start(&self) -> usize {
-        self.te_start
+    /// Number of trailing-edge nodes of every surface.
+    pub(crate) fn n_te_nodes(&self) -> usize {
+        self.la.n_te_nodes()
     }
 
     /// The linear UVLM.
@@ -872,13 +869,17 @@ impl<'a> MovedLattice<'a> {
     ) -> Result<Moved, String> {
         let (mut st, mut ve) = (Vec::new(), Vec::new());
         stations_at(model, q, v, self.map, self.aero, None, &mut self.scratch, &mut st, &mut ve);
-        self.lat
-            .update_stations(&st, if with_vel { Some(&ve) } else { None })
-            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        let (residual, forces) = self.la.evaluate(&self.lat).map_err(|e| e.to_string())?;
+        let vel = if with_vel { Some(ve.as_slice()) } else { None };
+        self.la.move_lattices(&mut self.lats, &st, vel).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        let (residual, forces) = match self.lats.as_slice() {
+            [one] => self.la.evaluate(one),
+            all => self.la.evaluate_surfaces(all),
+        }
+        .map_err(|e| e.to_string())?;
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
-        let loads = lump(self.map, self.aero, self.lat.ring_nodes(), &org, &forces);
-        let te = self.lat.ring_nodes()[self.te_start..].iter().flatten().copied().collect();
+        let positions: Vec<[f64; 3]> = self.lats.iter().flat_map(|l| l.ring_nodes().iter().copied()).collect();
+        let loads = lump(self.map, self.aero, &positions, &org, &forces);
+        let te = self.lats.iter().flat_map(|l| l.trailing_edge_nodes().iter().flatten().copied()).collect();
         Ok(Moved { residual, forces, loads, te })
     }
 }
@@ -905,7 +906,7 @@ fn geometric_terms<S: Structure>(
     let (nr, nb) = (moved.la.n_rings(), phi.ncols());
     let zeros = vec![0.0; model.n_dof()];
     let span = moved.aero.chord_extremes().1.max(1e-3);
-    let n_te = 3 * (moved.lat.n_spanwise() + 1);
+    let n_te = 3 * moved.n_te_nodes();
     let mut g = Geometric {
         rx: DMatrix::zeros(nr, nb),
         rv: DMatrix::zeros(nr, nb),
