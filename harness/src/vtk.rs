@@ -335,7 +335,9 @@ fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
 }
 
 /// Pressure jump across each bound ring of every lifting surface, Pa, surface after surface
-/// (see [`surface_pressure_jump`]). Zero before the first solve.
+/// (positive: the ring's normal side is pushed): the ring's share of the nodal loads of the last
+/// solve on its corners, along its normal, over its area; a smoothed panel pressure, not a
+/// separate solve. Zero before the first solve.
 pub fn pressure_jump(uv: &uvlm::Uvlm) -> Vec<f64> {
     uv.surfaces().iter().flat_map(|su| surface_pressure_jump(su.lattice(), su.loads())).collect()
 }
