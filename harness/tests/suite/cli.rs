@@ -1,12 +1,9 @@
 //! The binary's behaviour on bad input: one clear line naming the problem, a non-zero exit
 //! code, never a panic.
 
+use crate::common::root;
 use std::path::PathBuf;
 use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn harness(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_harness")).args(args).current_dir(root()).output().expect("binary runs")

@@ -3,15 +3,11 @@
 //! (`Uvlm::hinge_moment` on the equilibrium's lattice), a deflection schedule reaches the time
 //! march and its CSV, and bad input exits 2 naming the field.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
+use crate::common::root;
 use harness::case::{CaseFile, Formulation, Override, RunSpec};
 use harness::statics::{StaticPoint, run_static};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// The paper's wing with `set` applied.
 fn wing(set: &[&str]) -> RunSpec {

@@ -24,14 +24,9 @@
 //! ones: `τ_D = π²/4` without bending coupling (β = 0, the straight wing's Eq. 4.55) and
 //! `β_D = −6.3297` for a torsionally rigid wing (τ = 0).
 
-use std::path::PathBuf;
-
+use crate::common::root;
 use harness::case::{CaseFile, Formulation, Override};
 use harness::stability::{StabilityOutput, run_stability};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// `exp(A)` of a 3 × 3 matrix: Taylor series (30 terms) after scaling to a norm ≤ ½, then
 /// squaring back.

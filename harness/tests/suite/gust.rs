@@ -5,18 +5,10 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use harness::case::{CaseFile, Formulation, Override};
+use crate::common::{case, root};
+use harness::case::Formulation;
 use harness::gust::{HingeState, gust_history, peak};
 use rayon::prelude::*;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
-    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
-    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
-}
 
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))

@@ -1,12 +1,9 @@
 //! Honest answers: the binary refuses what it cannot do faithfully (a gate window it did not
 //! simulate, a t_end it cannot reach, ambiguous or unsafe input) instead of reporting success.
 
+use crate::common::root;
 use std::path::PathBuf;
 use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn harness(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_harness")).args(args).current_dir(root()).output().expect("binary runs")

@@ -4,6 +4,7 @@
 mod aero;
 mod browser;
 mod cli;
+mod common;
 mod control_surfaces;
 mod divergence_swept;
 mod external;

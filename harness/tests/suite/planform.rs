@@ -2,17 +2,13 @@
 //! streamwise sections on swept bodies, against lifting-line theory and published swept-wing
 //! lift slopes; a swept, tapered flexible wing in both formulations; bad planforms named.
 
-use harness::case::{CaseFile, Formulation, RunSpec};
+use harness::case::{Formulation, RunSpec};
 use harness::statics::run_static;
 use serde_json::{Value, json};
 
 /// Write `v` to a fresh file in this test's folder and expand it.
 fn spec(v: &Value, tag: &str) -> Result<RunSpec, String> {
-    let dir = std::env::temp_dir().join(format!("harness-planform-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(format!("{tag}.json"));
-    std::fs::write(&p, v.to_string()).unwrap();
-    CaseFile::read(&p).map_err(|e| e.to_string())?.expand(&[]).map_err(|e| e.to_string()).map(|mut v| v.remove(0))
+    crate::common::json_spec(v, "planform", tag)
 }
 
 /// A stiff half-wing along +X from a mirror plane at its root, the flow along −Y at 1 m/s,

@@ -5,12 +5,9 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
+use crate::common::root;
 use harness::case::{CaseFile, Formulation, Override, RunSpec};
 use harness::statics::run_static;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn expand(path: &Path, set: &[String]) -> Result<RunSpec, String> {
     let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();

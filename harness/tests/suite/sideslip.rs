@@ -2,21 +2,12 @@
 //! symmetry of a symmetric wing, the sideslip sweep's continuation to large folds in both
 //! formulations, and bad input named.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use harness::case::{CaseFile, Formulation, Override};
+use crate::common::{case, root};
+use harness::case::Formulation;
 use harness::statics::run_static;
 use nalgebra::{Matrix3, Vector3};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
-    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
-    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
-}
 
 /// Positive sideslip is wind from the right (starboard, +X): a stream along −Y becomes
 /// −V (sin β, cos β, 0), to rounding; zero sideslip leaves the stream bit for bit.

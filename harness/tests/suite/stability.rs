@@ -3,21 +3,12 @@
 //! 3-D lattice's departure from it, the Goland wing against SHARPy's linear UVLM, the paper's
 //! wing about its equilibria, and bad stability input.
 
-use std::path::PathBuf;
 use std::process::Command;
 
-use harness::case::{CaseFile, Formulation, Override};
+use crate::common::{case, root};
+use harness::case::Formulation;
 use harness::stability::{StabilityOutput, run_stability};
 use rayon::prelude::*;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
-    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
-    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
-}
 
 fn both(name: &str, set: &[&str]) -> (StabilityOutput, StabilityOutput) {
     let spec = case(name, set);

@@ -1,21 +1,12 @@
 //! Static aeroelastic equilibria and the wing loads: the two formulations agree, a damped time
 //! march settles on the static answer, the free body balances, and bad static input is named.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use harness::case::{CaseFile, Formulation, Override};
+use crate::common::{case, root};
+use harness::case::Formulation;
 use harness::scene::run_formulation;
 use harness::statics::run_static;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn case(name: &str, set: &[&str]) -> harness::case::RunSpec {
-    let ov: Vec<Override> = set.iter().map(|s| s.parse().unwrap()).collect();
-    CaseFile::read(&root().join("cases").join(name)).unwrap().expand(&ov).unwrap().remove(0)
-}
 
 /// ANCF and GEBF reach one equilibrium: coast angle within 0.2°, root bending moment within
 /// 0.5 % (of the larger of the point's value and 5 % of the sweep's largest, so that a moment

@@ -8,12 +8,8 @@
 //! `geometricallyExactBeamCurvedTest.py` (Gerstmayr). The bend is Bathe and Bolourchi (1979),
 //! IJNME 14:961–986.
 
-use std::path::PathBuf;
+use crate::common::root;
 use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// Both formulations' tips within 0.5 % of the published tip's distance from the root at the
 /// three loads, with the literature's eight elements (eight one-element bodies welded by locked

@@ -8,13 +8,10 @@
 //! The counts are small here; `HARNESS_KILLS=50 HARNESS_PAIRS=100 cargo test --release -p harness
 //! --test suite streamed -- --nocapture` runs the larger campaign and prints its figures.
 
+use crate::common::root;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn spawn(args: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_harness"))

@@ -3,17 +3,13 @@
 //! image; a tail in a wing's downwash against the far-field estimate; a body on no surface
 //! carries no aerodynamics; both formulations and the time march; bad surfaces named.
 
-use harness::case::{CaseFile, Formulation, RunSpec};
+use harness::case::{Formulation, RunSpec};
 use harness::statics::{StaticPoint, run_static};
 use serde_json::{Value, json};
 
 /// Write `v` to a fresh file in this test's folder and expand it.
 fn spec(v: &Value, tag: &str) -> Result<RunSpec, String> {
-    let dir = std::env::temp_dir().join(format!("harness-surfaces-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(format!("{tag}.json"));
-    std::fs::write(&p, v.to_string()).unwrap();
-    CaseFile::read(&p).map_err(|e| e.to_string())?.expand(&[]).map_err(|e| e.to_string()).map(|mut v| v.remove(0))
+    crate::common::json_spec(v, "surfaces", tag)
 }
 
 /// A clamped body `name` from `start` along `x_axis` (chord towards +Y), `length` long, with a

@@ -1,12 +1,9 @@
 //! `harness run --vtk`: ParaView files of the beams, the lattice and the wake, with `.pvd` time
 //! series, checked against the run's CSV.
 
-use std::path::{Path, PathBuf};
+use crate::common::root;
+use std::path::Path;
 use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 fn run(case: &str, t_end: &str, out: &Path, extra: &[&str]) {
     let o = Command::new(env!("CARGO_BIN_EXE_harness"))
