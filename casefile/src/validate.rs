@@ -420,11 +420,16 @@ fn check_aero_caps(a: &AeroSettings) -> Result<(), String> {
             return Err(format!("{field}: {v} is more than the limit of {cap}"));
         }
     }
-    if let Some(i) = a.panels_per_body.iter().position(|&p| p > MAX_PANELS_PER_BODY) {
-        return Err(format!(
-            "aero.panels_per_body[{i}]: {} is more than the limit of {MAX_PANELS_PER_BODY}",
-            a.panels_per_body[i]
-        ));
+    let panels = |field: &str, list: &[usize]| match list.iter().position(|&p| p > MAX_PANELS_PER_BODY) {
+        Some(i) => Err(format!("{field}[{i}]: {} is more than the limit of {MAX_PANELS_PER_BODY}", list[i])),
+        None => Ok(()),
+    };
+    panels("aero.panels_per_body", &a.panels_per_body)?;
+    for (k, s) in a.surfaces.iter().enumerate() {
+        panels(&format!("aero.surfaces[{k}].panels_per_body"), &s.panels_per_body)?;
+        if let Some(n) = s.n_chordwise.filter(|&n| n > MAX_CHORDWISE) {
+            return Err(format!("aero.surfaces[{k}].n_chordwise: {n} is more than the limit of {MAX_CHORDWISE}"));
+        }
     }
     Ok(())
 }

@@ -263,6 +263,12 @@ fn bad_surfaces_are_named() {
         "aero.surfaces[0].bodies[1]",
     );
     bad(&|v| v["aero"]["surfaces"] = json!([]), "aero.chord");
+    // Absurd sizes are refused before anything is laid out.
+    bad(
+        &|v| v["aero"]["surfaces"][1]["panels_per_body"] = json!([1_000_000_000]),
+        "aero.surfaces[1].panels_per_body[0]",
+    );
+    bad(&|v| v["aero"]["surfaces"][1]["n_chordwise"] = json!(100_000_000), "aero.surfaces[1].n_chordwise");
     // A tail root 5 mm from the wing's root: closer than a panel, not shared.
     bad(&|v| v["bodies"][1]["start"] = json!([0.005, 0.0, 0.0]), "aero.surfaces[1].bodies[0]");
 }
