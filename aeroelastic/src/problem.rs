@@ -363,15 +363,25 @@ pub enum Joint {
         /// Body name.
         body: String,
     },
+    /// No constraint: the body (the root of a free-flying chain, which has no parent) moves
+    /// with six rigid-body degrees of freedom relative to the ground.
+    Free {
+        /// Optional joint name.
+        #[cfg_attr(feature = "serde", serde(default))]
+        name: Option<String>,
+        /// Body name.
+        body: String,
+    },
 }
 
 impl Joint {
     /// The joint's name, if any.
     pub fn name(&self) -> Option<&str> {
         match self {
-            Joint::GroundHinge { name, .. } | Joint::FlaredHinge { name, .. } | Joint::Clamp { name, .. } => {
-                name.as_deref()
-            }
+            Joint::GroundHinge { name, .. }
+            | Joint::FlaredHinge { name, .. }
+            | Joint::Clamp { name, .. }
+            | Joint::Free { name, .. } => name.as_deref(),
         }
     }
 }
@@ -909,12 +919,13 @@ impl Problem {
                 Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
                     let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
                     if *locked {
-                        scene::JointSpec::LockedHinge { parent, child, beta }
+                        scene::JointSpec::LockedHinge { parent, child, beta, fold: 0.0 }
                     } else {
                         scene::JointSpec::FlaredHinge { parent, child, beta }
                     }
                 }
                 Joint::Clamp { body, .. } => scene::JointSpec::Clamp { body: idx(body) },
+                Joint::Free { body, .. } => scene::JointSpec::Free { body: idx(body) },
             })
             .collect();
         let forces = self
@@ -933,7 +944,7 @@ impl Problem {
                         rest: s.rest_deg.to_radians(),
                     })
                 }
-                Joint::Clamp { .. } => None,
+                Joint::Clamp { .. } | Joint::Free { .. } => None,
             })
             .collect();
         let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);

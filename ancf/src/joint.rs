@@ -64,6 +64,8 @@ pub(crate) enum Joint {
         r0: Vector3<f64>,
         frame0: Matrix3<f64>,
     },
+    /// A free root: no rows.
+    Free,
 }
 
 /// 3-vector block `b` (0 r, 1 r_x, 2 r_y, 3 r_z) of node `node` of `body`.
@@ -84,20 +86,30 @@ impl Joint {
                 let axis = axis.normalize();
                 Joint::Ground { body, axis, alpha: b.node_frame(0).transpose() * axis, r0: b.spec.start }
             }
-            JointSpec::FlaredHinge { parent, child, beta } | JointSpec::LockedHinge { parent, child, beta } => {
+            JointSpec::FlaredHinge { parent, child, beta } | JointSpec::LockedHinge { parent, child, beta, .. } => {
                 // the parent's end and the child's start section frames (twisted, docs/ancf.md §5)
                 let (bp, bc) = (&bodies[parent], &bodies[child]);
                 let (fp, fc) = (bp.node_frame(bp.n_nodes - 1), bc.node_frame(0));
                 let alpha_p = Vector3::new(beta.sin(), beta.cos(), 0.0);
                 let alpha_c = fc.transpose() * (fp * alpha_p);
-                let lock = matches!(spec, JointSpec::LockedHinge { .. })
-                    .then(|| [fc.transpose() * (fp * Vector3::y()), fc.transpose() * (fp * Vector3::z())]);
+                // Locked at fold θ: the relative pose F_Pᵀ F_C = R_rel rel0 with R_rel the turn
+                // by θ about −a (parent's end-section components), so the parent's y and z
+                // are, in the child's section, (R_rel rel0)ᵀ y and (R_rel rel0)ᵀ z.
+                let lock = match *spec {
+                    JointSpec::LockedHinge { fold, .. } => {
+                        let turn = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(-alpha_p), fold);
+                        let rel = turn.matrix() * (fp.transpose() * fc);
+                        Some([rel.transpose() * Vector3::y(), rel.transpose() * Vector3::z()])
+                    }
+                    _ => None,
+                };
                 Joint::Flared { parent, child, alpha_p, alpha_c, rel0: fp.transpose() * fc, lock }
             }
             JointSpec::Clamp { body } => {
                 let b = &bodies[body];
                 Joint::Clamp { body, r0: b.spec.start, frame0: b.node_frame(0) }
             }
+            JointSpec::Free { .. } => Joint::Free,
         }
     }
 
@@ -158,6 +170,7 @@ impl Joint {
                     }
                 }
             }
+            Joint::Free => {}
         }
         rows
     }
@@ -185,6 +198,7 @@ impl Joint {
                 let f = section_frame(&node_vector(b, q, 0, 2), &node_vector(b, q, 0, 3));
                 ((node_vector(b, q, 0, 0) - r0).norm(), rotation_angle(&(f * frame0.transpose())))
             }
+            Joint::Free => (0.0, 0.0),
         }
     }
 }

@@ -503,6 +503,47 @@ impl Model {
         e
     }
 
+    /// Linear momentum and angular momentum about the global origin (docs/ancf.md §13).
+    ///
+    /// With the constant mass matrix `M` and the kinetic energy `½ q̇ᵀ M q̇`, they are the
+    /// momentum map of the rigid motions: a translation `u` moves every node's position by `u`
+    /// and no slope, a rotation `ω` turns every nodal vector `e` (position and slopes) into
+    /// `ω × e`, and the field `r = S(x) e` follows exactly because it is linear in the nodal
+    /// vectors. So `p = Σ_nodes (M q̇)_r` and `L = Σ_vectors e × (M q̇)_e`, element by element
+    /// and over the point masses: the momenta the discrete equations of motion balance.
+    pub fn momentum(&self, q: &[f64], v: &[f64]) -> formulation::Momentum {
+        let mut s = scratch(&self.sensor);
+        let (qf, vf) = &mut *s;
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, &mut vf[..self.n_full]);
+        let mut out = formulation::Momentum::default();
+        let mut mv = [0.0; ELEMENT_DOF];
+        let mut add = |first: usize, mv: &[f64; ELEMENT_DOF]| {
+            for b in 0..ELEMENT_DOF / 3 {
+                let m = Vector3::new(mv[3 * b], mv[3 * b + 1], mv[3 * b + 2]);
+                let i = first + 3 * b;
+                out.angular += Vector3::new(qf[i], qf[i + 1], qf[i + 2]).cross(&m);
+                if b % 4 == 0 {
+                    out.linear += m;
+                }
+            }
+        };
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let first = b.offset + NODE_DOF * k;
+                mv.iter_mut().for_each(|x| *x = 0.0);
+                b.element.add_mass_times(1.0, &vf[first..first + ELEMENT_DOF], &mut mv);
+                add(first, &mv);
+            }
+        }
+        for p in &self.point_inertia {
+            mv.iter_mut().for_each(|x| *x = 0.0);
+            p.add_mass_times(1.0, &vf[p.first..p.first + ELEMENT_DOF], &mut mv);
+            add(p.first, &mv);
+        }
+        out
+    }
+
     /// Power dissipated by the hinge dampers `Σ c θ̇²`, W (≥ 0), at coordinates `q` and
     /// velocities `v` of the model's form. Its time integral is the work the dampers took out
     /// of `T + U + V + spring energy`.
@@ -1220,7 +1261,7 @@ fn joint_ties(joints: &[Joint], bodies: &[Body], factor: f64) -> Vec<NodeTie> {
                 tie(*parent, bodies[*parent].n_nodes - 1, free && on_x(alpha_p));
                 tie(*child, 0, free && on_x(alpha_c));
             }
-            Joint::Clamp { .. } => {}
+            Joint::Clamp { .. } | Joint::Free => {}
         }
     }
     ties

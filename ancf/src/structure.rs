@@ -1,6 +1,6 @@
 //! [`formulation::Structure`] for the ANCF model: what the analyses need from it.
 
-use formulation::{BeamGeometry, Energies, LoadError, SectionLoad, Structure};
+use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, Structure};
 use genalpha::{GenAlpha, IntegratorParams, State};
 use nalgebra::{Matrix3, Vector3};
 
@@ -23,6 +23,9 @@ impl Structure for Model {
     }
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
         Model::energies(self, q, v)
+    }
+    fn momentum(&self, q: &[f64], v: &[f64]) -> Momentum {
+        Model::momentum(self, q, v)
     }
     fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
         Model::dissipation_power(self, q, v)

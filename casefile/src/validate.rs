@@ -192,7 +192,7 @@ impl Case {
                         return Err(format!("joints[{i}].flare_deg: {flare_deg} is not in [-90, 90]"));
                     }
                 }
-                Joint::Clamp { body: b, .. } => body(format!("joints[{i}].body"), b)?,
+                Joint::Clamp { body: b, .. } | Joint::Free { body: b, .. } => body(format!("joints[{i}].body"), b)?,
             }
         }
         if let Some(n) = &self.fold_joint {

@@ -13,7 +13,8 @@
 //! * the integrator the formulation runs best with ([`Structure::integrator`]) and its state at
 //!   rest ([`Structure::initial_state`]);
 //! * the sensors of a time history: tip, fold angle, [`Energies`], the dampers' dissipation power
-//!   $\sum c\,\dot\theta^2$ and the position-level constraint residual;
+//!   $\sum c\,\dot\theta^2$, the position-level constraint residual and the [`Momentum`] of a
+//!   free-flying model;
 //! * the aerodynamic seam: the pose of a section at (body, arclength `s`) and the section loads
 //!   ([`SectionLoad`]), set through [`Structure::set_section_loads`], which checks every load
 //!   the same way for every formulation and returns a [`LoadError`] naming the station;
@@ -25,9 +26,11 @@
 mod energies;
 mod geometry;
 mod load;
+mod momentum;
 mod structure;
 
 pub use energies::Energies;
 pub use geometry::BeamGeometry;
 pub use load::{LoadError, SectionLoad, check_section_loads};
+pub use momentum::Momentum;
 pub use structure::Structure;

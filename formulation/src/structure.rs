@@ -3,7 +3,7 @@
 use genalpha::{ConstrainedSystem, GenAlpha, IntegratorParams, LinearSolver, State};
 use nalgebra::{Matrix3, Vector3};
 
-use crate::{BeamGeometry, Energies, LoadError, SectionLoad, check_section_loads};
+use crate::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, check_section_loads};
 
 /// What the analyses need from a structural model beyond the integrator's trait: the integrator
 /// it runs with, its state at rest, its sensors, the pose of a section and the section loads of
@@ -20,7 +20,7 @@ use crate::{BeamGeometry, Energies, LoadError, SectionLoad, check_section_loads}
 /// loads' moments about z (their forces are left out to keep the example short).
 ///
 /// ```
-/// use formulation::{BeamGeometry, Energies, LoadError, SectionLoad, Structure};
+/// use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, Structure};
 /// use genalpha::{ConstrainedSystem, DenseLu, GenAlpha, IntegratorParams, MatView, State};
 /// use nalgebra::{Matrix3, Rotation3, Vector3};
 ///
@@ -53,6 +53,12 @@ use crate::{BeamGeometry, Energies, LoadError, SectionLoad, check_section_loads}
 ///     fn fold(&self, _q: &[f64], _joint: usize) -> f64 { f64::NAN }
 ///     fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
 ///         Energies { kinetic: 0.5 * self.inertia() * v[0] * v[0], spring: 0.5 * self.k * q[0] * q[0], ..Default::default() }
+///     }
+///     fn momentum(&self, q: &[f64], v: &[f64]) -> Momentum {
+///         // The centre moves on a circle; about the pivot, L = J θ̇ (J about the rod's end).
+///         let centre = self.frame(q) * Vector3::new(0.5 * self.length, 0.0, 0.0);
+///         let linear = Vector3::z().cross(&centre) * (self.mass * v[0]);
+///         Momentum { linear, angular: Vector3::new(0.0, 0.0, self.inertia() * v[0]) }
 ///     }
 ///     fn dissipation_power(&self, _q: &[f64], _v: &[f64]) -> f64 { 0.0 }
 ///     fn has_force_elements(&self) -> bool { true }
@@ -106,6 +112,10 @@ pub trait Structure: ConstrainedSystem {
     fn fold(&self, q: &[f64], joint: usize) -> f64;
     /// Energies at coordinates `q` and velocities `v`.
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
+    /// Linear momentum and angular momentum about the global origin at coordinates `q` and
+    /// velocities `v`, evaluated with the model's own mass distribution (the quadrature of its
+    /// kinetic energy), so that they are the momenta its equations of motion balance.
+    fn momentum(&self, q: &[f64], v: &[f64]) -> Momentum;
     /// Power dissipated by the force elements' dampers, W (≥ 0).
     fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64;
     /// Whether the model has force elements (the spring and dissipated-work columns).

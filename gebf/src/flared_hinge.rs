@@ -38,6 +38,9 @@ pub(crate) struct FlaredHinge {
     pub a_c: V3,
     /// Reference relative rotation C^{BnAc}_0.
     pub rel0: M3,
+    /// Relative rotation C^{BnAc} a locked hinge is welded at: `R_rel rel0`, `R_rel` the turn by
+    /// the lock's fold about `−a_B` (`rel0` when locked at the reference fold).
+    pub rel_lock: M3,
 }
 
 /// Kinematic quantities of the joint at a configuration.
@@ -72,13 +75,17 @@ fn add_rows2(j: &mut MatView<'_>, n: &[V3], i0: usize, j0: usize, m: &M3) {
 }
 
 impl FlaredHinge {
-    pub fn new(parent: usize, child: usize, beta: f64, locked: bool, bp: &Body, bc: &Body) -> Self {
+    /// A flared hinge of flare `beta` (rad), free, or locked at fold `locked` (rad).
+    pub fn new(parent: usize, child: usize, beta: f64, locked: Option<f64>, bp: &Body, bc: &Body) -> Self {
         let a_b = V3::new(beta.sin(), beta.cos(), 0.0);
         let z = V3::z();
         let n = [z, a_b.cross(&z), a_b];
         // Reference: C^{GBn}_0 = C^{GAp}_0 C^{ApBn}(psi_n0), C^{GAp}_0 itself untwisted (psi_n0 = 0).
         let rel0 = bp.section_frame0(bp.n_nodes() - 1).transpose() * bc.frame;
-        Self { parent, child, a_b, n, n_ang: if locked { 3 } else { 2 }, a_c: rel0.transpose() * a_b, rel0 }
+        let turn = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(-a_b), locked.unwrap_or(0.0));
+        let rel_lock = turn.matrix() * rel0;
+        let n_ang = if locked.is_some() { 3 } else { 2 };
+        Self { parent, child, a_b, n, n_ang, a_c: rel0.transpose() * a_b, rel0, rel_lock }
     }
 
     /// Number of velocity rows: 5, or 6 when locked.
@@ -242,8 +249,8 @@ impl FlaredHinge {
         let fc = bc.frame_coord();
         q[fc..fc + 3].copy_from_slice(target.as_slice());
         let new = if self.n_ang == 3 {
-            // Locked: the child frame is exactly its reference pose relative to B_n.
-            Some(Quaternion::from_rotation_matrix(&(k.cp * k.cn.transpose() * self.rel0)))
+            // Locked: the child frame is exactly its welded pose relative to B_n.
+            Some(Quaternion::from_rotation_matrix(&(k.cp * k.cn.transpose() * self.rel_lock)))
         } else if s > 0.0 {
             let angle = s.atan2(a_child.dot(&a_parent));
             Some(Quaternion::from_rotation_vector(&(axis * (angle / s))).mul(&chi_c).normalized())

@@ -16,6 +16,8 @@ pub(crate) enum Joint {
     Ground(GroundHinge),
     Flared(FlaredHinge),
     Clamp(Clamp),
+    /// A free root: no rows.
+    Free,
 }
 
 impl Joint {
@@ -24,6 +26,7 @@ impl Joint {
             Joint::Ground(_) => GroundHinge::N_ROWS,
             Joint::Flared(j) => j.n_rows(),
             Joint::Clamp(_) => Clamp::N_ROWS,
+            Joint::Free => 0,
         }
     }
 
@@ -33,6 +36,7 @@ impl Joint {
             Joint::Ground(j) => j.psi(&bodies[j.body], v, out),
             Joint::Flared(j) => j.psi(bodies, q, v, out),
             Joint::Clamp(j) => j.psi(&bodies[j.body], v, out),
+            Joint::Free => {}
         }
     }
 
@@ -41,6 +45,7 @@ impl Joint {
             Joint::Ground(j) => j.add_b(&bodies[j.body], m, row0),
             Joint::Flared(j) => j.add_b(bodies, q, m, row0),
             Joint::Clamp(j) => j.add_b(&bodies[j.body], m, row0),
+            Joint::Free => {}
         }
     }
 
@@ -62,6 +67,7 @@ impl Joint {
             Joint::Ground(j) => j.violation(&bodies[j.body], q),
             Joint::Flared(j) => j.violation(bodies, q),
             Joint::Clamp(j) => j.violation(&bodies[j.body], q),
+            Joint::Free => (0.0, 0.0),
         }
     }
 
@@ -83,6 +89,7 @@ impl Joint {
                 q[fc..fc + 3].copy_from_slice(b.start.as_slice());
                 b.quat0.write_to(&mut q[fc + 3..fc + 7]);
             }
+            Joint::Free => {}
         }
     }
 }

@@ -84,6 +84,7 @@ mod joint;
 mod loads;
 mod modal;
 mod model;
+mod momentum;
 mod options;
 pub mod quaternion;
 mod rigid;

@@ -104,10 +104,14 @@ impl Model {
             .map(|spec| match *spec {
                 JointSpec::GroundHinge { body, ref axis } => Joint::Ground(GroundHinge::new(body, axis, &bs[body])),
                 JointSpec::Clamp { body } => Joint::Clamp(Clamp { body }),
+                JointSpec::Free { .. } => Joint::Free,
                 JointSpec::FlaredHinge { parent: p, child: c, beta }
-                | JointSpec::LockedHinge { parent: p, child: c, beta } => {
+                | JointSpec::LockedHinge { parent: p, child: c, beta, .. } => {
                     parent[c] = Some(p);
-                    let locked = matches!(spec, JointSpec::LockedHinge { .. });
+                    let locked = match *spec {
+                        JointSpec::LockedHinge { fold, .. } => Some(fold),
+                        _ => None,
+                    };
                     Joint::Flared(FlaredHinge::new(p, c, beta, locked, &bs[p], &bs[c]))
                 }
             })
@@ -117,7 +121,7 @@ impl Model {
         let joint_body: Vec<usize> = joints
             .iter()
             .map(|s| match s {
-                JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } => *body,
+                JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } | JointSpec::Free { body } => *body,
                 JointSpec::FlaredHinge { child, .. } | JointSpec::LockedHinge { child, .. } => *child,
             })
             .collect();

@@ -1,7 +1,7 @@
 //! [`formulation::Structure`] for the GEBF model: what the analyses need from it, with the
 //! section interpolation of the aerodynamic seam.
 
-use formulation::{BeamGeometry, Energies, LoadError, SectionLoad, Structure};
+use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, Structure};
 use genalpha::{DenseLu, GenAlpha, IntegratorParams, State};
 use nalgebra::{Matrix3, Vector3};
 
@@ -48,6 +48,9 @@ impl Structure for Model {
     }
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
         Model::energies(self, q, v)
+    }
+    fn momentum(&self, q: &[f64], v: &[f64]) -> Momentum {
+        Model::momentum(self, q, v)
     }
     fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
         Model::dissipation_power(self, q, v)

@@ -338,7 +338,7 @@ fn random_model_twisted(
         JointSpec::GroundHinge { body: 0, axis: V3::new(0.2, 1.0, 0.1) },
         JointSpec::FlaredHinge { parent: 0, child: 1, beta },
         if locked {
-            JointSpec::LockedHinge { parent: 1, child: 2, beta: -0.3 }
+            JointSpec::LockedHinge { parent: 1, child: 2, beta: -0.3, fold: 0.0 }
         } else {
             JointSpec::FlaredHinge { parent: 1, child: 2, beta: -0.3 }
         },

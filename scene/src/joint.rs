@@ -27,8 +27,16 @@ pub enum JointSpec {
         /// The body.
         body: usize,
     },
-    /// A flared hinge locked at its reference fold: the child's start section is welded to the
-    /// parent's end section. The fold angle is still measured about `a = sin β x + cos β y`.
+    /// No constraint: the body's start is free in space, with six rigid-body degrees of freedom
+    /// relative to the ground (the root of a free-flying chain). A body without any joint is
+    /// free too; the joint states it and refuses a parent.
+    Free {
+        /// The body.
+        body: usize,
+    },
+    /// A flared hinge locked at fold `fold`: the child's start section is welded to the parent's
+    /// end section, turned from their reference relative pose by `fold` about `−a`. The fold
+    /// angle is still measured about `a = sin β x + cos β y`.
     LockedHinge {
         /// Parent body (its end section).
         parent: usize,
@@ -36,6 +44,8 @@ pub enum JointSpec {
         child: usize,
         /// Flare angle β of the locked hinge, rad.
         beta: f64,
+        /// Fold angle at which the hinge is welded, rad (0: the reference configuration).
+        fold: f64,
     },
 }
 
@@ -43,7 +53,7 @@ impl JointSpec {
     /// The body the joint attaches at its start (the child of a hinge).
     pub fn attached_body(&self) -> usize {
         match *self {
-            JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } => body,
+            JointSpec::GroundHinge { body, .. } | JointSpec::Clamp { body } | JointSpec::Free { body } => body,
             JointSpec::FlaredHinge { child, .. } | JointSpec::LockedHinge { child, .. } => child,
         }
     }
@@ -54,6 +64,7 @@ impl JointSpec {
             JointSpec::GroundHinge { .. } => "ground hinge",
             JointSpec::FlaredHinge { .. } => "flared hinge",
             JointSpec::Clamp { .. } => "clamp",
+            JointSpec::Free { .. } => "free joint",
             JointSpec::LockedHinge { .. } => "locked hinge",
         }
     }

@@ -150,9 +150,12 @@ impl Scene {
                         return Err(Error::ZeroAxis { field: format!("{path}.axis") });
                     }
                 }
-                JointSpec::Clamp { body: b } => body(format!("{path}.body"), b)?,
+                JointSpec::Clamp { body: b } | JointSpec::Free { body: b } => body(format!("{path}.body"), b)?,
                 JointSpec::FlaredHinge { parent: p, child: c, beta }
-                | JointSpec::LockedHinge { parent: p, child: c, beta } => {
+                | JointSpec::LockedHinge { parent: p, child: c, beta, .. } => {
+                    if let JointSpec::LockedHinge { fold, .. } = *spec {
+                        finite(|| format!("{path}.lock_deg"), fold)?;
+                    }
                     body(format!("{path}.parent"), p)?;
                     body(format!("{path}.child"), c)?;
                     if p == c {
@@ -178,9 +181,14 @@ impl Scene {
             }
             let b = spec.attached_body();
             if let Some(other) = attached[b] {
-                let field = match spec {
-                    JointSpec::FlaredHinge { .. } | JointSpec::LockedHinge { .. } => format!("{path}.child"),
-                    _ => format!("{path}.body"),
+                // A free joint on a body that also hangs from another joint is named at the
+                // free joint, whichever comes first.
+                let (field, other) = match (&self.joints[other], spec) {
+                    (JointSpec::Free { .. }, _) => (format!("joints[{other}].body"), j),
+                    (_, JointSpec::FlaredHinge { .. } | JointSpec::LockedHinge { .. }) => {
+                        (format!("{path}.child"), other)
+                    }
+                    _ => (format!("{path}.body"), other),
                 };
                 return Err(Error::DoublyAttached { field, body: b, other });
             }
@@ -292,7 +300,7 @@ mod tests {
         assert_eq!(msg(&s), "forces[0].joint: no joint 4 (the scene has 2 joints)");
         s.forces[0] = ForceElement::HingeSpring { joint: 1, stiffness: 2.0, damping: f64::INFINITY, rest: 0.0 };
         assert_eq!(msg(&s), "joints[1].spring.damping: inf is not a finite number");
-        s.joints[1] = JointSpec::LockedHinge { parent: 0, child: 1, beta: 0.5 };
+        s.joints[1] = JointSpec::LockedHinge { parent: 0, child: 1, beta: 0.5, fold: 0.0 };
         s.forces[0] = ForceElement::HingeSpring { joint: 1, stiffness: 2.0, damping: 0.0, rest: 0.0 };
         assert_eq!(msg(&s), "joints[1].spring: a hinge spring needs a free ground or flared hinge, not a locked hinge");
         let mut s = pendulum();

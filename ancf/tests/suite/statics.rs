@@ -227,7 +227,7 @@ fn bend_scene(n: usize) -> ancf::Scene {
         })
         .collect();
     let mut joints = vec![JointSpec::Clamp { body: 0 }];
-    joints.extend((1..n).map(|k| JointSpec::LockedHinge { parent: k - 1, child: k, beta: 0.0 }));
+    joints.extend((1..n).map(|k| JointSpec::LockedHinge { parent: k - 1, child: k, beta: 0.0, fold: 0.0 }));
     Scene { bodies, joints, forces: Vec::new(), gravity: Vector3::zeros() }
 }
 

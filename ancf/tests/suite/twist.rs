@@ -40,7 +40,7 @@ fn twisted_wing(ground: bool, locked: bool) -> Scene {
         JointSpec::Clamp { body: 0 }
     };
     let hinge = if locked {
-        JointSpec::LockedHinge { parent: 0, child: 1, beta: 0.4 }
+        JointSpec::LockedHinge { parent: 0, child: 1, beta: 0.4, fold: 0.0 }
     } else {
         JointSpec::FlaredHinge { parent: 0, child: 1, beta: 0.4 }
     };

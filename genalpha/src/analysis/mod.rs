@@ -30,11 +30,13 @@
 //! our models (n < 500 tangent unknowns) take well under a second; the static Newton iteration
 //! factorises with the integrator's [`DenseLu`](crate::DenseLu).
 
+mod impact;
 mod linearise;
 mod modes;
 mod null_space;
 mod statics;
 
+pub use impact::{Impact, impact};
 pub use linearise::{Linearisation, linearise};
 pub use modes::{DampedMode, NaturalModes, SHIFT_RATIO};
 pub use null_space::{NULL_SPACE_RTOL, null_space};

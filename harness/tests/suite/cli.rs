@@ -334,3 +334,35 @@ fn a_run_waiting_on_a_folder_lock_answers_sigterm_issue_38() {
     let _ = std::fs::remove_dir_all(&out);
     assert_eq!(status, Some(130), "the run did not end on SIGTERM while waiting");
 }
+
+/// A free joint (issue 35) frees a root body; on a body that already hangs from a hinge it is
+/// refused with exit 2, named at the free joint whichever comes first. A free root falls freely
+/// under gravity: after 0.2 s the tip has dropped g t²/2 = 0.196 m.
+#[test]
+fn a_free_joint_frees_a_root_and_refuses_a_child() {
+    use serde_json::json;
+    let free = |body: &str| json!({"type": "free", "name": "flight", "body": body});
+    let after = tmp_case("free_after.json", |v| v["joints"].as_array_mut().unwrap().push(free("outer")));
+    let o = harness(&["run", after.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_clean_error(&o, "joints[2].body");
+    let before = tmp_case("free_before.json", |v| v["joints"].as_array_mut().unwrap().insert(0, free("outer")));
+    let o = harness(&["run", before.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_clean_error(&o, "joints[0].body");
+    let root = tmp_case("free_root.json", |v| {
+        v["joints"][0] = free("inner");
+        v["t_end"] = json!(0.2);
+        for k in ["references", "gate", "converge"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+    });
+    let out = root.with_file_name("free_root_out");
+    let o = harness(&["run", root.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["ancf", "gebf"] {
+        let csv = std::fs::read_to_string(out.join("double_pendulum_c1_beta45").join(format!("{f}.csv"))).unwrap();
+        let last: Vec<f64> = csv.lines().last().unwrap().split(',').take(4).map(|x| x.parse().unwrap()).collect();
+        assert!((last[0] - 0.2).abs() < 1e-9 && (last[3] + 0.196).abs() < 1e-9, "{f}: {last:?}");
+    }
+}
