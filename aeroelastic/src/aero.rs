@@ -367,6 +367,24 @@ pub fn simulate_aero_from<S: Structure>(
     observer: &mut dyn crate::run::Observer,
     equilibrium: Option<&[f64]>,
 ) -> crate::run::RunOutput {
+    let mut none = crate::events::Events::none();
+    simulate_aero_with_events(formulation, model, settings, aero, map, observer, equilibrium, &mut none)
+}
+
+/// [`simulate_aero_from`] with hinge events ([`crate::events`]): each one rebuilds `model`, with
+/// the aerodynamic loads of the step applied, and restarts the integrator at the end of the step
+/// nearest its time; the lattice and its wake go on.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_aero_with_events<S: Structure>(
+    formulation: crate::problem::Formulation,
+    model: &mut S,
+    settings: &crate::run::RunSettings,
+    aero: &AeroSettings,
+    map: &[StationMap],
+    observer: &mut dyn crate::run::Observer,
+    equilibrium: Option<&[f64]>,
+    events: &mut crate::events::Events<'_, S>,
+) -> crate::run::RunOutput {
     use crate::run::{Dissipation, RunOutput, SnapshotFeed, row};
     let start = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
@@ -409,7 +427,7 @@ pub fn simulate_aero_from<S: Structure>(
     let mut work = 0.0;
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
-    let mut dissipation = Dissipation::new(model, &s);
+    let mut dissipation = Dissipation::new(model, &s, events.any());
     // Wing loads from the free body of each output state (docs/statics.md §4).
     let load_model = settings.loads.as_ref();
     let mut load_scratch = crate::loads::LoadScratch::default();
@@ -421,7 +439,7 @@ pub fn simulate_aero_from<S: Structure>(
             r.hinge_moment = w.hinge_moment;
         }
     };
-    let mut r0 = row(model, fold, &s, 0);
+    let mut r0 = dissipation.record(row(model, fold, &s, 0));
     r0.aero_work = 0.0;
     r0.lift = c.lift;
     r0.control_hinge_moments = c.hinge;
@@ -443,6 +461,16 @@ pub fn simulate_aero_from<S: Structure>(
         c.move_to(model, &s.q, &s.v, s.t);
         work += 0.5 * dt * (power(&c.loads, &c.vel_n) + power(&c.loads, &c.vel));
         dissipation.step(model, &s);
+        match events.apply_due(model, &mut ga, &mut s, settings.params, &c.loads) {
+            Ok(Some(loss)) => {
+                dissipation.add_loss(loss);
+                dissipation.restart(model, &s);
+                // The stations' velocities after the event (a lock changes them).
+                c.move_to(model, &s.q, &s.v, s.t);
+            }
+            Ok(None) => {}
+            Err(e) => return fail(out, format!("step {k}: {e}")),
+        }
         if k % every == 0 || k == n_steps {
             let mut r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
             r.aero_work = work;
@@ -455,7 +483,8 @@ pub fn simulate_aero_from<S: Structure>(
             }
         }
     }
-    out.stats = *ga.stats();
+    out.stats = events.total_stats(ga.stats());
+    out.events = events.records.clone();
     out.wall_s = start.elapsed().as_secs_f64();
     out.aero_wall_s = c.uv.stats().wall_time;
     out

@@ -6,9 +6,10 @@ use formulation::Structure;
 use genalpha::Predictor;
 
 use crate::Error;
-use crate::aero::{simulate_aero, station_map};
+use crate::aero::{simulate_aero_with_events, station_map};
+use crate::events::{Events, ScheduledEvent};
 use crate::problem::{AncfPath, Block, Formulation, Problem};
-use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate};
+use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate_with_events};
 
 /// A formulation's model as a problem builds it: [`Structure`] plus its construction and its
 /// Newton predictor. A third formulation implements this and adds one line to [`dispatch`].
@@ -193,6 +194,31 @@ pub fn build_gebf(problem: &Problem) -> Result<gebf::Model, Error> {
     gebf::Model::from_scene(&problem.scene(f), options).map_err(|e| Error::Model { formulation: f, msg: e.to_string() })
 }
 
+/// The hinge events of `problem` (resolved to joint indices; names the case validation has
+/// checked) with a factory that rebuilds the model of formulation `M` with each hinge's new
+/// state, keeping the earlier ones.
+pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
+    let schedule = problem
+        .events
+        .iter()
+        .filter_map(|e| {
+            let joint = problem.joints.iter().position(|j| j.name() == Some(e.joint.as_str()))?;
+            Some(ScheduledEvent { time: e.time, joint, action: e.action })
+        })
+        .collect();
+    let mut current = problem.clone();
+    let rebuild = move |joint: usize, lock: Option<f64>| {
+        if let Some(crate::problem::Joint::FlaredHinge { locked, lock_deg, .. }) = current.joints.get_mut(joint) {
+            *locked = lock.is_some();
+            *lock_deg = lock.map_or(0.0, f64::to_degrees);
+        } else {
+            return Err(format!("joint {joint} is not a flared hinge"));
+        }
+        M::build(&current).map_err(|e| e.to_string())
+    };
+    Events::new(schedule, Box::new(rebuild))
+}
+
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot
 /// be built gives a failed [`RunOutput`] with the reason.
 pub fn run_formulation(problem: &Problem, f: Formulation) -> RunOutput {
@@ -214,11 +240,16 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
         fn run<M: BuildModel>(self) -> Self::Output {
             let Run { problem, f, observer } = self;
             let s = settings(problem, f);
+            let mut events = hinge_events::<M>(problem);
             match &problem.aero {
-                None => M::build(problem).map(|mut model| simulate(f, &mut model, &s, observer)),
+                None => {
+                    M::build(problem).map(|mut model| simulate_with_events(f, &mut model, &s, observer, &mut events))
+                }
                 Some(aero) => {
                     let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
-                    M::build(problem).map(|mut model| simulate_aero(f, &mut model, &s, aero, &map, observer))
+                    M::build(problem).map(|mut model| {
+                        simulate_aero_with_events(f, &mut model, &s, aero, &map, observer, None, &mut events)
+                    })
                 }
             }
         }

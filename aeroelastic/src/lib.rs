@@ -14,6 +14,7 @@ pub mod aero;
 pub mod aero_settings;
 pub mod clock;
 pub mod control_surface;
+pub mod events;
 pub mod factory;
 pub mod gust;
 pub mod gust_field;

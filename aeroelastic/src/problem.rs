@@ -45,6 +45,8 @@ pub struct Problem {
     pub output_dt: Option<f64>,
     /// Name of the joint whose fold angle is reported (none: the first flared hinge).
     pub fold_joint: Option<String>,
+    /// Hinge events of the time march: hinges locked or released at given times.
+    pub events: Vec<crate::events::HingeEvent>,
     /// ANCF's discretisation and integrator settings.
     pub ancf: AncfSettings,
     /// GEBF's discretisation and integrator settings.
@@ -346,10 +348,15 @@ pub enum Joint {
         child: String,
         /// Flare angle β, degrees, in [−90, 90].
         flare_deg: f64,
-        /// Lock the hinge at its reference fold (the child welded to the parent's end section):
-        /// used for the rigid-wing check. Default false.
+        /// Lock the hinge (the child welded to the parent's end section) at the fold `lock_deg`:
+        /// used for the rigid-wing check, and released or locked again by `events`. Default
+        /// false.
         #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "std::ops::Not::not"))]
         locked: bool,
+        /// Fold angle at which a locked hinge is welded, degrees (default 0: the reference
+        /// configuration).
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+        lock_deg: f64,
         /// Rotational spring and damper about the hinge axis, on the fold angle (default none;
         /// inactive while the hinge is `locked`).
         #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
@@ -916,10 +923,10 @@ impl Problem {
                     let axis = if a.norm() > 0.0 { a.normalize() } else { a };
                     scene::JointSpec::GroundHinge { body: idx(body), axis }
                 }
-                Joint::FlaredHinge { parent, child, flare_deg, locked, .. } => {
+                Joint::FlaredHinge { parent, child, flare_deg, locked, lock_deg, .. } => {
                     let (parent, child, beta) = (idx(parent), idx(child), flare_deg.to_radians());
                     if *locked {
-                        scene::JointSpec::LockedHinge { parent, child, beta, fold: 0.0 }
+                        scene::JointSpec::LockedHinge { parent, child, beta, fold: lock_deg.to_radians() }
                     } else {
                         scene::JointSpec::FlaredHinge { parent, child, beta }
                     }

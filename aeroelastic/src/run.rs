@@ -4,6 +4,7 @@ use std::time::Instant;
 
 use genalpha::{IntegratorParams, State, Stats};
 
+use crate::events::Events;
 use crate::problem::Formulation;
 
 pub use formulation::{BeamGeometry, Energies, Structure};
@@ -162,6 +163,8 @@ pub struct RunOutput {
     pub error: Option<String>,
     /// Wall time spent in the aerodynamics, s (0 without).
     pub aero_wall_s: f64,
+    /// The hinge events that acted, in order.
+    pub events: Vec<crate::events::EventRecord>,
 }
 
 impl RunOutput {
@@ -175,6 +178,7 @@ impl RunOutput {
             n_dof: 0,
             error: Some(error),
             aero_wall_s: 0.0,
+            events: Vec::new(),
         }
     }
 }
@@ -218,9 +222,24 @@ pub(crate) struct Dissipation {
 }
 
 impl Dissipation {
-    pub(crate) fn new<S: Structure + ?Sized>(model: &S, s: &State) -> Self {
-        let on = model.has_force_elements();
+    /// The dampers of `model` from state `s`; `events`: the run has hinge events, whose locks'
+    /// losses join the dissipated work (and put the spring and dissipated columns on).
+    pub(crate) fn new<S: Structure + ?Sized>(model: &S, s: &State, events: bool) -> Self {
+        let on = model.has_force_elements() || events;
         Self { on, t: s.t, power: if on { model.dissipation_power(&s.q, &s.v) } else { 0.0 }, work: 0.0 }
+    }
+
+    /// Account for energy an event removed (a hinge lock's impact), J.
+    pub(crate) fn add_loss(&mut self, loss: f64) {
+        self.work += loss;
+    }
+
+    /// Restart the power's trapezoid at state `s` of `model` (after a model change).
+    pub(crate) fn restart<S: Structure + ?Sized>(&mut self, model: &S, s: &State) {
+        if self.on {
+            self.power = model.dissipation_power(&s.q, &s.v);
+        }
+        self.t = s.t;
     }
 
     /// Account for the step that ended at state `s`.
@@ -237,6 +256,10 @@ impl Dissipation {
     pub(crate) fn record(&self, mut r: Row) -> Row {
         if self.on {
             r.dissipated = self.work;
+            if r.spring.is_nan() {
+                // A model without springs in a run with events: no spring energy.
+                r.spring = 0.0;
+            }
         }
         r
     }
@@ -258,6 +281,19 @@ pub fn simulate<S: Structure>(
     settings: &RunSettings,
     observer: &mut dyn Observer,
 ) -> RunOutput {
+    simulate_with_events(formulation, model, settings, observer, &mut Events::none())
+}
+
+/// [`simulate`] with hinge events ([`crate::events`]): each one rebuilds `model` and restarts
+/// the integrator at the end of the step nearest its time; what happened is in
+/// `RunOutput::events`.
+pub fn simulate_with_events<S: Structure>(
+    formulation: Formulation,
+    model: &mut S,
+    settings: &RunSettings,
+    observer: &mut dyn Observer,
+    events: &mut Events<'_, S>,
+) -> RunOutput {
     let start = Instant::now();
     let mut out = RunOutput {
         formulation,
@@ -267,6 +303,7 @@ pub fn simulate<S: Structure>(
         n_dof: model.n_dof(),
         error: None,
         aero_wall_s: 0.0,
+        events: Vec::new(),
     };
     let dt = settings.params.dt;
     // Validated cases hold a whole number of steps (within a relative 1e-9): round.
@@ -289,8 +326,8 @@ pub fn simulate<S: Structure>(
     }
     let fold = settings.fold_joint;
     let mut feed = SnapshotFeed::new(observer);
-    let mut dissipation = Dissipation::new(model, &s);
-    let r0 = row(model, fold, &s, 0);
+    let mut dissipation = Dissipation::new(model, &s, events.any());
+    let r0 = dissipation.record(row(model, fold, &s, 0));
     out.rows.push(r0);
     if let Err(e) = feed.feed(model, &r0, &s.q, None) {
         out.error = Some(format!("output at t = {}: {e}", s.t));
@@ -304,6 +341,17 @@ pub fn simulate<S: Structure>(
         match ga.step(model, &mut s) {
             Ok(st) => {
                 dissipation.step(model, &s);
+                match events.apply_due(model, &mut ga, &mut s, settings.params, &[]) {
+                    Ok(Some(loss)) => {
+                        dissipation.add_loss(loss);
+                        dissipation.restart(model, &s);
+                    }
+                    Ok(None) => {}
+                    Err(e) => {
+                        out.error = Some(format!("step {k}: {e}"));
+                        break;
+                    }
+                }
                 if k % every == 0 || k == n_steps {
                     let r = dissipation.record(row(model, fold, &s, st.n_newton_iters));
                     out.rows.push(r);
@@ -319,7 +367,8 @@ pub fn simulate<S: Structure>(
             }
         }
     }
-    out.stats = *ga.stats();
+    out.stats = events.total_stats(ga.stats());
+    out.events = events.records.clone();
     out.wall_s = start.elapsed().as_secs_f64();
     out
 }

@@ -89,3 +89,16 @@ pub fn static_header(surfaces: &[String]) -> String {
 pub fn surface_names(aero: Option<&aeroelastic::aero::AeroSettings>) -> Vec<String> {
     aero.map(|a| a.control_surfaces.iter().map(|c| c.name.clone()).collect()).unwrap_or_default()
 }
+
+/// The hinge events of a run as CSV (`<formulation>_events.csv`): per event the time it acted
+/// (s), the joint's name (`joints`: the case's joint names by index, `joint<k>` for an unnamed
+/// one), the action, the fold angle then (degrees) and the kinetic energy a lock removed (J).
+pub fn events_csv(events: &[aeroelastic::events::EventRecord], joints: &[Option<String>]) -> String {
+    let mut s = String::from("t,joint,action,fold_deg,energy_loss\n");
+    for e in events {
+        let name = joints.get(e.joint).cloned().flatten().unwrap_or_else(|| format!("joint{}", e.joint));
+        let _ =
+            writeln!(s, "{:.6},{name},{},{:.9e},{:.9e}", e.time, e.action.as_str(), e.fold.to_degrees(), e.energy_loss);
+    }
+    s
+}

@@ -78,6 +78,10 @@ pub struct Case {
     /// Name of the flared hinge whose fold angle is the `fold` sensor (default: the first one).
     #[serde(default)]
     pub fold_joint: Option<String>,
+    /// Hinge events of the time march: `[{ "time", "joint", "action": "lock" | "release" }]`
+    /// (docs/case-file.md §2.1).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<aeroelastic::events::HingeEvent>,
     /// ANCF settings.
     pub ancf: AncfSettings,
     /// GEBF settings.

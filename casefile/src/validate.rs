@@ -59,6 +59,7 @@ impl Case {
         let first = fs.first().copied().unwrap_or(Formulation::ALL[0]);
         self.scene(first).validate().map_err(|e| e.to_string())?;
         self.check_times(fs)?;
+        self.check_events()?;
         self.check_references()?;
         if let Some(a) = &self.aero {
             self.check_aero(a, fs)?;
@@ -176,6 +177,51 @@ impl Case {
 
     /// Every joint names existing bodies, flare angles lie in [−90°, 90°], and `fold_joint` is
     /// a flared hinge.
+    /// Each event on a flared hinge by name, at a time within the run, locking a free hinge or
+    /// releasing a locked one (in time order), on ANCF's DAE path (whose coordinates do not
+    /// depend on the joints).
+    fn check_events(&self) -> Result<(), String> {
+        use aeroelastic::events::HingeAction;
+        if !self.events.is_empty() && self.ancf.path == aeroelastic::problem::AncfPath::Ode {
+            return Err(
+                "events: hinge events need ancf.path \"dae\" (the ODE path's coordinates change with the joints)"
+                    .into(),
+            );
+        }
+        let mut order: Vec<usize> = (0..self.events.len()).collect();
+        order.sort_by(|&a, &b| self.events[a].time.total_cmp(&self.events[b].time));
+        let mut locked: Vec<Option<bool>> = self
+            .joints
+            .iter()
+            .map(|j| match j {
+                Joint::FlaredHinge { locked, .. } => Some(*locked),
+                _ => None,
+            })
+            .collect();
+        for k in order {
+            let e = &self.events[k];
+            if !(e.time.is_finite() && e.time > 0.0 && e.time <= self.t_end) {
+                return Err(format!("events[{k}].time: {} is not in (0, t_end = {}]", e.time, self.t_end));
+            }
+            let Some(j) = self.joints.iter().position(|j| j.name() == Some(e.joint.as_str())) else {
+                return Err(format!("events[{k}].joint: no joint named `{}`", e.joint));
+            };
+            let Some(state) = locked[j].as_mut() else {
+                return Err(format!("events[{k}].joint: `{}` is not a flared hinge", e.joint));
+            };
+            match (e.action, *state) {
+                (HingeAction::Lock, true) => {
+                    return Err(format!("events[{k}].action: `{}` is already locked at t = {}", e.joint, e.time));
+                }
+                (HingeAction::Release, false) => {
+                    return Err(format!("events[{k}].action: `{}` is not locked at t = {}", e.joint, e.time));
+                }
+                _ => *state = !*state,
+            }
+        }
+        Ok(())
+    }
+
     fn check_joints(&self) -> Result<(), String> {
         let body = |field: String, name: &str| -> Result<(), String> {
             if self.body_index(name).is_some() { Ok(()) } else { Err(format!("{field}: no body named `{name}`")) }

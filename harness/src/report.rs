@@ -46,6 +46,8 @@ pub struct CaseResult {
     pub gate_outcome: Option<GateOutcome>,
     /// The control surfaces' names (`aero.control_surfaces`): the CSV's hinge-moment columns.
     pub control_surfaces: Vec<String>,
+    /// The joints' names, by index (the hinge events' file and table).
+    pub joint_names: Vec<Option<String>>,
 }
 
 impl CaseResult {
@@ -104,6 +106,7 @@ impl CaseResult {
             gate: case.gate.clone(),
             gate_outcome: None,
             control_surfaces: casefile::csv::surface_names(case.aero.as_ref()),
+            joint_names: case.joints.iter().map(|j| j.name().map(str::to_string)).collect(),
         };
         res.gate_outcome = gate::evaluate(&res);
         res
@@ -142,6 +145,10 @@ struct Summary<'a> {
 pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     for run in &r.runs {
         write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows, &r.control_surfaces))?;
+        if !run.events.is_empty() {
+            let csv = casefile::csv::events_csv(&run.events, &r.joint_names);
+            write_file(&dir.join(format!("{}_events.csv", run.formulation)), &csv)?;
+        }
     }
     let summary = Summary {
         case: &r.name,
@@ -157,6 +164,38 @@ pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     let json = serde_json::to_string_pretty(&summary).map_err(|e| Error::Io(e.to_string()))?;
     write_file(&dir.join("summary.json"), &json)?;
     write_plots(dir, r)
+}
+
+/// The hinge events of a case's runs, one row per formulation and event (empty without events).
+fn events_table(r: &CaseResult) -> String {
+    let rows: Vec<Vec<String>> = r
+        .runs
+        .iter()
+        .flat_map(|run| run.events.iter().map(move |e| (run.formulation, e)))
+        .map(|(f, e)| {
+            let joint = r.joint_names.get(e.joint).cloned().flatten().unwrap_or_else(|| format!("joint {}", e.joint));
+            vec![
+                f.label().to_string(),
+                format!("{:.4}", e.time),
+                esc(&joint),
+                e.action.as_str().to_string(),
+                format!("{:.3}", e.fold.to_degrees()),
+                sci(Some(e.energy_loss), 3),
+            ]
+        })
+        .collect();
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "<h3>Hinge events</h3>\n<p class=\"note\">Each event acts at the end of the step nearest its time; a lock welds the hinge at the fold it has then and removes the kinetic energy of the impact (docs/coupling.md §8), counted in the dissipated work.</p>\n",
+    );
+    s.push_str(&html_table(
+        &["formulation", "t [s]", "joint", "action", "fold [deg]", "energy loss [J]"],
+        &rows,
+        &|i| i == 1 || i >= 4,
+    ));
+    s
 }
 
 /// How each formulation is drawn wherever both appear: GEBF a solid line, ANCF dashed with
@@ -831,6 +870,7 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
     for e in &r.reference_errors {
         let _ = writeln!(s, "<p class=\"fail\">{}</p>", esc(e));
     }
+    s.push_str(&events_table(r));
     let name = esc(&r.name);
     let _ = writeln!(
         s,

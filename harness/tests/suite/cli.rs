@@ -366,3 +366,45 @@ fn a_free_joint_frees_a_root_and_refuses_a_child() {
         assert!((last[0] - 0.2).abs() < 1e-9 && (last[3] + 0.196).abs() < 1e-9, "{f}: {last:?}");
     }
 }
+
+/// Hinge events (issue 35) refused with exit 2, naming the field: an event on a joint that is
+/// not a flared hinge, one on no joint, a time outside the run, a lock of a hinge locked at the
+/// time, a release of a free one, and events on ANCF's ODE path.
+#[test]
+fn bad_hinge_events_exit_2_naming_the_field() {
+    use serde_json::json;
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &str); 6] = [
+        (
+            "not_hinge",
+            |v| v["events"] = json!([{"time": 0.5, "joint": "root", "action": "release"}]),
+            "events[0].joint",
+        ),
+        ("no_joint", |v| v["events"] = json!([{"time": 0.5, "joint": "nope", "action": "lock"}]), "events[0].joint"),
+        ("late", |v| v["events"] = json!([{"time": 5.0, "joint": "fold", "action": "lock"}]), "events[0].time"),
+        (
+            "double_lock",
+            |v| v["events"] = json!([{"time": 0.9, "joint": "fold", "action": "lock"}, {"time": 0.5, "joint": "fold", "action": "lock"}]),
+            "events[0].action",
+        ),
+        (
+            "free_release",
+            |v| v["events"] = json!([{"time": 0.5, "joint": "fold", "action": "release"}]),
+            "events[0].action",
+        ),
+        (
+            "ode",
+            |v| {
+                v["events"] = json!([{"time": 0.5, "joint": "fold", "action": "lock"}]);
+                v["ancf"]["path"] = json!("ode");
+            },
+            "events: hinge events need ancf.path",
+        ),
+    ];
+    for (name, edit, needle) in cases {
+        let p = tmp_case(&format!("events_{name}.json"), edit);
+        let o = harness(&["run", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", String::from_utf8_lossy(&o.stderr));
+        assert_clean_error(&o, needle);
+    }
+}
