@@ -431,6 +431,7 @@ pub fn simulate_aero_with_events<S: Structure>(
     // Wing loads from the free body of each output state (docs/statics.md §4).
     let load_model = settings.loads.as_ref();
     let mut load_scratch = crate::loads::LoadScratch::default();
+    let mut trigger_scratch = crate::loads::LoadScratch::default();
     let mut with_loads = |model: &S, r: &mut crate::run::Row, s: &genalpha::State, loads: &[SectionLoad]| {
         if let Some(lm) = load_model {
             let w = lm.evaluate(model, &s.q, Some((&s.v, &s.v_dot)), loads, &mut load_scratch);
@@ -461,7 +462,13 @@ pub fn simulate_aero_with_events<S: Structure>(
         c.move_to(model, &s.q, &s.v, s.t);
         work += 0.5 * dt * (power(&c.loads, &c.vel_n) + power(&c.loads, &c.vel));
         dissipation.step(model, &s);
-        match events.apply_due(model, &mut ga, &mut s, settings.params, &c.loads) {
+        let rbm = match load_model {
+            Some(lm) if events.watches_root_bending_moment() => {
+                lm.evaluate(model, &s.q, Some((&s.v, &s.v_dot)), &c.loads, &mut trigger_scratch).root_bending_moment
+            }
+            _ => f64::NAN,
+        };
+        match events.apply_due(model, &mut ga, &mut s, settings.params, &c.loads, rbm) {
             Ok(Some(loss)) => {
                 dissipation.add_loss(loss);
                 dissipation.restart(model, &s);

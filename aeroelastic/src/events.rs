@@ -12,8 +12,11 @@
 //!   kinetic energy lost, `½ Δvᵀ M Δv`, is reported in [`EventRecord::energy_loss`] and joins the
 //!   dissipated work of the energy balance.
 //!
-//! The event takes effect at the end of the step nearest its time (the nominal steps of
-//! `dt` are kept: no step is shortened), recorded as [`EventRecord::time`].
+//! A timed event takes effect at the end of the step nearest its time (the nominal steps of
+//! `dt` are kept: no step is shortened); a triggered one ([`Trigger`]: a fold angle or the root
+//! bending moment past a threshold) at the end of the first step where its condition holds, as
+//! a gust-triggered release or a lock at a fold stop. Either is recorded with the time it acted,
+//! [`EventRecord::time`].
 
 use formulation::{SectionLoad, Structure};
 use genalpha::{GenAlpha, IntegratorParams, State};
@@ -41,18 +44,64 @@ impl HingeAction {
     }
 }
 
-/// A hinge event of a case: at `time`, `action` on the flared hinge named `joint`.
+/// A hinge event of a case: `action` on the flared hinge named `joint`, at `time` or when the
+/// condition `when` first holds (exactly one of the two).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct HingeEvent {
     /// Time, s, in (0, t_end]; the event acts at the end of the step nearest it.
-    pub time: f64,
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub time: Option<f64>,
+    /// The condition that triggers the event, checked at the end of every step; it acts once,
+    /// at the first step where it holds.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub when: Option<Trigger>,
     /// Name of the flared hinge (`joints[k].name`).
     pub joint: String,
     /// `"lock"` or `"release"`.
     pub action: HingeAction,
+}
+
+/// The condition of a triggered event: exactly one threshold.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Trigger {
+    /// The flared hinge whose fold angle is watched (default: the event's own `joint`).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub joint: Option<String>,
+    /// Fires when that fold angle exceeds this, degrees (fold up positive).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub fold_deg_above: Option<f64>,
+    /// Fires when that fold angle falls below this, degrees.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub fold_deg_below: Option<f64>,
+    /// Fires when the root bending moment at the clamp exceeds this, N·m (lift bending the wing
+    /// up positive; needs `aero` and a clamp: the `root_bending_moment` column).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub root_bending_moment_above: Option<f64>,
+}
+
+/// When a scheduled event acts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum When {
+    /// At the end of the step nearest this time, s.
+    Time(f64),
+    /// When the fold of flared hinge `joint` (index) exceeds `above` or falls below `below`
+    /// (rad).
+    Fold {
+        /// The watched hinge's index.
+        joint: usize,
+        /// Upper threshold, rad.
+        above: f64,
+        /// Lower threshold, rad.
+        below: f64,
+    },
+    /// When the root bending moment exceeds this, N·m.
+    RootBendingMoment(f64),
 }
 
 /// An event as it happened in a run.
@@ -73,8 +122,8 @@ pub struct EventRecord {
 /// An event of the schedule, resolved to a joint index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScheduledEvent {
-    /// Time, s.
-    pub time: f64,
+    /// When it acts.
+    pub when: When,
     /// Index of the hinge in the problem's joints.
     pub joint: usize,
     /// What it does.
@@ -87,8 +136,10 @@ pub type Rebuild<'a, S> = Box<dyn FnMut(usize, Option<f64>) -> Result<S, String>
 
 /// The events of a run still to come, how to rebuild the model for each, and what happened.
 pub struct Events<'a, S> {
-    /// Pending events, latest first (popped from the end).
+    /// Pending timed events, latest first (popped from the end).
     pending: Vec<ScheduledEvent>,
+    /// Pending triggered events, in the case's order.
+    triggered: Vec<ScheduledEvent>,
     rebuild: Rebuild<'a, S>,
     /// The events that acted, in order.
     pub records: Vec<EventRecord>,
@@ -98,9 +149,33 @@ pub struct Events<'a, S> {
 
 impl<'a, S: Structure> Events<'a, S> {
     /// The schedule `events` (any order) with the model factory `rebuild`.
-    pub fn new(mut events: Vec<ScheduledEvent>, rebuild: Rebuild<'a, S>) -> Self {
-        events.sort_by(|a, b| b.time.total_cmp(&a.time));
-        Self { pending: events, rebuild, records: Vec::new(), replaced: genalpha::Stats::default() }
+    pub fn new(events: Vec<ScheduledEvent>, rebuild: Rebuild<'a, S>) -> Self {
+        let time = |e: &ScheduledEvent| match e.when {
+            When::Time(t) => t,
+            _ => f64::NAN,
+        };
+        let (mut pending, triggered): (Vec<_>, Vec<_>) =
+            events.into_iter().partition(|e| matches!(e.when, When::Time(_)));
+        pending.sort_by(|a, b| time(b).total_cmp(&time(a)));
+        Self { pending, triggered, rebuild, records: Vec::new(), replaced: genalpha::Stats::default() }
+    }
+
+    /// Whether a pending event watches the root bending moment (which the march then evaluates
+    /// at every step).
+    pub fn watches_root_bending_moment(&self) -> bool {
+        self.triggered.iter().any(|e| matches!(e.when, When::RootBendingMoment(_)))
+    }
+
+    /// Whether `e`'s condition holds at `s` (`rbm`: the root bending moment there, NaN unknown).
+    fn holds(e: &ScheduledEvent, model: &S, s: &State, dt: f64, rbm: f64) -> bool {
+        match e.when {
+            When::Time(t) => t < s.t + 0.5 * dt,
+            When::Fold { joint, above, below } => {
+                let fold = model.fold(&s.q, joint);
+                fold > above || fold < below
+            }
+            When::RootBendingMoment(m) => rbm > m,
+        }
     }
 
     /// No events at all.
@@ -110,13 +185,13 @@ impl<'a, S: Structure> Events<'a, S> {
 
     /// Whether the run has any events (scheduled or done).
     pub fn any(&self) -> bool {
-        !self.pending.is_empty() || !self.records.is_empty()
+        !self.pending.is_empty() || !self.triggered.is_empty() || !self.records.is_empty()
     }
 
-    /// Apply every event due at the end of a step that reached `s.t` (steps of `dt`): rebuild
-    /// the model, carry the state over (projecting the velocities on a lock), apply `loads` to
-    /// the new model, and restart the integrator `ga`. Returns the energy the locks removed, or
-    /// `None` when no event was due.
+    /// Apply every event due at the end of a step that reached `s.t` (steps of `dt`; `rbm` the
+    /// root bending moment there, NaN when unknown): rebuild the model, carry the state over
+    /// (projecting the velocities on a lock), apply `loads` to the new model, and restart the
+    /// integrator `ga`. Returns the energy the locks removed, or `None` when no event was due.
     ///
     /// # Errors
     /// The event, its time and the reason, when the new model cannot be built, has other
@@ -128,10 +203,19 @@ impl<'a, S: Structure> Events<'a, S> {
         s: &mut State,
         params: IntegratorParams,
         loads: &[SectionLoad],
+        rbm: f64,
     ) -> Result<Option<f64>, String> {
         let mut loss = None;
-        while self.pending.last().is_some_and(|e| e.time < s.t + 0.5 * params.dt) {
-            let e = self.pending.pop().expect("checked above");
+        loop {
+            // The timed events due, in time order, then the triggered ones whose condition holds
+            // (checked on the state as the earlier events of this step left it).
+            let e = if self.pending.last().is_some_and(|e| Self::holds(e, model, s, params.dt, rbm)) {
+                self.pending.pop().expect("checked above")
+            } else if let Some(k) = self.triggered.iter().position(|e| Self::holds(e, model, s, params.dt, rbm)) {
+                self.triggered.remove(k)
+            } else {
+                break;
+            };
             let what = format!("event {} of joint {} at t = {} s", e.action.as_str(), e.joint, s.t);
             let rec = self.apply(e, model, ga, s, params, loads).map_err(|m| format!("{what}: {m}"))?;
             *loss.get_or_insert(0.0) += rec.energy_loss;

@@ -7,7 +7,7 @@ use genalpha::Predictor;
 
 use crate::Error;
 use crate::aero::{simulate_aero_with_events, station_map};
-use crate::events::{Events, ScheduledEvent};
+use crate::events::{Events, ScheduledEvent, When};
 use crate::problem::{AncfPath, Block, Formulation, Problem};
 use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate_with_events};
 
@@ -198,22 +198,39 @@ pub fn build_gebf(problem: &Problem) -> Result<gebf::Model, Error> {
 /// checked) with a factory that rebuilds the model of formulation `M` with each hinge's new
 /// state, keeping the earlier ones.
 pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
+    let index = |name: &str| problem.joints.iter().position(|j| j.name() == Some(name));
     let schedule = problem
         .events
         .iter()
         .filter_map(|e| {
-            let joint = problem.joints.iter().position(|j| j.name() == Some(e.joint.as_str()))?;
-            Some(ScheduledEvent { time: e.time, joint, action: e.action })
+            let joint = index(&e.joint)?;
+            let when = match (e.time, &e.when) {
+                (Some(t), _) => When::Time(t),
+                (None, Some(w)) => match w.root_bending_moment_above {
+                    Some(m) => When::RootBendingMoment(m),
+                    None => When::Fold {
+                        joint: w.joint.as_deref().map_or(Some(joint), index)?,
+                        above: w.fold_deg_above.map_or(f64::INFINITY, f64::to_radians),
+                        below: w.fold_deg_below.map_or(f64::NEG_INFINITY, f64::to_radians),
+                    },
+                },
+                (None, None) => return None,
+            };
+            Some(ScheduledEvent { when, joint, action: e.action })
         })
         .collect();
     let mut current = problem.clone();
     let rebuild = move |joint: usize, lock: Option<f64>| {
-        if let Some(crate::problem::Joint::FlaredHinge { locked, lock_deg, .. }) = current.joints.get_mut(joint) {
-            *locked = lock.is_some();
-            *lock_deg = lock.map_or(0.0, f64::to_degrees);
-        } else {
+        let Some(crate::problem::Joint::FlaredHinge { locked, lock_deg, .. }) = current.joints.get_mut(joint) else {
             return Err(format!("joint {joint} is not a flared hinge"));
+        };
+        match (*locked, lock.is_some()) {
+            (true, true) => return Err("the hinge is already locked".into()),
+            (false, false) => return Err("the hinge is not locked".into()),
+            _ => {}
         }
+        *locked = lock.is_some();
+        *lock_deg = lock.map_or(0.0, f64::to_degrees);
         M::build(&current).map_err(|e| e.to_string())
     };
     Events::new(schedule, Box::new(rebuild))

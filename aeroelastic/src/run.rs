@@ -341,7 +341,7 @@ pub fn simulate_with_events<S: Structure>(
         match ga.step(model, &mut s) {
             Ok(st) => {
                 dissipation.step(model, &s);
-                match events.apply_due(model, &mut ga, &mut s, settings.params, &[]) {
+                match events.apply_due(model, &mut ga, &mut s, settings.params, &[], f64::NAN) {
                     Ok(Some(loss)) => {
                         dissipation.add_loss(loss);
                         dissipation.restart(model, &s);

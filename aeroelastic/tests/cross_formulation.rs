@@ -3,7 +3,7 @@
 //! [`Formulation::ALL`] through the factory's [`dispatch`], so a third formulation is checked by
 //! implementing the trait.
 
-use aeroelastic::events::{Events, HingeAction, ScheduledEvent};
+use aeroelastic::events::{Events, HingeAction, ScheduledEvent, When};
 use aeroelastic::factory::{BuildModel, ForModel, dispatch};
 use aeroelastic::problem::Formulation;
 use aeroelastic::run::{NoObserver, RunSettings, simulate_with_events};
@@ -319,8 +319,8 @@ impl ForModel for StartedFree {
 /// GEBF's march becomes unstable after that release; ANCF's balance is then 1.2e-4.
 #[test]
 fn hinge_events_restart_and_keep_the_energy_balance() {
-    let release = |t| ScheduledEvent { time: t, joint: 1, action: HingeAction::Release };
-    let lock = |t| ScheduledEvent { time: t, joint: 1, action: HingeAction::Lock };
+    let release = |t| ScheduledEvent { when: When::Time(t), joint: 1, action: HingeAction::Release };
+    let lock = |t| ScheduledEvent { when: When::Time(t), joint: 1, action: HingeAction::Lock };
     for f in Formulation::ALL {
         let params = genalpha::IntegratorParams::new(0.8, 0.002);
         let (rows, _) = dispatch(f, EventMarch(vec![release(0.3)], params, 0.8));
@@ -358,5 +358,18 @@ fn hinge_events_restart_and_keep_the_energy_balance() {
         assert!(held < 1e-4, "{f}: the lock let the fold move {held}");
         assert!(balance_locked < 1e-4, "{f}: energy balance to 0.9 s {balance_locked}");
         assert!(balance < 8e-3, "{f}: energy balance {balance}");
+
+        // A lock at a fold stop: the first step whose fold falls below −0.2 rad.
+        let stop = ScheduledEvent {
+            when: When::Fold { joint: 1, above: f64::INFINITY, below: -0.2 },
+            joint: 1,
+            action: HingeAction::Lock,
+        };
+        let (rows, records) = dispatch(f, EventMarch(vec![release(0.3), stop], params, 0.8));
+        let k = rows.iter().position(|r| r.fold < -0.2).unwrap();
+        println!("{f}: fold stop −0.2 rad: locked at {:.4} s at {:.5} rad", records[1].time, records[1].fold);
+        assert_eq!(records.len(), 2);
+        assert!(records[1].time == rows[k].t && records[1].fold < -0.2 && rows[k - 1].fold >= -0.2);
+        assert!(rows[k..].iter().all(|r| (r.fold - records[1].fold).abs() < 1e-4), "{f}: the stop did not hold");
     }
 }

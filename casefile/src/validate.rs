@@ -177,19 +177,84 @@ impl Case {
 
     /// Every joint names existing bodies, flare angles lie in [−90°, 90°], and `fold_joint` is
     /// a flared hinge.
-    /// Each event on a flared hinge by name, at a time within the run, locking a free hinge or
-    /// releasing a locked one (in time order), on ANCF's DAE path (whose coordinates do not
-    /// depend on the joints).
+    /// Each event on a flared hinge by name, at a time within the run or on one condition, on
+    /// ANCF's DAE path (whose coordinates do not depend on the joints); the timed events of a
+    /// hinge without triggered ones lock a free hinge or release a locked one, in time order
+    /// (a triggered event's order is known only in the run, which refuses a lock of a locked
+    /// hinge naming the event and the time).
     fn check_events(&self) -> Result<(), String> {
-        use aeroelastic::events::HingeAction;
         if !self.events.is_empty() && self.ancf.path == aeroelastic::problem::AncfPath::Ode {
             return Err(
                 "events: hinge events need ancf.path \"dae\" (the ODE path's coordinates change with the joints)"
                     .into(),
             );
         }
-        let mut order: Vec<usize> = (0..self.events.len()).collect();
-        order.sort_by(|&a, &b| self.events[a].time.total_cmp(&self.events[b].time));
+        let hinge = |field: String, name: &str| match self.joints.iter().position(|j| j.name() == Some(name)) {
+            Some(j) if matches!(self.joints[j], Joint::FlaredHinge { .. }) => Ok(j),
+            Some(_) => Err(format!("{field}: `{name}` is not a flared hinge")),
+            None => Err(format!("{field}: no joint named `{name}`")),
+        };
+        let mut triggered = vec![false; self.joints.len()];
+        for (k, e) in self.events.iter().enumerate() {
+            let j = hinge(format!("events[{k}].joint"), &e.joint)?;
+            match (e.time, &e.when) {
+                (Some(t), None) => {
+                    if !(t.is_finite() && t > 0.0 && t <= self.t_end) {
+                        return Err(format!("events[{k}].time: {t} is not in (0, t_end = {}]", self.t_end));
+                    }
+                }
+                (None, Some(w)) => {
+                    triggered[j] = true;
+                    self.check_trigger(&format!("events[{k}].when"), w, &hinge)?;
+                }
+                _ => return Err(format!("events[{k}]: give either `time` or `when`, not both or neither")),
+            }
+        }
+        self.check_event_order(&triggered)
+    }
+
+    /// One condition `w` at `field`: exactly one finite threshold, a flared hinge to watch, and
+    /// for the root bending moment the aerodynamics and the clamp it is measured at.
+    fn check_trigger(
+        &self,
+        field: &str,
+        w: &aeroelastic::events::Trigger,
+        hinge: &dyn Fn(String, &str) -> Result<usize, String>,
+    ) -> Result<(), String> {
+        let set = [w.fold_deg_above, w.fold_deg_below, w.root_bending_moment_above];
+        if set.iter().filter(|x| x.is_some()).count() != 1 {
+            return Err(format!(
+                "{field}: give exactly one of fold_deg_above, fold_deg_below, root_bending_moment_above"
+            ));
+        }
+        for (name, x) in [("fold_deg_above", w.fold_deg_above), ("fold_deg_below", w.fold_deg_below)] {
+            if let Some(x) = x {
+                finite_in(&format!("{field}.{name}"), x)?;
+            }
+        }
+        if let Some(j) = &w.joint {
+            hinge(format!("{field}.joint"), j)?;
+        }
+        if let Some(m) = w.root_bending_moment_above {
+            finite_in(&format!("{field}.root_bending_moment_above"), m)?;
+            if w.joint.is_some() {
+                return Err(format!("{field}.joint: a root bending moment trigger watches no joint"));
+            }
+            if self.aero.is_none() || !self.joints.iter().any(|j| matches!(j, Joint::Clamp { .. })) {
+                return Err(format!(
+                    "{field}.root_bending_moment_above: needs `aero` and a clamp (where the moment is measured)"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The timed events of each hinge without triggered events, in time order: a lock of a free
+    /// hinge, a release of a locked one.
+    fn check_event_order(&self, triggered: &[bool]) -> Result<(), String> {
+        use aeroelastic::events::HingeAction;
+        let mut order: Vec<usize> = (0..self.events.len()).filter(|&k| self.events[k].time.is_some()).collect();
+        order.sort_by(|&a, &b| self.events[a].time.unwrap_or(0.0).total_cmp(&self.events[b].time.unwrap_or(0.0)));
         let mut locked: Vec<Option<bool>> = self
             .joints
             .iter()
@@ -200,21 +265,15 @@ impl Case {
             .collect();
         for k in order {
             let e = &self.events[k];
-            if !(e.time.is_finite() && e.time > 0.0 && e.time <= self.t_end) {
-                return Err(format!("events[{k}].time: {} is not in (0, t_end = {}]", e.time, self.t_end));
-            }
-            let Some(j) = self.joints.iter().position(|j| j.name() == Some(e.joint.as_str())) else {
-                return Err(format!("events[{k}].joint: no joint named `{}`", e.joint));
-            };
-            let Some(state) = locked[j].as_mut() else {
-                return Err(format!("events[{k}].joint: `{}` is not a flared hinge", e.joint));
-            };
+            let Some(j) = self.joints.iter().position(|j| j.name() == Some(e.joint.as_str())) else { continue };
+            let Some(state) = locked[j].as_mut().filter(|_| !triggered[j]) else { continue };
+            let t = e.time.unwrap_or(0.0);
             match (e.action, *state) {
                 (HingeAction::Lock, true) => {
-                    return Err(format!("events[{k}].action: `{}` is already locked at t = {}", e.joint, e.time));
+                    return Err(format!("events[{k}].action: `{}` is already locked at t = {t}", e.joint));
                 }
                 (HingeAction::Release, false) => {
-                    return Err(format!("events[{k}].action: `{}` is not locked at t = {}", e.joint, e.time));
+                    return Err(format!("events[{k}].action: `{}` is not locked at t = {t}", e.joint));
                 }
                 _ => *state = !*state,
             }
@@ -543,4 +602,9 @@ fn check_aero_static(st: &StaticSettings) -> Result<(), String> {
         w.validate("static.wake")?;
     }
     Ok(())
+}
+
+/// `value` finite, naming `field` otherwise.
+fn finite_in(field: &str, value: f64) -> Result<(), String> {
+    if value.is_finite() { Ok(()) } else { Err(format!("{field}: {value} is not finite")) }
 }

@@ -188,7 +188,7 @@ fn events_table(r: &CaseResult) -> String {
         return String::new();
     }
     let mut s = String::from(
-        "<h3>Hinge events</h3>\n<p class=\"note\">Each event acts at the end of the step nearest its time; a lock welds the hinge at the fold it has then and removes the kinetic energy of the impact (docs/coupling.md §8), counted in the dissipated work.</p>\n",
+        "<h3>Hinge events</h3>\n<p class=\"note\">Each event acts at the end of the step nearest its time, or of the first step where its condition holds; a lock welds the hinge at the fold it has then and removes the kinetic energy of the impact (docs/coupling.md §8), counted in the dissipated work.</p>\n",
     );
     s.push_str(&html_table(
         &["formulation", "t [s]", "joint", "action", "fold [deg]", "energy loss [J]"],

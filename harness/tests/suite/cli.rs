@@ -369,12 +369,13 @@ fn a_free_joint_frees_a_root_and_refuses_a_child() {
 
 /// Hinge events (issue 35) refused with exit 2, naming the field: an event on a joint that is
 /// not a flared hinge, one on no joint, a time outside the run, a lock of a hinge locked at the
-/// time, a release of a free one, and events on ANCF's ODE path.
+/// time, a release of a free one, events on ANCF's ODE path, a time and a condition together,
+/// a condition with two thresholds, and a root bending moment trigger without aerodynamics.
 #[test]
 fn bad_hinge_events_exit_2_naming_the_field() {
     use serde_json::json;
     type Edit = fn(&mut serde_json::Value);
-    let cases: [(&str, Edit, &str); 6] = [
+    let cases: [(&str, Edit, &str); 9] = [
         (
             "not_hinge",
             |v| v["events"] = json!([{"time": 0.5, "joint": "root", "action": "release"}]),
@@ -399,6 +400,24 @@ fn bad_hinge_events_exit_2_naming_the_field() {
                 v["ancf"]["path"] = json!("ode");
             },
             "events: hinge events need ancf.path",
+        ),
+        (
+            "both",
+            |v| v["events"] = json!([{"time": 0.5, "when": {"fold_deg_above": 10}, "joint": "fold", "action": "lock"}]),
+            "events[0]: give either",
+        ),
+        (
+            "two_thresholds",
+            |v| {
+                v["events"] =
+                    json!([{"when": {"fold_deg_above": 10, "fold_deg_below": -10}, "joint": "fold", "action": "lock"}])
+            },
+            "events[0].when: give exactly one",
+        ),
+        (
+            "rbm_no_aero",
+            |v| v["events"] = json!([{"when": {"root_bending_moment_above": 10}, "joint": "fold", "action": "lock"}]),
+            "events[0].when.root_bending_moment_above",
         ),
     ];
     for (name, edit, needle) in cases {
