@@ -425,7 +425,7 @@ pub fn simulate_aero_with_events<S: Structure>(
         return fail(out, format!("initial accelerations: {e}"));
     }
     let mut work = 0.0;
-    let fold = settings.fold_joint;
+    let fold = (settings.fold_joint, settings.roll_joint);
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s, events.any());
     // Wing loads from the free body of each output state (docs/statics.md §4).

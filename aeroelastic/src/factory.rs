@@ -172,6 +172,7 @@ pub fn settings(problem: &Problem, f: Formulation) -> RunSettings {
         t_end: problem.t_end,
         output_dt: problem.output_dt,
         fold_joint: problem.fold_joint_index(),
+        roll_joint: problem.roll_joint_index(),
         loads,
     }
 }

@@ -45,6 +45,8 @@ pub struct Problem {
     pub output_dt: Option<f64>,
     /// Name of the joint whose fold angle is reported (none: the first flared hinge).
     pub fold_joint: Option<String>,
+    /// Name of the ground hinge whose rate is the `roll_rate` column (none: no column).
+    pub roll_joint: Option<String>,
     /// Hinge events of the time march: hinges locked or released at given times.
     pub events: Vec<crate::events::HingeEvent>,
     /// ANCF's discretisation and integrator settings.
@@ -791,6 +793,12 @@ impl Problem {
     /// Index of the joint whose fold angle is reported.
     pub fn fold_joint_index(&self) -> Option<usize> {
         fold_joint_index(&self.joints, self.fold_joint.as_deref())
+    }
+
+    /// Index of the `roll_joint`, if the problem names one.
+    pub fn roll_joint_index(&self) -> Option<usize> {
+        let name = self.roll_joint.as_deref()?;
+        self.joints.iter().position(|j| j.name() == Some(name))
     }
 
     /// The settings of formulation `f`'s block.

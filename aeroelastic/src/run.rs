@@ -98,6 +98,8 @@ pub struct Row {
     pub tip: [f64; 3],
     /// Fold angle, rad.
     pub fold: f64,
+    /// Rate of the `roll_joint`'s angle, rad/s (NaN without one).
+    pub roll_rate: f64,
     /// Kinetic energy, J.
     pub kinetic: f64,
     /// Elastic energy, J.
@@ -142,6 +144,8 @@ pub struct RunSettings {
     pub output_dt: Option<f64>,
     /// The flared hinge whose fold angle is the `fold` column (None: NaN).
     pub fold_joint: Option<usize>,
+    /// The ground hinge whose rate is the `roll_rate` column (None: NaN, no column).
+    pub roll_joint: Option<usize>,
     /// The free bodies of the wing loads columns (None: NaN).
     pub loads: Option<crate::loads::LoadModel>,
 }
@@ -184,13 +188,19 @@ impl RunOutput {
 }
 
 /// The sensors of `model` at state `s` (aerodynamic columns NaN).
-pub fn row<S: Structure + ?Sized>(model: &S, fold_joint: Option<usize>, s: &State, newton_iterations: usize) -> Row {
+pub fn row<S: Structure + ?Sized>(
+    model: &S,
+    (fold_joint, roll_joint): (Option<usize>, Option<usize>),
+    s: &State,
+    newton_iterations: usize,
+) -> Row {
     let e = model.energies(&s.q, &s.v);
     let springs = model.has_force_elements();
     Row {
         t: s.t,
         tip: model.tip(&s.q),
         fold: fold_joint.map_or(f64::NAN, |j| model.fold(&s.q, j)),
+        roll_rate: roll_joint.map_or(f64::NAN, |j| model.hinge_rate(&s.q, &s.v, j)),
         kinetic: e.kinetic,
         elastic: e.elastic,
         potential: e.potential,
@@ -324,7 +334,7 @@ pub fn simulate_with_events<S: Structure>(
         out.error = Some(format!("initial accelerations: {e}"));
         return out;
     }
-    let fold = settings.fold_joint;
+    let fold = (settings.fold_joint, settings.roll_joint);
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s, events.any());
     let r0 = dissipation.record(row(model, fold, &s, 0));

@@ -583,6 +583,21 @@ impl Model {
         }))
     }
 
+    /// Rate of the hinge angle of [`hinge_angle`](Self::hinge_angle), rad/s, at `q`, `v` (the
+    /// model's form): the angle's gradient times the full velocities.
+    pub fn hinge_rate(&self, q: &[f64], v: &[f64], joint: usize) -> Result<f64, Error> {
+        let jt = self.joints.get(joint).ok_or(Error::NoSuchJoint { joint, n_joints: self.joints.len() })?;
+        if !matches!(jt, Joint::Ground { .. } | Joint::Flared { lock: None, .. }) {
+            return Err(Error::NotAFreeHinge { joint });
+        }
+        let hinge = HingeSpring::new(joint, jt, &self.bodies, 0.0, 0.0, 0.0);
+        let mut s = scratch(&self.sensor);
+        let (qf, vf) = &mut *s;
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, &mut vf[..self.n_full]);
+        Ok(HingeSpring::rate(&hinge.kinematics(qf, false), vf))
+    }
+
     /// Restart the hinge springs' angle unwrapping at `q` (the model's form): each spring's
     /// angle becomes its principal value in [−π, π). Call it before integrating from a state
     /// that is not the continuation of the model's last step (a model reused for a new run, or

@@ -14,13 +14,45 @@ pub const HEADER: &str =
 pub const HEADER_AERO: &str = "t,tip_x,tip_y,tip_z,fold,kinetic,elastic,potential,total,aero_work,constraint_residual,\
 newton_iterations,lift,root_bending_moment,root_torque,hinge_moment";
 
-/// The header line (without newline) of a CSV with or without the aerodynamic and the force
-/// element columns; with aerodynamics, a `<name>_hinge_moment` column per control surface
-/// (`surfaces`, the case's `aero.control_surfaces` names in order) at the end.
-pub fn header(aero: bool, springs: bool, surfaces: &[String]) -> String {
+/// Which optional column groups a time-history CSV has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Columns {
+    /// The aerodynamic columns (`aero_work`, `lift`, the wing loads, the control surfaces').
+    pub aero: bool,
+    /// `spring` and `dissipated` (force elements or hinge events).
+    pub springs: bool,
+    /// `roll_rate` (a case with a `roll_joint`).
+    pub roll: bool,
+}
+
+impl Columns {
+    /// The groups a row has values for.
+    pub fn of_row(r: &Row) -> Self {
+        Self { aero: r.aero_work.is_finite(), springs: r.spring.is_finite(), roll: r.roll_rate.is_finite() }
+    }
+
+    /// The groups any of `rows` has values for.
+    pub fn of(rows: &[Row]) -> Self {
+        rows.iter().map(Self::of_row).fold(Self::default(), |a, b| Self {
+            aero: a.aero || b.aero,
+            springs: a.springs || b.springs,
+            roll: a.roll || b.roll,
+        })
+    }
+}
+
+/// The header line (without newline) of a CSV with the column groups `c`: `roll_rate` after
+/// `fold`, `spring` and `dissipated` after `potential`, the aerodynamic columns; with
+/// aerodynamics, a `<name>_hinge_moment` column per control surface (`surfaces`, the case's
+/// `aero.control_surfaces` names in order) at the end.
+pub fn header(c: Columns, surfaces: &[String]) -> String {
+    let aero = c.aero;
     let header = if aero { HEADER_AERO } else { HEADER };
     let mut h =
-        if springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() };
+        if c.springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() };
+    if c.roll {
+        h = h.replacen(",fold,", ",fold,roll_rate,", 1);
+    }
     if aero {
         for name in surfaces {
             let _ = write!(h, ",{name}_hinge_moment");
@@ -29,15 +61,16 @@ pub fn header(aero: bool, springs: bool, surfaces: &[String]) -> String {
     h
 }
 
-/// Append one row (with its newline) in the columns of [`header`]`(aero, springs, surfaces)`
-/// with `n_surfaces` control surfaces.
-pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool, n_surfaces: usize) {
-    let _ = write!(
-        s,
-        "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},",
-        r.t, r.tip[0], r.tip[1], r.tip[2], r.fold, r.kinetic, r.elastic, r.potential,
-    );
-    if springs {
+/// Append one row (with its newline) in the columns of [`header`]`(c, surfaces)` with
+/// `n_surfaces` control surfaces.
+pub fn push_row(s: &mut String, r: &Row, c: Columns, n_surfaces: usize) {
+    let aero = c.aero;
+    let _ = write!(s, "{:.6},{:.9e},{:.9e},{:.9e},{:.9e},", r.t, r.tip[0], r.tip[1], r.tip[2], r.fold);
+    if c.roll {
+        let _ = write!(s, "{:.9e},", r.roll_rate);
+    }
+    let _ = write!(s, "{:.9e},{:.9e},{:.9e},", r.kinetic, r.elastic, r.potential);
+    if c.springs {
         let _ = write!(s, "{:.9e},{:.9e},", r.spring, r.dissipated);
     }
     let _ = write!(s, "{:.9e},", r.total);
@@ -59,13 +92,12 @@ pub fn push_row(s: &mut String, r: &Row, aero: bool, springs: bool, n_surfaces: 
 /// the model has force elements; the control surfaces' hinge moments (`surfaces`, their names)
 /// at the end of the aerodynamic columns.
 pub fn to_csv(rows: &[Row], surfaces: &[String]) -> String {
-    let aero = rows.iter().any(|r| r.aero_work.is_finite());
-    let springs = rows.iter().any(|r| r.spring.is_finite());
+    let c = Columns::of(rows);
     let mut s = String::with_capacity(rows.len() * (220 + 14 * surfaces.len()));
-    s.push_str(&header(aero, springs, surfaces));
+    s.push_str(&header(c, surfaces));
     s.push('\n');
     for r in rows {
-        push_row(&mut s, r, aero, springs, surfaces.len());
+        push_row(&mut s, r, c, surfaces.len());
     }
     s
 }

@@ -78,6 +78,9 @@ pub struct Case {
     /// Name of the flared hinge whose fold angle is the `fold` sensor (default: the first one).
     #[serde(default)]
     pub fold_joint: Option<String>,
+    /// Name of the ground hinge whose rate is the `roll_rate` column (a roll rig's shaft).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roll_joint: Option<String>,
     /// Hinge events of the time march: `[{ "time", "joint", "action": "lock" | "release" }]`
     /// (docs/case-file.md §2.1).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -19,6 +19,7 @@ impl Case {
             t_end: self.t_end,
             output_dt: self.output_dt,
             fold_joint: self.fold_joint.clone(),
+            roll_joint: self.roll_joint.clone(),
             events: self.events.clone(),
             ancf: self.ancf.clone(),
             gebf: self.gebf.clone(),

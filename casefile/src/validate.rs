@@ -300,6 +300,13 @@ impl Case {
                 Joint::Clamp { body: b, .. } | Joint::Free { body: b, .. } => body(format!("joints[{i}].body"), b)?,
             }
         }
+        if let Some(n) = &self.roll_joint {
+            match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
+                Some(Joint::GroundHinge { .. }) => {}
+                Some(_) => return Err(format!("roll_joint: `{n}` is not a ground hinge")),
+                None => return Err(format!("roll_joint: no joint named `{n}`")),
+            }
+        }
         if let Some(n) = &self.fold_joint {
             match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
                 Some(Joint::FlaredHinge { .. }) => {}

@@ -51,6 +51,7 @@ use crate::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, check_sect
 ///     fn initial_state(&self) -> State { State::at_rest(self, 0.0, vec![0.0]) }
 ///     fn tip(&self, q: &[f64]) -> [f64; 3] { (self.frame(q) * Vector3::new(self.length, 0.0, 0.0)).into() }
 ///     fn fold(&self, _q: &[f64], _joint: usize) -> f64 { f64::NAN }
+///     fn hinge_rate(&self, _q: &[f64], v: &[f64], _joint: usize) -> f64 { v[0] }
 ///     fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
 ///         Energies { kinetic: 0.5 * self.inertia() * v[0] * v[0], spring: 0.5 * self.k * q[0] * q[0], ..Default::default() }
 ///     }
@@ -110,6 +111,10 @@ pub trait Structure: ConstrainedSystem {
     fn tip(&self, q: &[f64]) -> [f64; 3];
     /// Fold angle of flared hinge `joint`, rad (NaN when it is not one).
     fn fold(&self, q: &[f64], joint: usize) -> f64;
+    /// Rate of the hinge angle of `joint`, rad/s, a ground hinge (the body's rotation about the
+    /// axis, right-hand rule) or a free flared hinge (the fold rate), as the hinge springs measure
+    /// it; NaN for another joint. The roll rate of a roll rig.
+    fn hinge_rate(&self, q: &[f64], v: &[f64], joint: usize) -> f64;
     /// Energies at coordinates `q` and velocities `v`.
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies;
     /// Linear momentum and angular momentum about the global origin at coordinates `q` and

@@ -341,6 +341,14 @@ impl Model {
         Ok(unwrap(principal, self.hinge_last[joint]))
     }
 
+    /// Rate of the hinge angle of [`hinge_angle`](Self::hinge_angle), rad/s, at `q`, `v`.
+    pub fn hinge_rate(&self, q: &[f64], v: &[f64], joint: usize) -> Result<f64, Error> {
+        let j = self.joints.get(joint).ok_or(Error::NoSuchJoint { joint, n_joints: self.joints.len() })?;
+        HingeSpring::angle_and_rate(j, &self.bodies, self.hinge_last[joint], q, v)
+            .map(|(_, rate)| rate)
+            .ok_or(Error::NotAFreeHinge { joint })
+    }
+
     /// Set the angles the hinge angles are unwrapped against to the principal angles at `q`
     /// (in (−π, π]). The model does this itself after every accepted step; call it before
     /// integrating from a state that is not the continuation of the last step (a model reused

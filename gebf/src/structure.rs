@@ -46,6 +46,9 @@ impl Structure for Model {
     fn fold(&self, q: &[f64], joint: usize) -> f64 {
         self.fold_angle(q, joint).unwrap_or(f64::NAN)
     }
+    fn hinge_rate(&self, q: &[f64], v: &[f64], joint: usize) -> f64 {
+        Model::hinge_rate(self, q, v, joint).unwrap_or(f64::NAN)
+    }
     fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
         Model::energies(self, q, v)
     }

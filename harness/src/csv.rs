@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use crate::Error;
 use crate::run::Row;
 
-pub use casefile::csv::{HEADER, HEADER_AERO, header, push_row, to_csv};
+pub use casefile::csv::{Columns, HEADER, HEADER_AERO, header, push_row, to_csv};
 pub use casefile::curve::{Curve, parse_curve, read_curve};
 
 /// A time-history CSV written while the run proceeds (docs/outputs.md §2): the header at the
@@ -20,7 +20,7 @@ pub use casefile::curve::{Curve, parse_curve, read_curve};
 #[derive(Debug)]
 pub struct CsvStream {
     inner: Arc<Mutex<StreamInner>>,
-    columns: Option<(bool, bool)>,
+    columns: Option<Columns>,
     /// The control surfaces' names: a hinge-moment column each (with aerodynamics).
     surfaces: Vec<String>,
 }
@@ -99,13 +99,13 @@ impl CsvStream {
     /// Append a row; written to the file at once if the last write is [`STREAM_FLUSH`] old.
     pub fn push(&mut self, r: &Row) -> Result<(), String> {
         let mut s = self.inner.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let (aero, springs) = *self.columns.get_or_insert_with(|| {
-            let c = (r.aero_work.is_finite(), r.spring.is_finite());
-            s.buf.push_str(&header(c.0, c.1, &self.surfaces));
+        let c = *self.columns.get_or_insert_with(|| {
+            let c = Columns::of_row(r);
+            s.buf.push_str(&header(c, &self.surfaces));
             s.buf.push('\n');
             c
         });
-        push_row(&mut s.buf, r, aero, springs, self.surfaces.len());
+        push_row(&mut s.buf, r, c, self.surfaces.len());
         if s.last_flush.elapsed() >= STREAM_FLUSH || s.buf.len() > 1 << 20 {
             s.flush()?;
         }

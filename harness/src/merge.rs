@@ -41,7 +41,7 @@ fn json_err(p: &Path) -> impl Fn(serde_json::Error) -> Error + '_ {
 }
 
 /// A row with every `f64` as its bits (`newton_iterations` as itself): the 18 columns, then
-/// the control surfaces' hinge moments (a record of 18 has none: NaN).
+/// the control surfaces' hinge moments (a record of 18 has none: NaN), then the roll rate.
 type RowBits = Vec<u64>;
 
 fn row_bits(r: &Row) -> RowBits {
@@ -67,6 +67,7 @@ fn row_bits(r: &Row) -> RowBits {
         b(r.hinge_moment),
     ];
     v.extend(r.control_hinge_moments.iter().map(|&h| b(h)));
+    v.push(b(r.roll_rate));
     v
 }
 
@@ -91,6 +92,7 @@ fn row_of(x: &[u64]) -> Row {
         root_torque: g(16),
         hinge_moment: g(17),
         control_hinge_moments: std::array::from_fn(|i| g(18 + i)),
+        roll_rate: g(18 + aeroelastic::control_surface::MAX_CONTROL_SURFACES),
     }
 }
 

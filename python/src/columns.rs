@@ -16,12 +16,13 @@ type Getter = fn(&Row) -> f64;
 type Setter = fn(&mut Row, f64);
 
 /// Every column a row can have, by its CSV name.
-const COLUMNS: [(&str, Getter); 18] = [
+const COLUMNS: [(&str, Getter); 19] = [
     ("t", |r| r.t),
     ("tip_x", |r| r.tip[0]),
     ("tip_y", |r| r.tip[1]),
     ("tip_z", |r| r.tip[2]),
     ("fold", |r| r.fold),
+    ("roll_rate", |r| r.roll_rate),
     ("kinetic", |r| r.kinetic),
     ("elastic", |r| r.elastic),
     ("potential", |r| r.potential),
@@ -38,12 +39,10 @@ const COLUMNS: [(&str, Getter); 18] = [
 ];
 
 /// The CSV column names of these rows (`casefile::csv::header`: aerodynamic columns when the run
-/// has them, `spring` and `dissipated` when the model has force elements, the control surfaces'
-/// `<name>_hinge_moment` last).
+/// has them, `spring` and `dissipated` when the model has force elements or hinge events,
+/// `roll_rate` with a roll joint, the control surfaces' `<name>_hinge_moment` last).
 fn header(rows: &[Row], surfaces: &[String]) -> Vec<String> {
-    let aero = rows.iter().any(|r| r.aero_work.is_finite());
-    let springs = rows.iter().any(|r| r.spring.is_finite());
-    casefile::csv::header(aero, springs, surfaces).split(',').map(str::to_string).collect()
+    casefile::csv::header(casefile::csv::Columns::of(rows), surfaces).split(',').map(str::to_string).collect()
 }
 
 /// The rows as a dict of NumPy arrays keyed by the CSV's column names (`newton_iterations` as
@@ -89,6 +88,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         t: f64::NAN,
         tip: [f64::NAN; 3],
         fold: f64::NAN,
+        roll_rate: f64::NAN,
         kinetic: f64::NAN,
         elastic: f64::NAN,
         potential: f64::NAN,
@@ -105,8 +105,9 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         control_hinge_moments: [f64::NAN; aeroelastic::control_surface::MAX_CONTROL_SURFACES],
     };
     let mut rows = vec![nan; n];
-    let setters: [(&str, Setter); 18] = [
+    let setters: [(&str, Setter); 19] = [
         ("t", |r, x| r.t = x),
+        ("roll_rate", |r, x| r.roll_rate = x),
         ("tip_x", |r, x| r.tip[0] = x),
         ("tip_y", |r, x| r.tip[1] = x),
         ("tip_z", |r, x| r.tip[2] = x),

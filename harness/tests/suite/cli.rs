@@ -427,3 +427,34 @@ fn bad_hinge_events_exit_2_naming_the_field() {
         assert_clean_error(&o, needle);
     }
 }
+
+/// `roll_joint` (issue 35) must name a ground hinge: a flared hinge or no joint is refused with
+/// exit 2 naming the field; with the ground hinge the CSV gains `roll_rate` after `fold`.
+#[test]
+fn roll_joint_names_a_ground_hinge() {
+    use serde_json::json;
+    for (name, joint, needle) in
+        [("flared", "fold", "roll_joint: `fold` is not a ground hinge"), ("none", "nope", "roll_joint: no joint")]
+    {
+        let p = tmp_case(&format!("roll_{name}.json"), |v| v["roll_joint"] = json!(joint));
+        let o = harness(&["run", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2));
+        assert_clean_error(&o, needle);
+    }
+    let p = tmp_case("roll_ok.json", |v| {
+        v["roll_joint"] = json!("root");
+        v["t_end"] = json!(0.01);
+        for k in ["references", "gate", "converge"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+    });
+    let out = p.with_file_name("roll_ok_out");
+    let o = harness(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("double_pendulum_c1_beta45").join("gebf.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().starts_with("t,tip_x,tip_y,tip_z,fold,roll_rate,kinetic,"));
+    // Released from rest under gravity, the pendulum swings down about +Y: a positive rate.
+    let last: Vec<f64> = lines.last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    assert!(last[5] > 0.0, "{last:?}");
+}
