@@ -209,43 +209,6 @@ pub fn cantilever_tip_compliance(body: &BodySpec) -> Matrix3<f64> {
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use approx::assert_relative_eq;
-
-    /// Untwisted: Timoshenko's cantilever (1e-14). A quarter turn of twist, θ = k s with
-    /// `kL = π/2`, weighs the two bending compliances with `∫ (L−s)² cos²θ`, `∫ (L−s)² sin²θ`
-    /// and couples y and z through `∫ (L−s)² sin θ cos θ`, integrated by parts in closed form
-    /// below (1e-13).
-    #[test]
-    fn the_tip_compliance_has_its_closed_forms() {
-        let sec = pretwisted_section();
-        let l = 1.3;
-        let (b, _) = cantilever(sec, l, 1);
-        let g = cantilever_tip_compliance(&b[0]);
-        assert_relative_eq!(g[(2, 2)], l.powi(3) / (3.0 * sec.ei_yy) + l / sec.ga_z, max_relative = 1e-14);
-        assert_relative_eq!(g[(1, 1)], l.powi(3) / (3.0 * sec.ei_zz) + l / sec.ga_y, max_relative = 1e-14);
-        assert_relative_eq!(g[(0, 0)], l / sec.ea, max_relative = 1e-14);
-        let (b, _) = pretwisted_cantilever(sec, l, 1, 0.0, std::f64::consts::FRAC_PI_2);
-        let g = cantilever_tip_compliance(&b[0]);
-        // ∫ (L−s)² cos²(ks) ds, ∫ (L−s)² sin²(ks) ds, ∫ (L−s)² sin(ks) cos(ks) ds with kL = π/2:
-        // ∫ (L−s)² cos(2ks) ds = [(L−s)² sin 2ks/(2k)] + ∫ (L−s) sin(2ks)/k ds = L/(2k²) − sin(2kL)/(4k³) = L/(2k²)
-        // ∫ (L−s)² sin(2ks) ds = L²/(2k) − ∫ (L−s) cos(2ks)/k ds = L²/(2k) − (1 − cos 2kL)/(4k³) = L²/(2k) − 1/(2k³)
-        let k = std::f64::consts::FRAC_PI_2 / l;
-        let (i0, ic2, is2) = (l.powi(3) / 3.0, l / (2.0 * k * k), l * l / (2.0 * k) - 1.0 / (2.0 * k.powi(3)));
-        let (cc, ss, sc) = (0.5 * (i0 + ic2), 0.5 * (i0 - ic2), 0.5 * is2);
-        // force along z bends about the section's y (EI_yy) where θ = 0, about its z where θ = 90°
-        let gzz = cc / sec.ei_yy + ss / sec.ei_zz + l / sec.ga_z;
-        let gyy = ss / sec.ei_yy + cc / sec.ei_zz + l / sec.ga_y;
-        let gyz = -sc * (1.0 / sec.ei_yy - 1.0 / sec.ei_zz);
-        assert_relative_eq!(g[(2, 2)], gzz, max_relative = 1e-13);
-        assert_relative_eq!(g[(1, 1)], gyy, max_relative = 1e-13);
-        assert_relative_eq!(g[(1, 2)], gyz, max_relative = 1e-13);
-        assert_relative_eq!(g[(2, 1)], gyz, max_relative = 1e-13);
-    }
-}
-
 /// The section of [`flying_spaghetti`]: EA = GA = 10⁴ N, GJ = EI = 500 N·m², ρA = 1 kg/m,
 /// ρI = 10 kg·m (polar 20).
 pub fn spaghetti_section() -> Section {
@@ -311,4 +274,41 @@ pub fn spaghetti_loads(t: f64) -> [Vector3<f64>; 2] {
         0.0
     };
     [Vector3::new(20.0, 0.0, 0.0) * p, Vector3::new(0.0, 20.0, -10.0) * p]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// Untwisted: Timoshenko's cantilever (1e-14). A quarter turn of twist, θ = k s with
+    /// `kL = π/2`, weighs the two bending compliances with `∫ (L−s)² cos²θ`, `∫ (L−s)² sin²θ`
+    /// and couples y and z through `∫ (L−s)² sin θ cos θ`, integrated by parts in closed form
+    /// below (1e-13).
+    #[test]
+    fn the_tip_compliance_has_its_closed_forms() {
+        let sec = pretwisted_section();
+        let l = 1.3;
+        let (b, _) = cantilever(sec, l, 1);
+        let g = cantilever_tip_compliance(&b[0]);
+        assert_relative_eq!(g[(2, 2)], l.powi(3) / (3.0 * sec.ei_yy) + l / sec.ga_z, max_relative = 1e-14);
+        assert_relative_eq!(g[(1, 1)], l.powi(3) / (3.0 * sec.ei_zz) + l / sec.ga_y, max_relative = 1e-14);
+        assert_relative_eq!(g[(0, 0)], l / sec.ea, max_relative = 1e-14);
+        let (b, _) = pretwisted_cantilever(sec, l, 1, 0.0, std::f64::consts::FRAC_PI_2);
+        let g = cantilever_tip_compliance(&b[0]);
+        // ∫ (L−s)² cos²(ks) ds, ∫ (L−s)² sin²(ks) ds, ∫ (L−s)² sin(ks) cos(ks) ds with kL = π/2:
+        // ∫ (L−s)² cos(2ks) ds = [(L−s)² sin 2ks/(2k)] + ∫ (L−s) sin(2ks)/k ds = L/(2k²) − sin(2kL)/(4k³) = L/(2k²)
+        // ∫ (L−s)² sin(2ks) ds = L²/(2k) − ∫ (L−s) cos(2ks)/k ds = L²/(2k) − (1 − cos 2kL)/(4k³) = L²/(2k) − 1/(2k³)
+        let k = std::f64::consts::FRAC_PI_2 / l;
+        let (i0, ic2, is2) = (l.powi(3) / 3.0, l / (2.0 * k * k), l * l / (2.0 * k) - 1.0 / (2.0 * k.powi(3)));
+        let (cc, ss, sc) = (0.5 * (i0 + ic2), 0.5 * (i0 - ic2), 0.5 * is2);
+        // force along z bends about the section's y (EI_yy) where θ = 0, about its z where θ = 90°
+        let gzz = cc / sec.ei_yy + ss / sec.ei_zz + l / sec.ga_z;
+        let gyy = ss / sec.ei_yy + cc / sec.ei_zz + l / sec.ga_y;
+        let gyz = -sc * (1.0 / sec.ei_yy - 1.0 / sec.ei_zz);
+        assert_relative_eq!(g[(2, 2)], gzz, max_relative = 1e-13);
+        assert_relative_eq!(g[(1, 1)], gyy, max_relative = 1e-13);
+        assert_relative_eq!(g[(1, 2)], gyz, max_relative = 1e-13);
+        assert_relative_eq!(g[(2, 1)], gyz, max_relative = 1e-13);
+    }
 }
