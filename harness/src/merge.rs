@@ -255,6 +255,9 @@ impl MetricsRecord {
                 "tip_z" => "tip_z",
                 _ => "",
             },
+            // The stress study's cells have no roll joint (a merged case's metrics are evaluated
+            // afresh from its rows).
+            roll: None,
         }
     }
 }

@@ -39,6 +39,35 @@ pub fn window_stats(d: &[(f64, f64)], t_start: f64, t_end: f64) -> DiffStats {
     s
 }
 
+/// The roll response of a run with a `roll_joint` (the `roll_rate` column): its steady rate,
+/// the mean over the last quarter of the run; how much it still moves there; and the rise time,
+/// the first time the rate reaches 90 % of the steady one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RollResponse {
+    /// Mean roll rate over the last quarter of the run, rad/s.
+    pub steady_rate: f64,
+    /// Largest minus smallest rate over that quarter, relative to |steady_rate|.
+    pub spread: f64,
+    /// First time |rate| ≥ 0.9 |steady_rate|, s (NaN if never).
+    pub rise_time_s: f64,
+}
+
+impl RollResponse {
+    /// The response of `rows` (None without a finite `roll_rate`).
+    pub fn of(rows: &[Row]) -> Option<Self> {
+        let (t0, t1) = (rows.first()?.t, rows.last()?.t);
+        if !rows.iter().all(|r| r.roll_rate.is_finite()) || t1 <= t0 {
+            return None;
+        }
+        let tail: Vec<f64> =
+            rows.iter().filter(|r| r.t >= t1 - 0.25 * (t1 - t0) - 1e-12).map(|r| r.roll_rate).collect();
+        let steady = tail.iter().sum::<f64>() / tail.len() as f64;
+        let (lo, hi) = tail.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        let rise = rows.iter().find(|r| r.roll_rate.abs() >= 0.9 * steady.abs()).map_or(f64::NAN, |r| r.t);
+        Some(Self { steady_rate: steady, spread: (hi - lo) / steady.abs(), rise_time_s: rise })
+    }
+}
+
 /// Per-formulation metrics.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FormulationMetrics {
@@ -81,6 +110,9 @@ pub struct FormulationMetrics {
     pub oscillations: Vec<crate::pencil::Oscillation>,
     /// The signal of `oscillations`: `fold` or `tip_z`.
     pub oscillation_signal: &'static str,
+    /// The roll response (a case with a `roll_joint`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roll: Option<RollResponse>,
 }
 
 impl FormulationMetrics {
@@ -110,6 +142,7 @@ impl FormulationMetrics {
             aero_wall_s: run.aero_wall_s,
             oscillations: Vec::new(),
             oscillation_signal: "",
+            roll: RollResponse::of(&run.rows),
         }
         .with_oscillations(run)
     }
@@ -195,4 +228,56 @@ pub struct ReferenceMetrics {
     pub diff: DiffStats,
     /// Gate limit if any, m.
     pub tip_max_m: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RollResponse;
+    use crate::run::Row;
+
+    /// A first-order roll response `p(t) = p_ss (1 − e^(−t/τ))`: the steady rate is the last
+    /// quarter's mean, the rise time τ ln 10 to within the sampling, and no roll column gives
+    /// no response.
+    #[test]
+    fn roll_response_of_a_first_order_lag() {
+        let (p_ss, tau) = (-3.0, 0.1);
+        let rows: Vec<Row> = (0..=2000)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                Row { t, roll_rate: p_ss * (1.0 - (-t / tau).exp()), ..nan_row() }
+            })
+            .collect();
+        let x = RollResponse::of(&rows).unwrap();
+        // Over 1.5–2 s the lag has decayed to e^−15: the mean is p_ss within 1e-6.
+        assert!((x.steady_rate - p_ss).abs() < 1e-6 * p_ss.abs(), "{x:?}");
+        assert!(x.spread < 1e-6, "{x:?}");
+        assert!((x.rise_time_s - tau * 10f64.ln()).abs() <= 1e-3, "{x:?}");
+        let none: Vec<Row> = rows.iter().map(|r| Row { roll_rate: f64::NAN, ..r.clone() }).collect();
+        assert!(RollResponse::of(&none).is_none());
+    }
+
+    /// A row with every value NaN.
+    fn nan_row() -> Row {
+        let nan = f64::NAN;
+        Row {
+            t: nan,
+            tip: [nan; 3],
+            fold: nan,
+            roll_rate: nan,
+            kinetic: nan,
+            elastic: nan,
+            potential: nan,
+            spring: nan,
+            dissipated: nan,
+            total: nan,
+            constraint_residual: nan,
+            newton_iterations: 0,
+            aero_work: nan,
+            lift: nan,
+            root_bending_moment: nan,
+            root_torque: nan,
+            hinge_moment: nan,
+            control_hinge_moments: [nan; aeroelastic::control_surface::MAX_CONTROL_SURFACES],
+        }
+    }
 }

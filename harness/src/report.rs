@@ -166,6 +166,32 @@ pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
     write_plots(dir, r)
 }
 
+/// The roll response of each formulation (empty without a roll joint).
+fn roll_table(r: &CaseResult) -> String {
+    let rows: Vec<Vec<String>> = Formulation::ALL
+        .iter()
+        .filter_map(|f| r.metrics.get(f).and_then(|m| m.roll).map(|x| (f, x)))
+        .map(|(f, x)| {
+            vec![
+                f.label().to_string(),
+                format!("{:.4}", x.steady_rate),
+                format!("{:.2}", 100.0 * x.spread),
+                format!("{:.3}", x.rise_time_s),
+            ]
+        })
+        .collect();
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "<h3>Roll</h3>\n<p class=\"note\">Steady roll rate: the mean over the last quarter of the run; spread: how much it still moves there; rise time: the first time the rate reaches 90 % of the steady one.</p>\n",
+    );
+    s.push_str(&html_table(&["formulation", "steady roll rate [rad/s]", "spread [%]", "rise time [s]"], &rows, &|i| {
+        i >= 1
+    }));
+    s
+}
+
 /// The hinge events of a case's runs, one row per formulation and event (empty without events).
 fn events_table(r: &CaseResult) -> String {
     let rows: Vec<Vec<String>> = r
@@ -263,6 +289,11 @@ fn has_aero(r: &CaseResult) -> bool {
 }
 
 /// Whether the case records a fold angle (it has a flared hinge).
+/// Whether the case has a roll joint (the `roll_rate` column).
+fn has_roll(r: &CaseResult) -> bool {
+    r.runs.iter().any(|x| x.rows.iter().any(|y| y.roll_rate.is_finite()))
+}
+
 fn has_fold(r: &CaseResult) -> bool {
     r.runs.iter().any(|x| x.rows.iter().any(|y| y.fold.is_finite()))
 }
@@ -319,6 +350,12 @@ pub fn plots(r: &CaseResult) -> Vec<PlotFile> {
             )
         },
     });
+    if has_roll(r) {
+        v.push(PlotFile {
+            file: "roll_rate.svg",
+            caption: format!("Roll rate of the roll joint against time: {forms}."),
+        });
+    }
     if has_fold(r) {
         v.push(PlotFile {
             file: "fold.svg",
@@ -522,6 +559,20 @@ fn write_per_run(dir: &Path, r: &CaseResult) -> Result<(), Error> {
                 x_label: "t [s]".into(),
                 y_label: "lift [N]".into(),
                 series: per_run(&|run| run.rows.iter().filter(|x| x.lift.is_finite()).map(|x| (x.t, x.lift)).collect()),
+                ..Panel::default()
+            }],
+            1,
+            (1000, 330),
+        )?;
+    }
+    if has_roll(r) {
+        panels_svg(
+            &dir.join("roll_rate.svg"),
+            &[Panel {
+                title: format!("{} — roll rate", r.name),
+                x_label: "t [s]".into(),
+                y_label: "roll rate [rad/s]".into(),
+                series: per_run(&|run| run.rows.iter().map(|x| (x.t, x.roll_rate)).collect()),
                 ..Panel::default()
             }],
             1,
@@ -871,6 +922,7 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
         let _ = writeln!(s, "<p class=\"fail\">{}</p>", esc(e));
     }
     s.push_str(&events_table(r));
+    s.push_str(&roll_table(r));
     let name = esc(&r.name);
     let _ = writeln!(
         s,
