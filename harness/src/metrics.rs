@@ -252,7 +252,7 @@ mod tests {
         assert!((x.steady_rate - p_ss).abs() < 1e-6 * p_ss.abs(), "{x:?}");
         assert!(x.spread < 1e-6, "{x:?}");
         assert!((x.rise_time_s - tau * 10f64.ln()).abs() <= 1e-3, "{x:?}");
-        let none: Vec<Row> = rows.iter().map(|r| Row { roll_rate: f64::NAN, ..r.clone() }).collect();
+        let none: Vec<Row> = rows.iter().map(|r| Row { roll_rate: f64::NAN, ..*r }).collect();
         assert!(RollResponse::of(&none).is_none());
     }
 
