@@ -445,6 +445,7 @@ pub fn simulate_aero_with_events<S: Structure>(
     r0.lift = c.lift;
     r0.control_hinge_moments = c.hinge;
     with_loads(model, &mut r0, &s, &c.loads);
+    events.set_root_bending_moment_start(r0.root_bending_moment);
     out.rows.push(r0);
     if let Err(e) = feed.feed(model, &r0, &s.q, Some(&c.uv)) {
         return fail(out, format!("output at t = {}: {e}", s.t));

@@ -83,6 +83,10 @@ pub struct Trigger {
     /// up positive; needs `aero` and a clamp: the `root_bending_moment` column).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub root_bending_moment_above: Option<f64>,
+    /// Fires when the root bending moment exceeds its value at the start of the run by this,
+    /// N·m (a gust's increment over the equilibrium it starts from; needs `aero` and a clamp).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub root_bending_moment_increment_above: Option<f64>,
 }
 
 /// When a scheduled event acts.
@@ -102,6 +106,8 @@ pub enum When {
     },
     /// When the root bending moment exceeds this, N·m.
     RootBendingMoment(f64),
+    /// When the root bending moment exceeds its value at the start by this, N·m.
+    RootBendingMomentIncrement(f64),
 }
 
 /// An event as it happened in a run.
@@ -145,6 +151,8 @@ pub struct Events<'a, S> {
     pub records: Vec<EventRecord>,
     /// Counters of the integrators the events replaced.
     replaced: genalpha::Stats,
+    /// The root bending moment at the start of the run, N·m (NaN until set).
+    rbm_start: f64,
 }
 
 impl<'a, S: Structure> Events<'a, S> {
@@ -157,17 +165,32 @@ impl<'a, S: Structure> Events<'a, S> {
         let (mut pending, triggered): (Vec<_>, Vec<_>) =
             events.into_iter().partition(|e| matches!(e.when, When::Time(_)));
         pending.sort_by(|a, b| time(b).total_cmp(&time(a)));
-        Self { pending, triggered, rebuild, records: Vec::new(), replaced: genalpha::Stats::default() }
+        Self {
+            pending,
+            triggered,
+            rebuild,
+            records: Vec::new(),
+            replaced: genalpha::Stats::default(),
+            rbm_start: f64::NAN,
+        }
+    }
+
+    /// The root bending moment at the start of the run, the reference of
+    /// [`When::RootBendingMomentIncrement`], N·m.
+    pub fn set_root_bending_moment_start(&mut self, m: f64) {
+        self.rbm_start = m;
     }
 
     /// Whether a pending event watches the root bending moment (which the march then evaluates
     /// at every step).
     pub fn watches_root_bending_moment(&self) -> bool {
-        self.triggered.iter().any(|e| matches!(e.when, When::RootBendingMoment(_)))
+        self.triggered
+            .iter()
+            .any(|e| matches!(e.when, When::RootBendingMoment(_) | When::RootBendingMomentIncrement(_)))
     }
 
     /// Whether `e`'s condition holds at `s` (`rbm`: the root bending moment there, NaN unknown).
-    fn holds(e: &ScheduledEvent, model: &S, s: &State, dt: f64, rbm: f64) -> bool {
+    fn holds(&self, e: &ScheduledEvent, model: &S, s: &State, dt: f64, rbm: f64) -> bool {
         match e.when {
             When::Time(t) => t < s.t + 0.5 * dt,
             When::Fold { joint, above, below } => {
@@ -175,6 +198,7 @@ impl<'a, S: Structure> Events<'a, S> {
                 fold > above || fold < below
             }
             When::RootBendingMoment(m) => rbm > m,
+            When::RootBendingMomentIncrement(m) => rbm - self.rbm_start > m,
         }
     }
 
@@ -209,9 +233,9 @@ impl<'a, S: Structure> Events<'a, S> {
         loop {
             // The timed events due, in time order, then the triggered ones whose condition holds
             // (checked on the state as the earlier events of this step left it).
-            let e = if self.pending.last().is_some_and(|e| Self::holds(e, model, s, params.dt, rbm)) {
+            let e = if self.pending.last().is_some_and(|e| self.holds(e, model, s, params.dt, rbm)) {
                 self.pending.pop().expect("checked above")
-            } else if let Some(k) = self.triggered.iter().position(|e| Self::holds(e, model, s, params.dt, rbm)) {
+            } else if let Some(k) = self.triggered.iter().position(|e| self.holds(e, model, s, params.dt, rbm)) {
                 self.triggered.remove(k)
             } else {
                 break;

@@ -207,9 +207,10 @@ pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
             let joint = index(&e.joint)?;
             let when = match (e.time, &e.when) {
                 (Some(t), _) => When::Time(t),
-                (None, Some(w)) => match w.root_bending_moment_above {
-                    Some(m) => When::RootBendingMoment(m),
-                    None => When::Fold {
+                (None, Some(w)) => match (w.root_bending_moment_above, w.root_bending_moment_increment_above) {
+                    (Some(m), _) => When::RootBendingMoment(m),
+                    (None, Some(m)) => When::RootBendingMomentIncrement(m),
+                    (None, None) => When::Fold {
                         joint: w.joint.as_deref().map_or(Some(joint), index)?,
                         above: w.fold_deg_above.map_or(f64::INFINITY, f64::to_radians),
                         below: w.fold_deg_below.map_or(f64::NEG_INFINITY, f64::to_radians),

@@ -9,9 +9,7 @@
 
 use std::time::Instant;
 
-use formulation::Structure;
-
-use crate::aero::{simulate_aero_from, station_map};
+use crate::aero::{simulate_aero_with_events, station_map};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::problem::{Formulation, Joint, Problem, Spring};
 
@@ -23,10 +21,20 @@ impl HingeState {
     pub fn apply(&self, case: &Problem) -> Result<Problem, String> {
         let mut c = case.clone();
         let j = c.fold_joint_index().ok_or("gust.hinges: the case has no flared hinge to free, lock or spring")?;
-        if let Joint::FlaredHinge { locked, spring, .. } = &mut c.joints[j] {
+        if let Joint::FlaredHinge { locked, spring, name, .. } = &mut c.joints[j] {
             match self {
                 HingeState::Free => *locked = false,
                 HingeState::Locked => *locked = true,
+                HingeState::Release { root_bending_moment_increment_above } => {
+                    *locked = true;
+                    let joint = name.get_or_insert_with(|| format!("joints[{j}]")).clone();
+                    let when = crate::events::Trigger {
+                        root_bending_moment_increment_above: Some(*root_bending_moment_increment_above),
+                        ..Default::default()
+                    };
+                    let action = crate::events::HingeAction::Release;
+                    c.events.push(crate::events::HingeEvent { time: None, when: Some(when), joint, action });
+                }
                 HingeState::Spring { stiffness, damping } => {
                     *locked = false;
                     let rest_deg = spring.map_or(0.0, |s| s.rest_deg);
@@ -71,6 +79,16 @@ impl GustSweep {
             return Err("gust.hinges: empty list".into());
         }
         for (k, h) in self.hinges.iter().enumerate() {
+            if let HingeState::Release { root_bending_moment_increment_above: m } = h {
+                if !m.is_finite() {
+                    return Err(format!("gust.hinges[{k}].root_bending_moment_increment_above: {m} is not finite"));
+                }
+                if !case.joints.iter().any(|j| matches!(j, Joint::Clamp { .. })) {
+                    return Err(format!(
+                        "gust.hinges[{k}]: a release on the root bending moment needs a clamp (where it is measured)"
+                    ));
+                }
+            }
             if let HingeState::Spring { stiffness, damping } = h {
                 if !(stiffness.is_finite() && *stiffness >= 0.0) {
                     return Err(format!("gust.hinges[{k}].stiffness: {stiffness} is not a non-negative number"));
@@ -193,7 +211,7 @@ pub fn gust_history(case: &Problem, f: Formulation, q_eq: Option<&[f64]>) -> Res
         type Output = Result<crate::run::RunOutput, String>;
         fn run<M: BuildModel>(self) -> Self::Output {
             let mut m = M::build(self.0).map_err(|e| e.to_string())?;
-            march(self.0, self.1, &mut m, self.2)
+            march::<M>(self.0, self.1, &mut m, self.2)
         }
     }
     let out = dispatch(f, March(case, f, q))?;
@@ -223,16 +241,19 @@ pub fn gust_history(case: &Problem, f: Formulation, q_eq: Option<&[f64]>) -> Res
     })
 }
 
-fn march<S: Structure>(
+/// The march of a gust run, with the case's hinge events (a [`HingeState::Release`]).
+fn march<M: BuildModel>(
     case: &Problem,
     f: Formulation,
-    model: &mut S,
+    model: &mut M,
     q: &[f64],
 ) -> Result<crate::run::RunOutput, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let map = station_map(case, aero)?;
     let settings = crate::factory::settings(case, f);
-    Ok(simulate_aero_from(f, model, &settings, aero, &map, &mut crate::run::NoObserver, Some(q)))
+    let mut events = crate::factory::hinge_events::<M>(case);
+    let observer = &mut crate::run::NoObserver;
+    Ok(simulate_aero_with_events(f, model, &settings, aero, &map, observer, Some(q), &mut events))
 }
 
 /// The largest-magnitude value of `v` (signed) and its time; (NaN, NaN) when empty.

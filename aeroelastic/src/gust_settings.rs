@@ -289,6 +289,13 @@ pub enum HingeState {
         #[cfg_attr(feature = "serde", serde(default))]
         damping: f64,
     },
+    /// Locked at the equilibrium (whose state is the locked wing's), and released when the gust
+    /// raises the root bending moment by more than this over its value there, N·m: a
+    /// load-triggered release (a hinge event, docs/coupling.md §8).
+    Release {
+        /// The root bending moment increment that releases the hinge, N·m.
+        root_bending_moment_increment_above: f64,
+    },
 }
 
 impl HingeState {
@@ -298,6 +305,7 @@ impl HingeState {
             HingeState::Free => "free",
             HingeState::Locked => "locked",
             HingeState::Spring { .. } => "spring",
+            HingeState::Release { .. } => "release",
         }
     }
 

@@ -221,10 +221,12 @@ impl Case {
         w: &aeroelastic::events::Trigger,
         hinge: &dyn Fn(String, &str) -> Result<usize, String>,
     ) -> Result<(), String> {
-        let set = [w.fold_deg_above, w.fold_deg_below, w.root_bending_moment_above];
+        let set =
+            [w.fold_deg_above, w.fold_deg_below, w.root_bending_moment_above, w.root_bending_moment_increment_above];
         if set.iter().filter(|x| x.is_some()).count() != 1 {
             return Err(format!(
-                "{field}: give exactly one of fold_deg_above, fold_deg_below, root_bending_moment_above"
+                "{field}: give exactly one of fold_deg_above, fold_deg_below, root_bending_moment_above, \
+                 root_bending_moment_increment_above"
             ));
         }
         for (name, x) in [("fold_deg_above", w.fold_deg_above), ("fold_deg_below", w.fold_deg_below)] {
@@ -235,15 +237,18 @@ impl Case {
         if let Some(j) = &w.joint {
             hinge(format!("{field}.joint"), j)?;
         }
-        if let Some(m) = w.root_bending_moment_above {
-            finite_in(&format!("{field}.root_bending_moment_above"), m)?;
+        let moment = [
+            ("root_bending_moment_above", w.root_bending_moment_above),
+            ("root_bending_moment_increment_above", w.root_bending_moment_increment_above),
+        ];
+        if let Some((name, m)) = moment.iter().find_map(|(n, x)| x.map(|m| (*n, m))) {
+            let field = format!("{field}.{name}");
+            finite_in(&field, m)?;
             if w.joint.is_some() {
-                return Err(format!("{field}.joint: a root bending moment trigger watches no joint"));
+                return Err(format!("{field}: a root bending moment trigger watches no joint"));
             }
             if self.aero.is_none() || !self.joints.iter().any(|j| matches!(j, Joint::Clamp { .. })) {
-                return Err(format!(
-                    "{field}.root_bending_moment_above: needs `aero` and a clamp (where the moment is measured)"
-                ));
+                return Err(format!("{field}: needs `aero` and a clamp (where the moment is measured)"));
             }
         }
         Ok(())

@@ -217,6 +217,7 @@ pub fn history_csv(s: &GustSummary, f: Formulation) -> String {
 fn hinge_name(h: &HingeState) -> String {
     match h {
         HingeState::Spring { stiffness, .. } => format!("spring {stiffness} N·m/rad"),
+        HingeState::Release { root_bending_moment_increment_above: m } => format!("released at ΔM {m} N·m"),
         _ => h.label().to_string(),
     }
 }
