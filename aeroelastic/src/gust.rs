@@ -256,6 +256,13 @@ fn march<M: BuildModel>(
     Ok(simulate_aero_with_events(f, model, &settings, aero, &map, observer, Some(q), &mut events))
 }
 
+/// The largest value of `v` and its time; (NaN, NaN) when empty.
+pub fn maximum(t: &[f64], v: &[f64]) -> (f64, f64) {
+    t.iter()
+        .zip(v)
+        .fold((f64::NAN, f64::NAN), |best, (&ti, &x)| if best.0.is_nan() || x > best.0 { (x, ti) } else { best })
+}
+
 /// The largest-magnitude value of `v` (signed) and its time; (NaN, NaN) when empty.
 pub fn peak(t: &[f64], v: &[f64]) -> (f64, f64) {
     let mut best = (f64::NAN, f64::NAN);
@@ -283,6 +290,9 @@ pub struct GustRun {
     pub gust_velocity: f64,
     /// Peak incremental root bending moment (largest magnitude, signed), N·m, and its time, s.
     pub peak_delta_root_bending_moment: (f64, f64),
+    /// Largest upward increment of the root bending moment, N·m, and its time, s: the gust load
+    /// a release relieves (whose largest-magnitude increment can be the relief itself).
+    pub max_delta_root_bending_moment: (f64, f64),
     /// Peak incremental root torque, N·m, and its time.
     pub peak_delta_root_torque: (f64, f64),
     /// Peak incremental hinge moment, N·m, and its time.
@@ -364,6 +374,7 @@ pub fn run_sweep(base: &Problem, cases: &[(Formulation, &Problem)]) -> Result<Gu
                 frequency_hz: airspeed / (2.0 * h),
                 gust_velocity: g.velocity(aero.rho),
                 peak_delta_root_bending_moment: (f64::NAN, f64::NAN),
+                max_delta_root_bending_moment: (f64::NAN, f64::NAN),
                 peak_delta_root_torque: (f64::NAN, f64::NAN),
                 peak_delta_hinge_moment: (f64::NAN, f64::NAN),
                 peak_delta_fold_deg: (f64::NAN, f64::NAN),
@@ -388,6 +399,7 @@ pub fn run_sweep(base: &Problem, cases: &[(Formulation, &Problem)]) -> Result<Gu
                 Ok(hist) => {
                     let inc = &hist.increments;
                     run.peak_delta_root_bending_moment = peak(&inc.t, &inc.delta_root_bending_moment);
+                    run.max_delta_root_bending_moment = maximum(&inc.t, &inc.delta_root_bending_moment);
                     run.peak_delta_root_torque = peak(&inc.t, &inc.delta_root_torque);
                     run.peak_delta_hinge_moment = peak(&inc.t, &inc.delta_hinge_moment);
                     run.peak_delta_fold_deg = peak(&inc.t, &inc.delta_fold_deg);

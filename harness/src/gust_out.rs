@@ -19,7 +19,7 @@ use crate::static_out::{Curves, panel, style};
 pub const HEADER: &str = "hinge,spring_stiffness,gradient_m,frequency_hz,gust_velocity,\
 peak_delta_root_bending_moment,t_peak_root_bending_moment,peak_delta_fold_deg,t_peak_fold,\
 peak_delta_root_torque,peak_delta_hinge_moment,peak_delta_lift,static_root_bending_moment,static_fold_deg,\
-alleviation_percent,cpu_s,error";
+alleviation_percent,cpu_s,error,max_delta_root_bending_moment,t_max_root_bending_moment";
 
 /// Column header of `gust_history_<f>.csv`.
 pub const HISTORY_HEADER: &str = "hinge,spring_stiffness,gradient_m,t,delta_root_bending_moment,delta_root_torque,\
@@ -166,7 +166,7 @@ pub fn to_csv(s: &GustSummary, f: Formulation) -> String {
         let eq = r.equilibrium.as_ref();
         let _ = writeln!(
             t,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.hinge.label(),
             r.hinge.stiffness(),
             r.gradient_m,
@@ -183,7 +183,9 @@ pub fn to_csv(s: &GustSummary, f: Formulation) -> String {
             eq.map_or(f64::NAN, |e| e.fold_deg),
             alleviation_of(s, r),
             r.cpu_s,
-            r.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
+            r.error.as_deref().unwrap_or("").replace([',', '\n'], ";"),
+            r.max_delta_root_bending_moment.0,
+            r.max_delta_root_bending_moment.1
         );
     }
     t

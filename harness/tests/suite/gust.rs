@@ -80,6 +80,10 @@ fn wing_gust_ancf_and_gebf_agree() {
         let h = r.history.as_ref().unwrap();
         // The peak is the largest magnitude of the recorded series.
         assert_eq!(peak(&h.increments.t, &h.increments.delta_root_bending_moment), r.peak_delta_root_bending_moment);
+        // The upward peak is the largest value, at or below the largest magnitude.
+        let up = h.increments.delta_root_bending_moment.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x));
+        assert_eq!(r.max_delta_root_bending_moment.0, up);
+        assert!(up <= r.peak_delta_root_bending_moment.0.abs());
         println!(
             "{} {} H = {} m: {:.2} s CPU for {} s simulated",
             r.formulation,
