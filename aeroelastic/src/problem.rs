@@ -49,6 +49,8 @@ pub struct Problem {
     pub roll_joint: Option<String>,
     /// Hinge events of the time march: hinges locked or released at given times.
     pub events: Vec<crate::events::HingeEvent>,
+    /// Thrusts: follower forces on bodies (`thrust`).
+    pub thrust: Vec<crate::thrust::Thrust>,
     /// ANCF's discretisation and integrator settings.
     pub ancf: AncfSettings,
     /// GEBF's discretisation and integrator settings.

@@ -85,6 +85,11 @@ pub struct Case {
     /// (docs/case-file.md §2.1).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<aeroelastic::events::HingeEvent>,
+    /// Thrusts, follower forces on bodies: `{ "body", "at", "direction", "magnitude" }` or a list
+    /// of them (docs/case-file.md §2.2).
+    #[serde(default, skip_serializing_if = "Vec::is_empty", deserialize_with = "one_or_many")]
+    #[cfg_attr(feature = "schema", schemars(with = "OneOrMany<aeroelastic::thrust::Thrust>"))]
+    pub thrust: Vec<aeroelastic::thrust::Thrust>,
     /// ANCF settings.
     pub ancf: AncfSettings,
     /// GEBF settings.
@@ -131,6 +136,27 @@ pub struct Case {
     #[serde(skip)]
     #[cfg_attr(feature = "schema", schemars(skip))]
     pub polars: Vec<aeroelastic::section_polars::BodyPolar>,
+}
+
+/// One entry or a list of them (the case field `thrust`).
+#[derive(Deserialize)]
+#[cfg_attr(feature = "schema", derive(JsonSchema))]
+#[serde(untagged)]
+#[allow(dead_code)] // only its schema and its deserialisation are used
+enum OneOrMany<T> {
+    One(T),
+    Many(Vec<T>),
+}
+
+fn one_or_many<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Ok(match OneOrMany::deserialize(d)? {
+        OneOrMany::One(t) => vec![t],
+        OneOrMany::Many(v) => v,
+    })
 }
 
 fn is_zero(v: &f64) -> bool {

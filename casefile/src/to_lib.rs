@@ -21,6 +21,7 @@ impl Case {
             fold_joint: self.fold_joint.clone(),
             roll_joint: self.roll_joint.clone(),
             events: self.events.clone(),
+            thrust: self.thrust.clone(),
             ancf: self.ancf.clone(),
             gebf: self.gebf.clone(),
             aero: self.aero.clone(),
