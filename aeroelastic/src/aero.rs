@@ -214,7 +214,7 @@ fn place_control_surfaces(
         let next = map[j].hinge.then(|| map.get(j + 1).map(|m| m.body)).flatten();
         map[j].control = crate::control_surface::surface_at(case, cs, map[j].body, map[j].s, next)?;
     }
-    crate::control_surface::columns(map, cs.len()).map(|_| ())
+    crate::control_surface::columns(map, cs).map(|_| ())
 }
 
 /// Blend the columns next to a slanted hinge column towards its slant, so that no panel folds
@@ -584,7 +584,7 @@ impl<'a> MarchAero<'a> {
         let mut scratch = (Vec::new(), Vec::new(), Vec::new());
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
         stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
-        let surface_columns = crate::control_surface::columns(map, aero.control_surfaces.len())?;
+        let surface_columns = crate::control_surface::columns(map, &aero.control_surfaces)?;
         let mut hinge = [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES];
         hinge.iter_mut().take(surface_columns.len()).for_each(|h| *h = 0.0);
         let mut params = aero.uvlm_params(aero.free_stream());

@@ -82,6 +82,12 @@ impl ControlSurface {
         }
     }
 
+    /// Whether `other` is deflected as this surface at every time: the same chord fraction and
+    /// deflection (number or schedule). Such surfaces may meet at a station.
+    pub fn alike(&self, other: &ControlSurface) -> bool {
+        self.chord_fraction == other.chord_fraction && self.deflection_deg == other.deflection_deg
+    }
+
     /// Whether this surface covers arclength `s` of body `body` (a panel edge; tolerance 1e-9
     /// of the body length).
     fn covers(&self, case: &Problem, body: usize, s: f64) -> bool {
@@ -104,9 +110,11 @@ pub(crate) fn surface_at(
     let on = |c: &ControlSurface| c.covers(case, body, s) || next.is_some_and(|n| c.covers(case, n, 0.0));
     let mut found = surfaces.iter().enumerate().filter(|(_, c)| on(c)).map(|(i, _)| i);
     match (found.next(), found.next()) {
+        (Some(a), Some(b)) if surfaces[a].alike(&surfaces[b]) && found.next().is_none() => Ok(Some(a)),
         (Some(a), Some(b)) => Err(format!(
             "aero.control_surfaces[{b}]: shares a lattice station column with aero.control_surfaces[{a}] \
-             (body `{}` at s = {s}); surfaces must be apart by at least one panel",
+             (body `{}` at s = {s}); surfaces must be apart by at least one panel, or have one chord fraction \
+             and one deflection",
             case.bodies[body].name
         )),
         (a, None) => Ok(a),
@@ -174,16 +182,25 @@ pub fn check(case: &Problem, surfaces: &[ControlSurface], lattice: &[Option<(usi
     Ok(())
 }
 
-/// Check that no two surfaces share a station column of `map`, and give each surface's columns.
+/// Each surface's station columns in `map` (a station shared with an alike surface that
+/// carries it, [`surface_at`], starts the later surface's range too).
 pub(crate) fn columns(
     map: &[crate::aero::StationMap],
-    n_surfaces: usize,
+    surfaces: &[ControlSurface],
 ) -> Result<Vec<std::ops::RangeInclusive<usize>>, String> {
-    let mut out = Vec::with_capacity(n_surfaces);
-    for i in 0..n_surfaces {
+    let mut out = Vec::with_capacity(surfaces.len());
+    for (i, c) in surfaces.iter().enumerate() {
         let mut js = map.iter().enumerate().filter(|(_, m)| m.control == Some(i)).map(|(j, _)| j);
-        let first = js.next().ok_or_else(|| format!("aero.control_surfaces[{i}].span: covers no lattice station"))?;
+        let mut first =
+            js.next().ok_or_else(|| format!("aero.control_surfaces[{i}].span: covers no lattice station"))?;
         let last = js.next_back().unwrap_or(first);
+        let shared = |j: usize| {
+            map[j].lifting == map[first].lifting
+                && map[j].control.is_some_and(|a| a != i && surfaces.get(a).is_some_and(|o| o.alike(c)))
+        };
+        if first > 0 && shared(first - 1) {
+            first -= 1;
+        }
         out.push(first..=last);
     }
     Ok(out)

@@ -34,6 +34,7 @@ pub mod stability_settings;
 pub mod static_hold;
 pub mod statics;
 pub mod thrust;
+pub mod trim;
 
 pub use problem::{Formulation, Problem};
 

@@ -253,6 +253,21 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         Ok(())
     }
 
+    /// Replace the aerodynamic settings (a turned free stream, new control-surface deflections;
+    /// the station map stays): the lattice is rebuilt at `q`, the aerodynamic stiffness kept (a
+    /// Newton iteration refreshes it when it stops contracting). The trim's step.
+    pub fn set_aero(&mut self, aero: &AeroSettings, q: &[f64]) -> Result<(), String> {
+        self.aero = aero.clone();
+        let v = self.aero.free_stream();
+        let solves = lock(&self.aero_state).n_solves;
+        let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake)?;
+        st.n_solves = solves;
+        *lock(&self.aero_state) = st;
+        self.speed2 = v.iter().map(|x| x * x).sum();
+        self.begin_solve(false);
+        Ok(())
+    }
+
     /// Change the sideslip angle (the airspeed kept): the lattice is rebuilt at `q`; the
     /// aerodynamic stiffness is kept (a Newton iteration refreshes it when it stops contracting).
     pub fn set_sideslip(&mut self, sideslip_deg: f64, q: &[f64]) -> Result<(), String> {
@@ -353,7 +368,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// lattice solve (call after [`Self::evaluate_at`]); the lattice's loads, without the section
     /// polars' correction.
     pub fn control_hinge_moments(&self, map: &[StationMap]) -> Result<Vec<f64>, String> {
-        let cols = crate::control_surface::columns(map, self.aero.control_surfaces.len())?;
+        let cols = crate::control_surface::columns(map, &self.aero.control_surfaces)?;
         let st = lock(&self.aero_state);
         let ranges = crate::lifting::surface_ranges(map);
         cols.into_iter()
@@ -713,7 +728,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
 
 /// Newton settings of the static points: the generic defaults, with room for the linear
 /// convergence of a kept aerodynamic stiffness.
-fn static_params() -> StaticParams {
+pub(crate) fn static_params() -> StaticParams {
     StaticParams { max_iter: ROUND_ITERATIONS, tol: 1e-10, rel_residual_tol: 1e-10 }
 }
 
@@ -959,7 +974,7 @@ fn walk_order(st: &crate::problem::StaticSettings, at: &[(f64, f64)]) -> (Vec<us
 /// Newton on the aeroelastic system from `x`, in rounds of up to [`ROUND_ITERATIONS`]
 /// iterations: the aerodynamic stiffness (the costly part of the tangent) is kept within a round
 /// and from the previous point, and re-evaluated at the start of every further round.
-fn solve_rounds<S: Structure>(
+pub(crate) fn solve_rounds<S: Structure>(
     sys: &mut AeroStatic<'_, S>,
     solver: &mut StaticSolver,
     x: &mut StaticSolution,
@@ -995,7 +1010,7 @@ fn solve_rounds<S: Structure>(
 /// load, which sets the fold, is the final one at every step while the elastic deflection grows
 /// from zero. A step that fails is halved. (Newton straight to the full load can land on a
 /// spurious state of a folded-over lattice on a flexible wing.)
-fn load_stepping<S: Structure>(
+pub(crate) fn load_stepping<S: Structure>(
     case: &Problem,
     build: fn(&Problem) -> Result<S, Error>,
     top: f64,
@@ -1068,7 +1083,7 @@ fn bisect_to<S: Structure>(
 }
 
 /// The outputs at the equilibrium `q` of `sys`.
-fn point_at<S: Structure>(
+pub(crate) fn point_at<S: Structure>(
     sys: &AeroStatic<'_, S>,
     q: &[f64],
     case: &Problem,

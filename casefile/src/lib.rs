@@ -123,6 +123,10 @@ pub struct Case {
     /// experiment or model curves to compare with. Needs `aero`.
     #[serde(default, rename = "static", skip_serializing_if = "Option::is_none")]
     pub statics: Option<StaticSettings>,
+    /// Trim in steady level flight (`harness trim`): the control surfaces that act as the
+    /// elevator and the solver's settings. Needs a free joint, `aero` and `thrust`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trim: Option<aeroelastic::trim::TrimSettings>,
     /// Linearised stability (`harness stability`): airspeeds, modes to track, the state to
     /// linearise about. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -73,6 +73,9 @@ impl Case {
         if let Some(g) = &self.gust {
             g.validate(&self.problem())?;
         }
+        if let Some(t) = &self.trim {
+            t.validate(&self.problem())?;
+        }
         match (&self.statics, self.aero.is_some()) {
             (Some(st), false) => self.check_structural_static(st)?,
             (Some(st), true) => check_aero_static(st)?,

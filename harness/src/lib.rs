@@ -28,6 +28,7 @@ pub mod signal;
 pub mod stability_out;
 pub mod static_out;
 pub mod stress;
+pub mod trim_out;
 pub mod view3d;
 pub mod vtk;
 

@@ -107,6 +107,20 @@ struct AnalysisArgs {
     shard: ShardOpt,
 }
 
+/// `harness trim`.
+#[derive(Args, Clone)]
+struct TrimArgs {
+    /// Case file (with a `trim` block, a free joint, `aero` and `thrust`).
+    case: PathBuf,
+    /// Formulation(s) to trim.
+    #[arg(long, value_parser = Which::parser(), default_value = "both")]
+    formulation: Which,
+    #[command(flatten)]
+    out: OutOpt,
+    #[command(flatten)]
+    set: SetOpt,
+}
+
 /// `harness all`.
 #[derive(Args)]
 struct AllArgs {
@@ -318,6 +332,10 @@ enum Cmd {
     /// equilibrium; writes `<out>/<case>/gust_{ancf,gebf}.csv`, `gust_history_*.csv`,
     /// `gust_summary.json` and plots (docs/gust.md).
     Gust(AnalysisArgs),
+    /// Trim a free aircraft in steady level flight (the case's `trim` block): angle of attack,
+    /// elevator deflection and thrust with no net force and pitching moment; writes
+    /// `<out>/<case>/trim_{ancf,gebf}.json` (docs/trim.md).
+    Trim(TrimArgs),
     /// List the runs the case files expand into.
     List(CaseSource),
     /// Print the JSON Schema of case files.
@@ -862,6 +880,28 @@ fn cmd_gust(a: &AnalysisArgs) -> Result<ExitCode> {
     analysis_loop(Analysis::Gust, &fs, &runs, plan.as_ref(), &a.out.out, |spec| gust_case(spec, &fs, &a.out.out, &file))
 }
 
+/// `harness trim`: every run of the case file trimmed; exit 2 without a `trim` block or on a bad
+/// one (named by the case's validation), 1 when a trim failed.
+fn cmd_trim(a: &TrimArgs) -> Result<ExitCode> {
+    let fs = a.formulation.formulations();
+    let file = CaseFile::read(&a.case)?;
+    let runs = file.expand_for(&a.set.set, &harness::budget::limits(), None, &fs)?;
+    let name = a.case.display().to_string();
+    if let Some(r) = runs.iter().find(|r| fs.iter().any(|&f| r.case(f).trim.is_none())) {
+        let msg = format!("trim: the case has no `trim` block ({})", r.name);
+        return Err(harness::Error::Case { file: name, msg }.into());
+    }
+    let mut failed = false;
+    for spec in &runs {
+        let outs = harness::trim_out::run(spec, &fs).map_err(|msg| harness::Error::Case { file: name.clone(), msg })?;
+        let dir = a.out.out.join(&spec.name);
+        harness::trim_out::write(&dir, &outs)?;
+        failed |= harness::trim_out::report(&spec.name, &outs);
+        println!("wrote {}", dir.display());
+    }
+    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
 /// `harness check`: exit 0 (runs), 1 (a run failed), 101 (a panic), 2 (bad input).
 fn cmd_check(a: &CheckArgs) -> Result<ExitCode> {
     use harness::fuzz::Class;
@@ -1398,6 +1438,7 @@ fn real_main() -> Result<ExitCode> {
         Cmd::Merge(a) => cmd_merge(a),
         Cmd::Stability(a) => cmd_stability(a),
         Cmd::Gust(a) => cmd_gust(a),
+        Cmd::Trim(a) => cmd_trim(a),
         Cmd::List(a) => cmd_list(a),
         Cmd::Schema => cmd_schema(),
     }

@@ -29,5 +29,6 @@ mod statics_bend;
 #[cfg(target_os = "linux")]
 mod streamed;
 mod surfaces;
+mod trim;
 mod vtk;
 mod vtk_parse;

@@ -1,0 +1,89 @@
+//! `harness trim`: the trimmed state of each formulation as `trim_<formulation>.json`, and the
+//! lines the command prints (docs/trim.md, docs/outputs.md §5).
+
+use std::path::Path;
+
+use serde_json::json;
+
+use crate::Error;
+use crate::case::RunSpec;
+use aeroelastic::Formulation;
+use aeroelastic::trim::{TrimOutput, run_trim};
+
+/// Trim `spec` with each formulation of `fs` (in parallel); the outputs in `fs`'s order, or the
+/// message when the case has no `trim` block.
+pub fn run(spec: &RunSpec, fs: &[Formulation]) -> Result<Vec<TrimOutput>, String> {
+    use rayon::prelude::*;
+    let settings: Vec<_> = fs
+        .iter()
+        .map(|&f| spec.case(f).trim.clone().ok_or_else(|| "trim: the case has no `trim` block".to_string()))
+        .collect::<Result<_, _>>()?;
+    Ok(fs.par_iter().zip(&settings).map(|(&f, t)| run_trim(&spec.case(f).problem(), f, t)).collect())
+}
+
+/// The JSON of one trim: `alpha_deg`, `controls` (name → deg), `thrust`, the residuals and the
+/// deformed state.
+pub fn to_json(o: &TrimOutput) -> serde_json::Value {
+    let controls: serde_json::Map<String, serde_json::Value> =
+        o.controls.iter().map(|(n, d)| (n.clone(), json!(d))).collect();
+    json!({
+        "formulation": o.formulation.as_str(),
+        "converged": o.converged,
+        "error": o.error,
+        "airspeed": o.airspeed,
+        "alpha_deg": o.alpha_deg,
+        "controls": controls,
+        "thrust": o.thrust,
+        "residuals": {
+            "force_forward": o.residuals.force_forward,
+            "force_up": o.residuals.force_up,
+            "pitch_moment": o.residuals.pitch_moment,
+        },
+        "lift": o.lift,
+        "drag": o.drag,
+        "tip": o.tip,
+        "iterations": o.iterations,
+        "static_solves": o.static_solves,
+        "wall_s": o.wall_s,
+        "state": { "q": o.q },
+    })
+}
+
+/// Write `<dir>/trim_<formulation>.json` for each output.
+pub fn write(dir: &Path, outs: &[TrimOutput]) -> Result<(), Error> {
+    for o in outs {
+        let text = serde_json::to_string_pretty(&to_json(o)).map_err(|e| Error::Io(e.to_string()))?;
+        crate::atomic::write(&dir.join(format!("trim_{}.json", o.formulation.as_str())), text.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// One line per formulation; true when a trim failed.
+pub fn report(name: &str, outs: &[TrimOutput]) -> bool {
+    let mut failed = false;
+    for o in outs {
+        let controls: Vec<String> = o.controls.iter().map(|(n, d)| format!("{n} {d:+.4} deg")).collect();
+        match &o.error {
+            None => println!(
+                "trim {name} {}: alpha {:.4} deg, {}, thrust {:.4} N at {} m/s; net load {:.2e} N forward, \
+                 {:.2e} N up, {:.2e} N m pitch; {} iterations, {} static solves, {:.2} s",
+                o.formulation,
+                o.alpha_deg,
+                controls.first().map_or("no elevator", String::as_str),
+                o.thrust,
+                o.airspeed,
+                o.residuals.force_forward,
+                o.residuals.force_up,
+                o.residuals.pitch_moment,
+                o.iterations,
+                o.static_solves,
+                o.wall_s
+            ),
+            Some(e) => {
+                failed = true;
+                eprintln!("trim {name} {}: FAILED: {e}", o.formulation);
+            }
+        }
+    }
+    failed
+}

@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""Write cases/horten_flying_wing.json: the Horten flying wing of Richards et al. (2016) as
+SHARPy's hangar describes it (ImperialCollegeLondon/sharpy, cases/hangar/horten_wing.py with the
+`Baseline` of cases/hangar/richards_wing.py; the trim of docs/source/content/example_notebooks/
+linear_horten.ipynb: M = 4, N = 11, Msf = 5, 28 m/s, rho 1.02, sigma 1).
+
+A half model (right wing) with a mirror plane at x = 0. Our axes: span +X, nose +Y, up +Z.
+* centre section: 0.4125 m (half of 0.825 m), chord 1.0 m, beam at 0.33 chord;
+* wing: 11 bodies (SHARPy's 11 elements, each its own constant section), beam swept 20 deg aft
+  from y = 0.4125 to the tip at 10 m, chord 1.0 -> 0.25 m along the stream (SHARPy's
+  aligned grid), beam at 0.33 chord, washout 0 -> -2 deg (nose down) at the tip;
+* stiffness per element k (alpha_k = k/10): K_root (1 - alpha_k^2) + K_tip alpha_k^2, K_tip =
+  0.25^2 K_root, K_root = diag(EA 1e6, GA 1e6, GA 1e6, GJ 4.24e5, EI_flap 3.84e5, EI_edge 2.46e7);
+  the centre section has the root's;
+* mass per element k: the thin-walled section at chord c_k = 1 - 0.75 alpha_k (a NACA 0012 skin
+  1.905 mm thick and an I-spar 0.1 c wide and 0.12 c deep, 1.27 mm, aluminium 2770 kg/m^3),
+  its mass and centre of mass computed here as SHARPy's hangar defines them, its rotary
+  inertias about that centre from the same thin walls;
+* point masses: half of the 15.29 kg fuselage at the centreline, a 5.244 kg engine at the end
+  of the centre section, where the thrust acts forward;
+* elevons on the outer 6 of the 11 wing elements, half the chord (2 of 4 panels);
+* lattice: 4 chordwise panels, 2 spanwise panels per element, a 20-row wake of 0.25 m rows.
+"""
+import json
+import math
+import os
+
+RHO_AL = 2770.0
+
+
+def polyline_props(y, z, t):
+    """Mass per length, centroid (length-weighted, as the hangar does) and the segment data."""
+    segs = []
+    for i in range(len(t)):
+        dy, dz = y[i + 1] - y[i], z[i + 1] - z[i]
+        length = math.hypot(dy, dz)
+        segs.append((length, t[i], 0.5 * (y[i] + y[i + 1]), 0.5 * (z[i] + z[i + 1])))
+    mass = sum(l * th for l, th, _, _ in segs) * RHO_AL
+    ltot = sum(l for l, _, _, _ in segs)
+    cy = sum(l * my for l, _, my, _ in segs) / ltot
+    cz = sum(l * mz for l, _, _, mz in segs) / ltot
+    return mass, (cy, cz), segs
+
+
+def naca0012_skin(c):
+    n = 100
+    ys = [c * i / (n - 1) for i in range(n)]
+    zs = [5 * 0.12 * (0.2969 * math.sqrt(x / c) - 0.1260 * x / c - 0.3516 * (x / c) ** 2
+                      + 0.2843 * (x / c) ** 3 - 0.1015 * (x / c) ** 4) * c for x in ys]
+    y = ys + ys[:-1][::-1]
+    z = zs + [-v for v in zs[:-1][::-1]]
+    y = [v - 0.25 * c for v in y]  # relative to the quarter chord, positive aft
+    return y, z, [0.127e-2 * 1.5] * (len(y) - 1)
+
+
+def i_spar(c):
+    w, zm, t = 0.1 * c, 0.12 * c, 0.127e-2
+    return ([-w / 2, w / 2, 0, 0, -w / 2, w / 2], [zm / 2, zm / 2, zm / 2, -zm / 2, -zm / 2, -zm / 2],
+            [t, 0, t, 0, t])
+
+
+def inertias(segs, cy, cz):
+    """Rotary inertias per length about the section's centre of mass: I_yy from the z distances,
+    I_zz from the chordwise ones, I_xx = I_yy + I_zz (a thin-walled section). The hangar's own
+    I_xx, I_yy, I_zz (measured about other points and on a 1 m slice) are not consistent beam
+    inertias (ANCF's slope inertias would be negative), so these replace them."""
+    iyy = sum(l * th * RHO_AL * (mz - cz) ** 2 for l, th, _, mz in segs)
+    izz = sum(l * th * RHO_AL * (my - cy) ** 2 for l, th, my, _ in segs)
+    return iyy + izz, iyy, izz
+
+
+def section(c):
+    items = [polyline_props(*naca0012_skin(c)), polyline_props(*i_spar(c))]
+    mass = sum(m for m, _, _ in items)
+    cy = sum(m * cm[0] for m, cm, _ in items) / mass
+    cz = sum(m * cm[1] for m, cm, _ in items) / mass
+    i = [sum(v) for v in zip(*(inertias(s, cy, cz) for _, _, s in items))]
+    return mass, cy, i
+
+
+def main():
+    n_el, span, half_fus, sweep = 11, 20.0, 0.4125, 20.0
+    k_root = dict(ea=1e6, ga_y=1e6, ga_z=1e6, gj=4.24e5, ei_yy=3.84e5, ei_zz=2.46e7)
+    taper = 0.25
+    wing_dy = (span / 2 - half_fus) / n_el
+    el_len = wing_dy / math.cos(math.radians(sweep))
+
+    def sec(k):
+        a = k / (n_el - 1)
+        c = 1.0 - 0.75 * a
+        m, cy, (ixx, iyy, izz) = section(c)
+        # Centre of mass ahead of the beam (0.33 c from the leading edge), as the hangar places it.
+        cg_fwd = -(cy + (0.25 - 0.33) * c)
+        stiff = {key: v * ((1 - a * a) + taper ** 2 * a * a) for key, v in k_root.items()}
+        return dict(mass=m, rho_ixx=ixx, rho_iyy=iyy, rho_izz=izz,
+                    cg_offset=[cg_fwd, 0.0], **stiff)
+
+    bodies = [dict(name="centre", start=[0, 0, 0], length=half_fus, x_axis=[1, 0, 0], y_axis=[0, 1, 0],
+                   section=sec(0),
+                   point_masses=[dict(at=0.0, mass=150 / 9.81 / 2, inertia=[0.5 * 150 / 9.81 / 2, 150 / 9.81 / 2, 150 / 9.81 / 2]),
+                                 dict(at=half_fus, mass=51.445 / 9.81, inertia=[0.29547, 0.29322, 0.29547])])]
+    joints = [dict(type="free", name="flight", body="centre")]
+    chord = [[1.0, 1.0]]
+    le = [[0.33, 0.33]]
+    twist_tip = -2.0
+    for k in range(n_el):
+        b = dict(name=f"w{k}", length=el_len, section=sec(k),
+                 twist_deg=[twist_tip * k / n_el, twist_tip * (k + 1) / n_el])
+        # Every body along the swept beam (a body's sweep_deg is relative to its parent's end).
+        b["x_axis"] = [math.cos(math.radians(sweep)), -math.sin(math.radians(sweep)), 0.0]
+        b["y_axis"] = [math.sin(math.radians(sweep)), math.cos(math.radians(sweep)), 0.0]
+        bodies.append(b)
+        joints.append(dict(type="flared_hinge", name=f"j{k}", parent="centre" if k == 0 else f"w{k - 1}",
+                           child=f"w{k}", flare_deg=0, locked=True))
+        c0, c1 = 1.0 - 0.75 * k / n_el, 1.0 - 0.75 * (k + 1) / n_el
+        chord.append([c0, c1])
+        le.append([0.33 * c0, 0.33 * c1])
+    names = ["centre"] + [f"w{k}" for k in range(n_el)]
+    controls = [dict(name=f"elevon{k}", body=f"w{k}", span=[0.0, el_len], chord_fraction=0.5, deflection_deg=0.1814)
+                for k in range(5, n_el)]
+    case = dict(
+        name="horten_flying_wing",
+        description=(
+            "The Horten flying wing of Richards, Yao, Herd, Hodges & Mardanpour (J. Aircraft 2016) as SHARPy's "
+            "hangar models it (ImperialCollegeLondon/sharpy cases/hangar/horten_wing.py and richards_wing.py, "
+            "Baseline; its trim in docs/source/content/example_notebooks/linear_horten.ipynb: alpha 4.5135 deg, "
+            "elevon 0.1814 deg, thrust 5.5129 N per engine at 28 m/s, rho 1.02). Half model with a mirror plane: "
+            "20 m span, 20 deg beam sweep, root chord 1.0, taper 0.25, washout 2 deg, elevons on the outer 6/11 "
+            "of each wing at half chord. Written by tools/horten_case.py; docs/trim.md."),
+        bodies=bodies, joints=joints, gravity=[0, 0, -9.81],
+        thrust=dict(name="engine", body="centre", at=half_fus, direction=[0, 1, 0], magnitude=5.5129),
+        t_end=0.05, output_dt=0.01,
+        ancf=dict(elements_per_body=[1] + [2] * n_el, dt=0.005, rho_inf=0.8),
+        gebf=dict(elements_per_body=[1] * (n_el + 1), dt=0.005, rho_inf=0.8),
+        aero=dict(rho=1.02, v_inf=[0, -28.0, 0], n_chordwise=4, n_wake_rows=40, cutoff_radius=1e-6,
+                  images=[dict(point=[0, 0, 0], normal=[1, 0, 0])],
+                  surfaces=[dict(name="wing", bodies=names, chord=chord, le_offset=le, sections="streamwise",
+                                 panels_per_body=[2] * (n_el + 1))],
+                  control_surfaces=controls),
+        trim=dict(elevator=[c["name"] for c in controls], alpha_deg=4.0,
+                  wake=dict(row_length=0.25, rows=20)),
+    )
+    out = os.path.join(os.path.dirname(__file__), "..", "cases", "horten_flying_wing.json")
+    with open(out, "w") as f:
+        json.dump(case, f, indent=2)
+        f.write("\n")
+    m_half = sum(b["section"]["mass"] * b["length"] for b in bodies) + sum(p["mass"] for p in bodies[0]["point_masses"])
+    print(f"wrote {out}: half-model mass {m_half:.3f} kg, sections {[round(b['section']['mass'], 2) for b in bodies]}")
+
+
+if __name__ == "__main__":
+    main()
