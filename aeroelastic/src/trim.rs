@@ -364,11 +364,11 @@ fn iterate<M: BuildModel>(
             Some(j) => j,
             None => {
                 let mut j = Matrix3::zeros();
-                for k in 0..3 {
+                for (k, h) in STEPS.into_iter().enumerate() {
                     let mut xk = x;
-                    xk.0[k] += STEPS[k];
+                    xk.0[k] += h;
                     let rk = held.residual(xk).map_err(|e| (x, e))?;
-                    j.set_column(k, &((rk.vector() - r.vector()) / STEPS[k]));
+                    j.set_column(k, &((rk.vector() - r.vector()) / h));
                 }
                 // Back to the equilibrium at x for the next step's warm start.
                 r = held.residual(x).map_err(|e| (x, e))?;
