@@ -31,6 +31,7 @@ __all__ = [
     "sweep",
     "static",
     "stability",
+    "trim",
     "tip_difference",
     "to_csv",
     "CaseError",
@@ -193,6 +194,40 @@ def stability(
     """
     runs = _expand(_core.stability, case, formulation, set, base_dir)
     shaped = {name: _shape(name, per, formulation, True) for name, per in runs}
+    return next(iter(shaped.values())) if len(shaped) == 1 else shaped
+
+
+def trim(
+    case: CaseLike,
+    formulation: str = "gebf",
+    set: Optional[Mapping[str, Any]] = None,
+    *,
+    base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Dict[str, Any]:
+    """The level-flight trim of a free aircraft (``harness trim``, the case's ``trim`` block).
+
+    Returns a dict as ``trim_<formulation>.json``: ``alpha_deg``, ``controls`` (name -> deg),
+    ``thrust`` (N), ``residuals`` (``force_forward``, ``force_up``, ``pitch_moment``),
+    ``converged``, ``error``, ``lift``, ``drag``, ``tip``, ``iterations``, ``static_solves``,
+    ``wall_s`` and ``q`` (the deformed state, a NumPy array); for ``"both"`` one such dict per
+    formulation, and for a case with a ``sweep`` ``{run name: ...}``. Raises :class:`CaseError`
+    when the case has no ``trim`` block or cannot be trimmed, :class:`RunError` when a trim
+    failed to converge.
+    """
+    runs = _expand(_core.trim, case, formulation, set, base_dir)
+
+    def one(name: str, f: str, text: str, err: Optional[str]) -> Dict[str, Any]:
+        if err is not None:
+            raise RunError(f"{name} {f}: {err}")
+        d = json.loads(text)
+        d["controls"] = {n: v for n, v in d["controls"]}
+        d["q"] = np.asarray(d["q"], dtype=float)
+        return d
+
+    shaped = {}
+    for name, per in runs:
+        out = {f: one(name, f, text, err) for f, (text, err) in per.items()}
+        shaped[name] = out if formulation == "both" else out[formulation]
     return next(iter(shaped.values())) if len(shaped) == 1 else shaped
 
 

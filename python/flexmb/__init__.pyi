@@ -39,6 +39,13 @@ def sweep(
     base_dir: Optional[Union[str, os.PathLike[str]]] = ...,
     check: bool = ...,
 ) -> Dict[str, Any]: ...
+def trim(
+    case: CaseLike,
+    formulation: str = ...,
+    set: Optional[Mapping[str, Any]] = ...,
+    *,
+    base_dir: Optional[Union[str, "os.PathLike[str]"]] = ...,
+) -> Dict[str, Any]: ...
 def static(
     case: CaseLike,
     formulation: str = ...,

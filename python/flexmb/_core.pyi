@@ -30,6 +30,9 @@ def static_sweep(
 def stability(
     case: str, from_path: bool, base_dir: str, formulations: List[str], overrides: List[str]
 ) -> List[Tuple[str, _PerFormulation]]: ...
+def trim(
+    case: str, from_path: bool, base_dir: str, formulations: List[str], overrides: List[str]
+) -> List[Tuple[str, Dict[str, Tuple[str, Optional[str]]]]]: ...
 def to_csv(columns: Dict[str, npt.NDArray[np.generic]]) -> str: ...
 def tip_difference(
     a: Dict[str, npt.NDArray[np.generic]], b: Dict[str, npt.NDArray[np.generic]]

@@ -191,6 +191,54 @@ fn static_sweep<'py>(
     Ok(list)
 }
 
+/// The level-flight trim of a case (`harness trim`): `[(run name, {formulation: (trim as JSON
+/// text, error or None)})]`.
+#[pyfunction]
+#[pyo3(signature = (case, from_path, base_dir, formulations, overrides))]
+fn trim<'py>(
+    py: Python<'py>,
+    case: &str,
+    from_path: bool,
+    base_dir: &str,
+    formulations: Vec<String>,
+    overrides: Vec<String>,
+) -> PyResult<Bound<'py, PyList>> {
+    let fs = self::formulations(&formulations)?;
+    let specs = py.allow_threads(|| load(case, from_path, base_dir, &overrides)).map_err(|e| to_py(py, e))?;
+    if let Some(s) = specs.iter().find(|s| fs.iter().any(|&f| s.case(f).trim.is_none())) {
+        let e = CaseError::new_err(format!("{}: trim: the case has no `trim` block", s.name));
+        e.value(py).setattr("field", "trim")?;
+        return Err(e);
+    }
+    let specs = std::sync::Arc::new(specs);
+    let outs = {
+        let (specs, fs) = (specs.clone(), fs.clone());
+        interruptible(py, move || {
+            specs
+                .iter()
+                .map(|spec| {
+                    fs.par_iter()
+                        .filter_map(|&f| {
+                            let c = spec.case(f);
+                            c.trim.as_ref().map(|t| aeroelastic::trim::run_trim(&c.problem(), f, t))
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .collect::<Vec<_>>()
+        })?
+    };
+    let list = PyList::empty(py);
+    for (spec, runs) in specs.iter().zip(outs) {
+        let per = PyDict::new(py);
+        for out in runs {
+            let text = serde_json::to_string(&out).map_err(|e| RunError::new_err(e.to_string()))?;
+            per.set_item(out.formulation.as_str(), (text, out.error.clone()))?;
+        }
+        list.append((spec.name.as_str(), per))?;
+    }
+    Ok(list)
+}
+
 /// The linearised stability sweep of a case (`harness stability`): `[(run name, {formulation:
 /// (columns, error or None)})]`, the columns named as in `stability_<f>.csv` plus `summary`.
 #[pyfunction]
@@ -288,6 +336,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(static_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(trim, m)?)?;
     m.add_function(wrap_pyfunction!(to_csv, m)?)?;
     m.add_function(wrap_pyfunction!(tip_difference, m)?)?;
     m.add_function(wrap_pyfunction!(native_seconds, m)?)?;
