@@ -95,57 +95,69 @@ def main():
         return dict(mass=m, rho_ixx=ixx, rho_iyy=iyy, rho_izz=izz,
                     cg_offset=[cg_fwd, 0.0], **stiff)
 
-    bodies = [dict(name="centre", start=[0, 0, 0], length=half_fus, x_axis=[1, 0, 0], y_axis=[0, 1, 0],
-                   section=sec(0),
-                   point_masses=[dict(at=0.0, mass=150 / 9.81 / 2, inertia=[0.5 * 150 / 9.81 / 2, 150 / 9.81 / 2, 150 / 9.81 / 2]),
-                                 dict(at=half_fus, mass=51.445 / 9.81, inertia=[0.29547, 0.29322, 0.29547])])]
-    joints = [dict(type="free", name="flight", body="centre")]
-    chord = [[1.0, 1.0]]
-    le = [[0.33, 0.33]]
-    twist_tip = -2.0
-    for k in range(n_el):
-        b = dict(name=f"w{k}", length=el_len, section=sec(k),
-                 twist_deg=[twist_tip * k / n_el, twist_tip * (k + 1) / n_el])
-        # Every body along the swept beam (a body's sweep_deg is relative to its parent's end).
-        b["x_axis"] = [math.cos(math.radians(sweep)), -math.sin(math.radians(sweep)), 0.0]
-        b["y_axis"] = [math.sin(math.radians(sweep)), math.cos(math.radians(sweep)), 0.0]
-        bodies.append(b)
-        joints.append(dict(type="flared_hinge", name=f"j{k}", parent="centre" if k == 0 else f"w{k - 1}",
-                           child=f"w{k}", flare_deg=0, locked=True))
-        c0, c1 = 1.0 - 0.75 * k / n_el, 1.0 - 0.75 * (k + 1) / n_el
-        chord.append([c0, c1])
-        le.append([0.33 * c0, 0.33 * c1])
-    names = ["centre"] + [f"w{k}" for k in range(n_el)]
-    controls = [dict(name=f"elevon{k}", body=f"w{k}", span=[0.0, el_len], chord_fraction=0.5, deflection_deg=0.1814)
-                for k in range(5, n_el)]
+    sw, cw = math.sin(math.radians(sweep)), math.cos(math.radians(sweep))
+    fus = 150 / 9.81
+    engine = dict(mass=51.445 / 9.81, inertia=[0.29547, 0.29322, 0.29547])
+    # The free body: a 5 cm hub along the aircraft's axis, ending at the centreline, carrying the
+    # fuselage's mass; both half-wings hang from its end (their root sections meet there).
+    bodies = [dict(name="hub", start=[0, 0.05, 0], length=0.05, x_axis=[0, -1, 0], y_axis=[0, 0, 1],
+                   section=dict(mass=0.01, rho_ixx=2e-6, rho_iyy=1e-6, rho_izz=1e-6, **k_root),
+                   point_masses=[dict(at=0.05, mass=fus, inertia=[0.5 * fus, fus, fus])])]
+    joints = [dict(type="free", name="flight", body="hub")]
+    surfaces, controls, elevator = [], [], []
+    for side, sign in (("r", 1.0), ("l", -1.0)):
+        # The left half-wing runs along -X with its section z axis down: its nose-down twist and
+        # trailing-edge-down deflection have the other sign.
+        names = [f"centre_{side}"]
+        bodies.append(dict(name=names[0], length=half_fus, x_axis=[sign, 0, 0], y_axis=[0, 1, 0], section=sec(0),
+                           point_masses=[dict(at=half_fus, **engine)]))
+        joints.append(dict(type="flared_hinge", name=f"root_{side}", parent="hub", child=names[0], flare_deg=0,
+                           locked=True))
+        chord, le = [[1.0, 1.0]], [[0.33, 0.33]]
+        for k in range(n_el):
+            name = f"{side}{k}"
+            c0, c1 = 1.0 - 0.75 * k / n_el, 1.0 - 0.75 * (k + 1) / n_el
+            bodies.append(dict(name=name, length=el_len, section=sec(k),
+                               x_axis=[sign * cw, -sw, 0.0], y_axis=[sign * sw, cw, 0.0],
+                               twist_deg=[-2.0 * sign * k / n_el, -2.0 * sign * (k + 1) / n_el]))
+            joints.append(dict(type="flared_hinge", name=f"{names[-1]}_{name}", parent=names[-1], child=name,
+                               flare_deg=0, locked=True))
+            names.append(name)
+            chord.append([c0, c1])
+            le.append([0.33 * c0, 0.33 * c1])
+            if k >= 5:
+                controls.append(dict(name=f"elevon_{name}", body=name, span=[0.0, el_len], chord_fraction=0.5,
+                                     deflection_deg=sign * 0.1814))
+                elevator.append(f"elevon_{name}" if sign > 0 else dict(name=f"elevon_{name}", gain=-1.0))
+        surfaces.append(dict(name=f"wing_{side}", bodies=names, chord=chord, le_offset=le, sections="streamwise",
+                             panels_per_body=[2] * (n_el + 1)))
     case = dict(
         name="horten_flying_wing",
         description=(
             "The Horten flying wing of Richards, Yao, Herd, Hodges & Mardanpour (J. Aircraft 2016) as SHARPy's "
             "hangar models it (ImperialCollegeLondon/sharpy cases/hangar/horten_wing.py and richards_wing.py, "
             "Baseline; its trim in docs/source/content/example_notebooks/linear_horten.ipynb: alpha 4.5135 deg, "
-            "elevon 0.1814 deg, thrust 5.5129 N per engine at 28 m/s, rho 1.02). Half model with a mirror plane: "
-            "20 m span, 20 deg beam sweep, root chord 1.0, taper 0.25, washout 2 deg, elevons on the outer 6/11 "
+            "elevon 0.1814 deg, thrust 5.5129 N per engine at 28 m/s, rho 1.02). Full span: a hub on the free joint "
+            "carrying the fuselage mass, two half-wings of 12 bodies each: 20 m span, 20 deg beam sweep, root chord 1.0, taper 0.25, washout 2 deg, elevons on the outer 6/11 "
             "of each wing at half chord. Written by tools/horten_case.py; docs/trim.md."),
         bodies=bodies, joints=joints, gravity=[0, 0, -9.81],
-        thrust=dict(name="engine", body="centre", at=half_fus, direction=[0, 1, 0], magnitude=5.5129),
-        t_end=0.05, output_dt=0.01,
-        ancf=dict(elements_per_body=[1] + [2] * n_el, dt=0.005, rho_inf=0.8),
-        gebf=dict(elements_per_body=[1] * (n_el + 1), dt=0.005, rho_inf=0.8),
-        aero=dict(rho=1.02, v_inf=[0, -28.0, 0], n_chordwise=4, n_wake_rows=40, cutoff_radius=1e-6,
-                  images=[dict(point=[0, 0, 0], normal=[1, 0, 0])],
-                  surfaces=[dict(name="wing", bodies=names, chord=chord, le_offset=le, sections="streamwise",
-                                 panels_per_body=[2] * (n_el + 1))],
+        thrust=[dict(name=f"engine_{side}", body=f"centre_{side}", at=half_fus, direction=[0, 1, 0], magnitude=5.5129)
+                for side in "rl"],
+        t_end=10.0, output_dt=10 * 0.25 / 28, initial="trim",
+        ancf=dict(elements_per_body=[1] + [2] * (2 * n_el + 2), dt=0.25 / 28, rho_inf=0.8),
+        gebf=dict(elements_per_body=[1] * (2 * n_el + 3), dt=0.25 / 28, rho_inf=0.8),
+        aero=dict(rho=1.02, v_inf=[0, -28.0, 0], n_chordwise=4, n_wake_rows=20, cutoff_radius=1e-6,
+                  surfaces=surfaces,
                   control_surfaces=controls),
-        trim=dict(elevator=[c["name"] for c in controls], alpha_deg=4.0,
+        trim=dict(elevator=elevator, alpha_deg=4.0,
                   wake=dict(row_length=0.25, rows=20)),
     )
     out = os.path.join(os.path.dirname(__file__), "..", "cases", "horten_flying_wing.json")
     with open(out, "w") as f:
         json.dump(case, f, indent=2)
         f.write("\n")
-    m_half = sum(b["section"]["mass"] * b["length"] for b in bodies) + sum(p["mass"] for p in bodies[0]["point_masses"])
-    print(f"wrote {out}: half-model mass {m_half:.3f} kg, sections {[round(b['section']['mass'], 2) for b in bodies]}")
+    mass = sum(b["section"]["mass"] * b["length"] + sum(p["mass"] for p in b.get("point_masses", [])) for b in bodies)
+    print(f"wrote {out}: mass {mass:.3f} kg, sections {[round(b['section']['mass'], 2) for b in bodies]}")
 
 
 if __name__ == "__main__":

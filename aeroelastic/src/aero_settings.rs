@@ -98,7 +98,7 @@ pub struct AeroSettings {
     /// `polars`; default 1.5e-5 (air near 20 °C).
     #[cfg_attr(feature = "serde", serde(default = "default_kinematic_viscosity"))]
     pub kinematic_viscosity: f64,
-    /// Trailing-edge control surfaces (at most 8): flaps over span ranges of bodies, at a fixed
+    /// Trailing-edge control surfaces (at most 16): flaps over span ranges of bodies, at a fixed
     /// deflection or a schedule in time (docs/case-file.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub control_surfaces: Vec<crate::control_surface::ControlSurface>,

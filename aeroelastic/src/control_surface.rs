@@ -6,7 +6,7 @@
 use crate::problem::Problem;
 
 /// Most control surfaces a case may have (the rows keep their hinge moments in a fixed array).
-pub const MAX_CONTROL_SURFACES: usize = 8;
+pub const MAX_CONTROL_SURFACES: usize = 16;
 
 /// One entry of `aero.control_surfaces`: a trailing-edge flap on a span range of one body.
 #[derive(Debug, Clone, PartialEq)]

@@ -238,6 +238,23 @@ pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
     Events::new(schedule, Box::new(rebuild))
 }
 
+/// A time march from the trimmed state (`initial: "trim"`, docs/trim.md §5): the trim with the
+/// march's own wake, then the march of the free aircraft in body axes from the trimmed
+/// coordinates, at rest, with the steady wake prefilled and its loads applied.
+fn from_trim<M: BuildModel>(problem: &Problem, f: Formulation, observer: &mut dyn Observer) -> Result<RunOutput, Error> {
+    let model_error = |msg: String| Error::Model { formulation: f, msg };
+    let (flight, trim) = crate::trim::trim_for_march::<M>(problem, f).map_err(model_error)?;
+    let (Some(aero), Some(aero0)) = (flight.aero.as_ref(), problem.aero.as_ref()) else {
+        return Err(model_error("initial: \"trim\" needs `aero`".into()));
+    };
+    // The lattice's layout of the reference flow, as the trim has it.
+    let map = station_map(problem, aero0).map_err(model_error)?;
+    let s = settings(&flight, f);
+    let mut events = hinge_events::<M>(&flight);
+    let mut model = M::build(&flight)?;
+    Ok(simulate_aero_with_events(f, &mut model, &s, aero, &map, observer, Some(&trim.q), &mut events))
+}
+
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot
 /// be built gives a failed [`RunOutput`] with the reason.
 pub fn run_formulation(problem: &Problem, f: Formulation) -> RunOutput {
@@ -258,6 +275,9 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
         type Output = Result<RunOutput, Error>;
         fn run<M: BuildModel>(self) -> Self::Output {
             let Run { problem, f, observer } = self;
+            if problem.initial == crate::trim::Initial::Trim {
+                return from_trim::<M>(problem, f, observer);
+            }
             let s = settings(problem, f);
             let mut events = hinge_events::<M>(problem);
             match &problem.aero {

@@ -51,6 +51,10 @@ pub struct Problem {
     pub events: Vec<crate::events::HingeEvent>,
     /// Thrusts: follower forces on bodies (`thrust`).
     pub thrust: Vec<crate::thrust::Thrust>,
+    /// The level-flight trim (`trim`; none: the case cannot be trimmed).
+    pub trim: Option<crate::trim::TrimSettings>,
+    /// Where a time march starts: the reference configuration, or the trimmed state.
+    pub initial: crate::trim::Initial,
     /// ANCF's discretisation and integrator settings.
     pub ancf: AncfSettings,
     /// GEBF's discretisation and integrator settings.

@@ -36,8 +36,11 @@ use crate::statics::{AeroStatic, load_stepping, point_at, solve_rounds, static_p
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct TrimSettings {
     /// The control surfaces (names in `aero.control_surfaces`) deflected together as the
-    /// elevator; their deflection in the case is the first guess.
-    pub elevator: Vec<String>,
+    /// elevator: a name, or `{ "name", "gain" }` for a surface deflected by `gain` times the
+    /// elevator's deflection (−1 on a wing whose section z axis points down, where trailing edge
+    /// down is the other way). The first surface's deflection in the case over its gain is the
+    /// first guess.
+    pub elevator: Vec<ElevatorSurface>,
     /// First guess of the angle of attack, degrees. Default 2.
     #[cfg_attr(feature = "serde", serde(default = "default_alpha"))]
     pub alpha_deg: f64,
@@ -53,6 +56,47 @@ pub struct TrimSettings {
     /// Most trim iterations. Default 30.
     #[cfg_attr(feature = "serde", serde(default = "default_iterations"))]
     pub max_iterations: usize,
+}
+
+/// One surface of the elevator.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(untagged))]
+pub enum ElevatorSurface {
+    /// A surface deflected as the elevator.
+    Name(String),
+    /// A surface deflected by `gain` times the elevator's deflection.
+    Geared {
+        /// Its name in `aero.control_surfaces`.
+        name: String,
+        /// Its deflection per unit of the elevator's (non-zero).
+        gain: f64,
+    },
+}
+
+impl ElevatorSurface {
+    /// Its name.
+    pub fn name(&self) -> &str {
+        match self {
+            ElevatorSurface::Name(n) | ElevatorSurface::Geared { name: n, .. } => n,
+        }
+    }
+
+    /// Its gain.
+    pub fn gain(&self) -> f64 {
+        match self {
+            ElevatorSurface::Name(_) => 1.0,
+            ElevatorSurface::Geared { gain, .. } => *gain,
+        }
+    }
+}
+
+impl TrimSettings {
+    /// The gain of control surface `name` in the elevator (none: not in it).
+    fn gain_of(&self, name: &str) -> Option<f64> {
+        self.elevator.iter().find(|e| e.name() == name).map(ElevatorSurface::gain)
+    }
 }
 
 #[cfg(feature = "serde")]
@@ -87,9 +131,13 @@ impl TrimSettings {
         if self.elevator.is_empty() {
             return Err("trim.elevator: name at least one control surface".into());
         }
-        for (k, name) in self.elevator.iter().enumerate() {
-            if !aero.control_surfaces.iter().any(|c| &c.name == name) {
+        for (k, e) in self.elevator.iter().enumerate() {
+            let name = e.name();
+            if !aero.control_surfaces.iter().any(|c| c.name == name) {
                 return Err(format!("trim.elevator[{k}]: no control surface named {name:?} in aero.control_surfaces"));
+            }
+            if !(e.gain().is_finite() && e.gain() != 0.0) {
+                return Err(format!("trim.elevator[{k}].gain: {} is not a finite non-zero number", e.gain()));
             }
         }
         if p.thrust.is_empty() {
@@ -110,6 +158,27 @@ impl TrimSettings {
             return Err(format!("trim.max_iterations: {} is not in 1..=1000", self.max_iterations));
         }
         Ok(())
+    }
+}
+
+/// Where a time march starts (case field `initial`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Initial {
+    /// The reference configuration at rest, the lattice started impulsively.
+    #[default]
+    Reference,
+    /// The trimmed state of the case's `trim`: the deformed aircraft in level flight, at rest in
+    /// body axes, with the steady wake (docs/trim.md §5).
+    Trim,
+}
+
+impl Initial {
+    /// Whether this is the default.
+    pub fn is_reference(&self) -> bool {
+        *self == Initial::Reference
     }
 }
 
@@ -155,7 +224,10 @@ pub struct TrimOutput {
     pub airspeed: f64,
     /// Angle of attack of the free body (the flow's incidence on the reference geometry), deg.
     pub alpha_deg: f64,
-    /// The elevator's control surfaces and their deflection, deg (trailing edge down positive).
+    /// The elevator's deflection, deg (each surface's over its gain).
+    pub elevator_deg: f64,
+    /// The elevator's control surfaces and their deflection, deg (trailing edge down positive in
+    /// each surface's section frame).
     pub controls: Vec<(String, f64)>,
     /// Each thrust element's magnitude, N.
     pub thrust: f64,
@@ -202,6 +274,7 @@ fn failed(p: &Problem, f: Formulation, msg: String) -> TrimOutput {
         formulation: f,
         airspeed: p.aero.as_ref().map_or(f64::NAN, AeroSettings::speed),
         alpha_deg: f64::NAN,
+        elevator_deg: f64::NAN,
         controls: Vec::new(),
         thrust: f64::NAN,
         residuals: TrimResiduals { force_forward: f64::NAN, force_up: f64::NAN, pitch_moment: f64::NAN },
@@ -231,8 +304,10 @@ fn held_problem(base: &Problem, t: &TrimSettings, x: Unknowns) -> Problem {
     if let Some(a) = p.aero.as_mut() {
         a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
         a.airspeed = None;
-        for c in a.control_surfaces.iter_mut().filter(|c| t.elevator.contains(&c.name)) {
-            c.deflection_deg = Deflection::Fixed(x.0[1]);
+        for c in &mut a.control_surfaces {
+            if let Some(g) = t.gain_of(&c.name) {
+                c.deflection_deg = Deflection::Fixed(g * x.0[1]);
+            }
         }
     }
     for th in &mut p.thrust {
@@ -241,14 +316,71 @@ fn held_problem(base: &Problem, t: &TrimSettings, x: Unknowns) -> Problem {
     p
 }
 
+/// A schedule moved so that it starts at `start`: the fixed value becomes `start`, a schedule
+/// keeps its changes from its value at t = 0.
+fn offset_to(d: &Deflection, start: f64) -> Deflection {
+    match d {
+        Deflection::Fixed(_) => Deflection::Fixed(start),
+        Deflection::Schedule(p) => {
+            let d0 = d.at(0.0).0;
+            Deflection::Schedule(p.iter().map(|&[t, v]| [t, v - d0 + start]).collect())
+        }
+    }
+}
+
+/// The problem of a time march from the trim `out` (docs/trim.md §5): in body axes, the flow and
+/// gravity turned by −α as in the trim, the free joint free; the elevator's surfaces and the
+/// thrusts at their trimmed values plus their schedules' changes from t = 0 (an elevator doublet
+/// or a thrust step on top of the trim).
+pub fn flight_problem(base: &Problem, out: &TrimOutput) -> Problem {
+    let mut p = base.clone();
+    let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), -out.alpha_deg.to_radians());
+    p.gravity = base.gravity.map(|g| (turn * Vector3::from(g)).into());
+    if let Some(a) = p.aero.as_mut() {
+        a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
+        a.airspeed = None;
+        for c in a.control_surfaces.iter_mut() {
+            if let Some((_, d)) = out.controls.iter().find(|(n, _)| n == &c.name) {
+                c.deflection_deg = offset_to(&c.deflection_deg, *d);
+            }
+        }
+    }
+    for th in &mut p.thrust {
+        th.magnitude = offset_to(&th.magnitude, out.thrust);
+    }
+    p.initial = Initial::Reference;
+    p
+}
+
+/// The trim a time march of `p` with formulation `M` starts from: the case's `trim` with the
+/// march's own frozen wake (`aero.n_wake_rows` rows of `V dt`), so that the march, whose wake is
+/// prefilled with that steady wake, starts in equilibrium. Returns the march's problem and the
+/// trim.
+///
+/// # Errors
+/// No `trim` block, or the trim failed.
+pub(crate) fn trim_for_march<M: BuildModel>(p: &Problem, f: Formulation) -> Result<(Problem, TrimOutput), String> {
+    let t = p.trim.as_ref().ok_or("initial: \"trim\" needs a `trim` block")?;
+    let aero = p.aero.as_ref().ok_or("initial: \"trim\" needs `aero`")?;
+    let mut t = t.clone();
+    t.wake = Some(crate::stability::march_wake(p, f, aero.speed()));
+    let out = trim_with::<M>(p, f, &t);
+    if let Some(e) = &out.error {
+        return Err(format!("the trim the run starts from failed: {e}"));
+    }
+    Ok((flight_problem(p, &out), out))
+}
+
 /// The first guess: α from the settings, δ the first elevator surface's deflection at t = 0, T the
 /// first thrust's magnitude at t = 0.
 fn first_guess(p: &Problem, t: &TrimSettings) -> Unknowns {
+    let first = t.elevator.first();
     let delta = p
         .aero
         .as_ref()
-        .and_then(|a| a.control_surfaces.iter().find(|c| t.elevator.contains(&c.name)))
-        .map_or(0.0, |c| c.deflection_deg.at(0.0).0);
+        .zip(first)
+        .and_then(|(a, e)| a.control_surfaces.iter().find(|c| c.name == e.name()).map(|c| (c, e.gain())))
+        .map_or(0.0, |(c, g)| c.deflection_deg.at(0.0).0 / g);
     let thrust = p.thrust.first().map_or(0.0, |th| th.magnitude_at(0.0));
     Unknowns([t.alpha_deg, delta, thrust])
 }
@@ -308,7 +440,7 @@ const STEPS: [f64; 3] = [0.05, 0.1, 0.5];
 /// Largest Newton step of α and δ, degrees.
 const MAX_ANGLE_STEP: f64 = 3.0;
 
-fn trim_with<M: BuildModel>(base: &Problem, f: Formulation, t: &TrimSettings) -> TrimOutput {
+pub(crate) fn trim_with<M: BuildModel>(base: &Problem, f: Formulation, t: &TrimSettings) -> TrimOutput {
     if let Err(e) = t.validate(base) {
         return failed(base, f, e);
     }
@@ -416,7 +548,8 @@ fn finish<M: BuildModel>(
         formulation: f,
         airspeed: held.sys.airspeed(),
         alpha_deg: x.0[0],
-        controls: t.elevator.iter().map(|n| (n.clone(), x.0[1])).collect(),
+        elevator_deg: x.0[1],
+        controls: t.elevator.iter().map(|e| (e.name().to_string(), e.gain() * x.0[1])).collect(),
         thrust: x.0[2],
         residuals,
         converged: error.is_none(),

@@ -127,6 +127,11 @@ pub struct Case {
     /// elevator and the solver's settings. Needs a free joint, `aero` and `thrust`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trim: Option<aeroelastic::trim::TrimSettings>,
+    /// Where a time march starts: `"reference"` (default: the reference configuration at rest,
+    /// an impulsively started lattice) or `"trim"` (the trimmed state of `trim`, in level flight
+    /// with the steady wake; docs/trim.md §5).
+    #[serde(default, skip_serializing_if = "aeroelastic::trim::Initial::is_reference")]
+    pub initial: aeroelastic::trim::Initial,
     /// Linearised stability (`harness stability`): airspeeds, modes to track, the state to
     /// linearise about. Needs `aero`.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -22,6 +22,8 @@ impl Case {
             roll_joint: self.roll_joint.clone(),
             events: self.events.clone(),
             thrust: self.thrust.clone(),
+            trim: self.trim.clone(),
+            initial: self.initial,
             ancf: self.ancf.clone(),
             gebf: self.gebf.clone(),
             aero: self.aero.clone(),

@@ -76,6 +76,9 @@ impl Case {
         if let Some(t) = &self.trim {
             t.validate(&self.problem())?;
         }
+        if self.initial == aeroelastic::trim::Initial::Trim && self.trim.is_none() {
+            return Err("initial: \"trim\" needs a `trim` block".into());
+        }
         match (&self.statics, self.aero.is_some()) {
             (Some(st), false) => self.check_structural_static(st)?,
             (Some(st), true) => check_aero_static(st)?,

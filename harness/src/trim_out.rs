@@ -32,6 +32,7 @@ pub fn to_json(o: &TrimOutput) -> serde_json::Value {
         "error": o.error,
         "airspeed": o.airspeed,
         "alpha_deg": o.alpha_deg,
+        "elevator_deg": o.elevator_deg,
         "controls": controls,
         "thrust": o.thrust,
         "residuals": {
@@ -65,11 +66,12 @@ pub fn report(name: &str, outs: &[TrimOutput]) -> bool {
         let controls: Vec<String> = o.controls.iter().map(|(n, d)| format!("{n} {d:+.4} deg")).collect();
         match &o.error {
             None => println!(
-                "trim {name} {}: alpha {:.4} deg, {}, thrust {:.4} N at {} m/s; net load {:.2e} N forward, \
-                 {:.2e} N up, {:.2e} N m pitch; {} iterations, {} static solves, {:.2} s",
+                "trim {name} {}: alpha {:.4} deg, elevator {:+.4} deg ({}), thrust {:.4} N at {:.2} m/s; net load \
+                 {:.2e} N forward, {:.2e} N up, {:.2e} N m pitch; {} iterations, {} static solves, {:.2} s",
                 o.formulation,
                 o.alpha_deg,
-                controls.first().map_or("no elevator", String::as_str),
+                o.elevator_deg,
+                controls.join(", "),
                 o.thrust,
                 o.airspeed,
                 o.residuals.force_forward,
