@@ -1,4 +1,4 @@
-//! Thrust, a follower force (docs/ancf.md §14, docs/gebf.md §15), in both formulations: the
+//! Thrust, a follower force (docs/ancf.md §14, docs/gebf.md §16), in both formulations: the
 //! small-load tip deflection of a cantilever, the follower condition under a large load, the
 //! two formulations' agreement there, and the energy balance with the thrusts' work.
 

@@ -41,7 +41,7 @@ pub struct Model {
     pub(crate) load_scale: f64,
     /// Hinge springs and dampers.
     springs: Vec<HingeSpring>,
-    /// Thrusts, follower forces (docs/gebf.md §15).
+    /// Thrusts, follower forces (docs/gebf.md §16).
     thrusts: Vec<Thrust>,
     /// Per joint: the hinge angle θ of the last accepted step (free hinges; 0 otherwise), rad,
     /// against which the principal angle is unwrapped (docs/gebf.md §13).

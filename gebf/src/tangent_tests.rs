@@ -558,7 +558,7 @@ fn hinge_spring_tangents_alone() {
     }
 }
 
-/// Thrusts (follower forces, docs/gebf.md §15) alone: the residual of the model with thrusts
+/// Thrusts (follower forces, docs/gebf.md §16) alone: the residual of the model with thrusts
 /// minus the one without, on twisted, deformed and rotated bodies, against finite differences
 /// along the retraction (c_k part; a thrust does not read velocities, so the c_c part is zero).
 /// The thrusts sit inside an element (quadratic weights on three nodes), at a body's tip node

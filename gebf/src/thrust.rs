@@ -1,4 +1,4 @@
-//! Thrust, a follower force (docs/gebf.md §15): `F = T(t) C^{GB}(s) d_B` at the axis point at
+//! Thrust, a follower force (docs/gebf.md §16): `F = T(t) C^{GB}(s) d_B` at the axis point at
 //! arclength `s` of a body, `d_B` the case's direction in the section.
 //!
 //! The force is shared among the three nodes of the element holding `s` with the quadratic

@@ -34,7 +34,7 @@ fn time_steps_with_springs_and_point_masses_do_not_allocate() {
     steps_do_not_allocate(Model::from_scene(&scene, Options { stabilization: true, ..Options::default() }).unwrap());
 }
 
-/// The same with thrusts (follower forces, docs/gebf.md §15): one inside an element, one at the
+/// The same with thrusts (follower forces, docs/gebf.md §16): one inside an element, one at the
 /// tip, on a schedule, with their power.
 #[test]
 fn time_steps_with_thrust_do_not_allocate() {
