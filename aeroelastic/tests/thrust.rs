@@ -16,8 +16,7 @@ const EI: f64 = 9.33;
 /// tip along the section's z (perpendicular to the axis).
 fn cantilever(f: f64, n_el: usize) -> Scene {
     let (bodies, joints) = samples::cantilever(samples::paper_section(1.0), 1.0, n_el);
-    let thrust =
-        ForceElement::Thrust { body: 0, at: 1.0, direction: Vector3::z(), magnitude: Schedule::constant(f) };
+    let thrust = ForceElement::Thrust { body: 0, at: 1.0, direction: Vector3::z(), magnitude: Schedule::constant(f) };
     Scene { forces: vec![thrust], ..Scene::new(bodies, joints, Vector3::zeros()) }
 }
 
@@ -118,8 +117,14 @@ impl ForModel for March<'_> {
     type Output = Vec<Row>;
     fn run<M: BuildModel>(self) -> Vec<Row> {
         let mut model = M::from_scene(self.0).unwrap();
-        let settings =
-            RunSettings { params: self.1, t_end: self.2, output_dt: None, fold_joint: None, roll_joint: None, loads: None };
+        let settings = RunSettings {
+            params: self.1,
+            t_end: self.2,
+            output_dt: None,
+            fold_joint: None,
+            roll_joint: None,
+            loads: None,
+        };
         let out = simulate(M::FORMULATION, &mut model, &settings, &mut NoObserver);
         assert!(out.error.is_none(), "{:?}", out.error);
         out.rows
@@ -151,7 +156,8 @@ fn thrust_work_closes_the_energy_balance() {
             let rows = dispatch(f, March(&scene, genalpha::IntegratorParams::new(1.0, dt), 1.0));
             let e0 = rows[0].total;
             let w_end = rows.last().unwrap().thrust_work;
-            let err = rows.iter().map(|r| (r.total + r.dissipated - e0 - r.thrust_work).abs()).fold(0.0, f64::max) / w_end;
+            let err =
+                rows.iter().map(|r| (r.total + r.dissipated - e0 - r.thrust_work).abs()).fold(0.0, f64::max) / w_end;
             let without = rows.iter().map(|r| (r.total - e0).abs()).fold(0.0, f64::max) / w_end;
             println!(
                 "{f} dt {dt:e}: thrust work {w_end:.6} J, max |E + W_d − E(0) − W_T| = {err:.2e} of it (without W_T: {without:.2})"

@@ -84,7 +84,8 @@ impl Thrust {
         let st = self.st;
         let w = point_weights(st.xi, st.l, 0.0, 0.0);
         let nodes = [(0usize, 1.0 - st.xi), (4usize, st.xi)];
-        let (dy, dz): (Matrix3<f64>, Matrix3<f64>) = (du.fixed_view::<3, 3>(0, 0).into(), du.fixed_view::<3, 3>(0, 3).into());
+        let (dy, dz): (Matrix3<f64>, Matrix3<f64>) =
+            (du.fixed_view::<3, 3>(0, 0).into(), du.fixed_view::<3, 3>(0, 3).into());
         for (a, &wa) in w.iter().enumerate().filter(|(_, wa)| **wa != 0.0) {
             for &(nb, wb) in &nodes {
                 let s = -c * p * wa * wb;

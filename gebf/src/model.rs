@@ -776,9 +776,6 @@ impl Model {
 
     /// The power of the thrusts `Σ F · ṙ` at time `t`, coordinates `q` and velocities `v`, W.
     pub fn thrust_power(&self, t: f64, q: &[f64], v: &[f64]) -> f64 {
-        self.thrusts
-            .iter()
-            .map(|th| th.power(&self.bodies[th.body], self.load_scale * th.magnitude(t), q, v))
-            .sum()
+        self.thrusts.iter().map(|th| th.power(&self.bodies[th.body], self.load_scale * th.magnitude(t), q, v)).sum()
     }
 }

@@ -598,7 +598,10 @@ fn thrust_tangents_alone() {
         }
         let fd = fd_q(&with, &q, n, part);
         let e = dense_rel_err(&an, &fd);
-        let asym = (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).map(|(i, j)| (an.get(i, j) - an.get(j, i)).abs()).fold(0.0, f64::max);
+        let asym = (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .map(|(i, j)| (an.get(i, j) - an.get(j, i)).abs())
+            .fold(0.0, f64::max);
         println!("thrust alone (seed {seed}): rel err {e:.2e}, unsymmetric part {asym:.2e}");
         assert!(e < TOL, "thrust alone (seed {seed}): rel err {e:.2e}");
         assert!(asym > 1e-3, "a follower force's tangent is unsymmetric");

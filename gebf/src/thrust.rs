@@ -39,7 +39,14 @@ pub(crate) struct Thrust {
 impl Thrust {
     /// The thrust at arclength `at` of `b` (body index `body`) with the unit direction
     /// `direction` in its reference section frame at `at` (`frame_at`, global columns).
-    pub(crate) fn new(body: usize, b: &Body, at: f64, frame_at: &nalgebra::Matrix3<f64>, direction: &Vector3<f64>, magnitude: Schedule) -> Self {
+    pub(crate) fn new(
+        body: usize,
+        b: &Body,
+        at: f64,
+        frame_at: &nalgebra::Matrix3<f64>,
+        direction: &Vector3<f64>,
+        magnitude: Schedule,
+    ) -> Self {
         let e = ((at / b.le).floor().max(0.0) as usize).min(b.n_elements - 1);
         let target = frame_at * direction;
         let shares = std::array::from_fn(|k| {

@@ -106,7 +106,10 @@ fn thrust_is_exact_in_the_reference_and_under_rigid_rotation() {
         let body = with.body_spec(1).unwrap().clone();
         let r = Rotation3::from_scaled_axis(Vector3::new(0.4, -1.1, 2.3)).into_inner();
         let poses = |rot| {
-            [RigidPose::at_rest(with.body_spec(0).unwrap().start), RigidPose { rotation: rot, ..RigidPose::at_rest(body.start) }]
+            [
+                RigidPose::at_rest(with.body_spec(0).unwrap().start),
+                RigidPose { rotation: rot, ..RigidPose::at_rest(body.start) },
+            ]
         };
         for rot in [nalgebra::Matrix3::identity(), r] {
             let q = with.rigid_state(&poses(rot)).unwrap().q;
