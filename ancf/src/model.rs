@@ -218,18 +218,7 @@ impl Model {
             elements_before += b.n_elements();
         }
 
-        let mut springs = Vec::new();
-        let mut thrusts = Vec::new();
-        for f in &scene.forces {
-            match *f {
-                ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
-                    springs.push(HingeSpring::new(joint, &joint_list[joint], &bodies, stiffness, damping, rest));
-                }
-                ForceElement::Thrust { body, at, ref direction, ref magnitude } => {
-                    thrusts.push(Thrust::new(&bodies[body], at, direction, magnitude.clone(), &q_ref));
-                }
-            }
-        }
+        let (springs, thrusts) = force_elements(&scene.forces, &joint_list, &bodies, &q_ref);
         let damped = springs.iter().any(|s| s.damping != 0.0);
         let ties = joint_ties(&joint_list, &bodies, options.joint_tie_factor);
 
@@ -1267,6 +1256,28 @@ impl Model {
         let lf = self.load_factor;
         self.thrusts.iter().map(|th| th.power(lf * th.magnitude(t), qf, vf)).sum()
     }
+}
+
+/// The scene's force elements built on the model's joints, bodies and full reference
+/// coordinates: the hinge springs and the thrusts.
+fn force_elements(
+    forces: &[ForceElement],
+    joints: &[Joint],
+    bodies: &[Body],
+    q_ref: &[f64],
+) -> (Vec<HingeSpring>, Vec<Thrust>) {
+    let (mut springs, mut thrusts) = (Vec::new(), Vec::new());
+    for f in forces {
+        match *f {
+            ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
+                springs.push(HingeSpring::new(joint, &joints[joint], bodies, stiffness, damping, rest));
+            }
+            ForceElement::Thrust { body, at, ref direction, ref magnitude } => {
+                thrusts.push(Thrust::new(&bodies[body], at, direction, magnitude.clone(), q_ref));
+            }
+        }
+    }
+    (springs, thrusts)
 }
 
 /// The section ties of the hinges (docs/ancf.md §3.5): at each node a hinge acts on, the
