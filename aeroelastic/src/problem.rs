@@ -967,6 +967,12 @@ impl Problem {
                 }
                 Joint::Clamp { .. } | Joint::Free { .. } => None,
             })
+            .chain(self.thrust.iter().map(|t| scene::ForceElement::Thrust {
+                body: idx(&t.body),
+                at: t.at,
+                direction: t.unit_direction().into(),
+                magnitude: t.schedule(),
+            }))
             .collect();
         let gravity = self.gravity.map(nalgebra::Vector3::from).unwrap_or_else(nalgebra::Vector3::zeros);
         scene::Scene { bodies, joints, forces, gravity }

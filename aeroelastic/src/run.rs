@@ -112,6 +112,8 @@ pub struct Row {
     pub dissipated: f64,
     /// Total energy T + U + V (+ spring potential), J.
     pub total: f64,
+    /// Work done by the thrusts since t = 0, J (NaN without thrust).
+    pub thrust_work: f64,
     /// Position-level constraint residual.
     pub constraint_residual: f64,
     /// Newton iterations of the step that reached this row.
@@ -211,6 +213,7 @@ pub fn row<S: Structure + ?Sized>(
         } else {
             e.kinetic + e.elastic + e.potential
         },
+        thrust_work: if model.has_external_power() { 0.0 } else { f64::NAN },
         constraint_residual: model.constraint_residual(&s.q),
         newton_iterations,
         aero_work: f64::NAN,
@@ -222,13 +225,20 @@ pub fn row<S: Structure + ?Sized>(
     }
 }
 
-/// Work dissipated by the dampers: the trapezoidal rule on the dissipation power over every
-/// accepted step (the rule the generalized-α energy balance follows at rho_inf = 1).
+/// Work dissipated by the dampers and work done by the thrusts: the trapezoidal rule on each
+/// power over every accepted step (the rule the generalized-α energy balance follows at
+/// rho_inf = 1).
 pub(crate) struct Dissipation {
     on: bool,
     t: f64,
     power: f64,
     work: f64,
+    /// Whether the model has thrusts.
+    thrust: bool,
+    /// Their power at `t`, W.
+    thrust_power: f64,
+    /// Their work since t = 0, J.
+    thrust_work: f64,
 }
 
 impl Dissipation {
@@ -236,7 +246,16 @@ impl Dissipation {
     /// losses join the dissipated work (and put the spring and dissipated columns on).
     pub(crate) fn new<S: Structure + ?Sized>(model: &S, s: &State, events: bool) -> Self {
         let on = model.has_force_elements() || events;
-        Self { on, t: s.t, power: if on { model.dissipation_power(&s.q, &s.v) } else { 0.0 }, work: 0.0 }
+        let thrust = model.has_external_power();
+        Self {
+            on,
+            t: s.t,
+            power: if on { model.dissipation_power(&s.q, &s.v) } else { 0.0 },
+            work: 0.0,
+            thrust,
+            thrust_power: if thrust { model.external_power(s.t, &s.q, &s.v) } else { 0.0 },
+            thrust_work: 0.0,
+        }
     }
 
     /// Account for energy an event removed (a hinge lock's impact), J.
@@ -249,6 +268,9 @@ impl Dissipation {
         if self.on {
             self.power = model.dissipation_power(&s.q, &s.v);
         }
+        if self.thrust {
+            self.thrust_power = model.external_power(s.t, &s.q, &s.v);
+        }
         self.t = s.t;
     }
 
@@ -259,11 +281,19 @@ impl Dissipation {
             self.work += 0.5 * (s.t - self.t) * (self.power + p);
             self.power = p;
         }
+        if self.thrust {
+            let p = model.external_power(s.t, &s.q, &s.v);
+            self.thrust_work += 0.5 * (s.t - self.t) * (self.thrust_power + p);
+            self.thrust_power = p;
+        }
         self.t = s.t;
     }
 
-    /// The row with the work dissipated so far.
+    /// The row with the work dissipated and the thrusts' work so far.
     pub(crate) fn record(&self, mut r: Row) -> Row {
+        if self.thrust {
+            r.thrust_work = self.thrust_work;
+        }
         if self.on {
             r.dissipated = self.work;
             if r.spring.is_nan() {

@@ -38,6 +38,14 @@ impl Thrust {
         if n > 0.0 { [d[0] / n, d[1] / n, d[2] / n] } else { d }
     }
 
+    /// The magnitude as the scene's schedule (a number: one point).
+    pub fn schedule(&self) -> scene::Schedule {
+        match &self.magnitude {
+            Deflection::Fixed(m) => scene::Schedule::constant(*m),
+            Deflection::Schedule(p) => scene::Schedule { points: p.iter().map(|x| (x[0], x[1])).collect() },
+        }
+    }
+
     /// Its display name: `name`, or `thrust<k>` for the k-th entry.
     pub fn label(&self, k: usize) -> String {
         self.name.clone().unwrap_or_else(|| format!("thrust{k}"))

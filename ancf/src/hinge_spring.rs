@@ -88,7 +88,11 @@ pub(crate) struct Kinematics {
 }
 
 /// `v = α₀ (r_y × r_z) + α₁ r_y + α₂ r_z` and `∂v/∂(r_y, r_z)` (3×6).
-fn frame_vector(ry: &Vector3<f64>, rz: &Vector3<f64>, alpha: &Vector3<f64>) -> (Vector3<f64>, SMatrix<f64, 3, 6>) {
+pub(crate) fn frame_vector(
+    ry: &Vector3<f64>,
+    rz: &Vector3<f64>,
+    alpha: &Vector3<f64>,
+) -> (Vector3<f64>, SMatrix<f64, 3, 6>) {
     let v = ry.cross(rz) * alpha[0] + ry * alpha[1] + rz * alpha[2];
     let mut j = SMatrix::<f64, 3, 6>::zeros();
     j.fixed_view_mut::<3, 3>(0, 0).copy_from(&(Matrix3::identity() * alpha[1] - rz.cross_matrix() * alpha[0]));

@@ -70,6 +70,7 @@ mod spec;
 pub mod statics;
 pub mod strain;
 mod structure;
+mod thrust;
 
 pub use error::Error;
 pub use formulation::Energies;

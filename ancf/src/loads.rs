@@ -66,7 +66,7 @@ pub(crate) fn add_point_force(st: Station, y: f64, z: f64, force: &Vector3<f64>,
     }
 }
 
-fn slopes(st: Station, q: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+pub(crate) fn slopes(st: Station, q: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
     let v = |b: usize| Vector3::new(q[st.first + 3 * b], q[st.first + 3 * b + 1], q[st.first + 3 * b + 2]);
     let (w1, w2) = (1.0 - st.xi, st.xi);
     (v(2) * w1 + v(6) * w2, v(3) * w1 + v(7) * w2)

@@ -14,6 +14,7 @@ use crate::point_mass::{PointInertia, point_mass_matrix, point_mass_weights};
 use crate::reduction::Reduction;
 use crate::shape::{ELEMENT_DOF, NODE_DOF, point_weights};
 use crate::strain::twisted_reference_element;
+use crate::thrust::Thrust;
 use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene, SolvePath};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::{Matrix3, Vector3};
@@ -115,6 +116,8 @@ pub struct Model {
     springs: Vec<HingeSpring>,
     /// Whether a spring has damping (the residual then reads the velocities).
     damped: bool,
+    /// Thrusts, follower forces (docs/ancf.md §14).
+    thrusts: Vec<Thrust>,
     /// Point masses (docs/ancf.md §12.2), each on its element.
     point_inertia: Vec<PointInertia>,
     /// Section ties at the joint nodes whose axis equation involves `r_x` (docs/ancf.md §3.5).
@@ -215,15 +218,7 @@ impl Model {
             elements_before += b.n_elements();
         }
 
-        let springs: Vec<HingeSpring> = scene
-            .forces
-            .iter()
-            .map(|f| match *f {
-                ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
-                    HingeSpring::new(joint, &joint_list[joint], &bodies, stiffness, damping, rest)
-                }
-            })
-            .collect();
+        let (springs, thrusts) = force_elements(&scene.forces, &joint_list, &bodies, &q_ref);
         let damped = springs.iter().any(|s| s.damping != 0.0);
         let ties = joint_ties(&joint_list, &bodies, options.joint_tie_factor);
 
@@ -278,9 +273,11 @@ impl Model {
                 rate: vec![0.0; if damped { n_full } else { 0 }],
             }),
             sensor: Mutex::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
-            symmetric: Arc::new(AtomicBool::new(true)),
+            // a follower force's tangent is unsymmetric
+            symmetric: Arc::new(AtomicBool::new(thrusts.is_empty())),
             springs,
             damped,
+            thrusts,
             point_inertia,
             ties,
         })
@@ -729,8 +726,9 @@ impl Model {
             }
         }
         // a follower moment's tangent is not symmetric; a damper's unsymmetric term vanishes at
-        // rest (statics, linearisation) and Newton's matrix of a time step leaves it out
-        self.symmetric.store(self.moments.is_empty(), Ordering::Relaxed);
+        // rest (statics, linearisation) and Newton's matrix of a time step leaves it out; a
+        // thrust's tangent is unsymmetric too
+        self.symmetric.store(self.moments.is_empty() && self.thrusts.is_empty(), Ordering::Relaxed);
         Ok(())
     }
 
@@ -754,15 +752,16 @@ impl Model {
         &self.rows
     }
 
-    /// `r = M v̇ + f_el(q) − λ_load (Q_g + Q_F + Q_M(q))` on full coordinates, with the hinge
-    /// springs at rest (`θ̇ = 0`: no damping force).
-    pub(crate) fn full_residual(&self, q: &[f64], v_dot: &[f64], r: &mut [f64]) {
-        self.full_residual_at(q, None, v_dot, r);
+    /// `r = M v̇ + f_el(q) − λ_load (Q_g + Q_F + Q_M(q) + Q_T(t, q))` on full coordinates, with
+    /// the hinge springs at rest (`θ̇ = 0`: no damping force).
+    pub(crate) fn full_residual(&self, t: f64, q: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.full_residual_at(t, q, None, v_dot, r);
     }
 
-    /// `r = M v̇ + f_el(q) + Σ (k(θ−θ₀) + cθ̇) θ_q − λ_load (Q_g + Q_F + Q_M(q))` on full
-    /// coordinates; `v` (full velocities) is read only by the dampers (`None`: θ̇ = 0).
-    fn full_residual_at(&self, q: &[f64], v: Option<&[f64]>, v_dot: &[f64], r: &mut [f64]) {
+    /// `r = M v̇ + f_el(q) + Σ (k(θ−θ₀) + cθ̇) θ_q − λ_load (Q_g + Q_F + Q_M(q) + Q_T(t, q))` on
+    /// full coordinates, the thrusts `Q_T` at time `t`; `v` (full velocities) is read only by the
+    /// dampers (`None`: θ̇ = 0).
+    fn full_residual_at(&self, t: f64, q: &[f64], v: Option<&[f64]>, v_dot: &[f64], r: &mut [f64]) {
         let lf = self.load_factor;
         for ((ri, g), p) in r.iter_mut().zip(&self.gravity_force).zip(&self.point_force) {
             *ri = -lf * (g + p);
@@ -784,6 +783,9 @@ impl Model {
             for (st, m) in &self.moments {
                 add_moment_force(*st, &(-lf * m), q, r);
             }
+        }
+        for th in &self.thrusts {
+            th.add_residual(lf * th.magnitude(t), q, r);
         }
         for p in &self.point_inertia {
             let range = p.first..p.first + ELEMENT_DOF;
@@ -811,6 +813,7 @@ impl Model {
     #[allow(clippy::too_many_arguments)] // the state, the three generalized-α weights and the kind
     fn add_iteration_matrix(
         &self,
+        t: f64,
         q: &[f64],
         v: Option<&[f64]>,
         c_m: f64,
@@ -853,6 +856,9 @@ impl Model {
             let lf = self.load_factor;
             for (st, m) in &self.moments {
                 moment_tangent(*st, m, q, c_k * lf, |i, j, blk| self.scatter_block(i, j, blk, k));
+            }
+            for th in &self.thrusts {
+                th.tangent(lf * th.magnitude(t), q, c_k, |i, j, blk| self.scatter_block(i, j, blk, k));
             }
         }
         for p in &self.point_inertia {
@@ -967,7 +973,7 @@ impl Model {
     /// Assemble `c_m M + c_k K_t` on full coordinates into a dense column-major matrix
     /// (DAE layout regardless of the path; used by the static solver and the modal analysis).
     /// The hinge springs enter with their stiffness at rest (`θ̇ = 0`, no damping).
-    pub(crate) fn assemble_full_inplace(&self, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
+    pub(crate) fn assemble_full_inplace(&self, t: f64, q: &[f64], c_m: f64, c_k: f64, k: &mut MatView<'_>) {
         let mut ke = ElementMatrix::zeros();
         for b in &self.bodies {
             for el in 0..b.n_elements() {
@@ -985,6 +991,9 @@ impl Model {
         let lf = self.load_factor;
         for (st, m) in &self.moments {
             moment_tangent(*st, m, q, c_k * lf, |i, j, blk| k.add_block(i, j, blk));
+        }
+        for th in &self.thrusts {
+            th.tangent(lf * th.magnitude(t), q, c_k, |i, j, blk| k.add_block(i, j, blk));
         }
         for p in &self.point_inertia {
             ke.as_mut_slice().fill(0.0);
@@ -1070,9 +1079,9 @@ impl ConstrainedSystem for Model {
         }
     }
 
-    fn residual_inplace(&self, _t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+    fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
         match self.options.path {
-            SolvePath::Dae => self.full_residual_at(q, Some(v), v_dot, r),
+            SolvePath::Dae => self.full_residual_at(t, q, Some(v), v_dot, r),
             SolvePath::Ode => {
                 let mut w = scratch(&self.work);
                 let Workspace { q: qf, v: af, r: rf, rate } = &mut *w;
@@ -1084,7 +1093,7 @@ impl ConstrainedSystem for Model {
                 } else {
                     None
                 };
-                self.full_residual_at(qf, vf, af, rf);
+                self.full_residual_at(t, qf, vf, af, rf);
                 self.reduction.project_inplace(rf, r);
             }
         }
@@ -1092,7 +1101,7 @@ impl ConstrainedSystem for Model {
 
     fn iteration_matrix_inplace(
         &self,
-        _t: f64,
+        t: f64,
         q: &[f64],
         v: &[f64],
         _v_dot: &[f64],
@@ -1102,7 +1111,7 @@ impl ConstrainedSystem for Model {
         k: &mut MatView<'_>,
     ) {
         match self.options.path {
-            SolvePath::Dae => self.add_iteration_matrix(q, Some(v), c_m, c_c, c_k, false, k),
+            SolvePath::Dae => self.add_iteration_matrix(t, q, Some(v), c_m, c_c, c_k, false, k),
             SolvePath::Ode => {
                 let mut w = scratch(&self.work);
                 let Workspace { q: qf, rate, .. } = &mut *w;
@@ -1113,7 +1122,7 @@ impl ConstrainedSystem for Model {
                 } else {
                     None
                 };
-                self.add_iteration_matrix(qf, vf, c_m, c_c, c_k, false, k);
+                self.add_iteration_matrix(t, qf, vf, c_m, c_c, c_k, false, k);
             }
         }
     }
@@ -1123,12 +1132,12 @@ impl ConstrainedSystem for Model {
     fn residual_and_static_matrix_inplace(&self, t: f64, q: &[f64], zeros: &[f64], r: &mut [f64], k: &mut MatView<'_>) {
         self.residual_inplace(t, q, zeros, zeros, r);
         match self.options.path {
-            SolvePath::Dae => self.add_iteration_matrix(q, None, 0.0, 0.0, 1.0, true, k),
+            SolvePath::Dae => self.add_iteration_matrix(t, q, None, 0.0, 0.0, 1.0, true, k),
             SolvePath::Ode => {
                 let mut w = scratch(&self.work);
                 let Workspace { q: qf, .. } = &mut *w;
                 self.reduction.expand_inplace(q, qf);
-                self.add_iteration_matrix(qf, None, 0.0, 0.0, 1.0, true, k);
+                self.add_iteration_matrix(t, qf, None, 0.0, 0.0, 1.0, true, k);
             }
         }
     }
@@ -1223,10 +1232,52 @@ impl Model {
 }
 
 impl Model {
-    /// Number of force elements (hinge springs and dampers) in the model.
+    /// Number of force elements (hinge springs and dampers, thrusts) in the model.
     pub fn n_force_elements(&self) -> usize {
-        self.springs.len()
+        self.springs.len() + self.thrusts.len()
     }
+
+    /// Whether the model has thrusts (the `thrust_work` column).
+    pub fn has_thrust(&self) -> bool {
+        !self.thrusts.is_empty()
+    }
+
+    /// The power of the thrusts `Σ F · ṙ(s)` at time `t`, coordinates `q` and velocities `v`
+    /// (the model's form), W. Does not allocate.
+    pub fn thrust_power(&self, t: f64, q: &[f64], v: &[f64]) -> f64 {
+        if self.thrusts.is_empty() {
+            return 0.0;
+        }
+        let mut sens = scratch(&self.sensor);
+        let (qf, vf) = &mut *sens;
+        let (qf, vf) = (&mut qf[..self.n_full], &mut vf[..self.n_full]);
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, vf);
+        let lf = self.load_factor;
+        self.thrusts.iter().map(|th| th.power(lf * th.magnitude(t), qf, vf)).sum()
+    }
+}
+
+/// The scene's force elements built on the model's joints, bodies and full reference
+/// coordinates: the hinge springs and the thrusts.
+fn force_elements(
+    forces: &[ForceElement],
+    joints: &[Joint],
+    bodies: &[Body],
+    q_ref: &[f64],
+) -> (Vec<HingeSpring>, Vec<Thrust>) {
+    let (mut springs, mut thrusts) = (Vec::new(), Vec::new());
+    for f in forces {
+        match *f {
+            ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
+                springs.push(HingeSpring::new(joint, &joints[joint], bodies, stiffness, damping, rest));
+            }
+            ForceElement::Thrust { body, at, ref direction, ref magnitude } => {
+                thrusts.push(Thrust::new(&bodies[body], at, direction, magnitude.clone(), q_ref));
+            }
+        }
+    }
+    (springs, thrusts)
 }
 
 /// The section ties of the hinges (docs/ancf.md §3.5): at each node a hinge acts on, the

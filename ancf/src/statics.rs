@@ -56,12 +56,12 @@ impl ConstrainedSystem for FullCoordinates<'_> {
     fn n_holonomic(&self) -> usize {
         self.0.n_constraint_rows()
     }
-    fn residual_inplace(&self, _t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
-        self.0.full_residual(q, v_dot, r);
+    fn residual_inplace(&self, t: f64, q: &[f64], _v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.0.full_residual(t, q, v_dot, r);
     }
     fn iteration_matrix_inplace(
         &self,
-        _t: f64,
+        t: f64,
         q: &[f64],
         _v: &[f64],
         _v_dot: &[f64],
@@ -70,7 +70,7 @@ impl ConstrainedSystem for FullCoordinates<'_> {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        self.0.assemble_full_inplace(q, c_m, c_k, k);
+        self.0.assemble_full_inplace(t, q, c_m, c_k, k);
     }
     fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {
         for (p, row) in phi.iter_mut().zip(self.0.rows()) {

@@ -36,6 +36,12 @@ impl Structure for Model {
     fn has_force_elements(&self) -> bool {
         self.n_force_elements() > 0
     }
+    fn external_power(&self, t: f64, q: &[f64], v: &[f64]) -> f64 {
+        self.thrust_power(t, q, v)
+    }
+    fn has_external_power(&self) -> bool {
+        self.has_thrust()
+    }
     fn constraint_residual(&self, q: &[f64]) -> f64 {
         Model::constraint_residual(self, q)
     }

@@ -80,3 +80,34 @@ fn spring_and_point_mass_primitives_do_not_allocate() {
         assert_eq!(allocations, 0, "{path:?}: {allocations} allocations");
     }
 }
+
+/// Time steps with thrusts (follower forces, docs/ancf.md §14), on both paths, with the skyline
+/// LU that the thrusts' unsymmetric tangent switches to its unsymmetric storage, and the
+/// thrusts' power of the energy balance: nothing allocates after the first step.
+#[test]
+fn time_steps_with_thrust_do_not_allocate() {
+    for path in [SolvePath::Dae, SolvePath::Ode] {
+        let (b, j, g) = samples::double_pendulum(1.0, 45.0, 4);
+        let thrust = |body, at, direction: Vector3<f64>| ForceElement::Thrust {
+            body,
+            at,
+            direction,
+            magnitude: scene::Schedule { points: vec![(0.0, 0.0), (0.1, 2.0), (0.3, 1.0)] },
+        };
+        let forces = vec![thrust(1, 0.5, Vector3::z()), thrust(0, 0.3, Vector3::new(0.0, 0.6, 0.8))];
+        let scene = Scene { forces, ..Scene::new(b, j, g) };
+        let mut model = Model::from_scene(&scene, Options { path, ..Default::default() }).unwrap();
+        let mut ga = model.integrator(genalpha::IntegratorParams::new(0.8, 0.002)).unwrap();
+        let mut s = model.initial_state();
+        ga.initialize(&model, &mut s).unwrap();
+        ga.step(&mut model, &mut s).unwrap(); // first step: lazy set-up, if any
+        let ((), allocations) = alloc_count::count(|| {
+            for _ in 0..100 {
+                ga.step(&mut model, &mut s).unwrap();
+                std::hint::black_box(model.thrust_power(s.t, &s.q, &s.v));
+                std::hint::black_box(model.energies(&s.q, &s.v));
+            }
+        });
+        assert_eq!(allocations, 0, "{path:?}: {allocations} allocations in 100 steps");
+    }
+}

@@ -23,12 +23,19 @@ pub struct Columns {
     pub springs: bool,
     /// `roll_rate` (a case with a `roll_joint`).
     pub roll: bool,
+    /// `thrust_work` (a case with thrust).
+    pub thrust: bool,
 }
 
 impl Columns {
     /// The groups a row has values for.
     pub fn of_row(r: &Row) -> Self {
-        Self { aero: r.aero_work.is_finite(), springs: r.spring.is_finite(), roll: r.roll_rate.is_finite() }
+        Self {
+            aero: r.aero_work.is_finite(),
+            springs: r.spring.is_finite(),
+            roll: r.roll_rate.is_finite(),
+            thrust: r.thrust_work.is_finite(),
+        }
     }
 
     /// The groups any of `rows` has values for.
@@ -37,12 +44,14 @@ impl Columns {
             aero: a.aero || b.aero,
             springs: a.springs || b.springs,
             roll: a.roll || b.roll,
+            thrust: a.thrust || b.thrust,
         })
     }
 }
 
 /// The header line (without newline) of a CSV with the column groups `c`: `roll_rate` after
-/// `fold`, `spring` and `dissipated` after `potential`, the aerodynamic columns; with
+/// `fold`, `spring` and `dissipated` after `potential`, `thrust_work` after `total`, the
+/// aerodynamic columns; with
 /// aerodynamics, a `<name>_hinge_moment` column per control surface (`surfaces`, the case's
 /// `aero.control_surfaces` names in order) at the end.
 pub fn header(c: Columns, surfaces: &[String]) -> String {
@@ -52,6 +61,9 @@ pub fn header(c: Columns, surfaces: &[String]) -> String {
         if c.springs { header.replace(",potential,", ",potential,spring,dissipated,") } else { header.to_string() };
     if c.roll {
         h = h.replacen(",fold,", ",fold,roll_rate,", 1);
+    }
+    if c.thrust {
+        h = h.replacen(",total,", ",total,thrust_work,", 1);
     }
     if aero {
         for name in surfaces {
@@ -74,6 +86,9 @@ pub fn push_row(s: &mut String, r: &Row, c: Columns, n_surfaces: usize) {
         let _ = write!(s, "{:.9e},{:.9e},", r.spring, r.dissipated);
     }
     let _ = write!(s, "{:.9e},", r.total);
+    if c.thrust {
+        let _ = write!(s, "{:.9e},", r.thrust_work);
+    }
     if aero {
         let _ = write!(s, "{:.9e},", r.aero_work);
     }

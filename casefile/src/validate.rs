@@ -311,6 +311,10 @@ impl Case {
                 Joint::Clamp { body: b, .. } | Joint::Free { body: b, .. } => body(format!("joints[{i}].body"), b)?,
             }
         }
+        for (k, t) in self.thrust.iter().enumerate() {
+            // the scene names the rest (`thrust[k].at`, `.direction`, `.magnitude`)
+            body(format!("thrust[{k}].body"), &t.body)?;
+        }
         if let Some(n) = &self.roll_joint {
             match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
                 Some(Joint::GroundHinge { .. }) => {}

@@ -125,6 +125,15 @@ pub trait Structure: ConstrainedSystem {
     fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64;
     /// Whether the model has force elements (the spring and dissipated-work columns).
     fn has_force_elements(&self) -> bool;
+    /// The power of the external follower forces (thrusts) `Σ F · ṗ` at time `t`, coordinates
+    /// `q` and velocities `v`, W: what the energy balance integrates as their work. Default 0.
+    fn external_power(&self, _t: f64, _q: &[f64], _v: &[f64]) -> f64 {
+        0.0
+    }
+    /// Whether the model has thrusts (the `thrust_work` column). Default: none.
+    fn has_external_power(&self) -> bool {
+        false
+    }
     /// Position-level joint violation (gap in m and axis misalignment in rad, Euclidean norm).
     fn constraint_residual(&self, q: &[f64]) -> f64;
     /// Number of bodies.

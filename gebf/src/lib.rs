@@ -95,6 +95,7 @@ pub mod simulate;
 mod statics;
 mod stiffness;
 mod structure;
+mod thrust;
 
 pub use body::BodySpec;
 pub use error::Error;

@@ -15,6 +15,7 @@ use crate::loads::{NodalLoad, add_load, add_load_tangent};
 use crate::quaternion::Quaternion;
 use crate::rigid_slice::{add_element_gravity, add_element_inertia, element_potential};
 use crate::stiffness::add_elastic;
+use crate::thrust::Thrust;
 use crate::{BodySpec, Error, ForceElement, JointSpec, Options, Scene};
 use genalpha::{ConstrainedSystem, MatView, State};
 use nalgebra::Vector3;
@@ -40,6 +41,8 @@ pub struct Model {
     pub(crate) load_scale: f64,
     /// Hinge springs and dampers.
     springs: Vec<HingeSpring>,
+    /// Thrusts, follower forces (docs/gebf.md §16).
+    thrusts: Vec<Thrust>,
     /// Per joint: the hinge angle θ of the last accepted step (free hinges; 0 otherwise), rad,
     /// against which the principal angle is unwrapped (docs/gebf.md §13).
     hinge_last: Vec<f64>,
@@ -134,15 +137,19 @@ impl Model {
             rows += j.n_rows();
         }
         let loads = bs.iter().map(|b| vec![NodalLoad::default(); b.n_nodes()]).collect();
-        let springs = scene
-            .forces
-            .iter()
-            .map(|f| match *f {
+        let mut springs = Vec::new();
+        let mut thrusts = Vec::new();
+        for f in &scene.forces {
+            match *f {
                 ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
-                    HingeSpring { joint, stiffness, damping, rest }
+                    springs.push(HingeSpring { joint, stiffness, damping, rest });
                 }
-            })
-            .collect();
+                ForceElement::Thrust { body, at, ref direction, ref magnitude } => {
+                    let frame_at = bodies[body].section_frame(at);
+                    thrusts.push(Thrust::new(body, &bs[body], at, &frame_at, direction, magnitude.clone()));
+                }
+            }
+        }
         let hinge_last = vec![0.0; js.len()];
         Ok(Model {
             bodies: bs,
@@ -158,6 +165,7 @@ impl Model {
             n_loaded: 0,
             load_scale: 1.0,
             springs,
+            thrusts,
             hinge_last,
         })
     }
@@ -468,6 +476,7 @@ impl Model {
     /// the chain rule and take the plain residual path).
     fn element_pass(
         &self,
+        t: f64,
         q: &[f64],
         v: &[f64],
         v_dot: &[f64],
@@ -547,6 +556,16 @@ impl Model {
             let matrix = matrix.as_mut().map(|(c, k)| (c.c_c, c.c_k, &mut **k));
             let j = &self.joints[s.joint];
             s.add(j, &self.bodies, self.hinge_last[s.joint], q, v, r.as_deref_mut(), matrix);
+        }
+        for th in &self.thrusts {
+            let b = &self.bodies[th.body];
+            let p = self.load_scale * th.magnitude(t);
+            if let Some(r) = r.as_deref_mut() {
+                th.add_residual(b, p, q, r);
+            }
+            if let Some((coeffs, k)) = matrix.as_mut() {
+                th.add_tangent(b, p, q, coeffs.c_k, k);
+            }
         }
     }
 
@@ -637,13 +656,13 @@ impl ConstrainedSystem for Model {
         }
     }
 
-    fn residual_inplace(&self, _t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
-        self.element_pass(q, v, v_dot, Some(r), None);
+    fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.element_pass(t, q, v, v_dot, Some(r), None);
     }
 
     fn iteration_matrix_inplace(
         &self,
-        _t: f64,
+        t: f64,
         q: &[f64],
         v: &[f64],
         v_dot: &[f64],
@@ -652,14 +671,14 @@ impl ConstrainedSystem for Model {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        self.element_pass(q, v, v_dot, None, Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
+        self.element_pass(t, q, v, v_dot, None, Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
     }
 
     /// One pass over the elements: the element routines produce the residual while they build
     /// the matrix.
     fn residual_and_iteration_matrix_inplace(
         &self,
-        _t: f64,
+        t: f64,
         q: &[f64],
         v: &[f64],
         v_dot: &[f64],
@@ -669,7 +688,7 @@ impl ConstrainedSystem for Model {
         c_k: f64,
         k: &mut MatView<'_>,
     ) {
-        self.element_pass(q, v, v_dot, Some(r), Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
+        self.element_pass(t, q, v, v_dot, Some(r), Some((MatrixCoefficients { c_m, c_c, c_k }, k)));
     }
 
     fn psi_inplace(&self, _t: f64, q: &[f64], v: &[f64], psi: &mut [f64]) {
@@ -745,8 +764,18 @@ impl ConstrainedSystem for Model {
 }
 
 impl Model {
-    /// Number of force elements (hinge springs and dampers) in the model.
+    /// Number of force elements (hinge springs and dampers, thrusts) in the model.
     pub fn n_force_elements(&self) -> usize {
-        self.springs.len()
+        self.springs.len() + self.thrusts.len()
+    }
+
+    /// Whether the model has thrusts (the `thrust_work` column).
+    pub fn has_thrust(&self) -> bool {
+        !self.thrusts.is_empty()
+    }
+
+    /// The power of the thrusts `Σ F · ṙ` at time `t`, coordinates `q` and velocities `v`, W.
+    pub fn thrust_power(&self, t: f64, q: &[f64], v: &[f64]) -> f64 {
+        self.thrusts.iter().map(|th| th.power(&self.bodies[th.body], self.load_scale * th.magnitude(t), q, v)).sum()
     }
 }

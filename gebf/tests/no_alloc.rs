@@ -34,6 +34,19 @@ fn time_steps_with_springs_and_point_masses_do_not_allocate() {
     steps_do_not_allocate(Model::from_scene(&scene, Options { stabilization: true, ..Options::default() }).unwrap());
 }
 
+/// The same with thrusts (follower forces, docs/gebf.md §16): one inside an element, one at the
+/// tip, on a schedule, with their power.
+#[test]
+fn time_steps_with_thrust_do_not_allocate() {
+    let (b, j, g) = samples::double_pendulum(1.0, 45.0, 5);
+    let mut scene = Scene::new(b, j, g);
+    for (body, at, direction) in [(1, 0.5, Vector3::z()), (0, 0.27, Vector3::new(0.0, 0.6, 0.8))] {
+        let magnitude = scene::Schedule { points: vec![(0.0, 0.0), (0.1, 2.0), (0.3, 1.0)] };
+        scene.forces.push(ForceElement::Thrust { body, at, direction, magnitude });
+    }
+    steps_do_not_allocate(Model::from_scene(&scene, Options { stabilization: true, ..Options::default() }).unwrap());
+}
+
 fn steps_do_not_allocate(mut m: Model) {
     let mut ga = GenAlpha::new(IntegratorParams::new(0.8, 0.002), &m).unwrap();
     let mut s = m.initial_state();
@@ -46,6 +59,7 @@ fn steps_do_not_allocate(mut m: Model) {
             std::hint::black_box(m.constraint_residual(&s.q));
             std::hint::black_box(m.energies(&s.q, &s.v));
             std::hint::black_box(m.dissipation_power(&s.q, &s.v));
+            std::hint::black_box(m.thrust_power(s.t, &s.q, &s.v));
         }
     });
     assert_eq!(allocations, 0, "{allocations} allocations in 200 steps");

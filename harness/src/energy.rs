@@ -105,9 +105,11 @@ pub fn run(specs: &[RunSpec]) -> Vec<EnergyRun> {
             let metrics = FormulationMetrics::of(&o[0]);
             let e0 = o[0].rows.first().map_or(0.0, |r| r.total);
             let peak = if metrics.peak_kinetic > 0.0 { metrics.peak_kinetic } else { 1.0 };
-            // E + W_dissipated is what is conserved when the case has dampers.
+            // E + W_dissipated − W_thrust is what is conserved when the case has dampers and
+            // thrusts.
             let d = |r: &crate::run::Row| if r.dissipated.is_finite() { r.dissipated } else { 0.0 };
-            let history = o[0].rows.iter().map(|r| (r.t, (r.total + d(r) - e0) / peak)).collect();
+            let th = |r: &crate::run::Row| if r.thrust_work.is_finite() { r.thrust_work } else { 0.0 };
+            let history = o[0].rows.iter().map(|r| (r.t, (r.total + d(r) - e0 - th(r)) / peak)).collect();
             EnergyRun {
                 case: specs[i].name.clone(),
                 formulation: f,

@@ -41,7 +41,8 @@ fn json_err(p: &Path) -> impl Fn(serde_json::Error) -> Error + '_ {
 }
 
 /// A row with every `f64` as its bits (`newton_iterations` as itself): the 18 columns, then
-/// the control surfaces' hinge moments (a record of 18 has none: NaN), then the roll rate.
+/// the control surfaces' hinge moments (a record of 18 has none: NaN), then the roll rate, then
+/// the thrusts' work (an older record without it: NaN).
 type RowBits = Vec<u64>;
 
 fn row_bits(r: &Row) -> RowBits {
@@ -68,6 +69,7 @@ fn row_bits(r: &Row) -> RowBits {
     ];
     v.extend(r.control_hinge_moments.iter().map(|&h| b(h)));
     v.push(b(r.roll_rate));
+    v.push(b(r.thrust_work));
     v
 }
 
@@ -93,6 +95,7 @@ fn row_of(x: &[u64]) -> Row {
         hinge_moment: g(17),
         control_hinge_moments: std::array::from_fn(|i| g(18 + i)),
         roll_rate: g(18 + aeroelastic::control_surface::MAX_CONTROL_SURFACES),
+        thrust_work: g(19 + aeroelastic::control_surface::MAX_CONTROL_SURFACES),
     }
 }
 

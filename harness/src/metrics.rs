@@ -121,9 +121,10 @@ impl FormulationMetrics {
         let e0 = run.rows.first().map_or(0.0, |r| r.total);
         let peak = run.rows.iter().map(|r| r.kinetic).fold(0.0, f64::max);
         let w = |r: &Row| if r.aero_work.is_finite() { r.aero_work } else { 0.0 };
-        // E(t) + W_dissipated(t) − W_aero(t) = E(0)
+        // E(t) + W_dissipated(t) − W_aero(t) − W_thrust(t) = E(0)
         let d = |r: &Row| if r.dissipated.is_finite() { r.dissipated } else { 0.0 };
-        let drift = run.rows.iter().map(|r| (r.total + d(r) - e0 - w(r)).abs()).fold(0.0, f64::max);
+        let th = |r: &Row| if r.thrust_work.is_finite() { r.thrust_work } else { 0.0 };
+        let drift = run.rows.iter().map(|r| (r.total + d(r) - e0 - w(r) - th(r)).abs()).fold(0.0, f64::max);
         Self {
             wall_s: run.wall_s,
             n_steps: run.stats.n_steps,
@@ -270,6 +271,7 @@ mod tests {
             spring: nan,
             dissipated: nan,
             total: nan,
+            thrust_work: nan,
             constraint_residual: nan,
             newton_iterations: 0,
             aero_work: nan,

@@ -492,10 +492,12 @@ fn write_energy(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         let peak = r.metrics.get(&run.formulation).map_or(1.0, |m| m.peak_kinetic).max(f64::MIN_POSITIVE);
         let w = |x: &crate::run::Row| if x.aero_work.is_finite() { x.aero_work } else { 0.0 };
         let d = |x: &crate::run::Row| if x.dissipated.is_finite() { x.dissipated } else { 0.0 };
+        // a thrust's work joins the balance as the aerodynamic work does
+        let th = |x: &crate::run::Row| if x.thrust_work.is_finite() { x.thrust_work } else { 0.0 };
         drift.push(Series::new(
             l,
             run_style(run.formulation),
-            run.rows.iter().map(|x| (x.t, (x.total + d(x) - e0 - w(x)) / peak)).collect(),
+            run.rows.iter().map(|x| (x.t, (x.total + d(x) - e0 - w(x) - th(x)) / peak)).collect(),
         ));
     }
     // The balance the drift panel shows: the terms the case has.

@@ -16,7 +16,7 @@ type Getter = fn(&Row) -> f64;
 type Setter = fn(&mut Row, f64);
 
 /// Every column a row can have, by its CSV name.
-const COLUMNS: [(&str, Getter); 19] = [
+const COLUMNS: [(&str, Getter); 20] = [
     ("t", |r| r.t),
     ("tip_x", |r| r.tip[0]),
     ("tip_y", |r| r.tip[1]),
@@ -29,6 +29,7 @@ const COLUMNS: [(&str, Getter); 19] = [
     ("spring", |r| r.spring),
     ("dissipated", |r| r.dissipated),
     ("total", |r| r.total),
+    ("thrust_work", |r| r.thrust_work),
     ("aero_work", |r| r.aero_work),
     ("constraint_residual", |r| r.constraint_residual),
     ("newton_iterations", |r| r.newton_iterations as f64),
@@ -40,6 +41,7 @@ const COLUMNS: [(&str, Getter); 19] = [
 
 /// The CSV column names of these rows (`casefile::csv::header`: aerodynamic columns when the run
 /// has them, `spring` and `dissipated` when the model has force elements or hinge events,
+/// `thrust_work` when it has thrusts,
 /// `roll_rate` with a roll joint, the control surfaces' `<name>_hinge_moment` last).
 fn header(rows: &[Row], surfaces: &[String]) -> Vec<String> {
     casefile::csv::header(casefile::csv::Columns::of(rows), surfaces).split(',').map(str::to_string).collect()
@@ -95,6 +97,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         spring: f64::NAN,
         dissipated: f64::NAN,
         total: f64::NAN,
+        thrust_work: f64::NAN,
         constraint_residual: f64::NAN,
         newton_iterations: 0,
         aero_work: f64::NAN,
@@ -105,7 +108,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         control_hinge_moments: [f64::NAN; aeroelastic::control_surface::MAX_CONTROL_SURFACES],
     };
     let mut rows = vec![nan; n];
-    let setters: [(&str, Setter); 19] = [
+    let setters: [(&str, Setter); 20] = [
         ("t", |r, x| r.t = x),
         ("roll_rate", |r, x| r.roll_rate = x),
         ("tip_x", |r, x| r.tip[0] = x),
@@ -118,6 +121,7 @@ pub fn rows_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<Row>> {
         ("spring", |r, x| r.spring = x),
         ("dissipated", |r, x| r.dissipated = x),
         ("total", |r, x| r.total = x),
+        ("thrust_work", |r, x| r.thrust_work = x),
         ("aero_work", |r, x| r.aero_work = x),
         ("constraint_residual", |r, x| r.constraint_residual = x),
         ("newton_iterations", |r, x| r.newton_iterations = x as usize),

@@ -167,4 +167,28 @@ pub enum Error {
         /// The previous point's arclength, m.
         previous: f64,
     },
+    /// A direction vector of zero length.
+    #[error("{field}: the direction has zero length")]
+    ZeroDirection {
+        /// Field path, e.g. `thrust[0].direction`.
+        field: String,
+    },
+    /// A schedule without points.
+    #[error("{field}: the schedule has no point")]
+    EmptySchedule {
+        /// Field path, e.g. `thrust[0].magnitude`.
+        field: String,
+    },
+    /// A schedule whose times do not increase strictly.
+    #[error(
+        "{field}: t = {value} does not exceed the previous point's t = {previous} (the schedule must increase strictly)"
+    )]
+    ScheduleNotIncreasing {
+        /// Field path, e.g. `thrust[0].magnitude[2].t`.
+        field: String,
+        /// The offending time, s.
+        value: f64,
+        /// The previous point's time, s.
+        previous: f64,
+    },
 }

@@ -3,8 +3,8 @@
 //! A [`Scene`] is a list of straight beam [`BodySpec`]s in their reference configuration (each
 //! with a cross-[`Section`], optional [`PointMass`]es and an optional built-in [`Twist`] of its
 //! sections), the [`JointSpec`]s that connect them to
-//! each other and to ground, the [`ForceElement`]s that act across joints (hinge springs and
-//! dampers), and gravity. Bodies are referred to by index into the body list, joints by index into
+//! each other and to ground, the [`ForceElement`]s (hinge springs and dampers across joints,
+//! thrusts on bodies), and gravity. Bodies are referred to by index into the body list, joints by index into
 //! the joint list.
 //!
 //! [`Scene::validate`] checks everything any later stage would reject (ANCF's slope inertias,
@@ -25,7 +25,7 @@ mod validate;
 
 pub use body::{BodySpec, PointMass, RigidBodyInertia};
 pub use error::Error;
-pub use force::ForceElement;
+pub use force::{ForceElement, Schedule};
 pub use joint::JointSpec;
 pub use section::Section;
 pub use twist::Twist;
@@ -39,7 +39,7 @@ pub struct Scene {
     pub bodies: Vec<BodySpec>,
     /// Joints between bodies and to ground.
     pub joints: Vec<JointSpec>,
-    /// Force elements acting across joints.
+    /// Force elements: hinge springs across joints, thrusts on bodies.
     pub forces: Vec<ForceElement>,
     /// Gravity, m/s².
     pub gravity: Vector3<f64>,
@@ -53,6 +53,6 @@ impl Scene {
 
     /// The hinge spring acting on joint `joint`, if any (the first one listed).
     pub fn spring_on(&self, joint: usize) -> Option<&ForceElement> {
-        self.forces.iter().find(|f| f.joint() == joint)
+        self.forces.iter().find(|f| f.joint() == Some(joint))
     }
 }

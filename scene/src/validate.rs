@@ -210,8 +210,13 @@ impl Scene {
     fn validate_forces(&self) -> Result<(), Error> {
         let nj = self.joints.len();
         let mut spring: Vec<Option<usize>> = vec![None; nj];
+        let mut n_thrust = 0;
         for (k, f) in self.forces.iter().enumerate() {
             match *f {
+                ForceElement::Thrust { body, at, ref direction, ref magnitude } => {
+                    self.validate_thrust(n_thrust, body, at, direction, &magnitude.points)?;
+                    n_thrust += 1;
+                }
                 ForceElement::HingeSpring { joint, stiffness, damping, rest } => {
                     if joint >= nj {
                         return Err(Error::NoSuchJoint { field: format!("forces[{k}].joint"), joint, n_joints: nj });
@@ -229,6 +234,52 @@ impl Scene {
                     non_negative(|| format!("{path}.damping"), damping)?;
                     finite(|| format!("{path}.rest_deg"), rest)?;
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// The `k`-th thrust (case field `thrust[k]`): an existing body, a point on it, a finite
+    /// non-zero direction, a finite magnitude schedule with strictly increasing times.
+    fn validate_thrust(
+        &self,
+        k: usize,
+        body: usize,
+        at: f64,
+        direction: &Vector3<f64>,
+        magnitude: &[(f64, f64)],
+    ) -> Result<(), Error> {
+        let path = format!("thrust[{k}]");
+        let nb = self.bodies.len();
+        if body >= nb {
+            return Err(Error::NoSuchBody { field: format!("{path}.body"), body, n_bodies: nb });
+        }
+        finite(|| format!("{path}.at"), at)?;
+        let len = self.bodies[body].length;
+        if at < -1e-12 * len || at > len * (1.0 + 1e-12) {
+            return Err(Error::OutOfRange { field: format!("{path}.at"), value: at, min: 0.0, max: len });
+        }
+        finite_vector(&format!("{path}.direction"), direction)?;
+        if direction.norm() == 0.0 {
+            return Err(Error::ZeroDirection { field: format!("{path}.direction") });
+        }
+        if magnitude.is_empty() {
+            return Err(Error::EmptySchedule { field: format!("{path}.magnitude") });
+        }
+        // A one-point schedule is the case's plain number: no index in the field's name.
+        let single = magnitude.len() == 1;
+        let point = |i: usize, part: &str| {
+            if single { format!("{path}.magnitude") } else { format!("{path}.magnitude[{i}]{part}") }
+        };
+        for (i, &(t, v)) in magnitude.iter().enumerate() {
+            finite(|| point(i, "[0]"), t)?;
+            finite(|| point(i, "[1]"), v)?;
+            if i > 0 && t <= magnitude[i - 1].0 {
+                return Err(Error::ScheduleNotIncreasing {
+                    field: point(i, "[0]"),
+                    value: t,
+                    previous: magnitude[i - 1].0,
+                });
             }
         }
         Ok(())
@@ -315,6 +366,33 @@ mod tests {
         );
         s.bodies[1].twist = crate::Twist::linear(0.1, 0.2, 0.5 * (1.0 + 1e-13));
         s.validate().unwrap();
+        let mut s = pendulum();
+        let thrust = |body, at, direction: Vector3<f64>, points: Vec<(f64, f64)>| ForceElement::Thrust {
+            body,
+            at,
+            direction,
+            magnitude: crate::Schedule { points },
+        };
+        s.forces.push(ForceElement::HingeSpring { joint: 1, stiffness: 2.0, damping: 0.0, rest: 0.0 });
+        s.forces.push(thrust(1, 0.5, Vector3::y(), vec![(0.0, 3.0)]));
+        s.validate().unwrap();
+        s.forces.push(thrust(2, 0.5, Vector3::y(), vec![(0.0, 3.0)]));
+        assert_eq!(msg(&s), "thrust[1].body: no body 2 (the scene has 2 bodies)");
+        s.forces[2] = thrust(1, 0.6, Vector3::y(), vec![(0.0, 3.0)]);
+        assert_eq!(msg(&s), "thrust[1].at: 0.6 is not in [0, 0.5]");
+        s.forces[2] = thrust(1, 0.2, Vector3::zeros(), vec![(0.0, 3.0)]);
+        assert_eq!(msg(&s), "thrust[1].direction: the direction has zero length");
+        s.forces[2] = thrust(1, 0.2, Vector3::new(0.0, f64::NAN, 1.0), vec![(0.0, 3.0)]);
+        assert_eq!(msg(&s), "thrust[1].direction[1]: NaN is not a finite number");
+        s.forces[2] = thrust(1, 0.2, Vector3::y(), vec![(0.0, f64::INFINITY)]);
+        assert_eq!(msg(&s), "thrust[1].magnitude: inf is not a finite number");
+        s.forces[2] = thrust(1, 0.2, Vector3::y(), vec![(0.0, 1.0), (0.0, 2.0)]);
+        assert_eq!(
+            msg(&s),
+            "thrust[1].magnitude[1][0]: t = 0 does not exceed the previous point's t = 0 (the schedule must increase strictly)"
+        );
+        s.forces[2] = thrust(1, 0.2, Vector3::y(), Vec::new());
+        assert_eq!(msg(&s), "thrust[1].magnitude: the schedule has no point");
         let mut s = pendulum();
         s.joints.push(JointSpec::Clamp { body: 1 });
         assert_eq!(msg(&s), "joints[2].body: body 1 is already attached at its start by joints[1]");

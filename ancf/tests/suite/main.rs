@@ -16,4 +16,5 @@ mod properties;
 mod rigid_limit;
 mod spring;
 mod statics;
+mod thrust;
 mod twist;

@@ -269,6 +269,7 @@ fn run_through_180(scene: &Scene, joint: usize, poses: Vec<RigidPose>, omega0: f
 fn scene_stiffness(scene: &Scene) -> f64 {
     match scene.forces[0] {
         ForceElement::HingeSpring { stiffness, .. } => stiffness,
+        ForceElement::Thrust { .. } => 0.0,
     }
 }
 

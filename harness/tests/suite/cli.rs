@@ -458,3 +458,57 @@ fn roll_joint_names_a_ground_hinge() {
     let last: Vec<f64> = lines.last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
     assert!(last[5] > 0.0, "{last:?}");
 }
+
+/// Thrust (case field `thrust`): a point outside its body, an unknown body, a zero direction and
+/// a schedule that does not increase are refused with exit 2 naming the field (JSON carries no
+/// non-finite number; the scene's own test names one); a valid thrust runs and its CSV gains `thrust_work` after `total`, which grows from 0.
+#[test]
+fn thrust_is_validated_and_its_work_is_a_column() {
+    use serde_json::json;
+    let good = json!({ "body": "outer", "at": 0.5, "direction": [0.0, 0.0, 1.0], "magnitude": 2.0 });
+    let bad = [
+        ("at", "at", json!(0.7), "thrust[0].at: 0.7 is not in [0, 0.5]"),
+        ("body", "body", json!("tip"), "thrust[0].body: no body named `tip`"),
+        ("direction", "direction", json!([0.0, 0.0, 0.0]), "thrust[0].direction: the direction has zero length"),
+        (
+            "schedule",
+            "magnitude",
+            json!([[0.0, 1.0], [0.0, 2.0]]),
+            "thrust[0].magnitude[1][0]: t = 0 does not exceed the previous point's t = 0",
+        ),
+    ];
+    for (name, field, value, needle) in bad {
+        let p = tmp_case(&format!("thrust_{name}/case.json"), |v| {
+            let mut t = good.clone();
+            t[field] = value.clone();
+            v["thrust"] = t;
+        });
+        let (path, folder) = (p.to_str().unwrap(), p.parent().unwrap().to_str().unwrap());
+        for args in [vec!["run", path], vec!["list", "--cases", folder], vec!["gate", path]] {
+            let o = harness(&args);
+            assert_eq!(o.status.code(), Some(2), "{name}: {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+            assert_clean_error(&o, needle);
+        }
+    }
+    let p = tmp_case("thrust_ok.json", |v| {
+        v["thrust"] = json!([good.clone()]);
+        v["t_end"] = json!(0.02);
+        for k in ["references", "gate", "converge"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+    });
+    let out = p.with_file_name("thrust_ok_out");
+    let o = harness(&["run", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["ancf", "gebf"] {
+        let csv = std::fs::read_to_string(out.join("double_pendulum_c1_beta45").join(format!("{f}.csv"))).unwrap();
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = header.iter().position(|c| *c == "thrust_work").expect("a thrust_work column");
+        assert_eq!(header[col - 1], "total", "{header:?}");
+        let work: Vec<f64> = lines.map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
+        assert_eq!(work[0], 0.0);
+        assert!(work.last().unwrap().abs() > 0.0, "{f}: {work:?}");
+    }
+    std::fs::remove_dir_all(out).ok();
+}
