@@ -152,12 +152,55 @@ def main():
         trim=dict(elevator=elevator, alpha_deg=4.0,
                   wake=dict(row_length=0.25, rows=20)),
     )
-    out = os.path.join(os.path.dirname(__file__), "..", "cases", "horten_flying_wing.json")
-    with open(out, "w") as f:
+    root = os.path.join(os.path.dirname(__file__), "..", "cases")
+    flight = dict(case, name="horten_level_flight",
+                  description=case["description"] + " Full span, for the time march from the trim (initial: trim): "
+                  "level flight at 28 m/s for 10 s.")
+    write(os.path.join(root, "flight", "horten_level_flight.json"), flight)
+    write(os.path.join(root, "horten_flying_wing.json"), half_model(case))
+
+
+def half_model(full):
+    """The right half of `full` with a mirror plane at x = 0 (the trim of a symmetric aircraft):
+    its centre section on the free joint, with half the fuselage's mass at the centreline."""
+    case = json.loads(json.dumps(full))
+    hub = case["bodies"][0]
+    fus = hub["point_masses"][0]
+    keep = [b for b in case["bodies"] if b["name"] == "centre_r" or b["name"].startswith("r")]
+    names = {b["name"] for b in keep}
+    keep[0]["start"] = [0.0, 0.0, 0.0]
+    keep[0]["point_masses"].insert(0, dict(at=0.0, mass=fus["mass"] / 2, inertia=[v / 2 for v in fus["inertia"]]))
+    case["bodies"] = keep
+    case["joints"] = [dict(type="free", name="flight", body="centre_r")] + [
+        j for j in case["joints"] if j.get("child") in names and j.get("parent") in names]
+    case["thrust"] = [t for t in case["thrust"] if t["body"] in names]
+    for blk in ("ancf", "gebf"):
+        case[blk]["elements_per_body"] = case[blk]["elements_per_body"][1:1 + len(keep)]
+    aero = case["aero"]
+    aero["images"] = [dict(point=[0, 0, 0], normal=[1, 0, 0])]
+    aero["surfaces"] = [sf for sf in aero["surfaces"] if sf["bodies"][0] in names]
+    aero["control_surfaces"] = [c for c in aero["control_surfaces"] if c["body"] in names]
+    case["trim"]["elevator"] = [e for e in case["trim"]["elevator"] if isinstance(e, str)]
+    # A free half model is not a symmetric aircraft in a time march (nothing keeps it symmetric):
+    # its march is a short drop from the reference; the flight is cases/flight/horten_level_flight.json.
+    case.pop("initial")
+    case["t_end"] = 0.25 / 28 * 6
+    case["output_dt"] = 0.25 / 28
+    case["description"] = full["description"].replace(
+        "Full span: a hub on the free joint carrying the fuselage mass, two half-wings of 12 bodies each",
+        "Half model with a mirror plane at x = 0 (the right half-wing of 12 bodies, its centre section on the "
+        "free joint with half the fuselage mass)") + " The time march is a 54 ms drop from the reference."
+    return case
+
+
+def write(path, case):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
         json.dump(case, f, indent=2)
         f.write("\n")
+    bodies = case["bodies"]
     mass = sum(b["section"]["mass"] * b["length"] + sum(p["mass"] for p in b.get("point_masses", [])) for b in bodies)
-    print(f"wrote {out}: mass {mass:.3f} kg, sections {[round(b['section']['mass'], 2) for b in bodies]}")
+    print(f"wrote {path}: {len(bodies)} bodies, mass {mass:.3f} kg")
 
 
 if __name__ == "__main__":

@@ -200,7 +200,7 @@ def test_trim_of_the_horten_wing():
     r = flexmb.trim(ROOT / "cases" / "horten_flying_wing.json", "gebf")
     assert r["converged"] and r["error"] is None
     assert abs(r["alpha_deg"] - 4.5135) < 0.1
-    assert set(r["controls"]) == {f"elevon{k}" for k in range(5, 11)}
+    assert set(r["controls"]) == {f"elevon_r{k}" for k in range(5, 11)}
     assert r["thrust"] > 0 and r["q"].ndim == 1 and r["q"].size > 100
     with pytest.raises(flexmb.CaseError) as e:
         flexmb.trim(PENDULUM)
