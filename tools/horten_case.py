@@ -158,6 +158,27 @@ def main():
                   "level flight at 28 m/s for 10 s.")
     write(os.path.join(root, "flight", "horten_level_flight.json"), flight)
     write(os.path.join(root, "horten_flying_wing.json"), half_model(case))
+    write(os.path.join(root, "flight", "horten_doublet.json"), doublet(flight))
+
+
+def doublet(flight):
+    """The full-span aircraft at 30 m/s, trimmed, with a 1 deg elevator doublet (0.5-0.9 s) on top
+    of the trim, flown 60 s: the phugoid of docs/trim.md section 5."""
+    case = json.loads(json.dumps(flight))
+    case["name"] = "horten_doublet"
+    case["description"] = flight["description"].replace(
+        "level flight at 28 m/s for 10 s.", "at 30 m/s, a 1 deg elevator doublet at 0.5-0.9 s, flown 60 s (the phugoid).")
+    dt = 0.25 / 30
+    case["aero"]["v_inf"] = [0, -30.0, 0]
+    for blk in ("ancf", "gebf"):
+        case[blk]["dt"] = dt
+    case["t_end"] = round(60 / dt) * dt
+    case["output_dt"] = 10 * dt
+    for cs in case["aero"]["control_surfaces"]:
+        g = 1.0 if cs["body"].startswith("r") else -1.0
+        d = cs["deflection_deg"]
+        cs["deflection_deg"] = [[0, d], [0.5, d], [0.6, d + g], [0.8, d - g], [0.9, d]]
+    return case
 
 
 def half_model(full):
