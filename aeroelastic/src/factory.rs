@@ -241,7 +241,11 @@ pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
 /// A time march from the trimmed state (`initial: "trim"`, docs/trim.md §5): the trim with the
 /// march's own wake, then the march of the free aircraft in body axes from the trimmed
 /// coordinates, at rest, with the steady wake prefilled and its loads applied.
-fn from_trim<M: BuildModel>(problem: &Problem, f: Formulation, observer: &mut dyn Observer) -> Result<RunOutput, Error> {
+fn from_trim<M: BuildModel>(
+    problem: &Problem,
+    f: Formulation,
+    observer: &mut dyn Observer,
+) -> Result<RunOutput, Error> {
     let model_error = |msg: String| Error::Model { formulation: f, msg };
     let (flight, trim) = crate::trim::trim_for_march::<M>(problem, f).map_err(model_error)?;
     let (Some(aero), Some(aero0)) = (flight.aero.as_ref(), problem.aero.as_ref()) else {
