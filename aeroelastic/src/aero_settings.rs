@@ -98,10 +98,38 @@ pub struct AeroSettings {
     /// `polars`; default 1.5e-5 (air near 20 °C).
     #[cfg_attr(feature = "serde", serde(default = "default_kinematic_viscosity"))]
     pub kinematic_viscosity: f64,
+    /// The time march's aerodynamics: `"uvlm"` (default, the lattice and its wake) or `"strip"`
+    /// (quasi-steady thin-aerofoil strips at the span stations, no wake: docs/coupling.md §9).
+    /// Statics, stability and gust use the lattice whatever this says.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "AeroModel::is_uvlm"))]
+    pub model: AeroModel,
+    /// Lift slope of the strips of `model: "strip"`, 1/rad. Default 2π.
+    #[cfg_attr(feature = "serde", serde(default = "default_lift_slope"))]
+    pub strip_lift_slope: f64,
     /// Trailing-edge control surfaces (at most 16): flaps over span ranges of bodies, at a fixed
     /// deflection or a schedule in time (docs/case-file.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
     pub control_surfaces: Vec<crate::control_surface::ControlSurface>,
+}
+
+/// The time march's aerodynamic model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum AeroModel {
+    /// The unsteady vortex lattice.
+    #[default]
+    Uvlm,
+    /// Quasi-steady strip theory.
+    Strip,
+}
+
+impl AeroModel {
+    /// Whether this is the default.
+    pub fn is_uvlm(&self) -> bool {
+        *self == AeroModel::Uvlm
+    }
 }
 
 /// A mirror plane of the flow.
@@ -166,6 +194,12 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+#[cfg(feature = "serde")]
+fn default_lift_slope() -> f64 {
+    2.0 * std::f64::consts::PI
+}
+
+#[cfg(feature = "serde")]
 fn default_cutoff() -> f64 {
     1e-6
 }

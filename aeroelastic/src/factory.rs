@@ -288,6 +288,15 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
                 None => {
                     M::build(problem).map(|mut model| simulate_with_events(f, &mut model, &s, observer, &mut events))
                 }
+                Some(aero) if aero.model == crate::aero_settings::AeroModel::Strip => {
+                    if events.any() {
+                        let msg = "events: hinge events with `aero.model: \"strip\"` are not implemented".into();
+                        return Err(Error::Model { formulation: f, msg });
+                    }
+                    let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
+                    M::build(problem)
+                        .map(|mut model| crate::strip_march::simulate_strip(f, &mut model, &s, aero, &map, observer))
+                }
                 Some(aero) => {
                     let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
                     M::build(problem).map(|mut model| {

@@ -33,6 +33,7 @@ pub mod stability;
 pub mod stability_settings;
 pub mod static_hold;
 pub mod statics;
+pub mod strip_march;
 pub mod thrust;
 pub mod trim;
 

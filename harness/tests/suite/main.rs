@@ -18,6 +18,7 @@ mod observer;
 mod planform;
 mod polars;
 mod properties;
+mod roll;
 mod send_sync;
 mod shard;
 mod sideslip;

@@ -1,0 +1,242 @@
+//! Quasi-steady strip theory in the time march (`aero.model: "strip"`, docs/coupling.md §9): each
+//! span station of the lifting surfaces carries the lift of a two-dimensional thin aerofoil at
+//! the incidence its own motion and the free stream give, with no wake and no induction. It is
+//! the classic reference of roll and flight-mechanics estimates (the roll rig's steady rate
+//! `p = (3/2)(V/s) τ (η₂² − η₁²) δ` and time constant `3 I / (ρ V c a s³)` are its results) and the
+//! cheap model to set against the lattice.
+//!
+//! At each strip (pose `R = [x y z]`, axis point `p`, velocity `v`, angular velocity `ω`):
+//! * the air's velocity relative to the three-quarter-chord point `r₃ = p + y (e − ¾c)` (`e` the
+//!   leading-edge offset, `c` the chord along `y`): `u = V∞ − v − ω × (r₃ − p)`, and its part in
+//!   the section plane `u⊥ = u − x (x·u)`;
+//! * the incidence `α = atan2(u·z, −u·y)`, and with a control surface of chord fraction `E`
+//!   deflected by `δ` (trailing edge down positive) the thin-aerofoil flap effectiveness
+//!   `τ = 1 − (θ − sin θ)/π`, `cos θ = 2E − 1`;
+//! * the lift per span `l = ½ ρ |u⊥|² c a (α + τ δ)` (lift slope `a`, `aero.strip_lift_slope`),
+//!   along `u⊥ × x / |u⊥|`, at the quarter chord `r₁ = p + y (e − ¼c)`;
+//! * per strip, the column between two neighbouring stations of a surface: at its middle (the
+//!   mean of the two stations' points, velocities and angular velocities, the frame `x` along the
+//!   column and `y` the stations' mean made normal to it), over its width, flapped when both its
+//!   stations carry the control surface, and lumped half to each station (force, and its moment
+//!   about the station's axis point).
+//!
+//! The loads of a step are those of the state at its start (a loosely coupled march, as the
+//! lattice's); their power `Σ F·v + M·ω` is integrated into the aerodynamic work with the
+//! trapezoidal rule, so the energy balance `E + W_damp − W_aero` holds as with the lattice.
+
+use std::time::Instant;
+
+use nalgebra::{Matrix3, Vector3};
+
+use formulation::{SectionLoad, Structure};
+use genalpha::State;
+
+use crate::aero::{AeroSettings, StationMap, section_state};
+use crate::problem::Formulation;
+use crate::run::{Dissipation, Observer, RunOutput, RunSettings, SnapshotFeed, row};
+
+/// The lift of every strip (the column between two neighbouring stations of a surface) at a
+/// state, lumped to the two stations.
+pub struct StripAero<'a> {
+    map: &'a [StationMap],
+    aero: &'a AeroSettings,
+    /// The columns: their first station (the second is the next one).
+    columns: Vec<usize>,
+    /// Each station's pose and velocity: axis point, frame, velocity, angular velocity.
+    kin: Vec<(Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>)>,
+    loads: Vec<SectionLoad>,
+    scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+}
+
+/// Thin-aerofoil flap effectiveness `dα/dδ` of a trailing-edge flap of chord fraction `e`.
+pub fn flap_effectiveness(e: f64) -> f64 {
+    let theta = (2.0 * e - 1.0).clamp(-1.0, 1.0).acos();
+    1.0 - (theta - theta.sin()) / std::f64::consts::PI
+}
+
+impl<'a> StripAero<'a> {
+    /// The strips of the stations `map` (the aerodynamic settings `aero`).
+    pub fn new(map: &'a [StationMap], aero: &'a AeroSettings) -> Self {
+        let columns =
+            crate::lifting::surface_ranges(map).into_iter().flat_map(|r| r.start..r.end.saturating_sub(1)).collect();
+        let loads = map
+            .iter()
+            .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
+            .collect();
+        let kin = vec![(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::zeros()); map.len()];
+        Self { map, aero, columns, kin, loads, scratch: (Vec::new(), Vec::new(), Vec::new()) }
+    }
+
+    /// The station loads at time `t` and state `(q, v)`, replacing the loads held so far; and the
+    /// power `Σ F·v + M·ω` at this state of the loads held so far and of the new ones, W.
+    pub fn evaluate<S: Structure + ?Sized>(
+        &mut self,
+        model: &S,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> (&[SectionLoad], f64, f64) {
+        for (k, m) in self.kin.iter_mut().zip(self.map) {
+            *k = section_state(model, q, v, m, &mut self.scratch);
+        }
+        let power_of =
+            |loads: &[SectionLoad], kin: &[(Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>)]| -> f64 {
+                loads.iter().zip(kin).map(|(l, k)| l.force.dot(&k.2) + l.moment.dot(&k.3)).sum()
+            };
+        let held = power_of(&self.loads, &self.kin);
+        for l in &mut self.loads {
+            l.force = Vector3::zeros();
+            l.moment = Vector3::zeros();
+        }
+        for &j in &self.columns {
+            let (f, r1) = self.column_force(j, t);
+            for i in [j, j + 1] {
+                let half = f * 0.5;
+                self.loads[i].force += half;
+                self.loads[i].moment += (r1 - self.kin[i].0).cross(&half);
+            }
+        }
+        let power = power_of(&self.loads, &self.kin);
+        (&self.loads, held, power)
+    }
+
+    /// The lift of column `j` (stations `j`, `j + 1`) at time `t` and its point of action (the
+    /// quarter chord at the column's middle).
+    fn column_force(&self, j: usize, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let (a, b) = (&self.kin[j], &self.kin[j + 1]);
+        let (ma, mb) = (&self.map[j], &self.map[j + 1]);
+        let p = 0.5 * (a.0 + b.0);
+        let (vel, omega) = (0.5 * (a.2 + b.2), 0.5 * (a.3 + b.3));
+        // The column's frame: x along it, y the stations' mean y made normal to x.
+        let x = (b.0 - a.0).try_normalize(1e-300).unwrap_or_else(|| a.1.column(0).into_owned());
+        let y_mean = 0.5 * (a.1.column(1) + b.1.column(1));
+        let y = (y_mean - x * x.dot(&y_mean)).normalize();
+        let z = x.cross(&y);
+        let (chord, le) = (0.5 * (ma.chord + mb.chord), 0.5 * (ma.le_offset + mb.le_offset));
+        let arm3 = y * (le - 0.75 * chord);
+        let r1 = p + y * (le - 0.25 * chord);
+        let u = Vector3::from(self.aero.free_stream()) - vel - omega.cross(&arm3);
+        let u_perp = u - x * x.dot(&u);
+        let speed2 = u_perp.norm_squared();
+        let alpha = u.dot(&z).atan2(-u.dot(&y));
+        // A column is flapped when both its stations carry the same control surface.
+        let flap = match (ma.control, mb.control) {
+            (Some(i), Some(k)) if i == k => {
+                let c = &self.aero.control_surfaces[i];
+                flap_effectiveness(c.chord_fraction) * c.deflection_deg.at(t).0.to_radians()
+            }
+            _ => 0.0,
+        };
+        if speed2 == 0.0 {
+            return (Vector3::zeros(), r1);
+        }
+        let width = (b.0 - a.0).norm();
+        let lift = 0.5 * self.aero.rho * speed2 * chord * self.aero.strip_lift_slope * (alpha + flap) * width;
+        (u_perp.cross(&x) / speed2.sqrt() * lift, r1)
+    }
+}
+
+/// Integrate `model` with strip aerodynamics `aero` on the stations `map` (see the module docs).
+pub fn simulate_strip<S: Structure>(
+    formulation: Formulation,
+    model: &mut S,
+    settings: &RunSettings,
+    aero: &AeroSettings,
+    map: &[StationMap],
+    observer: &mut dyn Observer,
+) -> RunOutput {
+    let start = Instant::now();
+    let mut out = RunOutput::failed(formulation, String::new());
+    out.error = None;
+    out.n_dof = model.n_dof();
+    let dt = settings.params.dt;
+    let n_steps = (settings.t_end / dt).round().max(1.0) as usize;
+    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let mut ga = match model.integrator(settings.params) {
+        Ok(g) => g,
+        Err(e) => return finish(out, start, Some(e.to_string())),
+    };
+    let mut s: State = model.initial_state();
+    let mut strips = StripAero::new(map, aero);
+    let lift_dir = crate::statics::lift_direction(aero.free_stream());
+    let (mut power, mut lift) = match apply(&mut strips, model, &s, &lift_dir) {
+        Ok((_, p, l)) => (p, l),
+        Err(e) => return finish(out, start, Some(format!("loads at t = {}: {e}", s.t))),
+    };
+    if let Err(e) = ga.initialize(model, &mut s) {
+        return finish(out, start, Some(format!("initial accelerations: {e}")));
+    }
+    let fold = (settings.fold_joint, settings.roll_joint);
+    let mut feed = SnapshotFeed::new(observer);
+    let mut dissipation = Dissipation::new(model, &s, false);
+    let mut work = 0.0;
+    let record = |d: &Dissipation, r: crate::run::Row, work: f64, lift: f64| {
+        let mut r = d.record(r);
+        r.aero_work = work;
+        r.lift = lift;
+        r
+    };
+    let r0 = record(&dissipation, row(model, fold, &s, 0), work, lift);
+    out.rows.push(r0);
+    if let Err(e) = feed.feed(model, &r0, &s.q, None) {
+        return finish(out, start, Some(format!("output at t = {}: {e}", s.t)));
+    }
+    for k in 1..=n_steps {
+        if crate::interrupt::interrupted() {
+            out.error = Some(crate::run::interrupted_message(s.t));
+            break;
+        }
+        let step = ga.step(model, &mut s);
+        let st = match step {
+            Ok(st) => st,
+            Err(e) => {
+                out.error = Some(format!("step {k}: {e}"));
+                break;
+            }
+        };
+        dissipation.step(model, &s);
+        // The loads held over the step did the work of their power at its start and its end
+        // (trapezoid); the next step's loads come from this state.
+        match apply(&mut strips, model, &s, &lift_dir) {
+            Ok((held, p, l)) => {
+                work += 0.5 * dt * (power + held);
+                (power, lift) = (p, l);
+            }
+            Err(e) => {
+                out.error = Some(format!("step {k} (t = {}): {e}", s.t));
+                break;
+            }
+        }
+        if k % every == 0 || k == n_steps {
+            let r = record(&dissipation, row(model, fold, &s, st.n_newton_iters), work, lift);
+            out.rows.push(r);
+            if let Err(e) = feed.feed(model, &r, &s.q, None) {
+                out.error = Some(format!("step {k}: output: {e}"));
+                break;
+            }
+        }
+    }
+    out.stats = ga.stats().clone();
+    let err = out.error.take();
+    finish(out, start, err)
+}
+
+/// The strips' loads at state `s` applied to `model`: the power of the loads held until now and
+/// of the new ones at `s`, and the new loads' lift (along `lift_dir`).
+fn apply<S: Structure>(
+    strips: &mut StripAero<'_>,
+    model: &mut S,
+    s: &State,
+    lift_dir: &Vector3<f64>,
+) -> Result<(f64, f64, f64), String> {
+    let (loads, held, power) = strips.evaluate(&*model, s.t, &s.q, &s.v);
+    let lift = loads.iter().map(|l| l.force.dot(lift_dir)).sum();
+    model.set_section_loads(loads).map_err(|e| e.to_string())?;
+    Ok((held, power, lift))
+}
+
+fn finish(mut out: RunOutput, start: Instant, error: Option<String>) -> RunOutput {
+    out.error = error;
+    out.wall_s = start.elapsed().as_secs_f64();
+    out
+}
