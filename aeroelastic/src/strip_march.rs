@@ -35,6 +35,9 @@ use crate::aero::{AeroSettings, StationMap, section_state};
 use crate::problem::Formulation;
 use crate::run::{Dissipation, Observer, RunOutput, RunSettings, SnapshotFeed, row};
 
+/// A station's pose and motion: axis point, section frame, velocity, angular velocity.
+type Kinematics = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
+
 /// The lift of every strip (the column between two neighbouring stations of a surface) at a
 /// state, lumped to the two stations.
 pub struct StripAero<'a> {
@@ -43,7 +46,7 @@ pub struct StripAero<'a> {
     /// The columns: their first station (the second is the next one).
     columns: Vec<usize>,
     /// Each station's pose and velocity: axis point, frame, velocity, angular velocity.
-    kin: Vec<(Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>)>,
+    kin: Vec<Kinematics>,
     loads: Vec<SectionLoad>,
     scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
 }
@@ -79,10 +82,9 @@ impl<'a> StripAero<'a> {
         for (k, m) in self.kin.iter_mut().zip(self.map) {
             *k = section_state(model, q, v, m, &mut self.scratch);
         }
-        let power_of =
-            |loads: &[SectionLoad], kin: &[(Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>)]| -> f64 {
-                loads.iter().zip(kin).map(|(l, k)| l.force.dot(&k.2) + l.moment.dot(&k.3)).sum()
-            };
+        let power_of = |loads: &[SectionLoad], kin: &[Kinematics]| -> f64 {
+            loads.iter().zip(kin).map(|(l, k)| l.force.dot(&k.2) + l.moment.dot(&k.3)).sum()
+        };
         let held = power_of(&self.loads, &self.kin);
         for l in &mut self.loads {
             l.force = Vector3::zeros();
@@ -216,7 +218,7 @@ pub fn simulate_strip<S: Structure>(
             }
         }
     }
-    out.stats = ga.stats().clone();
+    out.stats = *ga.stats();
     let err = out.error.take();
     finish(out, start, err)
 }
