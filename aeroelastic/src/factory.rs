@@ -256,7 +256,37 @@ fn from_trim<M: BuildModel>(
     let s = settings(&flight, f);
     let mut events = hinge_events::<M>(&flight);
     let mut model = M::build(&flight)?;
-    Ok(simulate_aero_with_events(f, &mut model, &s, aero, &map, observer, Some(&trim.q), &mut events))
+    // Body axes turned back by α, moving against the reference flow: the earth frame.
+    let rotation =
+        *nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), trim.alpha_deg.to_radians()).matrix();
+    let velocity = -nalgebra::Vector3::from(aero0.stream_without_sideslip());
+    let mut earth = EarthAxes { inner: observer, rotation, velocity };
+    Ok(simulate_aero_with_events(f, &mut model, &s, aero, &map, &mut earth, Some(&trim.q), &mut events))
+}
+
+/// Hands the snapshots of a run in body axes on with their earth placement: the axes turned by
+/// `rotation` and moving at `velocity` from the origin at t = 0.
+struct EarthAxes<'o> {
+    inner: &'o mut dyn Observer,
+    rotation: nalgebra::Matrix3<f64>,
+    velocity: nalgebra::Vector3<f64>,
+}
+
+impl Observer for EarthAxes<'_> {
+    fn wants_snapshots(&self) -> bool {
+        self.inner.wants_snapshots()
+    }
+
+    fn observe(&mut self, s: &crate::run::Snapshot<'_>) -> Result<(), String> {
+        let placement = crate::run::Placement { rotation: self.rotation, shift: self.velocity * s.t };
+        let moved =
+            crate::run::Snapshot { index: s.index, t: s.t, beams: s.beams, aero: s.aero, placement: Some(placement) };
+        self.inner.observe(&moved)
+    }
+
+    fn row(&mut self, row: &crate::run::Row) -> Result<(), String> {
+        self.inner.row(row)
+    }
 }
 
 /// Build and integrate formulation `f` of `case`. Never panics on bad input: a model that cannot

@@ -21,6 +21,30 @@ pub struct Snapshot<'a> {
     pub beams: &'a [BeamGeometry],
     /// The UVLM after the step (lattice, `gamma()`, `wake()`, `loads()`), if any.
     pub aero: Option<&'a uvlm::Uvlm>,
+    /// Where the run's axes are in the earth frame at this step, when they move (a flight from
+    /// its trim runs in body axes, docs/trim.md §5); none: the run's axes are the earth's.
+    pub placement: Option<Placement>,
+}
+
+/// The earth placement of a run's axes at one step: `x_earth = rotation · x + shift`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// Rotation from the run's axes to the earth's.
+    pub rotation: nalgebra::Matrix3<f64>,
+    /// The run's origin in the earth frame, m.
+    pub shift: nalgebra::Vector3<f64>,
+}
+
+impl Placement {
+    /// A point of the run's axes in the earth frame.
+    pub fn point(&self, p: &nalgebra::Vector3<f64>) -> nalgebra::Vector3<f64> {
+        self.rotation * p + self.shift
+    }
+
+    /// A frame (columns in the run's axes) in the earth frame.
+    pub fn frame(&self, r: &nalgebra::Matrix3<f64>) -> nalgebra::Matrix3<f64> {
+        self.rotation * r
+    }
 }
 
 /// Receives each output step's geometry (3-D output, animation, probes): the output seam. The time
@@ -84,7 +108,7 @@ impl<'o> SnapshotFeed<'o> {
         for (b, g) in self.beams.iter_mut().enumerate() {
             model.body_geometry(q, b, g);
         }
-        self.observer.observe(&Snapshot { index, t, beams: &self.beams, aero })
+        self.observer.observe(&Snapshot { index, t, beams: &self.beams, aero, placement: None })
     }
 }
 

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::case::{Case, Formulation, RunSpec};
-use crate::run::{BeamGeometry, Observer, Snapshot};
+use crate::run::{BeamGeometry, Observer, Placement, Snapshot};
 use aeroelastic::planform::Taper;
 
 pub use casefile::VtkOutput;
@@ -100,14 +100,31 @@ impl Observer for VtkWriter {
             std::fs::create_dir_all(&self.dir).map_err(|e| format!("{}: {e}", self.dir.display()))?;
             self.created = true;
         }
-        self.write_family(0, s.index, s.t, &beams_vtp(s.beams))?;
+        // A run in moving axes (a flight from its trim) is written in the earth frame.
+        let placed: Vec<BeamGeometry>;
+        let beams = match &s.placement {
+            Some(pl) => {
+                placed = s
+                    .beams
+                    .iter()
+                    .map(|b| BeamGeometry {
+                        arc: b.arc.clone(),
+                        positions: b.positions.iter().map(|p| pl.point(p)).collect(),
+                        frames: b.frames.iter().map(|r| pl.frame(r)).collect(),
+                    })
+                    .collect();
+                &placed[..]
+            }
+            None => s.beams,
+        };
+        self.write_family(0, s.index, s.t, &beams_vtp(beams))?;
         if let Some((chord, le)) = &self.chord {
-            let text = ribbon_vtp(s.beams, chord, le);
+            let text = ribbon_vtp(beams, chord, le);
             self.write_family(1, s.index, s.t, &text)?;
         }
         if let Some(uv) = s.aero {
-            self.write_family(2, s.index, s.t, &lattice_vtp(uv))?;
-            self.write_family(3, s.index, s.t, &wake_vtp(uv))?;
+            self.write_family(2, s.index, s.t, &lattice_vtp(uv, s.placement.as_ref()))?;
+            self.write_family(3, s.index, s.t, &wake_vtp(uv, s.placement.as_ref()))?;
         }
         self.finish()
     }
@@ -316,7 +333,7 @@ fn quads_vtp(points: &[[f64; 3]], quads: &[Vec<usize>], gamma: &[f64], delta_p: 
 
 /// The bound vortex rings of every lifting surface (corners: the ring nodes), circulation
 /// `gamma` and pressure jump `delta_p`, surface after surface in one polydata.
-fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
+fn lattice_vtp(uv: &uvlm::Uvlm, place: Option<&Placement>) -> String {
     let (mut points, mut quads, mut gamma, mut dp) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for su in uv.surfaces() {
         let l = su.lattice();
@@ -331,6 +348,7 @@ fn lattice_vtp(uv: &uvlm::Uvlm) -> String {
         points.extend_from_slice(l.ring_nodes());
         dp.extend(surface_pressure_jump(l, su.loads()));
     }
+    placed(&mut points, place);
     quads_vtp(&points, &quads, &gamma, Some(&dp))
 }
 
@@ -383,7 +401,7 @@ fn surface_pressure_jump(l: &uvlm::Lattice, loads: &uvlm::Loads) -> Vec<f64> {
 /// The wake rings of every lifting surface, surface after surface: per surface, node row 0 is
 /// the lattice's trailing-edge ring row, node row r + 1 the wake's detached row r; circulation
 /// `gamma`.
-fn wake_vtp(uv: &uvlm::Uvlm) -> String {
+fn wake_vtp(uv: &uvlm::Uvlm, place: Option<&Placement>) -> String {
     let (mut points, mut quads, mut gamma) = (Vec::new(), Vec::new(), Vec::new());
     for su in uv.surfaces() {
         let (l, w) = (su.lattice(), su.wake());
@@ -402,7 +420,17 @@ fn wake_vtp(uv: &uvlm::Uvlm) -> String {
             }
         }
     }
+    placed(&mut points, place);
     quads_vtp(&points, &quads, &gamma, None)
+}
+
+/// The points in the earth frame of `place` (unchanged without one).
+fn placed(points: &mut [[f64; 3]], place: Option<&Placement>) {
+    if let Some(pl) = place {
+        for p in points {
+            *p = pl.point(&nalgebra::Vector3::from(*p)).into();
+        }
+    }
 }
 
 #[cfg(test)]
