@@ -71,14 +71,15 @@ fn an_untrimmable_case_is_refused_naming_the_field() {
     assert!(err.contains("trim"), "{err}");
 }
 
-/// The hub's position and frame at every output step.
-struct HubTrack(Vec<(f64, nalgebra::Vector3<f64>, nalgebra::Matrix3<f64>)>);
+/// The hub's position and frame at every output step (body axes), and its earth position.
+struct HubTrack(Vec<(f64, nalgebra::Vector3<f64>, nalgebra::Matrix3<f64>)>, Vec<nalgebra::Vector3<f64>>);
 
 impl aeroelastic::run::Observer for HubTrack {
     fn observe(&mut self, s: &aeroelastic::run::Snapshot<'_>) -> Result<(), String> {
         let hub = &s.beams[0];
         let (Some(p), Some(r)) = (hub.positions.last(), hub.frames.last()) else { return Err("no hub".into()) };
         self.0.push((s.t, *p, *r));
+        self.1.push(s.placement.ok_or("a flight from trim has an earth placement")?.point(p));
         Ok(())
     }
 }
@@ -92,7 +93,7 @@ fn the_horten_wing_holds_level_flight_from_its_trim() {
     let spec = crate::common::case("flight/horten_level_flight.json", &[]);
     for f in Formulation::ALL {
         let problem = spec.case(f).problem();
-        let mut track = HubTrack(Vec::new());
+        let mut track = HubTrack(Vec::new(), Vec::new());
         let out = aeroelastic::factory::run_formulation_observed(&problem, f, &mut track);
         assert!(out.error.is_none(), "{f}: {:?}", out.error);
         let trim = aeroelastic::trim::run_trim(&problem, f, problem.trim.as_ref().unwrap());
@@ -111,6 +112,11 @@ fn the_horten_wing_holds_level_flight_from_its_trim() {
         assert!((t1 - t0 - 10.0).abs() < 1e-6);
         assert!(climb < 0.005 * flown, "{f}: altitude change {climb} m over {flown} m");
         assert!(pitch < 0.1, "{f}: pitch {pitch} deg");
+        // In the earth frame (the ParaView files') the hub flies level along +Y at 28 m/s.
+        for ((t, _, _), e) in track.0.iter().zip(&track.1) {
+            let expected = track.1[0] + nalgebra::Vector3::new(0.0, 28.0 * (t - t0), 0.0);
+            assert!((e - expected).norm() < 1e-3, "{f}: earth position {e} at {t} s, expected {expected}");
+        }
         eprintln!("{f} level flight: altitude change {climb:.3e} m over {flown} m, pitch {pitch:.3e} deg");
     }
 }
