@@ -204,8 +204,10 @@ fn bad_control_surfaces_exit_2_naming_the_field() {
         (vec![list(&[one("inner", "[0,6]", "0.25", "[[0,0],[0,1]]")])], "aero.control_surfaces[0].deflection_deg"),
         (vec![list(&[one("inner", "[0,6]", "0.25", "[]")])], "aero.control_surfaces[0].deflection_deg"),
         (vec![list(&[ok.clone(), ok.replace("[0,6]", "[9,12]")])], "aero.control_surfaces[1].name"),
+        // Two surfaces meeting at a station are refused unless they are alike (one chord
+        // fraction, one deflection: one flap continued across a station).
         (
-            vec![list(&[ok.clone(), one("inner", "[6,12]", "0.25", "2").replace("\"a\"", "\"b\"")])],
+            vec![list(&[ok.clone(), one("inner", "[6,12]", "0.25", "3").replace("\"a\"", "\"b\"")])],
             "aero.control_surfaces[1]",
         ),
         (
