@@ -79,6 +79,14 @@ impl Case {
         if self.initial == aeroelastic::trim::Initial::Trim && self.trim.is_none() {
             return Err("initial: \"trim\" needs a `trim` block".into());
         }
+        if self.initial == aeroelastic::trim::Initial::Trim
+            && fs.contains(&Formulation::Ancf)
+            && self.ancf.path == aeroelastic::problem::AncfPath::Ode
+        {
+            return Err("initial: \"trim\" needs ancf.path \"dae\" (the trim holds the free body, which changes \
+                        the ODE path's coordinates)"
+                .into());
+        }
         match (&self.statics, self.aero.is_some()) {
             (Some(st), false) => self.check_structural_static(st)?,
             (Some(st), true) => check_aero_static(st)?,

@@ -69,6 +69,16 @@ fn an_untrimmable_case_is_refused_naming_the_field() {
     });
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("trim"), "{err}");
+    // A march from the trim on ANCF's ODE path (whose coordinates change when the trim holds
+    // the free body) is refused by `run`, naming the path.
+    let flight = root().join("cases/flight/horten_level_flight.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["run", flight.to_str().unwrap(), "--out", dir.to_str().unwrap(), "--set", "ancf.path=ode"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("ancf.path") && !err.contains("panicked"), "{err}");
 }
 
 /// The hub's position and frame at every output step (body axes), and its earth position.
