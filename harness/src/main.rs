@@ -895,7 +895,7 @@ fn cmd_trim(a: &TrimArgs) -> Result<ExitCode> {
     for spec in &runs {
         let outs = harness::trim_out::run(spec, &fs).map_err(|msg| harness::Error::Case { file: name.clone(), msg })?;
         let dir = a.out.out.join(&spec.name);
-        harness::trim_out::write(&dir, &outs)?;
+        harness::trim_out::write(&dir, &spec.name, &outs)?;
         failed |= harness::trim_out::report(&spec.name, &outs);
         println!("wrote {}", dir.display());
     }
@@ -1108,6 +1108,7 @@ fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress, done: &mut Vec<Str
 struct AnalysisFailures {
     static_failed: usize,
     stability_failed: usize,
+    trim_failed: usize,
     gust_failed: usize,
 }
 
@@ -1140,6 +1141,15 @@ fn all_analyses(
         harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, &outs, history.as_ref())?;
         n.stability_failed += usize::from(report_stability(&spec.name, &outs));
         println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+    }
+    for spec in p.runs.iter().filter(|r| r.ancf.trim.is_some()) {
+        progress.phase(&format!("trim of {}", spec.name));
+        let t = std::time::Instant::now();
+        let outs = harness::trim_out::run(spec, &Formulation::ALL)
+            .map_err(|msg| harness::Error::Case { file: spec.name.clone(), msg })?;
+        harness::trim_out::write(&out.join(&spec.name), &spec.name, &outs)?;
+        n.trim_failed += usize::from(harness::trim_out::report(&spec.name, &outs));
+        println!("trim {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
     }
     // The gust sweeps (several minutes of CPU): not with --quick, and on a cluster as their own
     // array (`harness gust --shard`).
@@ -1184,6 +1194,9 @@ fn all_verdict(
     if n.stability_failed > 0 {
         eprintln!("stability: {} sweep(s) have airspeeds that could not be analysed", n.stability_failed);
     }
+    if n.trim_failed > 0 {
+        eprintln!("trim: {} case(s) could not be trimmed", n.trim_failed);
+    }
     if n.gust_failed > 0 {
         eprintln!("gust: {} sweep(s) have runs that failed", n.gust_failed);
     }
@@ -1191,7 +1204,7 @@ fn all_verdict(
         eprintln!("interrupted: the rows computed so far are written; studies skipped");
         return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
     }
-    let analyses_ok = n.static_failed == 0 && n.stability_failed == 0 && n.gust_failed == 0;
+    let analyses_ok = n.static_failed == 0 && n.stability_failed == 0 && n.trim_failed == 0 && n.gust_failed == 0;
     Ok(exit_code(errors, failed == 0 && gate_failed == 0 && analyses_ok))
 }
 

@@ -986,6 +986,20 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
             badge: None,
         });
     }
+    let trims = crate::trim_out::sections_html(out);
+    if !trims.is_empty() {
+        v.push(Section {
+            id: "trim".into(),
+            title: "Trim in level flight".into(),
+            group: Group::Study,
+            html: format!(
+                "<p>The angle of attack, elevator deflection and thrust with which the free aircraft's flexible \
+                 static equilibrium carries no net force and pitching moment (docs/trim.md). Files per case: \
+                 <code>trim_ancf.json</code>, <code>trim_gebf.json</code>.</p>\n{trims}"
+            ),
+            badge: None,
+        });
+    }
     let gusts = crate::gust_out::sections_html(out);
     if !gusts.is_empty() {
         v.push(Section {

@@ -50,13 +50,76 @@ pub fn to_json(o: &TrimOutput) -> serde_json::Value {
     })
 }
 
-/// Write `<dir>/trim_<formulation>.json` for each output.
-pub fn write(dir: &Path, outs: &[TrimOutput]) -> Result<(), Error> {
+/// The report fragment each trimmed case leaves in its folder.
+pub const SECTION_FILE: &str = "trim_section.html";
+
+/// Write `<dir>/trim_<formulation>.json` for each output, and the report fragment
+/// `<dir>/trim_section.html` of case `name`.
+pub fn write(dir: &Path, name: &str, outs: &[TrimOutput]) -> Result<(), Error> {
     for o in outs {
         let text = serde_json::to_string_pretty(&to_json(o)).map_err(|e| Error::Io(e.to_string()))?;
         crate::atomic::write(&dir.join(format!("trim_{}.json", o.formulation.as_str())), text.as_bytes())?;
     }
-    Ok(())
+    crate::atomic::write(&dir.join(SECTION_FILE), section_html(name, outs).as_bytes())
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// One case's trim table: per formulation α, elevator, thrust, the net load left, the work.
+pub fn section_html(name: &str, outs: &[TrimOutput]) -> String {
+    use std::fmt::Write as _;
+    let mut h = format!(
+        "<h3>{}</h3>\n<table><tr><th>formulation</th><th>airspeed (m/s)</th><th>α (deg)</th><th>elevator (deg)</th>\
+         <th>thrust (N)</th><th>net forward / up force (N)</th><th>net pitching moment (N m)</th><th>lift (N)</th>\
+         <th>drag (N)</th><th>iterations / static solves</th><th>wall (s)</th></tr>\n",
+        esc(name)
+    );
+    for o in outs {
+        let r = &o.residuals;
+        let _ = match &o.error {
+            None => writeln!(
+                h,
+                "<tr><td>{}</td><td>{:.2}</td><td>{:.4}</td><td>{:+.4}</td><td>{:.4}</td><td>{:.1e} / {:.1e}</td>\
+                 <td>{:.1e}</td><td>{:.1}</td><td>{:.3}</td><td>{} / {}</td><td>{:.2}</td></tr>",
+                o.formulation.label(),
+                o.airspeed,
+                o.alpha_deg,
+                o.elevator_deg,
+                o.thrust,
+                r.force_forward,
+                r.force_up,
+                r.pitch_moment,
+                o.lift,
+                o.drag,
+                o.iterations,
+                o.static_solves,
+                o.wall_s
+            ),
+            Some(e) => {
+                writeln!(h, "<tr><td>{}</td><td colspan=\"10\">failed: {}</td></tr>", o.formulation.label(), esc(e))
+            }
+        };
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// The trim sections of every case trimmed under `out` (`<out>/<case>/trim_section.html`), in
+/// name order; empty when there are none.
+pub fn sections_html(out: &Path) -> String {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
+        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
+        .unwrap_or_default();
+    files.sort();
+    let mut s = String::new();
+    for f in files {
+        if let Ok(t) = std::fs::read_to_string(&f) {
+            s.push_str(&t);
+        }
+    }
+    s
 }
 
 /// One line per formulation; true when a trim failed.
