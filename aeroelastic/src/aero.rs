@@ -391,9 +391,8 @@ pub fn simulate_aero_with_events<S: Structure>(
     out.error = None;
     out.n_dof = model.n_dof();
     let dt = settings.params.dt;
-    // Validated cases hold a whole number of steps (within a relative 1e-9): round.
-    let n_steps = (settings.t_end / dt).round().max(1.0) as usize;
-    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let n_steps = settings.n_steps();
+    let every = settings.output_every();
     let fail = |mut out: RunOutput, e: String| {
         out.error = Some(e);
         out.wall_s = start.elapsed().as_secs_f64();

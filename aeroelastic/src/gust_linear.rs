@@ -366,7 +366,7 @@ fn lift_row(nf: usize, v_inf: [f64; 3]) -> DMatrix<f64> {
 
 /// Steps of the time march over `[0, t_end]`.
 fn n_run(settings: &crate::run::RunSettings) -> usize {
-    (settings.t_end / settings.params.dt).round().max(1.0) as usize
+    settings.n_steps()
 }
 
 /// The linear model whose transfer [`transfer`] evaluates.
@@ -395,7 +395,7 @@ fn synthesise(
     let period = n as f64 * dt;
     let sigma = 18.4 / period;
     let gust: Vec<f64> = (0..n).map(|k| Vector3::from(field.velocity(front, k as f64 * dt)).dot(&gust_dir)).collect();
-    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let every = settings.output_every();
     let out_steps: Vec<usize> = (0..=n_run).filter(|k| k % every == 0 || *k == n_run).collect();
     let mut acc = vec![[0.0; N_OUT]; out_steps.len()];
     for k in 0..=n / 2 {

@@ -176,6 +176,19 @@ pub struct RunSettings {
     pub loads: Option<crate::loads::LoadModel>,
 }
 
+impl RunSettings {
+    /// Steps of the march over `[0, t_end]` (validated cases hold a whole number of steps within
+    /// a relative 1e-9: rounded), at least one.
+    pub fn n_steps(&self) -> usize {
+        (self.t_end / self.params.dt).round().max(1.0) as usize
+    }
+
+    /// Steps between output rows (every step without `output_dt`), at least one.
+    pub fn output_every(&self) -> usize {
+        self.output_dt.map_or(1, |o| ((o / self.params.dt).round() as usize).max(1))
+    }
+}
+
 /// Outcome of one run: what was computed, even when it failed part-way.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
@@ -369,10 +382,8 @@ pub fn simulate_with_events<S: Structure>(
         aero_wall_s: 0.0,
         events: Vec::new(),
     };
-    let dt = settings.params.dt;
-    // Validated cases hold a whole number of steps (within a relative 1e-9): round.
-    let n_steps = (settings.t_end / dt).round().max(1.0) as usize;
-    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let n_steps = settings.n_steps();
+    let every = settings.output_every();
     // Reserve for the expected rows, but never more than a bounded guess up front: the count
     // comes from user input (`dt`, `t_end`) and the vector grows as rows arrive anyway.
     out.rows.reserve((n_steps / every + 2).min(1 << 16));

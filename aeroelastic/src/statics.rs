@@ -243,14 +243,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// the aerodynamic stiffness is kept, scaled by the square of the speed ratio.
     pub fn set_airspeed(&mut self, airspeed: f64, q: &[f64]) -> Result<(), String> {
         self.aero.airspeed = Some(airspeed);
-        let v = self.aero.free_stream();
-        let solves = lock(&self.aero_state).n_solves;
-        let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake)?;
-        st.n_solves = solves;
-        *lock(&self.aero_state) = st;
-        self.speed2 = v.iter().map(|x| x * x).sum();
-        self.begin_solve(false);
-        Ok(())
+        self.rebuild_lattice(q)
     }
 
     /// Replace the aerodynamic settings (a turned free stream, new control-surface deflections;
@@ -258,6 +251,12 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// Newton iteration refreshes it when it stops contracting). The trim's step.
     pub fn set_aero(&mut self, aero: &AeroSettings, q: &[f64]) -> Result<(), String> {
         self.aero = aero.clone();
+        self.rebuild_lattice(q)
+    }
+
+    /// Rebuild the lattice of the current aerodynamic settings at `q`, keeping the solve count
+    /// and the aerodynamic stiffness.
+    fn rebuild_lattice(&mut self, q: &[f64]) -> Result<(), String> {
         let v = self.aero.free_stream();
         let solves = lock(&self.aero_state).n_solves;
         let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake)?;

@@ -152,8 +152,8 @@ pub fn simulate_strip<S: Structure>(
     out.error = None;
     out.n_dof = model.n_dof();
     let dt = settings.params.dt;
-    let n_steps = (settings.t_end / dt).round().max(1.0) as usize;
-    let every = settings.output_dt.map_or(1, |o| ((o / dt).round() as usize).max(1));
+    let n_steps = settings.n_steps();
+    let every = settings.output_every();
     let mut ga = match model.integrator(settings.params) {
         Ok(g) => g,
         Err(e) => return finish(out, start, Some(e.to_string())),

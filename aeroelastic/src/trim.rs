@@ -290,6 +290,17 @@ fn failed(p: &Problem, f: Formulation, msg: String) -> TrimOutput {
     }
 }
 
+/// Body axes at angle of attack `alpha_deg`: the free stream and gravity of `p` turned about +X
+/// by −α (the structure keeps its reference geometry).
+fn turn_flow(p: &mut Problem, alpha_deg: f64) {
+    let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), -alpha_deg.to_radians());
+    p.gravity = p.gravity.map(|g| (turn * Vector3::from(g)).into());
+    if let Some(a) = p.aero.as_mut() {
+        a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
+        a.airspeed = None;
+    }
+}
+
 /// The problem the trim solves at `x`: the free body clamped, the flow and gravity turned by −α
 /// about +X, the elevator at δ, every thrust at T.
 fn held_problem(base: &Problem, t: &TrimSettings, x: Unknowns) -> Problem {
@@ -299,11 +310,8 @@ fn held_problem(base: &Problem, t: &TrimSettings, x: Unknowns) -> Problem {
             *j = Joint::Clamp { name: name.clone(), body: body.clone() };
         }
     }
-    let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), -x.0[0].to_radians());
-    p.gravity = base.gravity.map(|g| (turn * Vector3::from(g)).into());
+    turn_flow(&mut p, x.0[0]);
     if let Some(a) = p.aero.as_mut() {
-        a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
-        a.airspeed = None;
         for c in &mut a.control_surfaces {
             if let Some(g) = t.gain_of(&c.name) {
                 c.deflection_deg = Deflection::Fixed(g * x.0[1]);
@@ -334,11 +342,8 @@ fn offset_to(d: &Deflection, start: f64) -> Deflection {
 /// or a thrust step on top of the trim).
 pub fn flight_problem(base: &Problem, out: &TrimOutput) -> Problem {
     let mut p = base.clone();
-    let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), -out.alpha_deg.to_radians());
-    p.gravity = base.gravity.map(|g| (turn * Vector3::from(g)).into());
+    turn_flow(&mut p, out.alpha_deg);
     if let Some(a) = p.aero.as_mut() {
-        a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
-        a.airspeed = None;
         for c in a.control_surfaces.iter_mut() {
             if let Some((_, d)) = out.controls.iter().find(|(n, _)| n == &c.name) {
                 c.deflection_deg = offset_to(&c.deflection_deg, *d);

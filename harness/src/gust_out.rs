@@ -358,9 +358,7 @@ pub fn write(dir: &Path, s: &GustSummary) -> Result<(), Error> {
     write_file(&dir.join(SECTION_FILE), &section_html(s, &folder))
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
+use crate::report::esc;
 
 /// "ancf 0.12 s, gebf 0.34 s", or what no run timed.
 fn cpu_phrase(max_cpu_s: &[(Formulation, f64)]) -> String {
@@ -459,26 +457,18 @@ pub fn section_html(s: &GustSummary, folder: &str) -> String {
 /// The gust sections of every sweep written under `out` (`<out>/<case>/gust_section.html`), in
 /// name order; empty when there are none.
 pub fn sections_html(out: &Path) -> String {
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
-        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
-        .unwrap_or_default();
-    files.sort();
-    let mut s = String::new();
-    if files.is_empty() {
-        return s;
+    let cases = crate::report::fragments(out, SECTION_FILE);
+    if cases.is_empty() {
+        return cases;
     }
-    s.push_str(
+    let mut s = String::from(
         "<p>1-cos gusts through the UVLM from the static aeroelastic equilibrium of each hinge state (the steady \
          wake laid out behind it), incremental loads over their equilibrium values; alleviation is the reduction of \
          the peak incremental root bending moment against the locked hinge (docs/gust.md). Files per case: \
          <code>gust_ancf.csv</code>, <code>gust_gebf.csv</code>, <code>gust_history_*.csv</code>, \
          <code>gust_summary.json</code>.</p>\n",
     );
-    for f in files {
-        if let Ok(t) = std::fs::read_to_string(&f) {
-            s.push_str(&t);
-        }
-    }
+    s.push_str(&cases);
     s
 }
 

@@ -724,7 +724,18 @@ pub fn summary_markdown(results: &[CaseResult]) -> String {
     s
 }
 
-fn esc(s: &str) -> String {
+/// The report fragments `<out>/<case>/<file>` that the analyses leave in their cases' folders,
+/// concatenated in case-name order; empty when there are none.
+pub fn fragments(out: &Path, file: &str) -> String {
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
+        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(file)).filter(|p| p.is_file()).collect())
+        .unwrap_or_default();
+    files.sort();
+    files.iter().filter_map(|f| std::fs::read_to_string(f).ok()).collect()
+}
+
+/// Text escaped for HTML.
+pub(crate) fn esc(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 

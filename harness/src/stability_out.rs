@@ -311,15 +311,5 @@ pub fn section_html(name: &str, folder: &str, runs: &[StabilityOutput]) -> Strin
 
 /// The stability sections of every sweep written under `out`, in name order.
 pub fn sections_html(out: &Path) -> String {
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
-        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
-        .unwrap_or_default();
-    files.sort();
-    let mut s = String::new();
-    for f in files {
-        if let Ok(t) = std::fs::read_to_string(&f) {
-            s.push_str(&t);
-        }
-    }
-    s
+    crate::report::fragments(out, SECTION_FILE)
 }

@@ -541,12 +541,9 @@ pub const SECTION_FILE: &str = "static_section.html";
 /// The static sections of every sweep written under `out` (`<out>/<case>/static_section.html`),
 /// in name order, with a heading; empty when there are none.
 pub fn sections_html(out: &Path) -> String {
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
-        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
-        .unwrap_or_default();
-    files.sort();
-    if files.is_empty() {
-        return String::new();
+    let cases = crate::report::fragments(out, SECTION_FILE);
+    if cases.is_empty() {
+        return cases;
     }
     let mut s = String::from(
         "<h2 id=\"static\">Static aeroelastic equilibria</h2>\n<p>Newton on the structure under the steady UVLM loads \
@@ -554,11 +551,7 @@ pub fn sections_html(out: &Path) -> String {
          highest; loads from the free body of the wing (docs/statics.md). Files per case: <code>static_ancf.csv</code>, \
          <code>static_gebf.csv</code>, <code>static_lift_*.csv</code>, <code>static_summary.json</code>.</p>\n",
     );
-    for f in files {
-        if let Ok(t) = std::fs::read_to_string(&f) {
-            s.push_str(&t);
-        }
-    }
+    s.push_str(&cases);
     s
 }
 

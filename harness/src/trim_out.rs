@@ -7,6 +7,7 @@ use serde_json::json;
 
 use crate::Error;
 use crate::case::RunSpec;
+use crate::report::esc;
 use aeroelastic::Formulation;
 use aeroelastic::trim::{TrimOutput, run_trim};
 
@@ -63,10 +64,6 @@ pub fn write(dir: &Path, name: &str, outs: &[TrimOutput]) -> Result<(), Error> {
     crate::atomic::write(&dir.join(SECTION_FILE), section_html(name, outs).as_bytes())
 }
 
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
 /// One case's trim table: per formulation α, elevator, thrust, the net load left, the work.
 pub fn section_html(name: &str, outs: &[TrimOutput]) -> String {
     use std::fmt::Write as _;
@@ -109,17 +106,7 @@ pub fn section_html(name: &str, outs: &[TrimOutput]) -> String {
 /// The trim sections of every case trimmed under `out` (`<out>/<case>/trim_section.html`), in
 /// name order; empty when there are none.
 pub fn sections_html(out: &Path) -> String {
-    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(out)
-        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.path().join(SECTION_FILE)).filter(|p| p.is_file()).collect())
-        .unwrap_or_default();
-    files.sort();
-    let mut s = String::new();
-    for f in files {
-        if let Ok(t) = std::fs::read_to_string(&f) {
-            s.push_str(&t);
-        }
-    }
-    s
+    crate::report::fragments(out, SECTION_FILE)
 }
 
 /// One line per formulation; true when a trim failed.
