@@ -137,7 +137,7 @@ def main():
             "The Horten flying wing of Richards, Yao, Herd, Hodges & Mardanpour (J. Aircraft 2016) as SHARPy's "
             "hangar models it (ImperialCollegeLondon/sharpy cases/hangar/horten_wing.py and richards_wing.py, "
             "Baseline; its trim in docs/source/content/example_notebooks/linear_horten.ipynb: alpha 4.5135 deg, "
-            "elevon 0.1814 deg, thrust 5.5129 N per engine at 28 m/s, rho 1.02). Full span: a hub on the free joint "
+            "elevon 0.1814 deg, thrust 5.4560 N per engine at 28 m/s, rho 1.02, from its start at 5.5129 N). Full span: a hub on the free joint "
             "carrying the fuselage mass, two half-wings of 12 bodies each: 20 m span, 20 deg beam sweep, root chord 1.0, taper 0.25, washout 2 deg, elevons on the outer 6/11 "
             "of each wing at half chord. Written by tools/horten_case.py; docs/trim.md."),
         bodies=bodies, joints=joints, gravity=[0, 0, -9.81],
@@ -155,7 +155,8 @@ def main():
     root = os.path.join(os.path.dirname(__file__), "..", "cases")
     flight = dict(case, name="horten_level_flight",
                   description=case["description"] + " Full span, for the time march from the trim (initial: trim): "
-                  "level flight at 28 m/s for 10 s.")
+                  "level flight at 28 m/s for 10 s; the flight-dynamics roots about the trim at 28 and 30 m/s.",
+                  stability=dict(airspeeds=[28.0, 30.0], modes=4, about="trim"))
     write(os.path.join(root, "flight", "horten_level_flight.json"), flight)
     write(os.path.join(root, "horten_flying_wing.json"), half_model(case))
     write(os.path.join(root, "flight", "horten_doublet.json"), doublet(flight))
@@ -167,7 +168,9 @@ def doublet(flight):
     case = json.loads(json.dumps(flight))
     case["name"] = "horten_doublet"
     case["description"] = flight["description"].replace(
-        "level flight at 28 m/s for 10 s.", "at 30 m/s, a 1 deg elevator doublet at 0.5-0.9 s, flown 60 s (the phugoid).")
+        "level flight at 28 m/s for 10 s; the flight-dynamics roots about the trim at 28 and 30 m/s.",
+        "at 30 m/s, a 1 deg elevator doublet at 0.5-0.9 s, flown 60 s (the phugoid).")
+    del case["stability"]
     dt = 0.25 / 30
     case["aero"]["v_inf"] = [0, -30.0, 0]
     for blk in ("ancf", "gebf"):

@@ -106,7 +106,8 @@ fn run<S: Structure>(
     let settings = crate::factory::settings(case, f);
     let wake = linear_wake(case, f, u);
     let nb_req = basis_modes.or(case.stability.as_ref().and_then(|s| s.basis_modes)).unwrap_or(30);
-    let red = reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, &map, aero, &wake, nb_req, None, None)?;
+    let red =
+        reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, &map, aero, &wake, (nb_req, 0), None, None)?;
     let nb = red.phi.ncols();
     let mut model = build(case).map_err(|e| e.to_string())?;
     let zero_loads = zero_loads(&map);

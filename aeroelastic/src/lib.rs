@@ -16,6 +16,7 @@ pub mod clock;
 pub mod control_surface;
 pub mod events;
 pub mod factory;
+pub mod flight_modes;
 pub mod gust;
 pub mod gust_field;
 pub mod gust_linear;

@@ -80,6 +80,9 @@ pub struct StabilityPoint {
     pub fold_deg: f64,
     /// Tracked roots, one per mode.
     pub roots: Vec<Root>,
+    /// About a trim: the free aircraft's rigid-body roots (phugoid, short period, Dutch roll,
+    /// roll subsidence, spiral; docs/stability.md §9). Empty otherwise.
+    pub flight_roots: Vec<crate::flight_modes::FlightRoot>,
     /// Smallest real eigenvalue of `M⁻¹ D(0)` (rad²/s²): negative past divergence, and also
     /// where a complex pair of the non-symmetric static stiffness has split into two negative
     /// real eigenvalues without a static divergence (a swept-back wing, docs/stability.md §3).
@@ -179,6 +182,9 @@ pub struct Reduced {
     pub n_wake_rings: usize,
     /// The modal basis `Φ` (tangent unknowns × basis modes).
     pub(crate) phi: DMatrix<f64>,
+    /// Basis modes the tracked roots start after: a free aircraft's rigid-body modes, whose roots
+    /// are found apart ([`crate::flight_modes`]).
+    pub(crate) skip: usize,
 }
 
 /// Steps of [`Reduced::continuation_path`].
@@ -186,7 +192,7 @@ const CONTINUATION_STEPS: usize = 8;
 
 /// The root of the conjugate pair in the upper half plane, with its vector (`D(s̄) = conj D(s)`:
 /// the conjugate root's vector is the conjugate vector).
-fn upper(s: C64, e: DVector<C64>) -> (C64, DVector<C64>) {
+pub(crate) fn upper(s: C64, e: DVector<C64>) -> (C64, DVector<C64>) {
     if s.im < 0.0 { (s.conj(), e.map(|x| x.conj())) } else { (s, e) }
 }
 
@@ -247,13 +253,18 @@ impl Reduced {
         self.m.nrows()
     }
 
+    /// The longest delay of the frozen wake at the current speed ratio, s (0 without a wake).
+    pub fn longest_delay(&self) -> f64 {
+        self.delays.iter().fold(0.0, |a: f64, t| a.max(t / self.ratio))
+    }
+
     /// Starting points of the root searches at the first airspeed: for each of the first `n`
-    /// structural modes, the eigenvalue nearest its structural one (`±iω`, or `+√(−ω²)` for an
+    /// structural modes after the first `skip`, the eigenvalue nearest its structural one (`±iω`, or `+√(−ω²)` for an
     /// unstable static mode) of the quadratic problem `M s² + C s + K + Q(s₀)` with the aerodynamic
     /// part frozen at that structural value `s₀`, and the mode's unit vector.
     pub fn starts(&self, n: usize) -> Vec<(C64, DVector<C64>)> {
         let nb = self.n_basis();
-        (0..n)
+        (self.skip..(self.skip + n).min(nb))
             .map(|m| {
                 let w2 = self.omega[m].signum() * self.omega[m] * self.omega[m];
                 let s0 = if w2 >= 0.0 { C64::new(0.0, w2.sqrt().max(1e-3)) } else { C64::new((-w2).sqrt(), 0.0) };
@@ -388,46 +399,57 @@ impl Reduced {
     /// Newton's method on `D(s) η = 0`, `cᴴ η = 1` from `(s, η)`; returns the root and its vector.
     /// `dD/ds` is a central difference, kept between iterations while they contract (a chord
     /// method: one evaluation of `D` per iteration) and refreshed when they do not.
-    pub fn newton(&self, mut s: C64, mut eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
-        let n = self.n_basis();
-        let c = eta.clone() / C64::new(eta.norm_squared().max(1e-300), 0.0);
-        let mut dp: Option<DMatrix<C64>> = None;
-        let mut last_step = f64::INFINITY;
-        for _ in 0..60 {
-            let d = self.d(s);
-            *count += 1;
-            if dp.is_none() {
-                let h = 1e-6 * (1.0 + s.norm());
-                dp = Some((self.d(s + h) - self.d(s - h)) / C64::new(2.0 * h, 0.0));
-                *count += 2;
-            }
-            let dpm = dp.as_ref().expect("set above");
-            let mut j = DMatrix::zeros(n + 1, n + 1);
-            j.view_mut((0, 0), (n, n)).copy_from(&d);
-            j.view_mut((0, n), (n, 1)).copy_from(&(dpm * &eta));
-            for i in 0..n {
-                j[(n, i)] = c[i].conj();
-            }
-            let mut f = DVector::zeros(n + 1);
-            f.rows_mut(0, n).copy_from(&(&d * &eta));
-            f[n] = c.dotc(&eta) - C64::new(1.0, 0.0);
-            let Some(dx) = j.lu().solve(&f) else { return (s, eta, false) };
-            eta -= dx.rows(0, n);
-            s -= dx[n];
-            if !(s.re.is_finite() && s.im.is_finite()) {
-                return (s, eta, false);
-            }
-            let step = dx[n].norm();
-            if step <= 1e-10 * (1.0 + s.norm()) {
-                return (s, eta, true);
-            }
-            if step > 0.5 * last_step {
-                dp = None;
-            }
-            last_step = step;
-        }
-        (s, eta, false)
+    pub fn newton(&self, s: C64, eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
+        newton_of(|x| self.d(x), s, eta, count)
     }
+}
+
+/// Newton's method on `d(s) η = 0`, `cᴴ η = 1` from `(s, η)`, as [`Reduced::newton`], for any
+/// matrix function `d` of the basis' size.
+pub(crate) fn newton_of(
+    d_of: impl Fn(C64) -> DMatrix<C64>,
+    mut s: C64,
+    mut eta: DVector<C64>,
+    count: &mut usize,
+) -> (C64, DVector<C64>, bool) {
+    let n = eta.len();
+    let c = eta.clone() / C64::new(eta.norm_squared().max(1e-300), 0.0);
+    let mut dp: Option<DMatrix<C64>> = None;
+    let mut last_step = f64::INFINITY;
+    for _ in 0..60 {
+        let d = d_of(s);
+        *count += 1;
+        if dp.is_none() {
+            let h = 1e-6 * (1.0 + s.norm());
+            dp = Some((d_of(s + h) - d_of(s - h)) / C64::new(2.0 * h, 0.0));
+            *count += 2;
+        }
+        let dpm = dp.as_ref().expect("set above");
+        let mut j = DMatrix::zeros(n + 1, n + 1);
+        j.view_mut((0, 0), (n, n)).copy_from(&d);
+        j.view_mut((0, n), (n, 1)).copy_from(&(dpm * &eta));
+        for i in 0..n {
+            j[(n, i)] = c[i].conj();
+        }
+        let mut f = DVector::zeros(n + 1);
+        f.rows_mut(0, n).copy_from(&(&d * &eta));
+        f[n] = c.dotc(&eta) - C64::new(1.0, 0.0);
+        let Some(dx) = j.lu().solve(&f) else { return (s, eta, false) };
+        eta -= dx.rows(0, n);
+        s -= dx[n];
+        if !(s.re.is_finite() && s.im.is_finite()) {
+            return (s, eta, false);
+        }
+        let step = dx[n].norm();
+        if step <= 1e-10 * (1.0 + s.norm()) {
+            return (s, eta, true);
+        }
+        if step > 0.5 * last_step {
+            dp = None;
+        }
+        last_step = step;
+    }
+    (s, eta, false)
 }
 
 /// Two-dimensional Theodorsen strips at the lattice's stations (Bisplinghoff, Ashley & Halfman
@@ -541,19 +563,7 @@ fn held_load_stiffness<S: Structure>(
     zero: &[SectionLoad],
 ) -> Result<Option<DMatrix<f64>>, String> {
     let n = model.n_dof();
-    let zeros = vec![0.0; n];
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
-    let (mut stations, mut vel) = (Vec::new(), Vec::new());
-    stations_at(&*model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
-    let mut uv = crate::lifting::new_uvlm(map, aero, &stations, aero.uvlm_params(aero.free_stream()))
-        .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let loads = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
-    if loads.nodal.iter().flatten().all(|x| *x == 0.0) {
-        return Ok(None);
-    }
-    let f: Vec<f64> = loads.nodal.iter().flatten().copied().collect();
-    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let l0 = lump(map, aero, &loads.positions, &origins, &f);
+    let Some(l0) = steady_station_loads(&*model, q, map, aero, None)? else { return Ok(None) };
     let mut k = DMatrix::zeros(n, n);
     let mut qq = vec![0.0; q.len()];
     let mut dq = vec![0.0; n];
@@ -571,6 +581,34 @@ fn held_load_stiffness<S: Structure>(
         }
     }
     Ok(Some(k))
+}
+
+/// The steady station loads of the lattice at `q` with `wake` (default: semi-infinite legs);
+/// `None` when they vanish.
+pub(crate) fn steady_station_loads<S: Structure>(
+    model: &S,
+    q: &[f64],
+    map: &[StationMap],
+    aero: &AeroSettings,
+    wake: Option<uvlm::SteadyWake>,
+) -> Result<Option<Vec<SectionLoad>>, String> {
+    let zeros = vec![0.0; model.n_dof()];
+    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let (mut stations, mut vel) = (Vec::new(), Vec::new());
+    stations_at(model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
+    let mut params = aero.uvlm_params(aero.free_stream());
+    if let Some(w) = wake {
+        params.steady_wake = w;
+    }
+    let mut uv =
+        crate::lifting::new_uvlm(map, aero, &stations, params).map_err(|e| format!("aerodynamic lattice: {e}"))?;
+    let loads = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
+    if loads.nodal.iter().flatten().all(|x| *x == 0.0) {
+        return Ok(None);
+    }
+    let f: Vec<f64> = loads.nodal.iter().flatten().copied().collect();
+    let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
+    Ok(Some(lump(map, aero, &loads.positions, &origins, &f)))
 }
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
@@ -636,7 +674,9 @@ struct ModalBasis {
 
 /// The first `nb` (at most the free motions) natural modes of `model` about `(q, λ, μ)` under
 /// the steady station loads of the lattice held fixed, and the modal matrices of the unloaded
-/// structure.
+/// structure. With `n_rigid` rigid-body modes (a free aircraft), the first `n_rigid` are replaced
+/// by the exact rigid-body motions, which the held loads and gravity otherwise mix with
+/// elastic deformation.
 fn modal_basis<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -644,7 +684,7 @@ fn modal_basis<S: Structure>(
     map: &[StationMap],
     aero: &AeroSettings,
     zero_loads: &[SectionLoad],
-    nb: usize,
+    (nb, n_rigid): (usize, usize),
 ) -> Result<ModalBasis, String> {
     let mut lin =
         genalpha::analysis::linearise(&*model, 0.0, q, lambda, mu).map_err(|e| format!("linearisation: {e}"))?;
@@ -663,7 +703,10 @@ fn modal_basis<S: Structure>(
         lin.stiffness -= kl;
     }
     let nb = nb.min(lin.n_free());
-    let phi = modes.shapes.columns(0, nb).into_owned();
+    let mut phi = modes.shapes.columns(0, nb).into_owned();
+    if n_rigid > 0 {
+        crate::flight_modes::exact_rigid_modes(&*model, q, &lin, n_rigid, &mut phi)?;
+    }
     let m = phi.transpose() * &lin.mass * &phi;
     let c = phi.transpose() * &lin.damping * &phi;
     let k = phi.transpose() * &lin.stiffness * &phi;
@@ -979,12 +1022,14 @@ impl Reduced {
             n_rings: 0,
             n_wake_rings: 0,
             phi: basis.phi,
+            skip: 0,
         }
     }
 }
 
 /// Build the flutter equation of `model` (no loads applied) about `(q, λ, μ)` at the airspeed of
-/// `aero`, with `nb` basis modes: the structural basis, optionally the mode shapes for the
+/// `aero`, with `nb` basis modes (the first `n_rigid` the exact rigid-body motions of a free
+/// aircraft): the structural basis, optionally the mode shapes for the
 /// report, then either Theodorsen strips (`strip_case`) or the linear UVLM on the equilibrium's
 /// lattice with its geometric terms along the modes and the wake nodes' motion.
 #[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
@@ -996,13 +1041,13 @@ pub fn reduce<S: Structure>(
     map: &[StationMap],
     aero: &AeroSettings,
     wake: &uvlm::LinearWake,
-    nb: usize,
+    (nb, n_rigid): (usize, usize),
     shapes_out: Option<(&Problem, &mut Vec<ModeShape>)>,
     strip_case: Option<&Problem>,
 ) -> Result<Reduced, String> {
     let zero_loads = zero_loads(map);
     model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
-    let basis = modal_basis(&mut model, q, (lambda, mu), map, aero, &zero_loads, nb)?;
+    let basis = modal_basis(&mut model, q, (lambda, mu), map, aero, &zero_loads, (nb, n_rigid))?;
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = StationScratch::default();
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
@@ -1055,6 +1100,7 @@ pub fn reduce<S: Structure>(
         n_rings: la.n_rings(),
         n_wake_rings: wake.row_lengths.len() * la.te_rings.len(),
         phi: basis.phi,
+        skip: 0,
     })
 }
 
@@ -1080,8 +1126,19 @@ pub fn wake_settings(case: &Problem, f: Formulation, airspeed: f64) -> WakeSetti
     case.stability.as_ref().and_then(|s| s.wake).unwrap_or_else(|| march_wake(case, f, airspeed))
 }
 
-/// An equilibrium: coordinates, holonomic and velocity multipliers, fold angle (degrees).
-type Equilibrium = (Vec<f64>, Vec<f64>, Vec<f64>, f64);
+/// A state a sweep linearises about.
+#[derive(Clone)]
+struct Equilibrium {
+    /// Coordinates, holonomic and velocity multipliers.
+    q: Vec<f64>,
+    lambda: Vec<f64>,
+    mu: Vec<f64>,
+    /// Fold angle, degrees (NaN without a fold hinge).
+    fold: f64,
+    /// About a trim: the free aircraft's problem in body axes (flow and gravity turned by −α,
+    /// elevator and thrust trimmed), which the point's model and lattice are built from.
+    flight: Option<Box<Problem>>,
+}
 
 /// Thread CPU time where the platform has it (so that the cost of a sweep does not depend on
 /// the machine's load), else wall time since the first call, s.
@@ -1151,6 +1208,9 @@ fn sweep<S: Structure>(
     };
     let mut out = empty_output(f, None);
     let nb_req = st.basis_modes.unwrap_or((2 * st.modes).max(20));
+    // About a trim the free aircraft's rigid-body modes join the basis, and their roots are found
+    // apart from the tracked elastic ones (`crate::flight_modes`).
+    let n_rigid = if st.about == About::Trim { crate::flight_modes::n_rigid(case) } else { 0 };
     // About a fixed state with a wake of fixed row lengths, the model is built once and scaled
     // with the airspeed (exact, see `Reduced::at_speed_ratio`).
     let fixed = st.about == About::Undeformed && (st.wake.is_some() || st.aerodynamics == AeroModel::Strip);
@@ -1160,25 +1220,29 @@ fn sweep<S: Structure>(
     // The last analysed airspeed, its static stiffness and the sign of `det D(0)` there.
     let mut last_static: Option<(f64, f64, f64)> = None;
     for (i, &u) in st.airspeeds.iter().enumerate() {
-        let mut a = aero.clone();
-        a.airspeed = Some(u);
         let point = |roots: Vec<Root>, smin: f64, omega: Vec<f64>, fold: f64, error: Option<String>| StabilityPoint {
             airspeed: u,
             fold_deg: fold,
             roots,
+            flight_roots: Vec::new(),
             static_stiffness_min: smin,
             structural_rad_s: omega,
             error,
         };
-        let (q, lam, mu, fold) = match &states[i] {
-            Ok(s) => s.clone(),
+        let state = match &states[i] {
+            Ok(s) => s,
             Err(e) => {
                 out.points.push(point(Vec::new(), f64::NAN, Vec::new(), f64::NAN, Some(e.clone())));
                 continue;
             }
         };
+        // About a trim the point's own problem: the free aircraft in its body axes.
+        let (problem, a) = match state.flight.as_deref() {
+            Some(p) => (p, p.aero.clone().unwrap_or_else(|| aero.clone())),
+            None => (case, AeroSettings { airspeed: Some(u), ..aero.clone() }),
+        };
         if !(fixed && cache.is_some()) {
-            let model = match build(case) {
+            let model = match build(problem) {
                 Ok(m) => m,
                 Err(e) => return empty_output(f, Some(e.to_string())),
             };
@@ -1187,10 +1251,14 @@ fn sweep<S: Structure>(
             let wake = linear_wake(case, f, u);
             let shapes = if i == 0 { Some((case, &mut out.shapes)) } else { None };
             let strip = (st.aerodynamics == AeroModel::Strip).then_some(case);
-            match reduce(model, &q, &lam, &mu, &map, &a, &wake, nb_req, shapes, strip) {
+            let nb = nb_req + n_rigid;
+            let reduced =
+                reduce(model, &state.q, &state.lambda, &state.mu, &map, &a, &wake, (nb, n_rigid), shapes, strip)
+                    .and_then(|r| crate::flight_modes::skip_rigid(r, n_rigid));
+            match reduced {
                 Ok(r) => cache = Some((u, r)),
                 Err(e) => {
-                    out.points.push(point(Vec::new(), f64::NAN, Vec::new(), fold, Some(e)));
+                    out.points.push(point(Vec::new(), f64::NAN, Vec::new(), state.fold, Some(e)));
                     cache = None;
                     continue;
                 }
@@ -1199,7 +1267,7 @@ fn sweep<S: Structure>(
         }
         let Some((u0, red)) = cache.as_mut() else { continue };
         let target = u / *u0;
-        let nmodes = st.modes.min(red.n_basis());
+        let nmodes = st.modes.min(red.n_basis() - red.skip);
         let first =
             if tracked.is_none() { Some(first_starts(red, nmodes, target, &mut out.n_evaluations)) } else { None };
         red.at_speed_ratio(target);
@@ -1234,8 +1302,19 @@ fn sweep<S: Structure>(
         out.solve_s += cpu_now() - ts;
         prev = tracked.take();
         tracked = Some(next);
-        let omega = red.omega.iter().take(nb_req).copied().collect();
-        out.points.push(point(roots, smin, omega, fold, None));
+        let omega = red.omega.iter().take(nb_req + n_rigid).copied().collect();
+        let mut pt = point(roots, smin, omega, state.fold, None);
+        if state.flight.is_some() {
+            let ts = cpu_now();
+            let motion = build(problem)
+                .map(|m| crate::flight_modes::StationMotion::new(&m, &state.q, &red.phi, (&map, &a, problem)));
+            match motion {
+                Ok(m) => pt.flight_roots = crate::flight_modes::flight_roots(red, n_rigid, &m, &mut out.n_evaluations),
+                Err(e) => pt.error = Some(e.to_string()),
+            }
+            out.solve_s += cpu_now() - ts;
+        }
+        out.points.push(pt);
     }
     flutter_speed(&mut out);
     out
@@ -1271,7 +1350,8 @@ fn equilibria<S: Structure>(
             let q = model.initial_state().q;
             let (nh, nv) = (model.n_holonomic(), model.n_velocity_constraints());
             let fold = case.fold_joint_index().map_or(f64::NAN, |j| model.fold(&q, j).to_degrees());
-            st.airspeeds.iter().map(|_| Ok((q.clone(), vec![0.0; nh], vec![0.0; nv], fold))).collect()
+            let state = Equilibrium { q, lambda: vec![0.0; nh], mu: vec![0.0; nv], fold, flight: None };
+            st.airspeeds.iter().map(|_| Ok(state.clone())).collect()
         }
         About::Equilibrium => {
             // Each equilibrium is the steady state of the frozen wake linearised about it. The
@@ -1292,13 +1372,46 @@ fn equilibria<S: Structure>(
                     return Err(e);
                 }
                 states.extend(so.points.into_iter().map(|p| match (p.state, p.error) {
-                    (Some((q, l, m)), None) => Ok((q, l, m, p.fold_deg)),
+                    (Some((q, lambda, mu)), None) => Ok(Equilibrium { q, lambda, mu, fold: p.fold_deg, flight: None }),
                     (_, e) => Err(e.unwrap_or_else(|| "no equilibrium".into())),
                 }));
             }
             states
         }
+        About::Trim => st.airspeeds.iter().map(|&u| trimmed(case, f, u, build)).collect(),
     })
+}
+
+/// The trimmed free aircraft at airspeed `u` (the case's `trim` with the analysis's frozen wake),
+/// with the multipliers of its start from rest.
+fn trimmed<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    u: f64,
+    build: fn(&Problem) -> Result<S, crate::Error>,
+) -> Result<Equilibrium, String> {
+    let mut c = case.clone();
+    let (Some(aero), Some(t)) = (c.aero.as_mut(), case.trim.as_ref()) else {
+        return Err("stability.about: \"trim\" needs `aero` and `trim`".into());
+    };
+    aero.airspeed = Some(u);
+    let map = station_map(&c, c.aero.as_ref().expect("set above"))?;
+    let wake = wake_settings(&c, f, u);
+    let mut t = t.clone();
+    t.wake = Some(wake);
+    let out = crate::trim::run_trim(&c, f, &t);
+    if let Some(e) = out.error {
+        return Err(format!("the trim at {u} m/s: {e}"));
+    }
+    let flight = crate::trim::flight_problem(&c, &out);
+    let aero = flight.aero.as_ref().ok_or("no aero")?;
+    let mut model = build(&flight).map_err(|e| e.to_string())?;
+    if let Some(loads) = steady_station_loads(&model, &out.q, &map, aero, Some(wake.steady_wake()))? {
+        model.set_section_loads(&loads).map_err(|e| e.to_string())?;
+    }
+    let (lambda, mu) = crate::flight_modes::rest_multipliers(&model, &out.q)?;
+    let fold = flight.fold_joint_index().map_or(f64::NAN, |j| model.fold(&out.q, j).to_degrees());
+    Ok(Equilibrium { q: out.q, lambda, mu, fold, flight: Some(Box::new(flight)) })
 }
 
 /// The starts of the first airspeed's roots (at speed ratio `target`), continued from a quarter
@@ -1341,7 +1454,7 @@ fn extrapolated_starts(
 }
 
 /// Whether two roots are one.
-fn same_root(a: C64, b: C64) -> bool {
+pub(crate) fn same_root(a: C64, b: C64) -> bool {
     (a - b).norm() <= 1e-6 * (1.0 + a.norm())
 }
 
@@ -1454,7 +1567,7 @@ const SCHUR_MAX_ITER: usize = 10_000;
 
 /// Eigenvalues of `a`, or `None` when `a` has a non-finite entry or the Schur iteration does not
 /// converge within [`SCHUR_MAX_ITER`] sweeps.
-fn bounded_eigenvalues(a: DMatrix<C64>) -> Option<DVector<C64>> {
+pub(crate) fn bounded_eigenvalues(a: DMatrix<C64>) -> Option<DVector<C64>> {
     if !a.iter().all(|x| x.re.is_finite() && x.im.is_finite()) {
         return None;
     }

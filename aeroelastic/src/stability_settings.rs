@@ -41,6 +41,10 @@ pub enum About {
     Equilibrium,
     /// The undeformed reference configuration.
     Undeformed,
+    /// The trimmed free aircraft in level flight at each airspeed (the case's `trim`): the
+    /// elastic roots and the rigid-body roots (phugoid, short period, Dutch roll, roll subsidence,
+    /// spiral).
+    Trim,
 }
 
 /// The aerodynamic model of a stability analysis.

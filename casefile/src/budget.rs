@@ -355,6 +355,8 @@ pub fn estimate_analysis(case: &Case, f: Formulation, a: Analysis) -> Estimate {
             let (per_point, once) = match st.about {
                 aeroelastic::stability::About::Equilibrium => (static_point + modes, 0.0),
                 aeroelastic::stability::About::Undeformed => (0.0, modes),
+                // A trim is about twenty static solves (three unknowns, difference quotients).
+                aeroelastic::stability::About::Trim => (20.0 * static_point + modes, 0.0),
             };
             e.wake_rings = wake;
             e.bytes += lattice + 16.0 * n * n;

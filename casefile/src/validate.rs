@@ -97,6 +97,21 @@ impl Case {
                 return Err("stability: a stability analysis needs `aero`".into());
             }
             st.validate()?;
+            if st.about == aeroelastic::stability::About::Trim {
+                if self.trim.is_none() {
+                    return Err("stability.about: \"trim\" needs a `trim` block".into());
+                }
+                if st.aerodynamics == aeroelastic::stability::AeroModel::Strip {
+                    return Err(
+                        "stability.aerodynamics: \"strip\" is not available about a trim (the lattice is)".into()
+                    );
+                }
+                if fs.contains(&Formulation::Ancf) && self.ancf.path == aeroelastic::problem::AncfPath::Ode {
+                    return Err("stability.about: \"trim\" needs ancf.path \"dae\" (the trim holds the free body, \
+                                which changes the ODE path's coordinates)"
+                        .into());
+                }
+            }
         }
         self.check_gate()
     }

@@ -34,6 +34,35 @@ pub fn to_csv(out: &StabilityOutput) -> String {
     s
 }
 
+/// The rigid-body roots of a sweep about trim (`flight_modes_<f>.csv`): one row per airspeed
+/// and root; `None` when the sweep has none.
+pub fn flight_modes_csv(out: &StabilityOutput) -> Option<String> {
+    if out.points.iter().all(|p| p.flight_roots.is_empty()) {
+        return None;
+    }
+    let mut s =
+        String::from("airspeed,name,real,imag,frequency_rad_s,period_s,damping_ratio,time_to_half_s,symmetric,rigid\n");
+    for p in &out.points {
+        for r in &p.flight_roots {
+            let _ = writeln!(
+                s,
+                "{},{},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.6},{:.6}",
+                p.airspeed,
+                r.name,
+                r.real,
+                r.imag,
+                r.real.hypot(r.imag),
+                r.period_s(),
+                r.damping_ratio(),
+                -std::f64::consts::LN_2 / r.real,
+                r.symmetric,
+                r.rigid
+            );
+        }
+    }
+    Some(s)
+}
+
 /// The JSON summary of one formulation.
 #[derive(Debug, Serialize)]
 struct Summary<'a> {
@@ -82,6 +111,9 @@ pub fn write_with_history(
 ) -> Result<(), Error> {
     for out in runs {
         write_file(&dir.join(format!("stability_{}.csv", out.formulation)), &to_csv(out))?;
+        if let Some(csv) = flight_modes_csv(out) {
+            write_file(&dir.join(format!("flight_modes_{}.csv", out.formulation)), &csv)?;
+        }
         let sum = Summary {
             case: name,
             formulation: out.formulation,
@@ -296,6 +328,7 @@ pub fn section_html(name: &str, folder: &str, runs: &[StabilityOutput]) -> Strin
         }
     }
     s.push_str("</table>\n");
+    s.push_str(&flight_table(runs));
     for (file, cap) in [
         ("stability_vg.svg", "V-g and V-f (ANCF solid, GEBF dashed)"),
         ("stability_locus.svg", "Root locus"),
@@ -306,6 +339,41 @@ pub fn section_html(name: &str, folder: &str, runs: &[StabilityOutput]) -> Strin
             "<figure><img src=\"{folder}/{file}\" alt=\"{cap}\" loading=\"lazy\"><figcaption>{cap}</figcaption></figure>"
         );
     }
+    s
+}
+
+/// The rigid-body roots of sweeps about trim: per formulation and airspeed, each root's name,
+/// `s`, period, damping ratio and time to half (negative: to double) amplitude. Empty without.
+fn flight_table(runs: &[StabilityOutput]) -> String {
+    if runs.iter().all(|o| o.points.iter().all(|p| p.flight_roots.is_empty())) {
+        return String::new();
+    }
+    let mut s = String::from(
+        "<table><caption>Flight-dynamics roots about the trim</caption><tr><th>formulation</th>\
+         <th>airspeed (m/s)</th><th>mode</th><th>s (1/s)</th><th>period (s)</th><th>ζ</th>\
+         <th>time to half (s)</th></tr>\n",
+    );
+    for o in runs {
+        for p in &o.points {
+            for r in &p.flight_roots {
+                let period = if r.imag > 0.0 { format!("{:.3}", r.period_s()) } else { "–".into() };
+                let _ = writeln!(
+                    s,
+                    "<tr><td>{}</td><td>{:.2}</td><td>{}</td><td>{:+.5} {} {:.5}i</td><td>{period}</td>\
+                     <td>{:.4}</td><td>{:.2}</td></tr>",
+                    o.formulation.as_str().to_uppercase(),
+                    p.airspeed,
+                    r.name.replace('_', " "),
+                    r.real,
+                    if r.imag >= 0.0 { '+' } else { '−' },
+                    r.imag.abs(),
+                    r.damping_ratio(),
+                    -std::f64::consts::LN_2 / r.real
+                );
+            }
+        }
+    }
+    s.push_str("</table>\n");
     s
 }
 
