@@ -5,9 +5,11 @@
 //! time. A run covers model set-up, the consistent start and the time loop. Sensors are read
 //! only at the start and the end, so the timing is the solver's.
 //! ANCF runs on both of its paths (the DAE with multipliers and the ODE of the constant velocity
-//! transformation), GEBF on its one. The work behind each time (Newton iterations,
-//! factorisations and step halvings per step) comes with it, so a change in speed can be told
-//! apart from a change in work.
+//! transformation), GEBF on its one; a march from a trim (`initial: "trim"`, which needs ANCF's
+//! DAE path) on the DAE path only. The work behind each time (Newton iterations, factorisations
+//! and step halvings per step) comes with it, so a change in speed can be told apart from a
+//! change in work. A case with a `trim` block also times the trim alone (path `trim`: its static
+//! solves in the `steps` column).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -35,7 +37,7 @@ pub struct BenchRow {
     pub case: String,
     /// Formulation.
     pub formulation: Formulation,
-    /// `dae` or `ode` for ANCF, `-` for GEBF.
+    /// `dae` or `ode` for ANCF, `-` for GEBF; `trim` for the trim alone.
     pub path: String,
     /// Number of timed runs.
     pub repeats: usize,
@@ -74,7 +76,8 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The configurations of `spec`: each formulation on each of its solve paths (ANCF with
-/// multipliers and by eliminating the joints, GEBF on its one), in [`Formulation::ALL`] order.
+/// multipliers and by eliminating the joints, GEBF on its one; a march from a trim on ANCF's DAE
+/// path only), in [`Formulation::ALL`] order.
 fn configurations(spec: &RunSpec) -> Vec<(Formulation, String, crate::case::Case)> {
     let mut out = Vec::new();
     for f in Formulation::ALL {
@@ -83,7 +86,9 @@ fn configurations(spec: &RunSpec) -> Vec<(Formulation, String, crate::case::Case
             out.push((f, "-".to_string(), base.clone()));
             continue;
         }
-        for path in [AncfPath::Dae, AncfPath::Ode] {
+        let paths: &[AncfPath] =
+            if base.initial.is_reference() { &[AncfPath::Dae, AncfPath::Ode] } else { &[AncfPath::Dae] };
+        for &path in paths {
             let mut c = base.clone();
             if let Some(p) = c.block_mut(f).path {
                 *p = path;
@@ -95,38 +100,95 @@ fn configurations(spec: &RunSpec) -> Vec<(Formulation, String, crate::case::Case
     out
 }
 
+/// The median and smallest thread CPU time and the median wall time of `repeats` calls of `work`
+/// (stopping after the first that fails), ms, and the last call's result.
+fn timed<T>(
+    repeats: usize,
+    mut work: impl FnMut() -> T,
+    failed: impl Fn(&T) -> bool,
+) -> Option<((f64, f64, f64, usize), T)> {
+    let (mut cpu, mut wall) = (Vec::with_capacity(repeats), Vec::with_capacity(repeats));
+    let mut last = None;
+    for _ in 0..repeats {
+        let (c0, t0) = (thread_cpu_s(), Instant::now());
+        let out = work();
+        let w = t0.elapsed().as_secs_f64();
+        wall.push(1e3 * w);
+        cpu.push(1e3 * c0.and_then(|c0| Some(thread_cpu_s()? - c0)).unwrap_or(w));
+        let stop = failed(&out);
+        last = Some(out);
+        if stop {
+            break; // a failed run is reported once, not timed again
+        }
+    }
+    let n = cpu.len();
+    let min = cpu.iter().copied().fold(f64::INFINITY, f64::min);
+    last.map(|out| ((median(&mut cpu), min, median(&mut wall), n), out))
+}
+
+/// The trim of `spec` alone (its `trim` block), per formulation, timed as [`run`] times a march.
+fn trim_rows(spec: &RunSpec, repeats: usize) -> Vec<BenchRow> {
+    let mut rows = Vec::new();
+    for f in Formulation::ALL {
+        let case = spec.case(f);
+        let Some(t) = case.trim.as_ref() else { return rows };
+        let problem = case.problem();
+        let work = || aeroelastic::trim::run_trim(&problem, f, t);
+        let Some(((cpu_median_ms, cpu_min_ms, wall_median_ms, n), out)) = timed(repeats, work, |o| o.error.is_some())
+        else {
+            continue;
+        };
+        rows.push(BenchRow {
+            case: spec.name.clone(),
+            formulation: f,
+            path: "trim".into(),
+            repeats: n,
+            cpu_median_ms,
+            cpu_min_ms,
+            wall_median_ms,
+            steps: out.static_solves,
+            newton_per_step: f64::NAN,
+            factorizations_per_step: f64::NAN,
+            halvings: 0,
+            error: out.error,
+        });
+    }
+    rows
+}
+
 /// Time every configuration of every spec `repeats` times (at least once), serially.
 pub fn run(specs: &[RunSpec], repeats: usize, progress: bool) -> Vec<BenchRow> {
     let repeats = repeats.max(1);
     let mut rows = Vec::new();
     for spec in specs {
+        let trims = trim_rows(spec, repeats);
+        if progress {
+            for r in &trims {
+                println!(
+                    "bench {:<28} {:<4} trim: cpu median {:8.1} ms (min {:8.1}), {} static solves",
+                    r.case, r.formulation, r.cpu_median_ms, r.cpu_min_ms, r.steps
+                );
+            }
+        }
+        rows.extend(trims);
         for (f, path, mut case) in configurations(spec) {
             case.output_dt = Some(case.t_end);
-            let (mut cpu, mut wall) = (Vec::with_capacity(repeats), Vec::with_capacity(repeats));
-            let mut last = None;
-            for _ in 0..repeats {
-                let (c0, t0) = (thread_cpu_s(), Instant::now());
-                let out = run_formulation(&case, f);
-                let w = t0.elapsed().as_secs_f64();
-                wall.push(1e3 * w);
-                cpu.push(1e3 * c0.and_then(|c0| Some(thread_cpu_s()? - c0)).unwrap_or(w));
-                let failed = out.error.is_some();
-                last = Some(out);
-                if failed {
-                    break; // a failed run is reported once, not timed again
-                }
-            }
-            let Some(out) = last else { continue };
+            let work = || run_formulation(&case, f);
+            let Some(((cpu_median_ms, cpu_min_ms, wall_median_ms, n), out)) =
+                timed(repeats, work, |o| o.error.is_some())
+            else {
+                continue;
+            };
             let st = out.stats;
             let per = |x: usize| if st.n_steps > 0 { x as f64 / st.n_steps as f64 } else { f64::NAN };
             let row = BenchRow {
                 case: spec.name.clone(),
                 formulation: f,
                 path,
-                repeats: cpu.len(),
-                cpu_min_ms: cpu.iter().copied().fold(f64::INFINITY, f64::min),
-                cpu_median_ms: median(&mut cpu),
-                wall_median_ms: median(&mut wall),
+                repeats: n,
+                cpu_min_ms,
+                cpu_median_ms,
+                wall_median_ms,
                 steps: st.n_steps,
                 newton_per_step: per(st.n_newton_iters),
                 factorizations_per_step: per(st.n_factorizations),
@@ -173,16 +235,17 @@ pub fn markdown(rows: &[BenchRow], targets: impl Fn(&str) -> bool) -> String {
             Some(e) => format!("failed: {e}"),
             None => format!("{:.1} ({:.1})", r.cpu_median_ms, r.cpu_min_ms),
         };
+        let per_step = |x: f64| if x.is_finite() { format!("{x:.2}") } else { "–".into() };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.1} | {} | {:.2} | {:.2} | {} |",
+            "| {} | {} | {} | {:.1} | {} | {} | {} | {} |",
             r.case,
             label(r),
             times,
             r.wall_median_ms,
             target,
-            r.newton_per_step,
-            r.factorizations_per_step,
+            per_step(r.newton_per_step),
+            per_step(r.factorizations_per_step),
             r.halvings
         );
     }
