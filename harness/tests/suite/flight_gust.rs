@@ -15,7 +15,10 @@ const RIGHT_TIP: usize = 12;
 /// The hub's start (the clamped section of the held aircraft, 5 cm ahead of the centreline) and
 /// its frame, and the right tip, at every output step.
 #[derive(Default)]
-struct Track(Vec<(f64, Vector3<f64>, Matrix3<f64>, Vector3<f64>)>);
+struct Track(Vec<Sample>);
+
+/// Time, hub start point and frame, right tip point.
+type Sample = (f64, Vector3<f64>, Matrix3<f64>, Vector3<f64>);
 
 impl Observer for Track {
     fn observe(&mut self, s: &Snapshot<'_>) -> Result<(), String> {
