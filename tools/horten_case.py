@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Write cases/horten_flying_wing.json: the Horten flying wing of Richards et al. (2016) as
+"""Write cases/horten_flying_wing.json and the full-span flights of cases/flight/ (level flight, the
+doublet free and held, the 1-cos gust free and held; docs/trim.md sections 5 and 6): the Horten flying wing of Richards et al. (2016) as
 SHARPy's hangar describes it (ImperialCollegeLondon/sharpy, cases/hangar/horten_wing.py with the
 `Baseline` of cases/hangar/richards_wing.py; the trim of docs/source/content/example_notebooks/
 linear_horten.ipynb: M = 4, N = 11, Msf = 5, 28 m/s, rho 1.02, sigma 1).
@@ -160,6 +161,66 @@ def main():
     write(os.path.join(root, "flight", "horten_level_flight.json"), flight)
     write(os.path.join(root, "horten_flying_wing.json"), half_model(case))
     write(os.path.join(root, "flight", "horten_doublet.json"), doublet(flight))
+    for held in (False, True):
+        write(os.path.join(root, "flight", f"horten_gust{'_held' if held else ''}.json"), gust(flight, held))
+    write(os.path.join(root, "flight", "horten_doublet_held.json"), doublet_held(flight))
+
+
+FREE_VS_HELD = (" The root loads are measured at the right wing's root joint (root_joint: root_r), in body axes; "
+                "docs/trim.md section 6 compares the free aircraft with the held one.")
+
+
+def gust(flight, held):
+    """The full-span aircraft trimmed at 30 m/s through a 1-cos vertical gust (H 5 m, 3 m/s peak),
+    free or held at its hub from the same trimmed state (initial: trim_held), 1.5 s: the gust load
+    peaks within its first 0.4 s."""
+    case = doublet(flight)
+    for cs in case["aero"]["control_surfaces"]:
+        cs["deflection_deg"] = cs["deflection_deg"][0][1]
+    name = "horten_gust_held" if held else "horten_gust"
+    case["name"] = name
+    what = ("held at its hub (the free joint a clamp) from the trimmed state (initial: trim_held)" if held
+            else "free, from the trim (initial: trim)")
+    case["description"] = flight["description"].replace(
+        " Full span, for the time march from the trim (initial: trim): level flight at 28 m/s for 10 s.",
+        f" Full span, trimmed at 30 m/s and {what}, through a 1-cos vertical gust (gradient 5 m, 3 m/s) for 1.5 s."
+        + FREE_VS_HELD)
+    dt = case["ancf"]["dt"]
+    case["t_end"] = round(1.5 / dt) * dt
+    case["output_dt"] = dt
+    case["root_joint"] = "root_r"
+    case["aero"]["gust"] = dict(kind="one_minus_cosine", gradient_m=5.0, velocity=3.0)
+    if held:
+        case["initial"] = "trim_held"
+    return reorder(case)
+
+
+def doublet_held(flight):
+    """The doublet of `doublet` on the aircraft held at its hub (initial: trim_held), 3 s: the elevons'
+    load on the wing without the aircraft's response."""
+    case = doublet(flight)
+    case["name"] = "horten_doublet_held"
+    case["description"] = flight["description"].replace(
+        " Full span, for the time march from the trim (initial: trim): level flight at 28 m/s for 10 s.",
+        " Full span, trimmed at 30 m/s and held at its hub (the free joint a clamp) from the trimmed state "
+        "(initial: trim_held), a 1 deg elevator doublet at 0.5-0.9 s, 3 s." + FREE_VS_HELD)
+    dt = case["ancf"]["dt"]
+    case["t_end"] = round(3.0 / dt) * dt
+    case["output_dt"] = dt
+    case["root_joint"] = "root_r"
+    case["initial"] = "trim_held"
+    return reorder(case)
+
+
+def reorder(case):
+    """`root_joint` after `joints` (where the case-file reference lists it), the rest in order."""
+    out = {}
+    for k, v in case.items():
+        if k != "root_joint":
+            out[k] = v
+        if k == "joints":
+            out["root_joint"] = case["root_joint"]
+    return out
 
 
 def doublet(flight):

@@ -80,11 +80,12 @@ pub struct Trigger {
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub fold_deg_below: Option<f64>,
     /// Fires when the root bending moment at the clamp exceeds this, N·m (lift bending the wing
-    /// up positive; needs `aero` and a clamp: the `root_bending_moment` column).
+    /// up positive; needs `aero` and a clamp or a `root_joint`: the `root_bending_moment` column).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub root_bending_moment_above: Option<f64>,
     /// Fires when the root bending moment exceeds its value at the start of the run by this,
-    /// N·m (a gust's increment over the equilibrium it starts from; needs `aero` and a clamp).
+    /// N·m (a gust's increment over the equilibrium it starts from; needs `aero` and a clamp or a
+    /// `root_joint`).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub root_bending_moment_increment_above: Option<f64>,
 }

@@ -240,7 +240,9 @@ pub fn hinge_events<M: BuildModel>(problem: &Problem) -> Events<'static, M> {
 
 /// A time march from the trimmed state (`initial: "trim"`, docs/trim.md §5): the trim with the
 /// march's own wake, then the march of the free aircraft in body axes from the trimmed
-/// coordinates, at rest, with the steady wake prefilled and its loads applied.
+/// coordinates, at rest, with the steady wake prefilled and its loads applied. With
+/// `initial: "trim_held"` the aircraft stays held at its free body (docs/trim.md §6): the
+/// trim's held equilibrium marched, its earth frame the wind tunnel's (turned by α, at rest).
 fn from_trim<M: BuildModel>(
     problem: &Problem,
     f: Formulation,
@@ -249,7 +251,7 @@ fn from_trim<M: BuildModel>(
     let model_error = |msg: String| Error::Model { formulation: f, msg };
     let (flight, trim) = crate::trim::trim_for_march::<M>(problem, f).map_err(model_error)?;
     let (Some(aero), Some(aero0)) = (flight.aero.as_ref(), problem.aero.as_ref()) else {
-        return Err(model_error("initial: \"trim\" needs `aero`".into()));
+        return Err(model_error(format!("initial: \"{}\" needs `aero`", problem.initial.name())));
     };
     // The lattice's layout of the reference flow, as the trim has it.
     let map = station_map(problem, aero0).map_err(model_error)?;
@@ -259,7 +261,11 @@ fn from_trim<M: BuildModel>(
     // Body axes turned back by α, moving against the reference flow: the earth frame.
     let rotation =
         *nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), trim.alpha_deg.to_radians()).matrix();
-    let velocity = -nalgebra::Vector3::from(aero0.stream_without_sideslip());
+    let velocity = if problem.initial == crate::trim::Initial::TrimHeld {
+        nalgebra::Vector3::zeros()
+    } else {
+        -nalgebra::Vector3::from(aero0.stream_without_sideslip())
+    };
     let mut earth = EarthAxes { inner: observer, rotation, velocity };
     Ok(simulate_aero_with_events(f, &mut model, &s, aero, &map, &mut earth, Some(&trim.q), &mut events))
 }
@@ -309,7 +315,7 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
         type Output = Result<RunOutput, Error>;
         fn run<M: BuildModel>(self) -> Self::Output {
             let Run { problem, f, observer } = self;
-            if problem.initial == crate::trim::Initial::Trim {
+            if problem.initial.is_trim() {
                 return from_trim::<M>(problem, f, observer);
             }
             let s = settings(problem, f);

@@ -262,6 +262,17 @@ impl GustSpec {
         }
     }
 
+    /// Direction of the gust velocity, to change in place (a flight in body axes turns it with
+    /// the flow, docs/trim.md §5).
+    pub fn direction_mut(&mut self) -> &mut [f64; 3] {
+        match self {
+            GustSpec::OneMinusCosine { direction, .. }
+            | GustSpec::SharpEdged { direction, .. }
+            | GustSpec::Sinusoidal { direction, .. }
+            | GustSpec::VonKarman { direction, .. } => direction,
+        }
+    }
+
     /// The gradient of a 1-cos gust, m (NaN for other kinds).
     pub fn gradient(&self) -> f64 {
         match self {

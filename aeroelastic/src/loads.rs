@@ -1,6 +1,7 @@
-//! Wing loads from a free body: the root wrench at a clamp and the hinge moment of a flared
-//! hinge, from the aerodynamic station loads, gravity and (in time histories) the inertia of the
-//! distributed mass and the point masses (docs/statics.md §4).
+//! Wing loads from a free body: the root wrench at a clamp (or at the case's `root_joint`, a
+//! wing's root on a free aircraft) and the hinge moment of a flared hinge, from the aerodynamic
+//! station loads, gravity and (in time histories) the inertia of the distributed mass and the
+//! point masses (docs/statics.md §4).
 //!
 //! Both formulations are measured by the same rule, written once against [`Structure`]: the
 //! free body is the set of bodies outboard of the cut, and its loads are integrated along the
@@ -73,7 +74,8 @@ const GAUSS3: [(f64, f64); 3] =
     [(0.112_701_665_379_258_3, 5.0 / 18.0), (0.5, 8.0 / 18.0), (0.887_298_334_620_741_7, 5.0 / 18.0)];
 
 impl LoadModel {
-    /// The free bodies of `case` as formulation `f` discretises it: the first clamp's body and
+    /// The free bodies of `case` as formulation `f` discretises it: the root body
+    /// ([`Problem::root_body_index`]: the `root_joint`'s child, or the first clamp's body) and
     /// everything joined outboard of it, and the outboard side of the fold hinge
     /// ([`Problem::fold_joint_index`]). `None` when the case has neither.
     pub fn new(case: &Problem, f: Formulation) -> Option<Self> {
@@ -116,10 +118,7 @@ impl LoadModel {
             }
             Cut { bodies: out }
         };
-        let clamp = case.joints.iter().find_map(|j| match j {
-            Joint::Clamp { body, .. } => case.body_index(body).map(|b| (b, subtree(b))),
-            _ => None,
-        });
+        let clamp = case.root_body_index().map(|b| (b, subtree(b)));
         let hinge = case.fold_joint_index().and_then(|i| match &case.joints[i] {
             Joint::FlaredHinge { parent, child, flare_deg, .. } => {
                 let (p, c) = (case.body_index(parent)?, case.body_index(child)?);

@@ -47,6 +47,10 @@ pub struct Problem {
     pub fold_joint: Option<String>,
     /// Name of the ground hinge whose rate is the `roll_rate` column (none: no column).
     pub roll_joint: Option<String>,
+    /// Name of the joint (a flared hinge or a clamp) at which the root loads are measured: the
+    /// free body of its child (or clamped body) and everything outboard of it (none: the first
+    /// clamp).
+    pub root_joint: Option<String>,
     /// Hinge events of the time march: hinges locked or released at given times.
     pub events: Vec<crate::events::HingeEvent>,
     /// Thrusts: follower forces on bodies (`thrust`).
@@ -799,6 +803,20 @@ impl Problem {
     /// Index of the joint whose fold angle is reported.
     pub fn fold_joint_index(&self) -> Option<usize> {
         fold_joint_index(&self.joints, self.fold_joint.as_deref())
+    }
+
+    /// The body at whose start the root loads are measured: the child of the `root_joint` (a
+    /// flared hinge) or the body of a clamp (the `root_joint`, or the first clamp without one).
+    pub fn root_body_index(&self) -> Option<usize> {
+        let joint = match self.root_joint.as_deref() {
+            Some(n) => self.joints.iter().find(|j| j.name() == Some(n))?,
+            None => self.joints.iter().find(|j| matches!(j, Joint::Clamp { .. }))?,
+        };
+        match joint {
+            Joint::FlaredHinge { child, .. } => self.body_index(child),
+            Joint::Clamp { body, .. } => self.body_index(body),
+            _ => None,
+        }
     }
 
     /// Index of the `roll_joint`, if the problem names one.

@@ -1391,6 +1391,8 @@ fn trimmed<S: Structure>(
     build: fn(&Problem) -> Result<S, crate::Error>,
 ) -> Result<Equilibrium, String> {
     let mut c = case.clone();
+    // The free aircraft, whatever the case's march starts from (`trim_held` would hold it).
+    c.initial = crate::trim::Initial::Reference;
     let (Some(aero), Some(t)) = (c.aero.as_mut(), case.trim.as_ref()) else {
         return Err("stability.about: \"trim\" needs `aero` and `trim`".into());
     };

@@ -173,12 +173,30 @@ pub enum Initial {
     /// The trimmed state of the case's `trim`: the deformed aircraft in level flight, at rest in
     /// body axes, with the steady wake (docs/trim.md §5).
     Trim,
+    /// The trimmed state of `Trim`, with the aircraft held at its free body for the whole march
+    /// (the free joint a clamp, as the trim holds it): the clamped wing of a comparison with the
+    /// free flight (docs/trim.md §6).
+    TrimHeld,
 }
 
 impl Initial {
     /// Whether this is the default.
     pub fn is_reference(&self) -> bool {
         *self == Initial::Reference
+    }
+
+    /// Whether the march starts from the trim (free or held).
+    pub fn is_trim(&self) -> bool {
+        matches!(self, Initial::Trim | Initial::TrimHeld)
+    }
+
+    /// The case file's spelling.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Initial::Reference => "reference",
+            Initial::Trim => "trim",
+            Initial::TrimHeld => "trim_held",
+        }
     }
 }
 
@@ -291,13 +309,27 @@ fn failed(p: &Problem, f: Formulation, msg: String) -> TrimOutput {
 }
 
 /// Body axes at angle of attack `alpha_deg`: the free stream and gravity of `p` turned about +X
-/// by −α (the structure keeps its reference geometry).
+/// by −α (the structure keeps its reference geometry). A gust's direction, given in the earth
+/// frame, turns with them.
 fn turn_flow(p: &mut Problem, alpha_deg: f64) {
     let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), -alpha_deg.to_radians());
     p.gravity = p.gravity.map(|g| (turn * Vector3::from(g)).into());
     if let Some(a) = p.aero.as_mut() {
         a.v_inf = Some((turn * Vector3::from(a.stream_without_sideslip())).into());
         a.airspeed = None;
+        if let Some(g) = a.gust.as_mut() {
+            let d = g.direction_mut();
+            *d = (turn * Vector3::from(*d)).into();
+        }
+    }
+}
+
+/// Hold the aircraft of `p` at its free body: every `free` joint becomes a clamp.
+pub fn hold(p: &mut Problem) {
+    for j in &mut p.joints {
+        if let Joint::Free { name, body } = j {
+            *j = Joint::Clamp { name: name.clone(), body: body.clone() };
+        }
     }
 }
 
@@ -305,11 +337,10 @@ fn turn_flow(p: &mut Problem, alpha_deg: f64) {
 /// about +X, the elevator at δ, every thrust at T.
 fn held_problem(base: &Problem, t: &TrimSettings, x: Unknowns) -> Problem {
     let mut p = base.clone();
-    for j in &mut p.joints {
-        if let Joint::Free { name, body } = j {
-            *j = Joint::Clamp { name: name.clone(), body: body.clone() };
-        }
-    }
+    hold(&mut p);
+    // The net load is measured at the clamp, over the whole aircraft, whatever joint the case
+    // measures its root loads at.
+    p.root_joint = None;
     turn_flow(&mut p, x.0[0]);
     if let Some(a) = p.aero.as_mut() {
         for c in &mut a.control_surfaces {
@@ -339,9 +370,13 @@ fn offset_to(d: &Deflection, start: f64) -> Deflection {
 /// The problem of a time march from the trim `out` (docs/trim.md §5): in body axes, the flow and
 /// gravity turned by −α as in the trim, the free joint free; the elevator's surfaces and the
 /// thrusts at their trimmed values plus their schedules' changes from t = 0 (an elevator doublet
-/// or a thrust step on top of the trim).
+/// or a thrust step on top of the trim). With `initial: "trim_held"` the free joint is a clamp,
+/// as in the trim's held problem.
 pub fn flight_problem(base: &Problem, out: &TrimOutput) -> Problem {
     let mut p = base.clone();
+    if p.initial == Initial::TrimHeld {
+        hold(&mut p);
+    }
     turn_flow(&mut p, out.alpha_deg);
     if let Some(a) = p.aero.as_mut() {
         for c in a.control_surfaces.iter_mut() {
@@ -365,8 +400,9 @@ pub fn flight_problem(base: &Problem, out: &TrimOutput) -> Problem {
 /// # Errors
 /// No `trim` block, or the trim failed.
 pub(crate) fn trim_for_march<M: BuildModel>(p: &Problem, f: Formulation) -> Result<(Problem, TrimOutput), String> {
-    let t = p.trim.as_ref().ok_or("initial: \"trim\" needs a `trim` block")?;
-    let aero = p.aero.as_ref().ok_or("initial: \"trim\" needs `aero`")?;
+    let initial = p.initial.name();
+    let t = p.trim.as_ref().ok_or_else(|| format!("initial: \"{initial}\" needs a `trim` block"))?;
+    let aero = p.aero.as_ref().ok_or_else(|| format!("initial: \"{initial}\" needs `aero`"))?;
     let mut t = t.clone();
     t.wake = Some(crate::stability::march_wake(p, f, aero.speed()));
     let out = trim_with::<M>(p, f, &t);

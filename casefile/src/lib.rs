@@ -81,6 +81,11 @@ pub struct Case {
     /// Name of the ground hinge whose rate is the `roll_rate` column (a roll rig's shaft).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roll_joint: Option<String>,
+    /// Name of the joint at which the `root_bending_moment` and `root_torque` columns are
+    /// measured: a flared hinge (its child and everything outboard, in the child's root section
+    /// frame; a wing's root on a free aircraft) or a clamp (default: the first clamp).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub root_joint: Option<String>,
     /// Hinge events of the time march: `[{ "time", "joint", "action": "lock" | "release" }]`
     /// (docs/case-file.md §2.1).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -128,8 +133,9 @@ pub struct Case {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub trim: Option<aeroelastic::trim::TrimSettings>,
     /// Where a time march starts: `"reference"` (default: the reference configuration at rest,
-    /// an impulsively started lattice) or `"trim"` (the trimmed state of `trim`, in level flight
-    /// with the steady wake; docs/trim.md §5).
+    /// an impulsively started lattice), `"trim"` (the trimmed state of `trim`, in level flight
+    /// with the steady wake; docs/trim.md §5) or `"trim_held"` (the same state with the aircraft
+    /// held at its free body throughout; docs/trim.md §6).
     #[serde(default, skip_serializing_if = "aeroelastic::trim::Initial::is_reference")]
     pub initial: aeroelastic::trim::Initial,
     /// Linearised stability (`harness stability`): airspeeds, modes to track, the state to

@@ -20,6 +20,7 @@ impl Case {
             output_dt: self.output_dt,
             fold_joint: self.fold_joint.clone(),
             roll_joint: self.roll_joint.clone(),
+            root_joint: self.root_joint.clone(),
             events: self.events.clone(),
             thrust: self.thrust.clone(),
             trim: self.trim.clone(),

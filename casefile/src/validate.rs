@@ -76,16 +76,18 @@ impl Case {
         if let Some(t) = &self.trim {
             t.validate(&self.problem())?;
         }
-        if self.initial == aeroelastic::trim::Initial::Trim && self.trim.is_none() {
-            return Err("initial: \"trim\" needs a `trim` block".into());
+        let initial = self.initial.name();
+        if self.initial.is_trim() && self.trim.is_none() {
+            return Err(format!("initial: \"{initial}\" needs a `trim` block"));
         }
-        if self.initial == aeroelastic::trim::Initial::Trim
+        if self.initial.is_trim()
             && fs.contains(&Formulation::Ancf)
             && self.ancf.path == aeroelastic::problem::AncfPath::Ode
         {
-            return Err("initial: \"trim\" needs ancf.path \"dae\" (the trim holds the free body, which changes \
-                        the ODE path's coordinates)"
-                .into());
+            return Err(format!(
+                "initial: \"{initial}\" needs ancf.path \"dae\" (the trim holds the free body, which changes the ODE \
+                 path's coordinates)"
+            ));
         }
         match (&self.statics, self.aero.is_some()) {
             (Some(st), false) => self.check_structural_static(st)?,
@@ -276,8 +278,11 @@ impl Case {
             if w.joint.is_some() {
                 return Err(format!("{field}: a root bending moment trigger watches no joint"));
             }
-            if self.aero.is_none() || !self.joints.iter().any(|j| matches!(j, Joint::Clamp { .. })) {
-                return Err(format!("{field}: needs `aero` and a clamp (where the moment is measured)"));
+            let root = self.root_joint.is_some() || self.joints.iter().any(|j| matches!(j, Joint::Clamp { .. }));
+            if self.aero.is_none() || !root {
+                return Err(format!(
+                    "{field}: needs `aero` and a clamp or a `root_joint` (where the moment is measured)"
+                ));
             }
         }
         Ok(())
@@ -343,6 +348,13 @@ impl Case {
                 Some(Joint::GroundHinge { .. }) => {}
                 Some(_) => return Err(format!("roll_joint: `{n}` is not a ground hinge")),
                 None => return Err(format!("roll_joint: no joint named `{n}`")),
+            }
+        }
+        if let Some(n) = &self.root_joint {
+            match self.joints.iter().find(|j| j.name() == Some(n.as_str())) {
+                Some(Joint::FlaredHinge { .. } | Joint::Clamp { .. }) => {}
+                Some(_) => return Err(format!("root_joint: `{n}` is neither a flared hinge nor a clamp")),
+                None => return Err(format!("root_joint: no joint named `{n}`")),
             }
         }
         if let Some(n) = &self.fold_joint {

@@ -8,6 +8,7 @@ mod common;
 mod control_surfaces;
 mod divergence_swept;
 mod external;
+mod flight_gust;
 mod fuzz;
 mod gate;
 mod geometry;
