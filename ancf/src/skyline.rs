@@ -37,6 +37,8 @@ pub struct SkylineLu {
     lval: Vec<f64>,
     uval: Vec<f64>,
     inv_diag: Vec<f64>,
+    /// Per-row pivot floors of the factorisation in hand ([`SkylineLu::pivot_floors`]).
+    floor: Vec<f64>,
     work: Vec<f64>,
     is_multiplier: Vec<bool>,
     last_coupled: Vec<usize>,
@@ -264,9 +266,9 @@ impl SkylineLu {
     /// `symmetric`, `lval` (L rows); false on a tiny pivot.
     fn factor_in_place(&mut self, symmetric: bool) -> bool {
         let n = self.n;
-        let scale = (0..n).map(|i| self.uval[self.uptr[i] + (i - self.first[i])].abs()).fold(0.0_f64, f64::max);
+        self.pivot_floors(symmetric);
         if symmetric {
-            return self.factorize_symmetric(scale);
+            return self.factorize_symmetric();
         }
         // Crout, in place.
         for j in 0..n {
@@ -292,7 +294,7 @@ impl SkylineLu {
             let s = dot(&self.lval[lpj..lpj + (j - fj)], &self.uval[upj..upj + (j - fj)]);
             let d = self.uval[upj + (j - fj)] - s;
             self.uval[upj + (j - fj)] = d;
-            if !d.is_finite() || d.abs() <= 1e-13 * scale {
+            if !d.is_finite() || d.abs() <= self.floor[j] {
                 return false;
             }
             self.inv_diag[j] = 1.0 / d;
@@ -300,22 +302,50 @@ impl SkylineLu {
         true
     }
 
+    /// The pivot below which row `i` counts as singular: 1e-13 of the magnitude of what forms
+    /// it, its diagonal `|a_ii|` or the largest first elimination term `|a_ik a_ki / a_kk|`
+    /// (k < i in the profile). A multiplier row (zero diagonal) has the scale of its Schur
+    /// complement `Σ b_k² / a_kk`, which is the inverse of a stiffness: against the matrix's
+    /// largest diagonal, as this test was before, a stiff structure's constraint pivots
+    /// (1e-9 against 1e9 on SHARPy's Horten wing) read as zero and sent every factorisation to
+    /// the dense LU. For the other rows the floor is at most the old one (`a_ik² ≤ a_ii a_kk`
+    /// for the positive definite structural blocks), so no pivot accepted before is refused.
+    fn pivot_floors(&mut self, symmetric: bool) {
+        let n = self.n;
+        if self.floor.len() != n {
+            self.floor.resize(n, 0.0);
+        }
+        for i in 0..n {
+            let (fi, up) = (self.first[i], self.uptr[i]);
+            let mut s = self.uval[up + (i - fi)].abs();
+            for k in fi..i {
+                let akk = self.uval[self.uptr[k] + (k - self.first[k])].abs();
+                if akk > 0.0 {
+                    let u = self.uval[up + (k - fi)]; // A[k][i]
+                    let l = if symmetric { u } else { self.lval[self.lptr[i] + (k - fi)] }; // A[i][k]
+                    s = s.max((l * u).abs() / akk);
+                }
+            }
+            self.floor[i] = 1e-13 * s;
+        }
+    }
+
     /// Crout for symmetric values (`L = D⁻¹Uᵀ`): column `j` of `U` and row `j` of `L` from the
     /// rows of `L` above. Consecutive columns, and consecutive rows, with the same profile start
     /// are taken together (columns in fours, else pairs; rows in pairs), so that each loaded value
     /// serves several products (the node-ordered ANCF unknowns come in runs of 12 with a common
     /// start).
-    fn factorize_symmetric(&mut self, scale: f64) -> bool {
+    fn factorize_symmetric(&mut self) -> bool {
         let n = self.n;
         let mut j = 0;
         while j < n {
             let f = self.first[j];
             let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
             let (ok, width) = match run {
-                4 if self.quad_pairs_rows_like_pairs(j) => (self.symmetric_column_quad(j, scale), 4),
-                4 => (self.symmetric_column_pair(j, scale), 2),
-                2 | 3 => (self.symmetric_column_pair(j, scale), 2),
-                _ => (self.symmetric_column(j, scale), 1),
+                4 if self.quad_pairs_rows_like_pairs(j) => (self.symmetric_column_quad(j), 4),
+                4 => (self.symmetric_column_pair(j), 2),
+                2 | 3 => (self.symmetric_column_pair(j), 2),
+                _ => (self.symmetric_column(j), 1),
             };
             if !ok {
                 return false;
@@ -343,8 +373,8 @@ impl SkylineLu {
     }
 
     /// Pivot `j` of the symmetric factorisation from its reduced diagonal entry.
-    fn set_pivot(&mut self, j: usize, d: f64, scale: f64) -> bool {
-        if !d.is_finite() || d.abs() <= 1e-13 * scale {
+    fn set_pivot(&mut self, j: usize, d: f64) -> bool {
+        if !d.is_finite() || d.abs() <= self.floor[j] {
             return false;
         }
         self.inv_diag[j] = 1.0 / d;
@@ -352,7 +382,7 @@ impl SkylineLu {
     }
 
     /// Column `j` alone (see [`factorize_symmetric`](Self::factorize_symmetric)).
-    fn symmetric_column(&mut self, j: usize, scale: f64) -> bool {
+    fn symmetric_column(&mut self, j: usize) -> bool {
         let fj = self.first[j];
         let (lpj, upj) = (self.lptr[j], self.uptr[j]);
         let (l_done, l_rest) = self.lval.split_at_mut(lpj);
@@ -385,11 +415,12 @@ impl SkylineLu {
         }
         let d = u_j[j - fj] - dot(l_j, &u_j[..j - fj]);
         u_j[j - fj] = d;
-        self.set_pivot(j, d, scale)
+        self.set_pivot(j, d)
     }
 
     /// Columns `j` and `j + 1` with the same profile start `f` together.
-    fn symmetric_column_pair(&mut self, j: usize, scale: f64) -> bool {
+    fn symmetric_column_pair(&mut self, j: usize) -> bool {
+        let floor_j = self.floor[j];
         let f = self.first[j];
         let (lpj, upj, upj1) = (self.lptr[j], self.uptr[j], self.uptr[j + 1]);
         let (l_done, l_rest) = self.lval.split_at_mut(lpj);
@@ -428,7 +459,7 @@ impl SkylineLu {
         // pivot j, then row j of column j + 1, then pivot j + 1
         let d = u_j[j - f] - dot(l_j, &u_j[..j - f]);
         u_j[j - f] = d;
-        if !d.is_finite() || d.abs() <= 1e-13 * scale {
+        if !d.is_finite() || d.abs() <= floor_j {
             return false;
         }
         let dj = 1.0 / d;
@@ -438,14 +469,15 @@ impl SkylineLu {
         let d1 = u_j1[j + 1 - f] - dot(l_j1, &u_j1[..j + 1 - f]);
         u_j1[j + 1 - f] = d1;
         self.inv_diag[j] = dj;
-        self.set_pivot(j + 1, d1, scale)
+        self.set_pivot(j + 1, d1)
     }
     /// Columns `j .. j + 4` with the same profile start `f` together: the rows above `j` in
     /// pairs against all four columns (eight products per loaded pair of `L` values), then the
     /// 4 × 4 diagonal block as two column pairs. Every product is summed in the same order as
     /// in [`symmetric_column_pair`](Self::symmetric_column_pair) on the pairs `(j, j + 1)` and
     /// `(j + 2, j + 3)`, so both give the same factors bit for bit.
-    fn symmetric_column_quad(&mut self, j: usize, scale: f64) -> bool {
+    fn symmetric_column_quad(&mut self, j: usize) -> bool {
+        let floors = [self.floor[j], self.floor[j + 1], self.floor[j + 2], self.floor[j + 3]];
         let f = self.first[j];
         let m = j - f;
         // the L rows j .. j + 4 and the U columns j .. j + 4 follow each other in storage
@@ -498,7 +530,7 @@ impl SkylineLu {
             }
         }
         // pivots j, j + 1
-        let Some((dj, dj1)) = pair_diagonal(l0, l1, u0, u1, m, scale) else { return false };
+        let Some((dj, dj1)) = pair_diagonal(l0, l1, u0, u1, m, (floors[0], floors[1])) else { return false };
         (self.inv_diag[j], self.inv_diag[j + 1]) = (dj, dj1);
         // rows j, j + 1 of columns j + 2, j + 3
         let s = dot2x2(l0, &l1[..m], &u2[..m], &u3[..m]);
@@ -510,7 +542,7 @@ impl SkylineLu {
         (u2[m], u3[m], u2[m + 1], u3[m + 1]) = (a0, b0, a1, b1);
         (l2[m], l3[m], l2[m + 1], l3[m + 1]) = (a0 * dj, b0 * dj, a1 * dj1, b1 * dj1);
         // pivots j + 2, j + 3
-        let Some((dj2, dj3)) = pair_diagonal(l2, l3, u2, u3, m + 2, scale) else { return false };
+        let Some((dj2, dj3)) = pair_diagonal(l2, l3, u2, u3, m + 2, (floors[2], floors[3])) else { return false };
         (self.inv_diag[j + 2], self.inv_diag[j + 3]) = (dj2, dj3);
         true
     }
@@ -518,7 +550,8 @@ impl SkylineLu {
 
 /// The 2 × 2 diagonal block of a column pair whose rows above it are reduced: pivot `m` of
 /// column `u0` (L row `l0`, length `m`), row `m` of column `u1` (giving `l1[m]`), pivot `m + 1`
-/// of `u1` (L row `l1`, length `m + 1`). The inverse pivots, or `None` for a tiny pivot.
+/// of `u1` (L row `l1`, length `m + 1`). The inverse pivots, or `None` for a pivot at or below
+/// its floor.
 #[inline]
 fn pair_diagonal(
     l0: &[f64],
@@ -526,11 +559,11 @@ fn pair_diagonal(
     u0: &mut [f64],
     u1: &mut [f64],
     m: usize,
-    scale: f64,
+    (floor0, floor1): (f64, f64),
 ) -> Option<(f64, f64)> {
     let d = u0[m] - dot(l0, &u0[..m]);
     u0[m] = d;
-    if !d.is_finite() || d.abs() <= 1e-13 * scale {
+    if !d.is_finite() || d.abs() <= floor0 {
         return None;
     }
     let dj = 1.0 / d;
@@ -539,7 +572,7 @@ fn pair_diagonal(
     l1[m] = u * dj;
     let d1 = u1[m + 1] - dot(&l1[..m + 1], &u1[..m + 1]);
     u1[m + 1] = d1;
-    if !d1.is_finite() || d1.abs() <= 1e-13 * scale {
+    if !d1.is_finite() || d1.abs() <= floor1 {
         return None;
     }
     Some((dj, 1.0 / d1))
@@ -824,6 +857,7 @@ impl LinearSolver for SkylineLu {
         self.uval = Vec::new();
         self.work = vec![0.0; n];
         self.inv_diag = vec![0.0; n];
+        self.floor = vec![0.0; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
         self.contiguous = vec![false; n];
@@ -1176,6 +1210,44 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A stiff structure's constraint pivots are the inverse of its stiffness: with diagonals of
+    /// 1e9 the multiplier rows' pivots are about 1e-9, far below 1e-13 of the largest diagonal,
+    /// yet not singular. The skyline path takes them (nalgebra's fully pivoted LU agrees), and a
+    /// repeated constraint row, which is singular, still goes to the dense fallback.
+    #[test]
+    fn stiff_constraint_pivots_stay_on_the_skyline() {
+        let mut a = kkt(60, 5);
+        for i in 0..60 {
+            for j in 0..60 {
+                let v = a.get(i, j);
+                *a.get_mut(i, j) = 1e8 * v;
+            }
+        }
+        let b: Vec<f64> = (0..62).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut s = SkylineLu::new();
+        s.set_dimension(62);
+        s.factorize(&a).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x);
+        assert_eq!((s.n_skyline, s.n_dense), (1, 0), "the skyline path must be taken");
+        let full = nalgebra::DMatrix::from_fn(62, 62, |i, j| a.get(i, j));
+        let y = full.full_piv_lu().solve(&nalgebra::DVector::from_vec(b.clone())).unwrap();
+        let scale = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (p, q) in x.iter().zip(&y) {
+            assert!((p - q).abs() <= 1e-10 * scale, "{p} vs {q}");
+        }
+        // The second multiplier row made a copy of the first: singular.
+        for c in 0..62 {
+            let v = a.get(60, c);
+            *a.get_mut(61, c) = v;
+            *a.get_mut(c, 61) = v;
+        }
+        let mut s = SkylineLu::new();
+        s.set_dimension(62);
+        let _ = s.factorize(&a);
+        assert_eq!((s.n_skyline, s.n_dense), (0, 1));
     }
 
     #[test]
