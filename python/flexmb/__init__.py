@@ -188,7 +188,10 @@ def stability(
     airspeed and tracked mode: ``airspeed``, ``mode``, ``real``, ``imag``, ``frequency_hz``,
     ``frequency_rad_s``, ``damping_ratio``, ``converged``) plus ``summary``, a dict with
     ``flutter_speed``, ``flutter_frequency_rad_s``, ``flutter_mode`` and ``divergence_speed`` (None
-    when the sweep finds none); for ``"both"`` one such dict per formulation, and for a case with a
+    when the sweep finds none), and about a trim (``stability.about: "trim"``) ``flight_modes``: a
+    list of dicts (``airspeed``, ``name`` such as ``"phugoid"``, ``real``, ``imag``, ``period_s``,
+    ``damping_ratio``, ``symmetric``, ``rigid``) as ``flight_modes_<formulation>.csv``; for
+    ``"both"`` one such dict per formulation, and for a case with a
     ``sweep`` ``{run name: ...}``. Raises :class:`CaseError` when the case has no ``stability``
     block and :class:`RunError` when the analysis could not start.
     """

@@ -3,7 +3,7 @@
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 
 use aeroelastic::run::Row;
 use aeroelastic::stability::StabilityOutput;
@@ -233,6 +233,25 @@ pub fn stability_columns<'py>(py: Python<'py>, out: &StabilityOutput) -> PyResul
     summary.set_item("flutter_frequency_rad_s", out.flutter_frequency_rad_s)?;
     summary.set_item("flutter_mode", out.flutter_mode)?;
     summary.set_item("divergence_speed", out.divergence_speed)?;
+    if out.points.iter().any(|p| !p.flight_roots.is_empty()) {
+        // About a trim: the rigid-body roots, one dict per airspeed and root.
+        let modes = PyList::empty(py);
+        for p in &out.points {
+            for r in &p.flight_roots {
+                let m = PyDict::new(py);
+                m.set_item("airspeed", p.airspeed)?;
+                m.set_item("name", &r.name)?;
+                m.set_item("real", r.real)?;
+                m.set_item("imag", r.imag)?;
+                m.set_item("period_s", r.period_s())?;
+                m.set_item("damping_ratio", r.damping_ratio())?;
+                m.set_item("symmetric", r.symmetric)?;
+                m.set_item("rigid", r.rigid)?;
+                modes.append(m)?;
+            }
+        }
+        summary.set_item("flight_modes", modes)?;
+    }
     d.set_item("summary", summary)?;
     Ok(d)
 }

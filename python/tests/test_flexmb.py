@@ -195,6 +195,14 @@ def test_stability_sweep_columns():
     assert e.value.field == "stability"
 
 
+def test_flight_modes_of_the_horten_wing_about_trim():
+    """flexmb.stability about a trim gives the free aircraft's phugoid: SHARPy's 20.7 s within 10 %."""
+    r = flexmb.stability(ROOT / "cases" / "flight" / "horten_level_flight.json", "gebf", set={"stability.airspeeds": [30]})
+    modes = {m["name"]: m for m in r["summary"]["flight_modes"]}
+    assert {"phugoid", "short_period", "dutch_roll", "roll_subsidence", "spiral"} <= set(modes)
+    assert abs(modes["phugoid"]["period_s"] - 20.7) < 0.1 * 20.7
+
+
 def test_trim_of_the_horten_wing():
     """flexmb.trim gives harness trim's trimmed state: SHARPy's alpha within 0.1 deg."""
     r = flexmb.trim(ROOT / "cases" / "horten_flying_wing.json", "gebf")
