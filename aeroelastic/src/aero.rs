@@ -9,7 +9,8 @@
 //!
 //! Scheme per step `n → n+1` (dt of the structure):
 //! 1. predict the structure at `t_{n+1}` (`q_n ∘ exp(h v_n + ½h² a_n)`), move the lattice there;
-//! 2. convect and shed the wake, solve the UVLM, lump loads to the stations;
+//! 2. convect and shed the wake, solve the UVLM, lump loads to the stations and, with section
+//!    polars, correct them strip by strip (`polar_correction.rs`, docs/section_aero.md §7);
 //! 3. apply them and solve the structural step;
 //! 4. strong coupling (optional): move the lattice to the new structure, re-solve the same UVLM
 //!    step, relax the loads and redo the structural step from `n` until the relative load change
@@ -18,6 +19,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::polar_correction::{StripPolars, StripReport};
 use crate::problem::{Joint, Problem};
 
 pub use crate::aero_settings::{AeroSettings, Coupling, MirrorPlane, RunsGuard, register_runs};
@@ -410,7 +412,7 @@ pub fn simulate_aero_with_events<S: Structure>(
         s.q.copy_from_slice(q);
         s.v.iter_mut().for_each(|x| *x = 0.0);
     }
-    let mut c = match MarchAero::start(model, &s, map, aero, dt, equilibrium.is_some()) {
+    let mut c = match MarchAero::start(model, &s, map, aero, dt, equilibrium.is_some(), settings.polars.as_ref()) {
         Ok(c) => c,
         Err(e) => return fail(out, e),
     };
@@ -494,6 +496,7 @@ pub fn simulate_aero_with_events<S: Structure>(
     out.events = events.records.clone();
     out.wall_s = start.elapsed().as_secs_f64();
     out.aero_wall_s = c.uv.stats().wall_time;
+    out.strips = c.strips();
     out
 }
 
@@ -529,6 +532,10 @@ struct MarchAero<'a> {
     surface_columns: Vec<std::ops::RangeInclusive<usize>>,
     /// Hinge moment of each control surface at the last solve, N·m (NaN past the surfaces).
     hinge: [f64; crate::control_surface::MAX_CONTROL_SURFACES],
+    /// The section polars that correct the lumped loads (none: the lattice's as they are).
+    polars: Option<&'a StripPolars>,
+    /// The polars' correction of the last solve.
+    report: StripReport,
 }
 
 /// Buffers of the lumping of the lattice's nodal loads to the stations: the stations' origins,
@@ -572,6 +579,7 @@ impl<'a> MarchAero<'a> {
     /// The lattice of `model` at `s` with an empty wake or, `at_equilibrium`, the steady solution
     /// there with its wake prefilled and its loads applied to `model`; the UVLM's clock, at which
     /// a disturbance is evaluated, starts at the structure's and advances with each commit.
+    /// `polars` correct every solve's lumped loads.
     fn start<S: Structure>(
         model: &mut S,
         s: &genalpha::State,
@@ -579,6 +587,7 @@ impl<'a> MarchAero<'a> {
         aero: &'a AeroSettings,
         dt: f64,
         at_equilibrium: bool,
+        polars: Option<&'a StripPolars>,
     ) -> Result<Self, String> {
         let mut scratch = (Vec::new(), Vec::new(), Vec::new());
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
@@ -617,6 +626,8 @@ impl<'a> MarchAero<'a> {
             vp: vec![0.0; s.v.len()],
             surface_columns,
             hinge,
+            polars,
+            report: StripReport::default(),
         };
         c.uv.set_time(s.t).map_err(|e| format!("aerodynamic clock: {e}"))?;
         if at_equilibrium {
@@ -631,6 +642,7 @@ impl<'a> MarchAero<'a> {
         self.uv.solve_steady().map_err(|e| format!("steady aerodynamics at the equilibrium: {e}"))?;
         self.lift =
             self.lumping.apply(&self.uv, &self.ranges, &self.stations, self.aero.free_stream(), &mut self.loads);
+        self.lift += self.correct(false, self.uv.time()).map_err(|e| format!("at the equilibrium: {e}"))?;
         self.hinge_moments()?;
         self.uv.prefill_wake(self.dt).map_err(|e| format!("steady wake at the equilibrium: {e}"))?;
         model.set_section_loads(&self.loads).map_err(|e| format!("loads at the equilibrium: {e}"))
@@ -651,16 +663,55 @@ impl<'a> MarchAero<'a> {
         Ok(())
     }
 
-    /// Move the lattice to the stations, solve the pending UVLM step and lump its loads into
-    /// `loads` (`into_new`: `new_loads`); the lift of the solve.
-    fn solve(&mut self, into_new: bool) -> Result<f64, String> {
+    /// Move the lattice to the stations, solve the pending UVLM step (at time `t`) and lump its
+    /// loads into `loads` (`into_new`: `new_loads`), corrected by the section polars; the lift of
+    /// the solve.
+    fn solve(&mut self, into_new: bool, t: f64) -> Result<f64, String> {
         crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, Some(&self.vel))
             .map_err(|e| e.to_string())?;
         self.uv.solve_step().map_err(|e| e.to_string())?;
         let target = if into_new { &mut self.new_loads } else { &mut self.loads };
         let lift = self.lumping.apply(&self.uv, &self.ranges, &self.stations, self.aero.free_stream(), target);
+        let delta = self.correct(into_new, t)?;
         self.hinge_moments()?;
-        Ok(lift)
+        Ok(lift + delta)
+    }
+
+    /// Correct the last solve's lumped loads (`into_new`: `new_loads`, else `loads`) by the
+    /// section polars, with the statics' [`StripPolars::correct`]; the change of lift, N (0
+    /// without polars). A strip's flow is the air's velocity relative to its quarter-chord
+    /// midpoint `p` without the lattice's induction: the free stream plus the disturbance at `p`
+    /// at time `t`, less the mean of its two stations' rigid-arm velocities `v + ω × (p − o)`.
+    /// The control surfaces' hinge moments stay the lattice's.
+    fn correct(&mut self, into_new: bool, t: f64) -> Result<f64, String> {
+        let Some(polars) = self.polars else { return Ok(0.0) };
+        let flow = self.uv.flow();
+        let v_inf = Vector3::from(flow.free_stream());
+        let (stations, vel) = (&self.stations, &self.vel);
+        let air = |j: usize, p: Vector3<f64>| {
+            let gust = flow.disturbance().map_or_else(Vector3::zeros, |d| Vector3::from(d.velocity(p.into(), t)));
+            let motion = |k: usize| {
+                let (st, v): (&uvlm::SpanStation, &uvlm::StationVelocity) = (&stations[k], &vel[k]);
+                v.linear + v.angular.cross(&(p - st.origin))
+            };
+            v_inf + gust - 0.5 * (motion(j) + motion(j + 1))
+        };
+        let target = if into_new { &mut self.new_loads } else { &mut self.loads };
+        polars.correct(stations, self.map, self.uv.loads(), air, 1.0, target, &mut self.report)?;
+        Ok(uvlm::lift_drag_of(self.report.total_delta.into(), self.aero.free_stream(), SPAN_DIR).0)
+    }
+
+    /// The strips of the last solve with the polars' correction (empty without polars), their
+    /// lift coefficients at the free stream's dynamic pressure.
+    fn strips(&self) -> Vec<crate::statics::Strip> {
+        if self.polars.is_none() {
+            return Vec::new();
+        }
+        let v_inf = self.aero.free_stream();
+        let speed2 = v_inf.iter().map(|x| x * x).sum::<f64>();
+        let lift_dir = crate::statics::lift_direction(v_inf);
+        let qdyn = 0.5 * self.aero.rho * speed2;
+        crate::statics::strips_of(self.map, &self.stations, self.uv.loads(), &self.report, lift_dir, qdyn)
     }
 
     /// Relax the applied loads towards the sub-iteration's; whether the relative change was
@@ -710,7 +761,7 @@ impl<'a> MarchAero<'a> {
         // 2. Wake and aerodynamic solve at the predicted lattice.
         let aero_err = |e: String| format!("step {k} (t = {t1:.4} s): aerodynamics: {e}");
         self.uv.advance_wake(dt).map_err(|e| aero_err(e.to_string()))?;
-        self.lift = self.solve(false).map_err(aero_err)?;
+        self.lift = self.solve(false, t1).map_err(aero_err)?;
         // 3. Structural step with these loads.
         let s_n: genalpha::State = s.clone();
         model.set_section_loads(&self.loads).map_err(|e| format!("step {k} (t = {t1:.4} s): {e}"))?;
@@ -718,7 +769,7 @@ impl<'a> MarchAero<'a> {
         // 4. Strong coupling.
         for _ in 0..self.aero.coupling.max_sub_iterations {
             self.move_to(model, &s.q, &s.v, t1);
-            self.lift = self.solve(true).map_err(aero_err)?;
+            self.lift = self.solve(true, t1).map_err(aero_err)?;
             if self.relax() {
                 break;
             }

@@ -8,6 +8,7 @@ use genalpha::Predictor;
 use crate::Error;
 use crate::aero::{simulate_aero_with_events, station_map};
 use crate::events::{Events, ScheduledEvent, When};
+use crate::polar_correction::StripPolars;
 use crate::problem::{AncfPath, Block, Formulation, Problem};
 use crate::run::{NoObserver, Observer, RunOutput, RunSettings, simulate_with_events};
 
@@ -174,6 +175,7 @@ pub fn settings(problem: &Problem, f: Formulation) -> RunSettings {
         fold_joint: problem.fold_joint_index(),
         roll_joint: problem.roll_joint_index(),
         loads,
+        polars: None,
     }
 }
 
@@ -303,9 +305,6 @@ pub fn run_formulation(problem: &Problem, f: Formulation) -> RunOutput {
 
 /// As [`run_formulation`], handing every output step's geometry to `observer`.
 pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mut dyn Observer) -> RunOutput {
-    if let Err(e) = crate::section_polars::refuse_unwired(problem, "time march") {
-        return RunOutput::failed(f, e);
-    }
     struct Run<'a, 'o> {
         problem: &'a Problem,
         f: Formulation,
@@ -315,10 +314,12 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
         type Output = Result<RunOutput, Error>;
         fn run<M: BuildModel>(self) -> Self::Output {
             let Run { problem, f, observer } = self;
+            let model_error = |msg: String| Error::Model { formulation: f, msg };
             if problem.initial.is_trim() {
+                crate::section_polars::refuse_unwired(problem, "time march from a trim").map_err(model_error)?;
                 return from_trim::<M>(problem, f, observer);
             }
-            let s = settings(problem, f);
+            let mut s = settings(problem, f);
             let mut events = hinge_events::<M>(problem);
             match &problem.aero {
                 None => {
@@ -329,12 +330,15 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
                         let msg = "events: hinge events with `aero.model: \"strip\"` are not implemented".into();
                         return Err(Error::Model { formulation: f, msg });
                     }
+                    crate::section_polars::refuse_unwired(problem, "strip-theory time march (`aero.model: \"strip\"`)")
+                        .map_err(model_error)?;
                     let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
                     M::build(problem)
                         .map(|mut model| crate::strip_march::simulate_strip(f, &mut model, &s, aero, &map, observer))
                 }
                 Some(aero) => {
-                    let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
+                    let map = station_map(problem, aero).map_err(model_error)?;
+                    s.polars = StripPolars::of(problem).map_err(model_error)?;
                     M::build(problem).map(|mut model| {
                         simulate_aero_with_events(f, &mut model, &s, aero, &map, observer, None, &mut events)
                     })

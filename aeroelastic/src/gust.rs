@@ -250,7 +250,8 @@ fn march<M: BuildModel>(
 ) -> Result<crate::run::RunOutput, String> {
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let map = station_map(case, aero)?;
-    let settings = crate::factory::settings(case, f);
+    let mut settings = crate::factory::settings(case, f);
+    settings.polars = crate::polar_correction::StripPolars::of(case)?;
     let mut events = crate::factory::hinge_events::<M>(case);
     let observer = &mut crate::run::NoObserver;
     Ok(simulate_aero_with_events(f, model, &settings, aero, &map, observer, Some(q), &mut events))
@@ -336,7 +337,6 @@ pub fn run_sweep(base: &Problem, cases: &[(Formulation, &Problem)]) -> Result<Gu
     let t0 = Instant::now();
     let case = base;
     let sweep = case.gust.as_ref().ok_or("the case has no `gust` block")?;
-    crate::section_polars::refuse_unwired(case, "gust analysis")?;
     for &(_, c) in cases {
         c.gust.as_ref().ok_or("the case has no `gust` block")?.validate(c)?;
     }

@@ -94,6 +94,7 @@ fn run<S: Structure>(
     basis_modes: Option<usize>,
     wake_motion: bool,
 ) -> Result<LinearGustHistory, String> {
+    crate::section_polars::refuse_unwired(case, "linear gust model")?;
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let spec = aero.gust.as_ref().ok_or("the case has no `aero.gust`")?;
     let map = station_map(case, aero)?;

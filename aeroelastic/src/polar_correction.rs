@@ -19,7 +19,7 @@ use crate::problem::Problem;
 use crate::section_polars::polars_by_body;
 
 /// The polars of a problem's bodies with the air they act in.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StripPolars {
     by_body: Vec<Option<Arc<aerofoil::Polar>>>,
     rho: f64,

@@ -174,6 +174,11 @@ pub struct RunSettings {
     pub roll_joint: Option<usize>,
     /// The free bodies of the wing loads columns (None: NaN).
     pub loads: Option<crate::loads::LoadModel>,
+    /// The section polars that correct the lattice's strip loads in the time march
+    /// (docs/section_aero.md §7; none: uncorrected). [`crate::factory::settings`] leaves them
+    /// unset: the analyses that apply them set them from the problem
+    /// ([`crate::polar_correction::StripPolars::of`]).
+    pub polars: Option<crate::polar_correction::StripPolars>,
 }
 
 impl RunSettings {
@@ -208,6 +213,10 @@ pub struct RunOutput {
     pub aero_wall_s: f64,
     /// The hinge events that acted, in order.
     pub events: Vec<crate::events::EventRecord>,
+    /// The lattice's strips at the last solve with the section polars' correction (lift per span
+    /// and its coefficient at the free stream's dynamic pressure, effective incidence); empty
+    /// without `aero.polars`.
+    pub strips: Vec<crate::statics::Strip>,
 }
 
 impl RunOutput {
@@ -222,6 +231,7 @@ impl RunOutput {
             error: Some(error),
             aero_wall_s: 0.0,
             events: Vec::new(),
+            strips: Vec::new(),
         }
     }
 }
@@ -381,6 +391,7 @@ pub fn simulate_with_events<S: Structure>(
         error: None,
         aero_wall_s: 0.0,
         events: Vec::new(),
+        strips: Vec::new(),
     };
     let n_steps = settings.n_steps();
     let every = settings.output_every();

@@ -1117,31 +1117,7 @@ pub(crate) fn point_at<S: Structure>(
     let total = Vector3::from(uv_loads.total_force()) + report.total_delta;
     let lift = total.dot(&lift_dir);
     let drag = total.dot(&Vector3::from(v_inf).normalize());
-    // Column j of the lattice lies between stations j and j + 1.
-    let arc = |m: &StationMap| m.arc;
-    let qdyn = 0.5 * rho * airspeed * airspeed;
-    // The planform's chord at the station (along the stream for streamwise sections, also at a
-    // hinge column, whose slant is the flare's).
-    let chord = |m: &StationMap| m.planform_chord;
-    // The lattice's strips run surface after surface, one fewer than the surface's stations.
-    let strips = (0..stations.len().saturating_sub(1))
-        .filter(|&j| map[j].lifting == map[j + 1].lifting)
-        .filter_map(|j| {
-            let i = j - map[j].lifting;
-            let f = Vector3::from(*uv_loads.strip.get(i)?) + report.delta_force.get(j).copied().unwrap_or_default();
-            let (a, b) = (stations[j].origin, stations[j + 1].origin);
-            let width = (b - a).norm();
-            let l = f.dot(&lift_dir) / width;
-            let mid = 0.5 * (a + b);
-            Some(Strip {
-                s: 0.5 * (arc(&map[j]) + arc(&map[j + 1])),
-                position: mid.into(),
-                lift_per_span: l,
-                cl: l / (qdyn * 0.5 * (chord(&map[j]) + chord(&map[j + 1]))),
-                alpha: report.alpha.get(j).copied().unwrap_or(f64::NAN),
-            })
-        })
-        .collect();
+    let strips = strips_of(map, &stations, &uv_loads, &report, lift_dir, 0.5 * rho * airspeed * airspeed);
     StaticPoint {
         airspeed,
         sideslip_deg: sys.sideslip_deg(),
@@ -1157,6 +1133,43 @@ pub(crate) fn point_at<S: Structure>(
         strips,
         state: None,
     }
+}
+/// The strips (lattice columns) of the lattice solution `loads` on `stations` (driven as `map`
+/// says), their forces changed by the section polars' correction `report` (empty: none): lift
+/// per unit span along `lift_dir`, its coefficient at the dynamic pressure `qdyn` (Pa) on the
+/// planform's chord, and the effective incidence. Shared by the statics and the time march.
+pub(crate) fn strips_of(
+    map: &[StationMap],
+    stations: &[uvlm::SpanStation],
+    loads: &uvlm::Loads,
+    report: &StripReport,
+    lift_dir: Vector3<f64>,
+    qdyn: f64,
+) -> Vec<Strip> {
+    // Column j of the lattice lies between stations j and j + 1.
+    let arc = |m: &StationMap| m.arc;
+    // The planform's chord at the station (along the stream for streamwise sections, also at a
+    // hinge column, whose slant is the flare's).
+    let chord = |m: &StationMap| m.planform_chord;
+    // The lattice's strips run surface after surface, one fewer than the surface's stations.
+    (0..stations.len().saturating_sub(1))
+        .filter(|&j| map[j].lifting == map[j + 1].lifting)
+        .filter_map(|j| {
+            let i = j - map[j].lifting;
+            let f = Vector3::from(*loads.strip.get(i)?) + report.delta_force.get(j).copied().unwrap_or_default();
+            let (a, b) = (stations[j].origin, stations[j + 1].origin);
+            let width = (b - a).norm();
+            let l = f.dot(&lift_dir) / width;
+            let mid = 0.5 * (a + b);
+            Some(Strip {
+                s: 0.5 * (arc(&map[j]) + arc(&map[j + 1])),
+                position: mid.into(),
+                lift_per_span: l,
+                cl: l / (qdyn * 0.5 * (chord(&map[j]) + chord(&map[j + 1]))),
+                alpha: report.alpha.get(j).copied().unwrap_or(f64::NAN),
+            })
+        })
+        .collect()
 }
 
 /// Unit lift direction: perpendicular to the free stream and to the global X axis (the span).

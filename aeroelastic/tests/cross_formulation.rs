@@ -271,6 +271,7 @@ impl ForModel for EventMarch {
             fold_joint: Some(1),
             roll_joint: None,
             loads: None,
+            polars: None,
         };
         let out = simulate_with_events(Formulation::ALL[0], &mut model, &settings, &mut NoObserver, &mut events);
         assert!(out.error.is_none(), "{:?}", out.error);

@@ -124,6 +124,7 @@ impl ForModel for March<'_> {
             fold_joint: None,
             roll_joint: None,
             loads: None,
+            polars: None,
         };
         let out = simulate(M::FORMULATION, &mut model, &settings, &mut NoObserver);
         assert!(out.error.is_none(), "{:?}", out.error);

@@ -153,6 +153,8 @@ impl RunRecord {
             // The shards' exact results do not carry the hinge events' records (their effect is
             // in the rows; each shard's own folder has its events CSV).
             events: Vec::new(),
+            // Nor the section polars' strips of the last solve (an in-memory diagnostic).
+            strips: Vec::new(),
         }
     }
 }
