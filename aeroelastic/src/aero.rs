@@ -387,8 +387,50 @@ pub fn simulate_aero_with_events<S: Structure>(
     equilibrium: Option<&[f64]>,
     events: &mut crate::events::Events<'_, S>,
 ) -> crate::run::RunOutput {
+    let start = equilibrium.map_or(MarchStart::Rest, MarchStart::Equilibrium);
+    march_aero(formulation, model, settings, (aero, map), observer, start, events, None).0
+}
+
+/// Where a coupled march starts.
+pub enum MarchStart<'q> {
+    /// The model's initial state at rest, the lattice started impulsively.
+    Rest,
+    /// A static aeroelastic equilibrium's coordinates (see [`simulate_aero_from`]).
+    Equilibrium(&'q [f64]),
+    /// Where another march stopped ([`march_aero`]'s checkpoint): its coordinates, velocities
+    /// and time, its lattice with its wake, clock and disturbance, and its last loads, on the
+    /// model given (which may differ from the stopped march's in its joints' states, as after a
+    /// hinge event: the same coordinates and velocities, consistent accelerations).
+    Resume(Box<MarchCheckpoint>),
+}
+
+/// The state of a coupled march at the end of a step, to resume it from ([`MarchStart::Resume`]).
+pub struct MarchCheckpoint {
+    /// The structure's state (time, coordinates, velocities; the rest is recomputed).
+    pub state: genalpha::State,
+    /// The step it ended.
+    pub step: usize,
+    uv: uvlm::Uvlm,
+    loads: Vec<SectionLoad>,
+    lift: f64,
+    hinge: [f64; crate::control_surface::MAX_CONTROL_SURFACES],
+}
+
+/// The coupled march of `model` from `start` to the settings' end, or, with `stop_after`, to the
+/// end of that step, returning the checkpoint to resume from (docs/coupling.md §8).
+#[allow(clippy::too_many_arguments)]
+pub fn march_aero<S: Structure>(
+    formulation: crate::problem::Formulation,
+    model: &mut S,
+    settings: &crate::run::RunSettings,
+    (aero, map): (&AeroSettings, &[StationMap]),
+    observer: &mut dyn crate::run::Observer,
+    start: MarchStart<'_>,
+    events: &mut crate::events::Events<'_, S>,
+    stop_after: Option<usize>,
+) -> (crate::run::RunOutput, Option<MarchCheckpoint>) {
     use crate::run::{Dissipation, RunOutput, SnapshotFeed, row};
-    let start = std::time::Instant::now();
+    let wall = std::time::Instant::now();
     let mut out = RunOutput::failed(formulation, String::new());
     out.error = None;
     out.n_dof = model.n_dof();
@@ -397,35 +439,22 @@ pub fn simulate_aero_with_events<S: Structure>(
     let every = settings.output_every();
     let fail = |mut out: RunOutput, e: String| {
         out.error = Some(e);
-        out.wall_s = start.elapsed().as_secs_f64();
-        out
+        out.wall_s = wall.elapsed().as_secs_f64();
+        (out, None)
     };
     let mut ga = match model.integrator(settings.params) {
         Ok(g) => g,
         Err(e) => return fail(out, e.to_string()),
     };
-    let mut s = model.initial_state();
-    if let Some(q) = equilibrium {
-        if q.len() != s.q.len() {
-            return fail(out, format!("equilibrium: {} coordinates for a model of {}", q.len(), s.q.len()));
-        }
-        s.q.copy_from_slice(q);
-        s.v.iter_mut().for_each(|x| *x = 0.0);
-    }
-    let mut c = match MarchAero::start(model, &s, map, aero, dt, equilibrium.is_some(), settings.polars.as_ref()) {
-        Ok(c) => c,
+    let (mut s, mut c, first) = match march_start(model, settings, (aero, map), start) {
+        Ok(x) => x,
         Err(e) => return fail(out, e),
     };
-    if let Some(g) = &aero.gust {
-        match crate::gust_field::disturbance(g, aero, &c.stations, settings.t_end, s.t) {
-            Ok(d) => c.uv.set_disturbance(Some(d)),
-            Err(e) => return fail(out, format!("aero.gust: {e}")),
-        }
-    }
     if let Err(e) = ga.initialize(model, &mut s) {
         return fail(out, format!("initial accelerations: {e}"));
     }
     let mut work = 0.0;
+    let mut stopped = None;
     let fold = (settings.fold_joint, settings.roll_joint);
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s, events.any());
@@ -451,7 +480,7 @@ pub fn simulate_aero_with_events<S: Structure>(
     if let Err(e) = feed.feed(model, &r0, &s.q, Some(&c.uv)) {
         return fail(out, format!("output at t = {}: {e}", s.t));
     }
-    for k in 1..=n_steps {
+    for k in first..=n_steps {
         if crate::interrupt::interrupted() {
             out.error = Some(crate::run::interrupted_message(s.t));
             break;
@@ -491,13 +520,70 @@ pub fn simulate_aero_with_events<S: Structure>(
                 return fail(out, format!("step {k}: output: {e}"));
             }
         }
+        if stop_after == Some(k) {
+            stopped = Some(k);
+            break;
+        }
     }
     out.stats = events.total_stats(ga.stats());
     out.events = events.records.clone();
-    out.wall_s = start.elapsed().as_secs_f64();
+    out.wall_s = wall.elapsed().as_secs_f64();
     out.aero_wall_s = c.uv.stats().wall_time;
     out.strips = c.strips();
-    out
+    let checkpoint =
+        stopped.map(|step| MarchCheckpoint { state: s, step, uv: c.uv, loads: c.loads, lift: c.lift, hinge: c.hinge });
+    (out, checkpoint)
+}
+
+/// The structure's state, the lattice side and the first step of a march from `start`, with the
+/// start's loads applied to `model` (the integrator's consistent start follows). A rest or
+/// equilibrium start attaches the case's gust; a resumed march keeps its lattice's.
+fn march_start<'a, S: Structure>(
+    model: &mut S,
+    settings: &'a crate::run::RunSettings,
+    (aero, map): (&'a AeroSettings, &'a [StationMap]),
+    start: MarchStart<'_>,
+) -> Result<(genalpha::State, MarchAero<'a>, usize), String> {
+    let dt = settings.params.dt;
+    let mut s = model.initial_state();
+    let polars = settings.polars.as_ref();
+    let equilibrium = match start {
+        MarchStart::Resume(ck) => {
+            let (q, v) = (&ck.state.q, &ck.state.v);
+            if q.len() != s.q.len() || v.len() != s.v.len() {
+                return Err(format!(
+                    "resume: {} coordinates and {} velocities for a model of {} and {}",
+                    q.len(),
+                    v.len(),
+                    s.q.len(),
+                    s.v.len()
+                ));
+            }
+            s.t = ck.state.t;
+            s.q.copy_from_slice(q);
+            s.v.copy_from_slice(v);
+            model.set_section_loads(&ck.loads).map_err(|e| format!("resume: loads: {e}"))?;
+            let first = ck.step + 1;
+            let c = MarchAero::resume(model, &s, (map, aero, dt), polars, *ck)?;
+            return Ok((s, c, first));
+        }
+        MarchStart::Equilibrium(q) => Some(q),
+        MarchStart::Rest => None,
+    };
+    if let Some(q) = equilibrium {
+        if q.len() != s.q.len() {
+            return Err(format!("equilibrium: {} coordinates for a model of {}", q.len(), s.q.len()));
+        }
+        s.q.copy_from_slice(q);
+        s.v.iter_mut().for_each(|x| *x = 0.0);
+    }
+    let mut c = MarchAero::start(model, &s, map, aero, dt, equilibrium.is_some(), polars)?;
+    if let Some(g) = &aero.gust {
+        let d = crate::gust_field::disturbance(g, aero, &c.stations, settings.t_end, s.t)
+            .map_err(|e| format!("aero.gust: {e}"))?;
+        c.uv.set_disturbance(Some(d));
+    }
+    Ok((s, c, 1))
 }
 
 /// The span direction of the lift (the global X axis).
@@ -592,9 +678,6 @@ impl<'a> MarchAero<'a> {
         let mut scratch = (Vec::new(), Vec::new(), Vec::new());
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
         stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
-        let surface_columns = crate::control_surface::columns(map, &aero.control_surfaces)?;
-        let mut hinge = [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES];
-        hinge.iter_mut().take(surface_columns.len()).for_each(|h| *h = 0.0);
         let mut params = aero.uvlm_params(aero.free_stream());
         if at_equilibrium && !aero.wake_closure {
             // The equilibrium's steady solution with the march's own unclosed wake (its rows
@@ -607,7 +690,50 @@ impl<'a> MarchAero<'a> {
             .iter()
             .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
             .collect();
-        let mut c = MarchAero {
+        let mut c = Self::with_lattice(uv, (scratch, stations, vel), s, (map, aero, dt), loads, polars)?;
+        c.uv.set_time(s.t).map_err(|e| format!("aerodynamic clock: {e}"))?;
+        if at_equilibrium {
+            c.steady_start(model)?;
+        }
+        Ok(c)
+    }
+
+    /// The lattice side of a march resumed from `ck` ([`MarchCheckpoint`]): its lattice, wake and
+    /// clock as they were, its stations moved to `model` at `s`, its last loads (already applied
+    /// to `model` by the caller).
+    fn resume<S: Structure>(
+        model: &S,
+        s: &genalpha::State,
+        (map, aero, dt): (&'a [StationMap], &'a AeroSettings, f64),
+        polars: Option<&'a StripPolars>,
+        ck: MarchCheckpoint,
+    ) -> Result<Self, String> {
+        let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+        let (mut stations, mut vel) = (Vec::new(), Vec::new());
+        stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
+        if ck.loads.len() != map.len() {
+            return Err(format!("resume: {} station loads for {} stations", ck.loads.len(), map.len()));
+        }
+        let mut c = Self::with_lattice(ck.uv, (scratch, stations, vel), s, (map, aero, dt), ck.loads, polars)?;
+        c.lift = ck.lift;
+        c.hinge = ck.hinge;
+        Ok(c)
+    }
+
+    /// The lattice side around the lattice `uv` with the stations and velocities `at` of `s`,
+    /// the applied `loads`.
+    fn with_lattice(
+        uv: uvlm::Uvlm,
+        (scratch, stations, vel): ((Vec<f64>, Vec<f64>, Vec<f64>), Vec<uvlm::SpanStation>, Vec<uvlm::StationVelocity>),
+        s: &genalpha::State,
+        (map, aero, dt): (&'a [StationMap], &'a AeroSettings, f64),
+        loads: Vec<SectionLoad>,
+        polars: Option<&'a StripPolars>,
+    ) -> Result<Self, String> {
+        let surface_columns = crate::control_surface::columns(map, &aero.control_surfaces)?;
+        let mut hinge = [f64::NAN; crate::control_surface::MAX_CONTROL_SURFACES];
+        hinge.iter_mut().take(surface_columns.len()).for_each(|h| *h = 0.0);
+        Ok(MarchAero {
             uv,
             map,
             aero,
@@ -628,12 +754,7 @@ impl<'a> MarchAero<'a> {
             hinge,
             polars,
             report: StripReport::default(),
-        };
-        c.uv.set_time(s.t).map_err(|e| format!("aerodynamic clock: {e}"))?;
-        if at_equilibrium {
-            c.steady_start(model)?;
-        }
-        Ok(c)
+        })
     }
 
     /// The steady solution on the equilibrium's lattice, its wake laid out as the unsteady solver
