@@ -586,6 +586,10 @@ fn march_start<'a, S: Structure>(
     Ok((s, c, 1))
 }
 
+/// The stations placed on a structure: the scratch of [`stations_at`], the stations and their
+/// velocities.
+type Placed = ((Vec<f64>, Vec<f64>, Vec<f64>), Vec<uvlm::SpanStation>, Vec<uvlm::StationVelocity>);
+
 /// The span direction of the lift (the global X axis).
 const SPAN_DIR: [f64; 3] = [1.0, 0.0, 0.0];
 
@@ -724,7 +728,7 @@ impl<'a> MarchAero<'a> {
     /// the applied `loads`.
     fn with_lattice(
         uv: uvlm::Uvlm,
-        (scratch, stations, vel): ((Vec<f64>, Vec<f64>, Vec<f64>), Vec<uvlm::SpanStation>, Vec<uvlm::StationVelocity>),
+        (scratch, stations, vel): Placed,
         s: &genalpha::State,
         (map, aero, dt): (&'a [StationMap], &'a AeroSettings, f64),
         loads: Vec<SectionLoad>,
