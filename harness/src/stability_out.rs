@@ -351,7 +351,7 @@ fn flight_table(runs: &[StabilityOutput]) -> String {
     let mut s = String::from(
         "<table><caption>Flight-dynamics roots about the trim</caption><tr><th>formulation</th>\
          <th>airspeed (m/s)</th><th>mode</th><th>s (1/s)</th><th>period (s)</th><th>ζ</th>\
-         <th>time to half (s)</th></tr>\n",
+         <th>time to half (s; negative: to double)</th></tr>\n",
     );
     for o in runs {
         for p in &o.points {
