@@ -453,6 +453,7 @@ pub fn march_aero<S: Structure>(
     if let Err(e) = ga.initialize(model, &mut s) {
         return fail(out, format!("initial accelerations: {e}"));
     }
+    model.start_march(s.t, &s.q, &s.v);
     let mut work = 0.0;
     let mut stopped = None;
     let fold = (settings.fold_joint, settings.roll_joint);

@@ -293,6 +293,7 @@ impl<'a, S: Structure> Events<'a, S> {
         let mut restarted = new.integrator(params).map_err(|err| err.to_string())?;
         restarted.initialize(&new, s).map_err(|err| format!("accelerations after the event: {err}"))?;
         *model = new;
+        model.start_march(s.t, &s.q, &s.v);
         add_stats(&mut self.replaced, ga.stats());
         *ga = restarted;
         Ok(EventRecord { time: s.t, joint: e.joint, action: e.action, fold, energy_loss })

@@ -192,7 +192,11 @@ pub fn build_ancf(problem: &Problem) -> Result<ancf::Model, Error> {
 
 /// Build the GEBF model of a problem.
 pub fn build_gebf(problem: &Problem) -> Result<gebf::Model, Error> {
-    let options = gebf::Options { stabilization: problem.gebf.stabilization, ..Default::default() };
+    let options = gebf::Options {
+        stabilization: problem.gebf.stabilization,
+        conserve_momentum: problem.gebf.conserve_momentum,
+        ..Default::default()
+    };
     let f = <gebf::Model as BuildModel>::FORMULATION;
     gebf::Model::from_scene(&problem.scene(f), options).map_err(|e| Error::Model { formulation: f, msg: e.to_string() })
 }

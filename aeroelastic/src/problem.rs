@@ -651,6 +651,11 @@ pub struct GebfSettings {
     /// Position-level projection of the joints after each step. Default off.
     #[cfg_attr(feature = "serde", serde(default))]
     pub stabilization: bool,
+    /// After each step, restore the linear and angular momentum to their balance with the
+    /// external loads by the smallest rigid velocity change (docs/gebf.md §15.1): free flight
+    /// then keeps both momenta to round-off. Default off (they drift at second order).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub conserve_momentum: bool,
     /// Where the generalized-α step enforces the equations of motion. Default `arnold_bruls`;
     /// `chung_hulbert` keeps the floating frames' gyroscopic forces from doing discrete work
     /// (at rho_inf = 1, the implicit midpoint rule): use it for energy studies. Not available

@@ -410,6 +410,7 @@ pub fn simulate_with_events<S: Structure>(
         out.error = Some(format!("initial accelerations: {e}"));
         return out;
     }
+    model.start_march(s.t, &s.q, &s.v);
     let fold = (settings.fold_joint, settings.roll_joint);
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s, events.any());

@@ -168,6 +168,7 @@ pub fn simulate_strip<S: Structure>(
     if let Err(e) = ga.initialize(model, &mut s) {
         return finish(out, start, Some(format!("initial accelerations: {e}")));
     }
+    model.start_march(s.t, &s.q, &s.v);
     let fold = (settings.fold_joint, settings.roll_joint);
     let mut feed = SnapshotFeed::new(observer);
     let mut dissipation = Dissipation::new(model, &s, false);

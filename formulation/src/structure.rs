@@ -157,6 +157,10 @@ pub trait Structure: ConstrainedSystem {
         check_section_loads(loads, |b| self.body_length(b))?;
         self.apply_section_loads(loads)
     }
+    /// A march starts (or restarts after a model change) from the state `(t, q, v)`: a
+    /// formulation that carries a quantity across steps, such as GEBF's momentum projection,
+    /// takes it from here. Called after the initial accelerations. Default: nothing.
+    fn start_march(&mut self, _t: f64, _q: &[f64], _v: &[f64]) {}
     /// Bring stored coordinates back to their canonical branch without changing the
     /// configuration, after every Newton update of a static solve (GEBF: rotation vectors past
     /// π and the joints' position projection). Default: nothing.

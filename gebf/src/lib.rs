@@ -85,6 +85,7 @@ mod loads;
 mod modal;
 mod model;
 mod momentum;
+mod momentum_hold;
 mod options;
 pub mod quaternion;
 mod rigid;

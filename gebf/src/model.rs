@@ -46,6 +46,8 @@ pub struct Model {
     /// Per joint: the hinge angle θ of the last accepted step (free hinges; 0 otherwise), rad,
     /// against which the principal angle is unwrapped (docs/gebf.md §13).
     hinge_last: Vec<f64>,
+    /// The momentum projection's last accepted state (with `options.conserve_momentum`).
+    pub(crate) momentum_hold: Option<crate::momentum_hold::MomentumHold>,
 }
 
 /// The element's local unknowns as two contiguous global ranges: (first local index, first
@@ -167,6 +169,7 @@ impl Model {
             springs,
             thrusts,
             hinge_last,
+            momentum_hold: None,
         })
     }
 
@@ -723,12 +726,15 @@ impl ConstrainedSystem for Model {
         }
     }
 
-    fn post_step(&mut self, _t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
+    fn post_step(&mut self, t: f64, q: &mut [f64], v: &mut [f64], v_dot: &mut [f64], a: &mut [f64]) {
         self.rescale_rotations(q, Some((&mut *v, &mut *v_dot, &mut *a)));
         if self.options.stabilization {
             for &j in &self.projection_order {
                 self.joints[j].project(&self.bodies, q, [&mut *v, &mut *v_dot, &mut *a]);
             }
+        }
+        if self.options.conserve_momentum {
+            self.project_momentum(t, q, v);
         }
         // The accepted angles, for the unwrapping in the next step (the rescaling and the
         // projection above keep every rotation, so they do not move the angle).

@@ -13,11 +13,15 @@ pub struct Options {
     /// Gauss points per element for the elastic forces: 2 (default) is the reduced integration
     /// of SHARPy/xbeam; 3 is full integration (stiffer in shear).
     pub n_gauss_stiffness: usize,
+    /// After every step, restore the linear and angular momentum to their balance with the
+    /// external loads over the step by the smallest rigid velocity change (docs/gebf.md §15.1).
+    /// Off by default: both momenta then drift at the integrator's second order.
+    pub conserve_momentum: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { stabilization: false, n_gauss_stiffness: 2 }
+        Self { stabilization: false, n_gauss_stiffness: 2, conserve_momentum: false }
     }
 }
 

@@ -55,6 +55,9 @@ impl Structure for Model {
     fn momentum(&self, q: &[f64], v: &[f64]) -> Momentum {
         Model::momentum(self, q, v)
     }
+    fn start_march(&mut self, t: f64, q: &[f64], v: &[f64]) {
+        self.hold_momentum(t, q, v);
+    }
     fn dissipation_power(&self, q: &[f64], v: &[f64]) -> f64 {
         Model::dissipation_power(self, q, v)
     }

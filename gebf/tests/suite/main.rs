@@ -8,6 +8,7 @@ mod generic_analysis;
 mod inertia;
 mod memory;
 mod modes;
+mod momentum_projection;
 mod paper_cases;
 mod paper_reference;
 mod properties;
