@@ -198,9 +198,6 @@ fn bad_polar_input_names_the_field() {
     let spec = healy(&[polars_set(&good, "[0,1]")]).unwrap();
     let stab = harness::stability::run_stability(&spec.gebf.problem(), Formulation::Gebf);
     assert!(stab.error.as_deref().is_some_and(|e| e.contains("aero.polars")), "{:?}", stab.error);
-    let strip = healy(&[polars_set(&good, "[0,1]"), r#"aero.model="strip""#.into()]).unwrap();
-    let run = run_formulation(&strip.gebf, Formulation::Gebf);
-    assert!(run.error.as_deref().is_some_and(|e| e.contains("aero.polars")), "{:?}", run.error);
 }
 
 /// The columns of a time-history row that the march's comparisons check.
