@@ -105,14 +105,18 @@ impl StripPolars {
             let (pa, pb) = (a.origin + a.arm(0.25), b.origin + b.arm(0.25));
             let frame = strip_frame(&a.frame, &b.frame);
             let p = 0.5 * (pa + pb);
-            let geometry = StripGeometry {
-                frame,
-                chord: 0.5 * (a.chord + b.chord),
-                width: (pb - pa).dot(&frame.column(0)).abs(),
-            };
+            let geometry =
+                StripGeometry { frame, chord: 0.5 * (a.chord + b.chord), width: (pb - pa).dot(&frame.column(0)).abs() };
             let force = Vector3::from(loads.strip[i]);
             let (df, dm, c) = self
-                .correct_one(polar, &aerofoil::LatticeSection::THIN_PLATE, &geometry, flow(j, p), reynolds_factor, force)
+                .correct_one(
+                    polar,
+                    &aerofoil::LatticeSection::THIN_PLATE,
+                    &geometry,
+                    flow(j, p),
+                    reynolds_factor,
+                    force,
+                )
                 .map_err(|e| format!("polar of strip {j} (body {body}): {e}"))?;
             for (k, st) in [(j, a), (j + 1, b)] {
                 out[k].force += 0.5 * df;

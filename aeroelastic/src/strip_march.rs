@@ -86,7 +86,8 @@ impl<'a> StripAero<'a> {
             .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
             .collect();
         let kin = vec![(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::zeros()); map.len()];
-        let none = ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: Vector3::zeros(), alpha: f64::NAN };
+        let none =
+            ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: Vector3::zeros(), alpha: f64::NAN };
         let last = vec![none; columns.len()];
         Self { map, aero, polars, columns, kin, loads, last, scratch: (Vec::new(), Vec::new(), Vec::new()) }
     }
