@@ -20,6 +20,12 @@
 //!   stations carry the control surface, and lumped half to each station (force, and its moment
 //!   about the station's axis point).
 //!
+//! With section polars (`aero.polars`) a strip's thin-aerofoil lift goes through the lattice's
+//! strip correction ([`StripPolars::correct_one`]) with the strip's own lift line: the polar's
+//! `cl(α + τ δ, Re)` replaces it, its profile drag `cd q c w` acts along `u⊥` and its moment
+//! `cm q c² w` about the span, quasi-steadily on the three-quarter-chord incidence
+//! (docs/section_aero.md §7.6).
+//!
 //! The loads of a step are those of the state at its start (a loosely coupled march, as the
 //! lattice's); their power `Σ F·v + M·ω` is integrated into the aerodynamic work with the
 //! trapezoidal rule, so the energy balance `E + W_damp − W_aero` holds as with the lattice.
