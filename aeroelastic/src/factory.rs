@@ -261,7 +261,9 @@ fn from_trim<M: BuildModel>(
     };
     // The lattice's layout of the reference flow, as the trim has it.
     let map = station_map(problem, aero0).map_err(model_error)?;
-    let s = settings(&flight, f);
+    let mut s = settings(&flight, f);
+    // The trim's polars correct the march's loads too, so the trimmed state is its equilibrium.
+    s.polars = StripPolars::of(&flight).map_err(model_error)?;
     let mut events = hinge_events::<M>(&flight);
     let mut model = M::build(&flight)?;
     // Body axes turned back by α, moving against the reference flow: the earth frame.
@@ -320,7 +322,6 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
             let Run { problem, f, observer } = self;
             let model_error = |msg: String| Error::Model { formulation: f, msg };
             if problem.initial.is_trim() {
-                crate::section_polars::refuse_unwired(problem, "time march from a trim").map_err(model_error)?;
                 return from_trim::<M>(problem, f, observer);
             }
             let mut s = settings(problem, f);
@@ -334,9 +335,8 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
                         let msg = "events: hinge events with `aero.model: \"strip\"` are not implemented".into();
                         return Err(Error::Model { formulation: f, msg });
                     }
-                    crate::section_polars::refuse_unwired(problem, "strip-theory time march (`aero.model: \"strip\"`)")
-                        .map_err(model_error)?;
-                    let map = station_map(problem, aero).map_err(|msg| Error::Model { formulation: f, msg })?;
+                    let map = station_map(problem, aero).map_err(model_error)?;
+                    s.polars = StripPolars::of(problem).map_err(model_error)?;
                     M::build(problem)
                         .map(|mut model| crate::strip_march::simulate_strip(f, &mut model, &s, aero, &map, observer))
                 }

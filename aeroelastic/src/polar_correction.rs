@@ -100,29 +100,24 @@ impl StripPolars {
             }
             let i = j - map[j].lifting;
             let body = map[j + 1].body;
-            let Some(polar) = self.by_body.get(body).and_then(Option::as_ref) else { continue };
+            let Some(polar) = self.polar_of(body) else { continue };
             let (a, b) = (&stations[j], &stations[j + 1]);
             let (pa, pb) = (a.origin + a.arm(0.25), b.origin + b.arm(0.25));
             let frame = strip_frame(&a.frame, &b.frame);
             let p = 0.5 * (pa + pb);
-            let strip = aerofoil::Strip {
-                flow: frame.transpose() * flow(j, p),
-                chord: 0.5 * (a.chord + b.chord),
-                width: (pb - pa).dot(&frame.column(0)).abs(),
-                rho: self.rho,
-                kinematic_viscosity: self.kinematic_viscosity / reynolds_factor,
-                fixed_reynolds: None,
-                quarter_chord: Vector3::zeros(),
-            };
-            let inviscid = aerofoil::StripLoads {
-                force: frame.transpose() * Vector3::from(loads.strip[i]),
-                moment: Vector3::zeros(),
-            };
-            let c = aerofoil::correct_strip(polar, &aerofoil::LatticeSection::THIN_PLATE, &strip, &inviscid)
+            let geometry =
+                StripGeometry { frame, chord: 0.5 * (a.chord + b.chord), width: (pb - pa).dot(&frame.column(0)).abs() };
+            let force = Vector3::from(loads.strip[i]);
+            let (df, dm, c) = self
+                .correct_one(
+                    polar,
+                    &aerofoil::LatticeSection::THIN_PLATE,
+                    &geometry,
+                    flow(j, p),
+                    reynolds_factor,
+                    force,
+                )
                 .map_err(|e| format!("polar of strip {j} (body {body}): {e}"))?;
-            let df = frame * (c.loads.force - inviscid.force);
-            // About the strip's quarter-chord point (the inviscid moment is zero here).
-            let dm = frame * c.loads.moment;
             for (k, st) in [(j, a), (j + 1, b)] {
                 out[k].force += 0.5 * df;
                 out[k].moment += (p - st.origin).cross(&(0.5 * df)) + 0.5 * dm;
@@ -135,6 +130,54 @@ impl StripPolars {
         }
         Ok(())
     }
+
+    /// The polar of body `body` (none: its strips are not corrected).
+    pub fn polar_of(&self, body: usize) -> Option<&aerofoil::Polar> {
+        self.by_body.get(body).and_then(Option::as_ref).map(|p| &**p)
+    }
+
+    /// Correct one strip of geometry `g` whose uncorrected force `force` (global, N; no moment
+    /// about its quarter chord) comes from the lift line `line` (the lattice's thin plate, or a
+    /// strip model's own slope), in the air velocity `flow` relative to it (global, m/s), its
+    /// Reynolds number `reynolds_factor` times its own `V c/ν`: the change of force and the
+    /// moment about the quarter chord (global), and the correction (strip frame).
+    ///
+    /// # Errors
+    /// The polar's range errors, an impossible strip.
+    pub fn correct_one(
+        &self,
+        polar: &aerofoil::Polar,
+        line: &aerofoil::LatticeSection,
+        g: &StripGeometry,
+        flow: Vector3<f64>,
+        reynolds_factor: f64,
+        force: Vector3<f64>,
+    ) -> Result<(Vector3<f64>, Vector3<f64>, aerofoil::Correction), aerofoil::AerofoilError> {
+        let strip = aerofoil::Strip {
+            flow: g.frame.transpose() * flow,
+            chord: g.chord,
+            width: g.width,
+            rho: self.rho,
+            kinematic_viscosity: self.kinematic_viscosity / reynolds_factor,
+            fixed_reynolds: None,
+            quarter_chord: Vector3::zeros(),
+        };
+        let inviscid = aerofoil::StripLoads { force: g.frame.transpose() * force, moment: Vector3::zeros() };
+        let c = aerofoil::correct_strip(polar, line, &strip, &inviscid)?;
+        Ok((g.frame * (c.loads.force - inviscid.force), g.frame * c.loads.moment, c))
+    }
+}
+
+/// A strip's frame (columns span `x̂`, chord towards the leading edge `ŷ`, normal `ẑ`; global,
+/// orthonormal), chord and span width, m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StripGeometry {
+    /// The frame.
+    pub frame: Matrix3<f64>,
+    /// Chord, m.
+    pub chord: f64,
+    /// Width along `x̂`, m.
+    pub width: f64,
 }
 
 /// The strip frame between two station frames (columns span, chord towards the leading edge,

@@ -20,6 +20,12 @@
 //!   stations carry the control surface, and lumped half to each station (force, and its moment
 //!   about the station's axis point).
 //!
+//! With section polars (`aero.polars`) a strip's thin-aerofoil lift goes through the lattice's
+//! strip correction ([`StripPolars::correct_one`]) with the strip's own lift line: the polar's
+//! `cl(α + τ δ, Re)` replaces it, its profile drag `cd q c w` acts along `u⊥` and its moment
+//! `cm q c² w` about the span, quasi-steadily on the three-quarter-chord incidence
+//! (docs/section_aero.md §7.6).
+//!
 //! The loads of a step are those of the state at its start (a loosely coupled march, as the
 //! lattice's); their power `Σ F·v + M·ω` is integrated into the aerodynamic work with the
 //! trapezoidal rule, so the energy balance `E + W_damp − W_aero` holds as with the lattice.
@@ -32,6 +38,7 @@ use formulation::{SectionLoad, Structure};
 use genalpha::State;
 
 use crate::aero::{AeroSettings, StationMap, section_state};
+use crate::polar_correction::{StripGeometry, StripPolars};
 use crate::problem::Formulation;
 use crate::run::{Dissipation, Observer, RunOutput, RunSettings, SnapshotFeed, row};
 
@@ -43,12 +50,29 @@ type Kinematics = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
 pub struct StripAero<'a> {
     map: &'a [StationMap],
     aero: &'a AeroSettings,
+    /// The section polars that replace the strips' thin-aerofoil lift (none: `a (α + τ δ)`).
+    polars: Option<&'a StripPolars>,
     /// The columns: their first station (the second is the next one).
     columns: Vec<usize>,
     /// Each station's pose and velocity: axis point, frame, velocity, angular velocity.
     kin: Vec<Kinematics>,
     loads: Vec<SectionLoad>,
+    /// Each column's last loads (in the order of `columns`).
+    last: Vec<ColumnLoad>,
     scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+}
+
+/// One column's loads at a state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ColumnLoad {
+    /// Force, N (global).
+    force: Vector3<f64>,
+    /// Moment about `at` (the polar's `cm`; zero without a polar), N·m.
+    moment: Vector3<f64>,
+    /// The point of action: the quarter chord at the column's middle.
+    at: Vector3<f64>,
+    /// The incidence the polar was read at, `α + τ δ`, rad (NaN without a polar).
+    alpha: f64,
 }
 
 /// Thin-aerofoil flap effectiveness `dα/dδ` of a trailing-edge flap of chord fraction `e`.
@@ -58,27 +82,34 @@ pub fn flap_effectiveness(e: f64) -> f64 {
 }
 
 impl<'a> StripAero<'a> {
-    /// The strips of the stations `map` (the aerodynamic settings `aero`).
-    pub fn new(map: &'a [StationMap], aero: &'a AeroSettings) -> Self {
-        let columns =
+    /// The strips of the stations `map` (the aerodynamic settings `aero`), their lift read from
+    /// the section polars `polars` where a body has one (docs/section_aero.md §7.5).
+    pub fn new(map: &'a [StationMap], aero: &'a AeroSettings, polars: Option<&'a StripPolars>) -> Self {
+        let columns: Vec<usize> =
             crate::lifting::surface_ranges(map).into_iter().flat_map(|r| r.start..r.end.saturating_sub(1)).collect();
         let loads = map
             .iter()
             .map(|m| SectionLoad { body: m.body, s: m.s, force: Vector3::zeros(), moment: Vector3::zeros() })
             .collect();
         let kin = vec![(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::zeros()); map.len()];
-        Self { map, aero, columns, kin, loads, scratch: (Vec::new(), Vec::new(), Vec::new()) }
+        let none =
+            ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: Vector3::zeros(), alpha: f64::NAN };
+        let last = vec![none; columns.len()];
+        Self { map, aero, polars, columns, kin, loads, last, scratch: (Vec::new(), Vec::new(), Vec::new()) }
     }
 
     /// The station loads at time `t` and state `(q, v)`, replacing the loads held so far; and the
     /// power `Σ F·v + M·ω` at this state of the loads held so far and of the new ones, W.
+    ///
+    /// # Errors
+    /// A polar's range error, naming the strip and its body.
     pub fn evaluate<S: Structure + ?Sized>(
         &mut self,
         model: &S,
         t: f64,
         q: &[f64],
         v: &[f64],
-    ) -> (&[SectionLoad], f64, f64) {
+    ) -> Result<(&[SectionLoad], f64, f64), String> {
         for (k, m) in self.kin.iter_mut().zip(self.map) {
             *k = section_state(model, q, v, m, &mut self.scratch);
         }
@@ -90,21 +121,22 @@ impl<'a> StripAero<'a> {
             l.force = Vector3::zeros();
             l.moment = Vector3::zeros();
         }
-        for &j in &self.columns {
-            let (f, r1) = self.column_force(j, t);
+        for (n, &j) in self.columns.iter().enumerate() {
+            let c = self.column_load(j, t)?;
             for i in [j, j + 1] {
-                let half = f * 0.5;
+                let half = c.force * 0.5;
                 self.loads[i].force += half;
-                self.loads[i].moment += (r1 - self.kin[i].0).cross(&half);
+                self.loads[i].moment += (c.at - self.kin[i].0).cross(&half) + 0.5 * c.moment;
             }
+            self.last[n] = c;
         }
         let power = power_of(&self.loads, &self.kin);
-        (&self.loads, held, power)
+        Ok((&self.loads, held, power))
     }
 
-    /// The lift of column `j` (stations `j`, `j + 1`) at time `t` and its point of action (the
-    /// quarter chord at the column's middle).
-    fn column_force(&self, j: usize, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+    /// The loads of column `j` (stations `j`, `j + 1`) at time `t`, acting at the quarter chord
+    /// at the column's middle.
+    fn column_load(&self, j: usize, t: f64) -> Result<ColumnLoad, String> {
         let (a, b) = (&self.kin[j], &self.kin[j + 1]);
         let (ma, mb) = (&self.map[j], &self.map[j + 1]);
         let p = 0.5 * (a.0 + b.0);
@@ -129,12 +161,55 @@ impl<'a> StripAero<'a> {
             }
             _ => 0.0,
         };
+        let mut out = ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: r1, alpha: f64::NAN };
         if speed2 == 0.0 {
-            return (Vector3::zeros(), r1);
+            return Ok(out);
         }
         let width = (b.0 - a.0).norm();
         let lift = 0.5 * self.aero.rho * speed2 * chord * self.aero.strip_lift_slope * (alpha + flap) * width;
-        (u_perp.cross(&x) / speed2.sqrt() * lift, r1)
+        out.force = u_perp.cross(&x) / speed2.sqrt() * lift;
+        let Some((polars, polar)) = self.polars.and_then(|p| Some((p, p.polar_of(mb.body)?))) else { return Ok(out) };
+        if width == 0.0 {
+            // Two stations at one point: no strip (and no lift above).
+            return Ok(out);
+        }
+        // The polar replaces the thin-aerofoil lift: the correction inverts the strip's own lift
+        // line (slope `a`, no zero-lift incidence), so it reads the polar at `α + τ δ` exactly,
+        // and adds the profile drag along `u⊥` and the moment `cm q c² w` about the span.
+        let line = aerofoil::LatticeSection { lift_slope: self.aero.strip_lift_slope, zero_lift_alpha: 0.0 };
+        let g = StripGeometry { frame: Matrix3::from_columns(&[x, y, z]), chord, width };
+        let (df, dm, c) = polars
+            .correct_one(polar, &line, &g, u, 1.0, out.force)
+            .map_err(|e| format!("polar of strip {j} (body {}): {e}", mb.body))?;
+        out.force += df;
+        out.moment = dm;
+        out.alpha = c.alpha;
+        Ok(out)
+    }
+
+    /// The strips at the last evaluation with a section polar (empty without polars): lift per
+    /// span along `lift_dir`, its coefficient at the dynamic pressure `qdyn` (Pa) on the
+    /// planform's chord, and the incidence the polar was read at.
+    fn strips(&self, lift_dir: &Vector3<f64>, qdyn: f64) -> Vec<crate::statics::Strip> {
+        if self.polars.is_none() {
+            return Vec::new();
+        }
+        self.columns
+            .iter()
+            .zip(&self.last)
+            .map(|(&j, c)| {
+                let (a, b) = (self.kin[j].0, self.kin[j + 1].0);
+                let l = c.force.dot(lift_dir) / (b - a).norm();
+                let chord = 0.5 * (self.map[j].planform_chord + self.map[j + 1].planform_chord);
+                crate::statics::Strip {
+                    s: 0.5 * (self.map[j].arc + self.map[j + 1].arc),
+                    position: (0.5 * (a + b)).into(),
+                    lift_per_span: l,
+                    cl: l / (qdyn * chord),
+                    alpha: c.alpha,
+                }
+            })
+            .collect()
     }
 }
 
@@ -159,7 +234,7 @@ pub fn simulate_strip<S: Structure>(
         Err(e) => return finish(out, start, Some(e.to_string())),
     };
     let mut s: State = model.initial_state();
-    let mut strips = StripAero::new(map, aero);
+    let mut strips = StripAero::new(map, aero, settings.polars.as_ref());
     let lift_dir = crate::statics::lift_direction(aero.free_stream());
     let (mut power, mut lift) = match apply(&mut strips, model, &s, &lift_dir) {
         Ok((_, p, l)) => (p, l),
@@ -220,6 +295,8 @@ pub fn simulate_strip<S: Structure>(
         }
     }
     out.stats = *ga.stats();
+    let speed = aero.speed();
+    out.strips = strips.strips(&lift_dir, 0.5 * aero.rho * speed * speed);
     let err = out.error.take();
     finish(out, start, err)
 }
@@ -232,7 +309,7 @@ fn apply<S: Structure>(
     s: &State,
     lift_dir: &Vector3<f64>,
 ) -> Result<(f64, f64, f64), String> {
-    let (loads, held, power) = strips.evaluate(&*model, s.t, &s.q, &s.v);
+    let (loads, held, power) = strips.evaluate(&*model, s.t, &s.q, &s.v)?;
     let lift = loads.iter().map(|l| l.force.dot(lift_dir)).sum();
     model.set_section_loads(loads).map_err(|e| e.to_string())?;
     Ok((held, power, lift))

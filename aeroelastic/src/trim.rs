@@ -25,6 +25,7 @@ use crate::aero::{AeroSettings, StationMap, station_map};
 use crate::control_surface::Deflection;
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::loads::{LoadModel, LoadScratch};
+use crate::polar_correction::StripPolars;
 use crate::problem::{Formulation, Joint, Problem};
 use crate::stability_settings::WakeSettings;
 use crate::statics::{AeroStatic, load_stepping, point_at, solve_rounds, static_params};
@@ -485,9 +486,6 @@ pub(crate) fn trim_with<M: BuildModel>(base: &Problem, f: Formulation, t: &TrimS
     if let Err(e) = t.validate(base) {
         return failed(base, f, e);
     }
-    if let Err(e) = crate::section_polars::refuse_unwired(base, "trim") {
-        return failed(base, f, e);
-    }
     let Some(root) = free_body(base) else { return failed(base, f, "no free body".into()) };
     let x0 = first_guess(base, t);
     let p0 = held_problem(base, t, x0);
@@ -505,15 +503,26 @@ pub(crate) fn trim_with<M: BuildModel>(base: &Problem, f: Formulation, t: &TrimS
     };
     let q_ref = model.initial_state().q;
     let wake = t.wake.as_ref().map_or(uvlm::SteadyWake::SemiInfinite, WakeSettings::steady_wake);
-    let sys = match AeroStatic::new(model, &q_ref, &map, &aero0, wake, base.span()) {
+    let mut sys = match AeroStatic::new(model, &q_ref, &map, &aero0, wake, base.span()) {
         Ok(s) => s,
         Err(e) => return failed(base, f, e),
     };
+    // The section polars correct every equilibrium's loads, so the net load (and the thrust that
+    // balances the profile drag) is of the corrected loads; docs/trim.md §2.
+    match StripPolars::of(base) {
+        Ok(p) => sys.set_polars(p),
+        Err(e) => return failed(base, f, e),
+    }
     let solver = StaticSolver::new(&sys, static_params());
     let x = StaticSolution::guess(&sys, &q_ref);
     let mut held = Held { base, f, t, sys, solver, x, map: &map, root, solves: 1 };
-    // The first equilibrium by load stepping from the reference configuration.
-    if let Err(e) = load_stepping(&p0, M::build, aero0.speed(), &mut held.sys, &mut held.solver, &mut held.x) {
+    // The first equilibrium by load stepping from the reference configuration, the polars read
+    // at the trim airspeed's Reynolds numbers while the dynamic pressure is ramped (as a static
+    // sweep's first point); every later equilibrium at the strips' own `V c/ν`.
+    held.sys.hold_reynolds_at(Some(aero0.speed()));
+    let stepped = load_stepping(&p0, M::build, aero0.speed(), &mut held.sys, &mut held.solver, &mut held.x);
+    held.sys.hold_reynolds_at(None);
+    if let Err(e) = stepped {
         return failed(base, f, e);
     }
     let out = iterate(&mut held, x0);
