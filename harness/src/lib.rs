@@ -5,12 +5,13 @@
 //! external references ([`metrics`]), writes CSV, `summary.json`, SVG plots and an HTML index
 //! ([`report`], [`plot`]), a 3-D view ([`view3d`]) and ParaView files ([`vtk`]) and enforces the cross-formulation gate ([`gate`]). Studies: refinement
 //! ladders ([`converge`]), the stress matrix ([`stress`]), energy by integrator form
-//! ([`energy`]), speed ([`bench`](mod@bench)). Sweeps split across processes or a SLURM job array
+//! ([`energy`]), speed ([`bench`](mod@bench), [`bench_aero`]). Sweeps split across processes or a SLURM job array
 //! ([`shard`]) and are merged into one report ([`merge`]).
 #![warn(missing_docs)]
 
 pub mod atomic;
 pub mod bench;
+pub mod bench_aero;
 pub mod converge;
 pub mod csv;
 pub mod driver;

@@ -269,6 +269,11 @@ struct BenchArgs {
     /// Timed runs per configuration.
     #[arg(long, default_value_t = 7)]
     repeats: usize,
+    /// Time the aerodynamics instead: the coupled step of the paper's and Healy's wings against
+    /// the wake's length (direct and treecode), a 20 s wing run, Healy's static and gust sweeps
+    /// and a flutter sweep, from the case files in `--cases`; writes `<out>/bench/aero.*`.
+    #[arg(long)]
+    aero: bool,
     #[command(flatten)]
     out: OutOpt,
 }
@@ -1406,6 +1411,14 @@ fn files_runs(a: &FilesArgs) -> Result<(Vec<RunSpec>, Vec<harness::Error>, bool)
 
 /// `harness bench`: exit 2 when a case file was bad, 1 when a timed run failed.
 fn cmd_bench(a: &BenchArgs) -> Result<ExitCode> {
+    if a.aero {
+        let t = std::time::Instant::now();
+        let b = harness::bench_aero::run(&a.files.cases.cases, true)?;
+        harness::bench_aero::write(&a.out.out.join("bench"), &b)?;
+        println!("bench --aero: done in {:.1} s", t.elapsed().as_secs_f64());
+        let failed = b.steps.iter().any(|r| r.error.is_some()) || b.analyses.iter().any(|r| r.error.is_some());
+        return Ok(if failed { ExitCode::from(1) } else { ExitCode::SUCCESS });
+    }
     let (runs, errors, explicit) = files_runs(&a.files)?;
     let runs: Vec<_> = runs.into_iter().filter(|r| explicit || r.ancf.aero.is_none()).collect();
     let rows = run_bench(&runs, a.repeats, &a.out.out.join("bench"))?;

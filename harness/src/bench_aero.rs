@@ -1,0 +1,375 @@
+//! `harness bench --aero`: where the aeroelastic analyses spend their time.
+//!
+//! Two parts, written to `<out>/bench/aero.{csv,md,json}` and `aero_wake.svg`:
+//!
+//! * **The step against the wake's length.** The coupled time step of the paper's wing
+//!   (`wing_aoa5.json`) and of Healy's wing (`healy_ffwt_flare10_aoa5.json`), GEBF, with the
+//!   wake cut to 20, 40, 80, 160 and 320 rows, summed directly and through the treecode
+//!   (`aero.wake_aggregation`). A run marches until its wake is full and 20 steps more; an
+//!   observer reads the process's CPU time at every step, and the figure is the mean over the
+//!   last 20 steps (process time, so that the lattice's own threads count).
+//! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
+//!   Healy's static sweep per formulation, the Goland wing's 21-speed flutter sweep, and Healy's
+//!   gust sweep (both formulations, run as `harness all` runs it).
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use plotters::prelude::*;
+use serde::Serialize;
+
+use crate::Error;
+use crate::case::{CaseFile, Formulation, Override, RunSpec};
+use crate::csv::write_file;
+use crate::plot::colors;
+use aeroelastic::run::{Observer, Row, Snapshot};
+
+/// The wake lengths the step is timed at, rows.
+pub const WAKE_ROWS: [usize; 5] = [20, 40, 80, 160, 320];
+/// Steps timed once the wake is full.
+const TIMED_STEPS: usize = 20;
+
+/// One timed step.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepRow {
+    /// Case name.
+    pub case: String,
+    /// Wake rows.
+    pub rows: usize,
+    /// The wake summed through the treecode.
+    pub treecode: bool,
+    /// Mean process CPU time of a step with the wake full, ms.
+    pub cpu_ms: f64,
+    /// Why the run stopped early, if it did.
+    pub error: Option<String>,
+}
+
+/// One timed analysis.
+#[derive(Debug, Clone, Serialize)]
+pub struct AnalysisRow {
+    /// What ran.
+    pub analysis: String,
+    /// Formulation, or `both`.
+    pub formulation: String,
+    /// Process CPU time, s.
+    pub cpu_s: f64,
+    /// Wall time, s.
+    pub wall_s: f64,
+    /// Why it failed, if it did.
+    pub error: Option<String>,
+}
+
+/// Everything `bench --aero` measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct AeroBench {
+    /// The step against the wake's length.
+    pub steps: Vec<StepRow>,
+    /// The whole analyses.
+    pub analyses: Vec<AnalysisRow>,
+}
+
+/// CPU time of the whole process (every thread), s.
+fn process_cpu_s() -> f64 {
+    // SAFETY: `getrusage` fills the zeroed struct it is given and reads nothing else.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return f64::NAN;
+    }
+    let s = |t: libc::timeval| t.tv_sec as f64 + 1e-6 * t.tv_usec as f64;
+    s(u.ru_utime) + s(u.ru_stime)
+}
+
+/// Reads the process's CPU time at every row of a run.
+#[derive(Default)]
+struct CpuPerRow(Vec<f64>);
+
+impl Observer for CpuPerRow {
+    fn wants_snapshots(&self) -> bool {
+        false
+    }
+    fn observe(&mut self, _snapshot: &Snapshot<'_>) -> Result<(), String> {
+        Ok(())
+    }
+    fn row(&mut self, _row: &Row) -> Result<(), String> {
+        self.0.push(process_cpu_s());
+        Ok(())
+    }
+}
+
+/// The run of case file `file` in `cases` with the overrides `sets`.
+fn spec(cases: &Path, file: &str, sets: &[String]) -> Result<RunSpec, Error> {
+    let path = cases.join(file);
+    let case =
+        CaseFile::read(&path).map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
+    let overrides = sets
+        .iter()
+        .map(|s| s.parse::<Override>().map_err(|e| Error::Override(e.to_string())))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut runs =
+        case.expand(&overrides).map_err(|e| Error::Case { file: path.display().to_string(), msg: e.to_string() })?;
+    runs.truncate(1);
+    runs.pop().ok_or_else(|| Error::Case { file: path.display().to_string(), msg: "no run".into() })
+}
+
+/// The mean CPU time of a GEBF step of `file` with a wake of `rows` rows, full.
+fn step_row(cases: &Path, file: &str, rows: usize, treecode: bool) -> Result<StepRow, Error> {
+    let probe = spec(cases, file, &[])?;
+    let dt = probe.case(Formulation::ALL[1]).block(Formulation::ALL[1]).dt;
+    let steps = rows + 2 + TIMED_STEPS;
+    let sets = [
+        format!("aero.n_wake_rows={rows}"),
+        format!("aero.wake_aggregation={treecode}"),
+        format!("t_end={}", steps as f64 * dt),
+        format!("output_dt={dt}"),
+    ];
+    let run = spec(cases, file, &sets)?;
+    let mut cpu = CpuPerRow::default();
+    let out = aeroelastic::factory::run_formulation_observed(
+        &run.case(Formulation::ALL[1]).problem(),
+        Formulation::ALL[1],
+        &mut cpu,
+    );
+    let n = cpu.0.len();
+    let cpu_ms =
+        if n > TIMED_STEPS { 1e3 * (cpu.0[n - 1] - cpu.0[n - 1 - TIMED_STEPS]) / TIMED_STEPS as f64 } else { f64::NAN };
+    Ok(StepRow { case: run.name.clone(), rows, treecode, cpu_ms, error: out.error })
+}
+
+/// Time `work` once: process CPU and wall seconds and its error.
+fn timed(analysis: &str, formulation: &str, work: impl FnOnce() -> Option<String>) -> AnalysisRow {
+    let (c0, t0) = (process_cpu_s(), Instant::now());
+    let error = work();
+    AnalysisRow {
+        analysis: analysis.into(),
+        formulation: formulation.into(),
+        cpu_s: process_cpu_s() - c0,
+        wall_s: t0.elapsed().as_secs_f64(),
+        error,
+    }
+}
+
+/// The whole analyses of the module docs.
+fn analyses(cases: &Path) -> Result<Vec<AnalysisRow>, Error> {
+    let mut out = Vec::new();
+    let wing = spec(cases, "wing_aoa5.json", &[])?;
+    let healy = spec(cases, "healy_ffwt_flare10_aoa5.json", &[])?;
+    for f in Formulation::ALL {
+        let p = wing.case(f).problem();
+        out.push(timed(&format!("{} s run of the paper's wing", p.t_end), &f.to_string(), || {
+            aeroelastic::factory::run_formulation(&p, f).error
+        }));
+        let p = healy.case(f).problem();
+        out.push(timed("Healy static sweep (12 airspeeds)", &f.to_string(), || {
+            aeroelastic::statics::run_static(&p, f).points.iter().find_map(|x| x.error.clone())
+        }));
+    }
+    let goland = spec(cases, "goland_flutter.json", &[])?;
+    for f in Formulation::ALL {
+        let p = goland.case(f).problem();
+        let n = p.stability.as_ref().map_or(0, |s| s.airspeeds.len());
+        out.push(timed(&format!("Goland flutter sweep ({n} airspeeds)"), &f.to_string(), || {
+            aeroelastic::stability::run_stability(&p, f).error
+        }));
+    }
+    let gust = spec(cases, "healy_ffwt_gust.json", &[])?;
+    let base = gust.case(Formulation::ALL[0]).problem();
+    let problems: Vec<_> = Formulation::ALL.iter().map(|&f| (f, gust.case(f).problem())).collect();
+    let pairs: Vec<_> = problems.iter().map(|(f, p)| (*f, p)).collect();
+    out.push(timed("Healy gust sweep", "both", || aeroelastic::gust::run_sweep(&base, &pairs).err()));
+    Ok(out)
+}
+
+/// Run both parts; with `progress`, print each figure as it comes.
+pub fn run(cases: &Path, progress: bool) -> Result<AeroBench, Error> {
+    let mut steps = Vec::new();
+    for file in ["wing_aoa5.json", "healy_ffwt_flare10_aoa5.json"] {
+        for rows in WAKE_ROWS {
+            for treecode in [false, true] {
+                let r = step_row(cases, file, rows, treecode)?;
+                if progress {
+                    let how = if treecode { "treecode" } else { "direct" };
+                    println!("bench --aero {:<26} {rows:>4} rows {how:<8}: {:8.2} ms CPU per step", r.case, r.cpu_ms);
+                }
+                steps.push(r);
+            }
+        }
+    }
+    let analyses = analyses(cases)?;
+    if progress {
+        for a in &analyses {
+            println!(
+                "bench --aero {:<40} {:<4}: {:8.2} s CPU, {:8.2} s wall",
+                a.analysis, a.formulation, a.cpu_s, a.wall_s
+            );
+        }
+    }
+    Ok(AeroBench { steps, analyses })
+}
+
+/// The ratio of the step's cost at the longest wake to that at 1/8 of it, per case and summation.
+pub fn scaling(b: &AeroBench) -> Vec<(String, bool, f64)> {
+    let mut out = Vec::new();
+    for r in b.steps.iter().filter(|r| r.rows == WAKE_ROWS[4]) {
+        let short = b.steps.iter().find(|s| s.case == r.case && s.treecode == r.treecode && s.rows == WAKE_ROWS[1]);
+        if let Some(s) = short {
+            out.push((r.case.clone(), r.treecode, r.cpu_ms / s.cpu_ms));
+        }
+    }
+    out
+}
+
+/// The markdown summary.
+pub fn markdown(b: &AeroBench) -> String {
+    let mut s = String::from("# Aerodynamic benchmark\n\nCPU time per coupled step (GEBF) with the wake full, ms:\n\n");
+    s.push_str("| case | summation |");
+    for r in WAKE_ROWS {
+        let _ = write!(s, " {r} rows |");
+    }
+    s.push_str(" 320 / 40 rows |\n|---|---|");
+    s.push_str(&"---|".repeat(WAKE_ROWS.len() + 1));
+    s.push('\n');
+    let ratios = scaling(b);
+    let mut seen: Vec<(String, bool)> = Vec::new();
+    for r in &b.steps {
+        if seen.contains(&(r.case.clone(), r.treecode)) {
+            continue;
+        }
+        seen.push((r.case.clone(), r.treecode));
+        let _ = write!(s, "| {} | {} |", r.case, if r.treecode { "treecode" } else { "direct" });
+        for rows in WAKE_ROWS {
+            let x = b.steps.iter().find(|x| x.case == r.case && x.treecode == r.treecode && x.rows == rows);
+            let _ = write!(s, " {:.2} |", x.map_or(f64::NAN, |x| x.cpu_ms));
+        }
+        let ratio = ratios.iter().find(|x| x.0 == r.case && x.1 == r.treecode).map_or(f64::NAN, |x| x.2);
+        let _ = writeln!(s, " {ratio:.2}× |");
+    }
+    s.push_str("\nWhole analyses:\n\n| analysis | formulation | CPU s | wall s | error |\n|---|---|---|---|---|\n");
+    for a in &b.analyses {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2} | {:.2} | {} |",
+            a.analysis,
+            a.formulation,
+            a.cpu_s,
+            a.wall_s,
+            a.error.as_deref().unwrap_or("")
+        );
+    }
+    s
+}
+
+/// Write `aero.csv`, `aero.md`, `aero.json` and `aero_wake.svg` into `dir`.
+pub fn write(dir: &Path, b: &AeroBench) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
+    let mut csv = String::from("case,rows,treecode,cpu_ms_per_step\n");
+    for r in &b.steps {
+        let _ = writeln!(csv, "{},{},{},{:.4}", r.case, r.rows, r.treecode, r.cpu_ms);
+    }
+    write_file(&dir.join("aero.csv"), &csv)?;
+    write_file(&dir.join("aero.md"), &markdown(b))?;
+    let json = serde_json::to_string_pretty(b).map_err(|e| Error::Io(e.to_string()))?;
+    write_file(&dir.join("aero.json"), &json)?;
+    svg(&dir.join("aero_wake.svg"), b).map_err(|e| Error::Plot { file: "aero_wake.svg".into(), msg: e.to_string() })
+}
+
+/// Step time against wake rows, log–log, one line per case and summation.
+fn svg(path: &Path, b: &AeroBench) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (720, 440)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let ok: Vec<&StepRow> = b.steps.iter().filter(|r| r.cpu_ms.is_finite() && r.cpu_ms > 0.0).collect();
+    let lo = ok.iter().map(|r| r.cpu_ms).fold(f64::INFINITY, f64::min).min(1.0) * 0.7;
+    let hi = ok.iter().map(|r| r.cpu_ms).fold(0.0, f64::max).max(lo * 10.0) * 1.4;
+    let (x0, x1) = (WAKE_ROWS[0] as f64 * 0.8, WAKE_ROWS[4] as f64 * 1.25);
+    let mut chart = ChartBuilder::on(&root)
+        .caption("CPU time per coupled step against the wake's length", ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (x0..x1).log_scale().with_key_points(WAKE_ROWS.iter().map(|&r| r as f64).collect()),
+            (lo..hi).log_scale().with_key_points(vec![0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0]),
+        )?;
+    chart
+        .configure_mesh()
+        .light_line_style(TRANSPARENT)
+        .x_desc("wake rows")
+        .y_desc("ms per step (process CPU)")
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y}"))
+        .draw()?;
+    let palette = colors::PALETTE;
+    let mut k = 0;
+    let mut seen: Vec<(String, bool)> = Vec::new();
+    for r in &ok {
+        if seen.contains(&(r.case.clone(), r.treecode)) {
+            continue;
+        }
+        seen.push((r.case.clone(), r.treecode));
+        let pts: Vec<(f64, f64)> = ok
+            .iter()
+            .filter(|x| x.case == r.case && x.treecode == r.treecode)
+            .map(|x| (x.rows as f64, x.cpu_ms))
+            .collect();
+        let c = palette[k % palette.len()];
+        k += 1;
+        let label = format!("{} ({})", r.case, if r.treecode { "treecode" } else { "direct" });
+        let style = if r.treecode { c.stroke_width(2) } else { c.stroke_width(1) };
+        chart
+            .draw_series(LineSeries::new(pts.clone(), style))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table's ratio is the 320-row step over the 40-row one, and every file is written.
+    #[test]
+    fn the_table_reports_the_eightfold_wake_and_the_files_are_written() {
+        let step = |case: &str, rows: usize, treecode: bool, cpu_ms: f64| StepRow {
+            case: case.into(),
+            rows,
+            treecode,
+            cpu_ms,
+            error: None,
+        };
+        let mut steps = Vec::new();
+        for (k, rows) in WAKE_ROWS.iter().enumerate() {
+            steps.push(step("wing", *rows, false, 1.0 + k as f64));
+            steps.push(step("wing", *rows, true, 2.0 * (1.0 + k as f64).sqrt()));
+        }
+        let b = AeroBench {
+            steps,
+            analyses: vec![AnalysisRow {
+                analysis: "a run".into(),
+                formulation: "gebf".into(),
+                cpu_s: 1.5,
+                wall_s: 2.0,
+                error: None,
+            }],
+        };
+        let ratios = scaling(&b);
+        assert_eq!(ratios.len(), 2);
+        assert!((ratios[0].2 - 5.0 / 2.0).abs() < 1e-12, "{ratios:?}");
+        let md = markdown(&b);
+        assert!(md.contains("| wing | direct | 1.00 | 2.00 | 3.00 | 4.00 | 5.00 | 2.50× |"), "{md}");
+        let dir = std::env::temp_dir().join(format!("flexmb-bench-aero-{}", std::process::id()));
+        write(&dir, &b).unwrap();
+        for f in ["aero.csv", "aero.md", "aero.json", "aero_wake.svg"] {
+            assert!(dir.join(f).is_file(), "{f}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
