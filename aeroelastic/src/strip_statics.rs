@@ -249,3 +249,40 @@ pub(crate) fn strip_rows(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::LiftingLine;
+    use std::f64::consts::PI;
+
+    /// An elliptic planform's lifting line has the closed form `F = 1/(1 + a/(π AR))` at every
+    /// station (Prandtl); Glauert's series reproduces it to rounding.
+    #[test]
+    fn the_lifting_line_factor_of_an_elliptic_wing_is_prandtls() {
+        let (s, c0) = (0.5, 0.1);
+        for slope in [2.0 * PI, 5.0] {
+            let ll = LiftingLine::new(s, slope, |eta: f64| c0 * (1.0 - eta * eta).sqrt()).unwrap();
+            // Mirrored span b = 2s, area π c0 b/4.
+            let ar = (2.0 * s) * (2.0 * s) / (PI * c0 * 2.0 * s / 4.0);
+            let exact = 1.0 / (1.0 + slope / (PI * ar));
+            for eta in [0.0, 0.3, 0.7, 0.95] {
+                let f = ll.factor(eta, c0 * (1.0 - eta * eta).sqrt());
+                assert!((f - exact).abs() < 1e-12, "η {eta}: {f} against {exact}");
+            }
+        }
+    }
+
+    /// A rectangular wing's factor falls from the root to zero at the tip, and its mean lies
+    /// under the elliptic wing's of the same aspect ratio (a rectangular wing is less efficient).
+    #[test]
+    fn a_rectangular_wing_loses_lift_towards_its_tip() {
+        let (s, c) = (0.5, 0.078);
+        let ll = LiftingLine::new(s, 2.0 * PI, |_| c).unwrap();
+        let f: Vec<f64> = (0..=20).map(|k| ll.factor(f64::from(k) / 20.0, c)).collect();
+        assert!(f.windows(2).all(|w| w[1] <= w[0] + 1e-12), "{f:?}");
+        assert!(f[20].abs() < 1e-12);
+        let mean = f[..20].iter().sum::<f64>() / 20.0;
+        let ar = 2.0 * s / c;
+        assert!(mean < 1.0 / (1.0 + 2.0 / ar) && mean > 0.7, "mean {mean}");
+    }
+}
