@@ -281,6 +281,10 @@ mod tests {
         let f: Vec<f64> = (0..=20).map(|k| ll.factor(f64::from(k) / 20.0, c)).collect();
         assert!(f.windows(2).all(|w| w[1] <= w[0] + 1e-12), "{f:?}");
         assert!(f[20].abs() < 1e-12);
+        // The values docs/statics.md §8 quotes (root, mid-span, hinge, the tip body's middle).
+        for (eta, v) in [(0.0, 0.9164), (0.5, 0.8891), (0.73, 0.8306), (0.865, 0.7314), (0.95, 0.5532)] {
+            assert!((ll.factor(eta, c) - v).abs() < 1e-4, "F({eta}) = {}", ll.factor(eta, c));
+        }
         let mean = f[..20].iter().sum::<f64>() / 20.0;
         let ar = 2.0 * s / c;
         assert!(mean < 1.0 / (1.0 + 2.0 / ar) && mean > 0.7, "mean {mean}");

@@ -115,6 +115,9 @@ pub struct CurveResult {
     pub points: Vec<(f64, f64, f64)>,
     /// RMS of model − experiment over 12–33 m/s, degrees.
     pub rms_deg: Option<f64>,
+    /// RMS of model − Healy's own model at that model's airspeeds in 12–33 m/s, degrees (none on
+    /// the flare-30° curve, which has no such model curve).
+    pub rms_vs_healy_deg: Option<f64>,
     /// Points without an equilibrium (their messages).
     pub failures: Vec<String>,
 }
@@ -190,7 +193,12 @@ fn problem(cases: &Path, stem: &str, reading: &Reading, f: Formulation) -> Resul
 }
 
 /// One curve of a reading against its experiment.
-fn curve(problem: &aeroelastic::Problem, f: Formulation, stem: &str, exp: &[(f64, f64)]) -> CurveResult {
+fn curve(
+    problem: &aeroelastic::Problem,
+    f: Formulation,
+    stem: &str,
+    (exp, healy): (&[(f64, f64)], Option<&[(f64, f64)]>),
+) -> CurveResult {
     let out = aeroelastic::statics::run_static(problem, f);
     let mut model: Vec<(f64, f64)> = out
         .points
@@ -202,8 +210,12 @@ fn curve(problem: &aeroelastic::Problem, f: Formulation, stem: &str, exp: &[(f64
     let mut failures: Vec<String> =
         out.points.iter().filter_map(|p| p.error.as_ref().map(|e| format!("{} m/s: {e}", p.airspeed))).collect();
     failures.extend(out.error);
-    let points: Vec<(f64, f64, f64)> = exp.iter().filter_map(|&(u, c)| interp(&model, u).map(|m| (u, c, m))).collect();
-    CurveResult { case: stem.into(), rms_deg: rms(&points), model, points, failures }
+    let against = |r: &[(f64, f64)]| -> Vec<(f64, f64, f64)> {
+        r.iter().filter_map(|&(u, c)| interp(&model, u).map(|m| (u, c, m))).collect()
+    };
+    let rms_vs_healy_deg = healy.and_then(|h| rms(&against(h)));
+    let points = against(exp);
+    CurveResult { case: stem.into(), rms_deg: rms(&points), rms_vs_healy_deg, model, points, failures }
 }
 
 /// Every reading of the experiment with formulation `f` (cases and references under `cases`).
@@ -219,8 +231,8 @@ pub fn run(cases: &Path, f: Formulation) -> Result<Vec<ReadingResult>, Error> {
             let curves: Vec<CurveResult> = CASES
                 .par_iter()
                 .zip(&problems)
-                .zip(&refs.experiment)
-                .map(|((stem, p), exp)| curve(p, f, stem, exp))
+                .enumerate()
+                .map(|(k, (stem, p))| curve(p, f, stem, (&refs.experiment[k], refs.healy.get(k).map(Vec::as_slice))))
                 .collect();
             let (per_5deg, level_pitch, level_failures) = pitch_measures(&problems[0], f, &curves, &refs);
             Ok(ReadingResult { reading, curves, per_5deg, level_pitch, level_failures })
@@ -307,7 +319,8 @@ fn level_rms(v: &[(f64, f64, f64)]) -> Option<f64> {
 
 /// The CSV: one row per reading, measure, curve and airspeed
 /// (`reading,aero,polars,geometry,measure,curve,airspeed,model,experiment`; `measure` is
-/// `coast_deg`, `rms_deg` (airspeed empty), `per_5deg_pitch` or `level_pitch_deg`).
+/// `coast_deg`, `rms_deg` and `rms_vs_healy_model_deg` (airspeed empty), `per_5deg_pitch` or
+/// `level_pitch_deg`).
 pub fn to_csv(results: &[ReadingResult], healy: &HealyModel) -> String {
     let mut s = String::from("reading,aero,polars,geometry,measure,curve,airspeed,model,experiment\n");
     let aero = |a: Aero| serde_json::to_value(a).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
@@ -320,6 +333,9 @@ pub fn to_csv(results: &[ReadingResult], healy: &HealyModel) -> String {
                 let _ = writeln!(s, "{head},coast_deg,{},{u},{},{}", c.case, num(m), num(x));
             }
             let _ = writeln!(s, "{head},rms_deg,{},,{},", c.case, c.rms_deg.map_or(String::new(), num));
+            if let Some(r) = c.rms_vs_healy_deg {
+                let _ = writeln!(s, "{head},rms_vs_healy_model_deg,{},,{},", c.case, num(r));
+            }
         }
         for &(u, m, x) in &r.per_5deg {
             let _ = writeln!(s, "{head},per_5deg_pitch,flare10,{u},{},{}", num(m), num(x));
@@ -361,25 +377,29 @@ pub fn to_html(results: &[ReadingResult], healy: &HealyModel, f: Formulation) ->
     );
     h.push_str(
         "<table><tr><th>reading</th><th>flare 10°, pitch 0°</th><th>flare 10°, pitch 5°</th>\
-         <th>flare 30°, pitch 10°</th><th>Δ/5° (exp.)</th><th>level pitch RMS</th><th>failed points</th></tr>\n",
+         <th>flare 30°, pitch 10°</th><th>Δ/5° (exp.)</th><th>level pitch RMS</th>\
+         <th>against Healy's model (pitch 0° / 5°)</th><th>failed points</th></tr>\n",
     );
     for r in results {
         let (m, x) = mean_from(&r.per_5deg);
         let failed: usize = r.curves.iter().map(|c| c.failures.len()).sum::<usize>() + r.level_failures.len();
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td>{}°</td><td>{}°</td><td>{}°</td><td>{m:.1}° ({x:.1}°)</td><td>{}°</td><td>{failed}</td></tr>",
+            "<tr><td>{}</td><td>{}°</td><td>{}°</td><td>{}°</td><td>{m:.1}° ({x:.1}°)</td><td>{}°</td>\
+             <td>{}° / {}°</td><td>{failed}</td></tr>",
             r.reading.label(),
             cell(r.curves[0].rms_deg, 1),
             cell(r.curves[1].rms_deg, 1),
             cell(r.curves[2].rms_deg, 1),
             cell(level_rms(&r.level_pitch), 2),
+            cell(r.curves[0].rms_vs_healy_deg, 1),
+            cell(r.curves[1].rms_vs_healy_deg, 1),
         );
     }
     let (m, x) = mean_from(&healy.per_5deg);
     let _ = writeln!(
         h,
-        "<tr><td>Healy's own model (strip theory)</td><td>{}°</td><td>{}°</td><td>–</td><td>{m:.1}° ({x:.1}°)</td><td>{}°</td><td></td></tr></table>",
+        "<tr><td>Healy's own model (strip theory)</td><td>{}°</td><td>{}°</td><td>–</td><td>{m:.1}° ({x:.1}°)</td><td>{}°</td><td>–</td><td></td></tr></table>",
         cell(healy.rms_deg[0], 1),
         cell(healy.rms_deg[1], 1),
         cell(level_rms(&healy.level_pitch), 2)
@@ -419,11 +439,55 @@ fn per_airspeed_html(h: &mut String, results: &[ReadingResult], healy: &HealyMod
     }
 }
 
-/// Write `healy_readings.csv` and the report's section into `out`.
+/// The coast angle of every geometry-1 reading on curve `k`, with the experiment and Healy's
+/// own model, into `path` (SVG).
+fn plot_curve(path: &Path, k: usize, results: &[ReadingResult], refs: &References) -> Result<(), Error> {
+    use crate::static_out::Style;
+    use plotters::style::RGBColor;
+    const COLOURS: [RGBColor; 3] = [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(148, 103, 189)];
+    let mut curves: crate::static_out::Curves = results
+        .iter()
+        .filter(|r| r.reading.geometry == 1)
+        .map(|r| {
+            let colour = COLOURS[r.reading.aero as usize];
+            let style = if r.reading.polars { Style::Dashed } else { Style::Solid };
+            (r.reading.label().replace(", geometry 1", ""), colour, r.curves[k].model.clone(), style)
+        })
+        .collect();
+    curves.push(("experiment".into(), RGBColor(30, 30, 30), refs.experiment[k].clone(), Style::Points));
+    if let Some(h) = refs.healy.get(k) {
+        let band: Vec<(f64, f64)> = h.iter().copied().filter(|p| (11.0..=34.0).contains(&p.0)).collect();
+        curves.push(("Healy's own model".into(), RGBColor(44, 160, 44), band, Style::Points));
+    }
+    let title = ["flare 10°, pitch 0°", "flare 10°, pitch 5°", "flare 30°, pitch 10°"][k];
+    crate::static_out::panel(
+        path,
+        &format!("Healy {title}: coast angle by reading"),
+        "airspeed [m/s]",
+        "fold angle [deg] (tip up +)",
+        &curves,
+    )
+}
+
+/// Write `healy_readings.csv`, the coast-angle figures `healy_readings_<case>.svg` and the
+/// report's section into `out` (cases and references under `cases`).
 ///
 /// # Errors
-/// A file that cannot be written.
-pub fn write(out: &Path, results: &[ReadingResult], healy: &HealyModel, f: Formulation) -> Result<(), Error> {
+/// A file that cannot be written or a reference that cannot be read.
+pub fn write(
+    out: &Path,
+    cases: &Path,
+    results: &[ReadingResult],
+    healy: &HealyModel,
+    f: Formulation,
+) -> Result<(), Error> {
     write_file(&out.join("healy_readings.csv"), &to_csv(results, healy))?;
-    write_file(&out.join(SECTION_FILE), &to_html(results, healy, f))
+    let refs = read_references(cases)?;
+    let mut html = to_html(results, healy, f);
+    for (k, stem) in CASES.iter().enumerate() {
+        let file = format!("healy_readings_{stem}.svg");
+        plot_curve(&out.join(&file), k, results, &refs)?;
+        let _ = writeln!(html, "<figure><img src=\"{file}\" alt=\"coast angle by reading, {stem}\"></figure>");
+    }
+    write_file(&out.join(SECTION_FILE), &html)
 }

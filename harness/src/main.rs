@@ -886,7 +886,7 @@ fn healy_readings(cases: &Path, out: &Path, f: Formulation) -> Result<bool> {
     let t = std::time::Instant::now();
     let results = hr::run(cases, f)?;
     let healy = hr::healy_model(cases)?;
-    hr::write(out, &results, &healy, f)?;
+    hr::write(out, cases, &results, &healy, f)?;
     let mut failed = false;
     for r in &results {
         let rms: Vec<String> = r.curves.iter().map(|c| c.rms_deg.map_or("-".into(), |x| format!("{x:.2}"))).collect();
