@@ -42,12 +42,12 @@ pub fn fold_at(case: &Problem, f: Formulation, airspeed: f64, pitch_deg: f64) ->
 
 /// The root pitch at which the fold of `case` is zero at `airspeed` (formulation `f`), within
 /// `tol_deg` of fold, from two known points `(pitch, fold)` (degrees): secant steps (each
-/// limited to ±10° and to ±[`MAX_PITCH_DEG`]), then the Illinois variant of regula falsi once a
+/// limited to ±10° and to ±30°), then the Illinois variant of regula falsi once a
 /// sign change brackets the root.
 ///
 /// # Errors
 /// A static solution that fails, a search that leaves the pitch range or does not converge in
-/// [`MAX_SOLVES`] solutions.
+/// 12 solutions.
 pub fn level_pitch(
     case: &Problem,
     f: Formulation,

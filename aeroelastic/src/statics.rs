@@ -36,6 +36,10 @@ use crate::polar_correction::{StripPolars, StripReport};
 use crate::problem::{Formulation, Problem};
 use crate::strip_statics::StripStatics;
 
+/// What turns a lattice solve into station loads besides the lattice: the section polars'
+/// correction, or the static strips in its place, each with the factor on its Reynolds numbers.
+type Sources<'a> = (Option<(&'a StripPolars, f64)>, Option<(&'a StripStatics, f64)>);
+
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
     uv: uvlm::Uvlm,
@@ -101,8 +105,7 @@ impl SteadyAero {
         q: &[f64],
         map: &[StationMap],
         aero: &AeroSettings,
-        polars: Option<(&StripPolars, f64)>,
-        strips: Option<(&StripStatics, f64)>,
+        (polars, strips): Sources<'_>,
         out: &mut [SectionLoad],
     ) -> Result<(), String> {
         stations_at(model, q, &self.zeros, map, aero, None, &mut self.scratch, &mut self.stations, &mut self.vel);
@@ -358,7 +361,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         let re_factor = self.reynolds_airspeed.map_or(1.0, |u| u / self.speed2.sqrt());
         let polars = self.polars.as_ref().map(|p| (p, re_factor));
         let strips = self.strips.as_ref().map(|s| (s, re_factor));
-        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, polars, strips, out) {
+        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, (polars, strips), out) {
             Ok(()) => true,
             Err(e) => {
                 *lock(&self.error) = Some(e);
@@ -494,7 +497,8 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         self.load_part(t, q, &loads_q, &zeros, &mut scratch, &mut tg.r0);
         // The strips are cheap: a central difference (second order) instead of a forward one.
         let central = self.strips.is_some();
-        let mut back = if central { vec![0.0; n] } else { Vec::new() };
+        // The backward loads of a central difference; the forward difference's base otherwise.
+        let mut back = if central { vec![0.0; n] } else { tg.r0.clone() };
         for j in 0..n {
             let h = self.fd_step / read(&self.model).increment_weight(j).max(1e-12);
             let ok = self.load_part_at(t, q, j, h, tg, &zeros, &mut scratch)
@@ -504,13 +508,10 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
                     std::mem::swap(&mut tg.r1, &mut back);
                     ok
                 });
-            for i in 0..n {
+            let step = if central { 2.0 * h } else { h };
+            for (i, (r1, b)) in tg.r1.iter().zip(&back).enumerate() {
                 // A column that failed keeps the structural tangent alone.
-                tg.k[i * n + j] = match (ok, central) {
-                    (false, _) => 0.0,
-                    (true, false) => (tg.r1[i] - tg.r0[i]) / h,
-                    (true, true) => (tg.r1[i] - back[i]) / (2.0 * h),
-                };
+                tg.k[i * n + j] = if ok { (r1 - b) / step } else { 0.0 };
             }
         }
         tg.speed2 = self.speed2;

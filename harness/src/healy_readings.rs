@@ -35,6 +35,9 @@ const POLARS: &str =
 /// `hinge_line_y = le_offset − chord/2 = −0.020 m`.
 const GEOMETRY_2: [&str; 3] = ["aero.chord=0.08", "aero.le_offset=0.02", "joints.1.hinge_line_y=-0.02"];
 
+/// A point of a curve: airspeed (m/s), coast angle (degrees).
+type Point = (f64, f64);
+
 /// The aerodynamics of a reading.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -197,7 +200,7 @@ fn curve(
     problem: &aeroelastic::Problem,
     f: Formulation,
     stem: &str,
-    (exp, healy): (&[(f64, f64)], Option<&[(f64, f64)]>),
+    (exp, healy): (&[Point], Option<&[Point]>),
 ) -> CurveResult {
     let out = aeroelastic::statics::run_static(problem, f);
     let mut model: Vec<(f64, f64)> = out
