@@ -123,11 +123,15 @@ impl StripStatics {
         if aero.strip_tip_loss == TipLoss::LiftingLine {
             for r in crate::lifting::surface_ranges(map) {
                 let st = &map[r.clone()];
+                // A surface has a strip only between two stations.
                 let (Some(first), Some(last)) = (st.first(), st.last()) else { continue };
+                if st.len() < 2 {
+                    continue;
+                }
                 let (a0, span) = (first.arc, last.arc - first.arc);
                 let chord = |eta: f64| {
                     let s = a0 + eta * span;
-                    let k = st.partition_point(|m| m.arc < s).clamp(1, st.len().max(2) - 1);
+                    let k = st.partition_point(|m| m.arc < s).clamp(1, st.len() - 1);
                     let (p, q) = (&st[k - 1], &st[k]);
                     let w = if q.arc > p.arc { ((s - p.arc) / (q.arc - p.arc)).clamp(0.0, 1.0) } else { 0.0 };
                     p.planform_chord + w * (q.planform_chord - p.planform_chord)
