@@ -98,14 +98,21 @@ pub struct AeroSettings {
     /// `polars`; default 1.5e-5 (air near 20 °C).
     #[cfg_attr(feature = "serde", serde(default = "default_kinematic_viscosity"))]
     pub kinematic_viscosity: f64,
-    /// The time march's aerodynamics: `"uvlm"` (default, the lattice and its wake) or `"strip"`
-    /// (quasi-steady thin-aerofoil strips at the span stations, no wake: docs/coupling.md §9).
-    /// Statics, stability and gust use the lattice whatever this says.
+    /// The time march's and the statics' aerodynamics: `"uvlm"` (default, the lattice and its
+    /// wake) or `"strip"` (quasi-steady thin-aerofoil strips at the span stations, no wake:
+    /// docs/coupling.md §9; in the statics the steady strips of `strip_statics.rs`, with the
+    /// section polars and `strip_tip_loss`, docs/statics.md §8). Stability (its own
+    /// `stability.aerodynamics`), gust and trim use the lattice whatever this says.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "AeroModel::is_uvlm"))]
     pub model: AeroModel,
     /// Lift slope of the strips of `model: "strip"`, 1/rad. Default 2π.
     #[cfg_attr(feature = "serde", serde(default = "default_lift_slope"))]
     pub strip_lift_slope: f64,
+    /// The static strips' tip loss (`model: "strip"`, statics only): `"none"` (default: every
+    /// strip two-dimensional) or `"lifting_line"` (each strip's incidence scaled by the
+    /// lifting-line factor of its planform, docs/statics.md §8).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "TipLoss::is_none"))]
+    pub strip_tip_loss: TipLoss,
     /// Trailing-edge control surfaces (at most 16): flaps over span ranges of bodies, at a fixed
     /// deflection or a schedule in time (docs/case-file.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
@@ -129,6 +136,28 @@ impl AeroModel {
     /// Whether this is the default.
     pub fn is_uvlm(&self) -> bool {
         *self == AeroModel::Uvlm
+    }
+}
+
+/// The tip loss of the static strips (`aero.strip_tip_loss`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum TipLoss {
+    /// Two-dimensional strips.
+    #[default]
+    None,
+    /// Prandtl's lifting line (Glauert's series) on the flat planform mirrored at its root: each
+    /// strip's incidence times the ratio of its lifting-line lift to its two-dimensional lift
+    /// at a uniform incidence.
+    LiftingLine,
+}
+
+impl TipLoss {
+    /// Whether this is the default (no tip loss).
+    pub fn is_none(&self) -> bool {
+        *self == TipLoss::None
     }
 }
 

@@ -321,6 +321,7 @@ pub fn run_formulation_observed(problem: &Problem, f: Formulation, observer: &mu
         fn run<M: BuildModel>(self) -> Self::Output {
             let Run { problem, f, observer } = self;
             let model_error = |msg: String| Error::Model { formulation: f, msg };
+            crate::section_polars::refuse_tip_loss(problem, "time march").map_err(model_error)?;
             if problem.initial.is_trim() {
                 return from_trim::<M>(problem, f, observer);
             }

@@ -21,7 +21,9 @@ pub mod gust;
 pub mod gust_field;
 pub mod gust_linear;
 pub mod gust_settings;
+pub mod hinge_line;
 pub mod interrupt;
+pub mod level_coast;
 pub mod lifting;
 pub mod loads;
 pub mod pencil;
@@ -35,6 +37,7 @@ pub mod stability_settings;
 pub mod static_hold;
 pub mod statics;
 pub mod strip_march;
+pub mod strip_statics;
 pub mod thrust;
 pub mod trim;
 

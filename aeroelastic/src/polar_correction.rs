@@ -63,6 +63,16 @@ impl StripPolars {
         }))
     }
 
+    /// The polar of body `body`, if it has one.
+    pub fn polar_of(&self, body: usize) -> Option<&aerofoil::Polar> {
+        self.by_body.get(body).and_then(Option::as_deref)
+    }
+
+    /// The air's kinematic viscosity, m²/s.
+    pub fn kinematic_viscosity(&self) -> f64 {
+        self.kinematic_viscosity
+    }
+
     /// Correct the station loads `out` (the lattice's, lumped to the stations) of the lattice
     /// solution `loads` on `stations` (driven as `map` says); `flow(p)` is the air velocity
     /// relative to the structure at the global point `p`, without the lattice's induction.
@@ -129,11 +139,6 @@ impl StripPolars {
             report.profile_drag += c.profile_drag();
         }
         Ok(())
-    }
-
-    /// The polar of body `body` (none: its strips are not corrected).
-    pub fn polar_of(&self, body: usize) -> Option<&aerofoil::Polar> {
-        self.by_body.get(body).and_then(Option::as_ref).map(|p| &**p)
     }
 
     /// Correct one strip of geometry `g` whose uncorrected force `force` (global, N; no moment

@@ -373,6 +373,16 @@ pub enum Joint {
         /// inactive while the hinge is `locked`).
         #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
         spring: Option<Spring>,
+        /// Where the hinge line crosses the chord at the parent's end station (`length` from its
+        /// start): the distance from the beam axis along the parent's end section's y axis
+        /// (towards the leading edge), m. Default 0: the hinge line passes through the beam axis
+        /// there. Otherwise the line through that point along the flare axis meets the beam axis
+        /// `−y tan β` further outboard, and the joint sits there: the parent is lengthened and the
+        /// child shortened by that much, the child's `start`, point masses and thrusts moved with
+        /// it, so that its outer end and its masses stay in place (docs/statics.md §6). Healy's
+        /// model code pivots the flare about mid-chord: `y = le_offset − chord/2`.
+        #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "is_zero"))]
+        hinge_line_y: f64,
     },
     /// The body's start section clamped to ground.
     Clamp {

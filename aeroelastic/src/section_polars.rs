@@ -121,11 +121,24 @@ pub fn polars_by_body(polars: &[BodyPolar], n_bodies: usize) -> Result<Vec<Optio
     Ok(out)
 }
 
-/// Why `analysis` cannot run `problem` with section polars: the statics, the time marches (the
-/// lattice's, the strip theory's, from a trim), the marched gust and the trim apply them
-/// (docs/section_aero.md §7); stability and the linear gust model do not yet, and running them
-/// would ignore the polars.
+/// Why `analysis` cannot run `problem` with a strip tip loss, which only the statics' strips
+/// apply (docs/statics.md §8).
+pub fn refuse_tip_loss(problem: &Problem, analysis: &str) -> Result<(), String> {
+    if problem.aero.as_ref().is_some_and(|a| !a.strip_tip_loss.is_none()) {
+        return Err(format!(
+            "aero.strip_tip_loss: only the statics' strips apply a tip loss; the {analysis} would ignore it \
+             (docs/statics.md §8)"
+        ));
+    }
+    Ok(())
+}
+
+/// Why `analysis` cannot run `problem` with section polars or a strip tip loss (which only the
+/// statics apply): the statics, the time marches (the lattice's, the strip theory's, from a
+/// trim), the marched gust and the trim apply the polars (docs/section_aero.md §7); stability and
+/// the linear gust model do not yet, and running them would ignore the polars.
 pub fn refuse_unwired(problem: &Problem, analysis: &str) -> Result<(), String> {
+    refuse_tip_loss(problem, analysis)?;
     let given = !problem.polars.is_empty() || problem.aero.as_ref().is_some_and(|a| !a.polars.is_empty());
     if given {
         return Err(format!(

@@ -29,10 +29,16 @@ use crate::Error;
 use formulation::Structure;
 
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
+use crate::aero_settings::AeroModel;
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::loads::{LoadModel, LoadScratch, WingLoads};
 use crate::polar_correction::{StripPolars, StripReport};
 use crate::problem::{Formulation, Problem};
+use crate::strip_statics::StripStatics;
+
+/// What turns a lattice solve into station loads besides the lattice: the section polars'
+/// correction, or the static strips in its place, each with the factor on its Reynolds numbers.
+type Sources<'a> = (Option<(&'a StripPolars, f64)>, Option<(&'a StripStatics, f64)>);
 
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
@@ -61,6 +67,7 @@ impl SteadyAero {
         aero: &AeroSettings,
         v_inf: [f64; 3],
         wake: uvlm::SteadyWake,
+        lattice: bool,
     ) -> Result<Self, String> {
         let mut s = Self {
             uv: placeholder_uvlm()?,
@@ -76,27 +83,36 @@ impl SteadyAero {
             report: StripReport::default(),
         };
         stations_at(model, q, &s.zeros, map, aero, None, &mut s.scratch, &mut s.stations, &mut s.vel);
+        s.ranges = crate::lifting::surface_ranges(map);
+        if !lattice {
+            // The static strips need the stations only (a folded tip is no lattice's concern).
+            return Ok(s);
+        }
         let mut params = aero.uvlm_params(v_inf);
         params.steady_wake = wake;
         s.uv = crate::lifting::new_uvlm(map, aero, &s.stations, params)
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        s.ranges = crate::lifting::surface_ranges(map);
         Ok(s)
     }
 
     /// Station loads of the steady solution on the lattice of `model` at `q`, into `out`,
     /// corrected by the section polars `polars` (the structure at rest: each strip sees the free
-    /// stream).
+    /// stream); or with `strips`, the static strips' loads instead of the lattice's (their
+    /// Reynolds numbers scaled by the factor beside them).
     fn loads_at<S: Structure>(
         &mut self,
         model: &S,
         q: &[f64],
         map: &[StationMap],
         aero: &AeroSettings,
-        polars: Option<(&StripPolars, f64)>,
+        (polars, strips): Sources<'_>,
         out: &mut [SectionLoad],
     ) -> Result<(), String> {
         stations_at(model, q, &self.zeros, map, aero, None, &mut self.scratch, &mut self.stations, &mut self.vel);
+        if let Some((st, re_factor)) = strips {
+            self.n_solves += 1;
+            return st.loads(&self.stations, (map, aero), re_factor, out, &mut self.report);
+        }
         crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, None)
             .map_err(|e| format!("aerodynamic lattice: {e}"))?;
         self.uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
@@ -169,6 +185,8 @@ pub struct AeroStatic<'a, S: Structure> {
     polars: Option<StripPolars>,
     /// The airspeed whose Reynolds numbers the polars are read at (none: the current one).
     reynolds_airspeed: Option<f64>,
+    /// The static strips that replace the lattice (`aero.model: "strip"`; none: the lattice).
+    strips: Option<StripStatics>,
 }
 
 impl<'a, S: Structure> AeroStatic<'a, S> {
@@ -183,7 +201,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         span: f64,
     ) -> Result<Self, String> {
         let v = aero.free_stream();
-        let st = SteadyAero::new(&model, q, map, aero, v, wake)?;
+        let st = SteadyAero::new(&model, q, map, aero, v, wake, true)?;
         let n = model.n_dof();
         let loads: Vec<SectionLoad> = map
             .iter()
@@ -215,7 +233,22 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
             fd_step: 1e-7 * span.max(1e-3),
             polars: None,
             reynolds_airspeed: None,
+            strips: None,
         })
+    }
+
+    /// Replace the lattice by the static strips `strips` from now on (none: the lattice). Their
+    /// aerodynamic stiffness is a central difference of the strips' generalised load (cheap: no
+    /// lattice solve), refreshed at every round of Newton iterations.
+    pub fn set_strips(&mut self, strips: Option<StripStatics>) {
+        self.strips = strips;
+        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).valid = false;
+        self.begin_solve(true);
+    }
+
+    /// Whether the static strips replace the lattice.
+    pub fn has_strips(&self) -> bool {
+        self.strips.is_some()
     }
 
     /// Correct the lattice's loads by the section polars `polars` from now on (none: the
@@ -259,7 +292,8 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     fn rebuild_lattice(&mut self, q: &[f64]) -> Result<(), String> {
         let v = self.aero.free_stream();
         let solves = lock(&self.aero_state).n_solves;
-        let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake)?;
+        let lattice = self.strips.is_none();
+        let mut st = SteadyAero::new(&*read(&self.model), q, self.map, &self.aero, v, self.wake, lattice)?;
         st.n_solves = solves;
         *lock(&self.aero_state) = st;
         self.speed2 = v.iter().map(|x| x * x).sum();
@@ -326,7 +360,8 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         let model = read(&self.model);
         let re_factor = self.reynolds_airspeed.map_or(1.0, |u| u / self.speed2.sqrt());
         let polars = self.polars.as_ref().map(|p| (p, re_factor));
-        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, polars, out) {
+        let strips = self.strips.as_ref().map(|s| (s, re_factor));
+        match lock(&self.aero_state).loads_at(&*model, q, self.map, &self.aero, (polars, strips), out) {
             Ok(()) => true,
             Err(e) => {
                 *lock(&self.error) = Some(e);
@@ -420,6 +455,29 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         }
     }
 
+    /// The generalised aerodynamic load at `q` moved by `h` along coordinate `j`, into `tg.r1`;
+    /// false when the aerodynamics failed there.
+    #[allow(clippy::too_many_arguments)] // the point, the step and the work buffers
+    fn load_part_at(
+        &self,
+        t: f64,
+        q: &[f64],
+        j: usize,
+        h: f64,
+        tg: &mut AeroTangent,
+        zeros: &[f64],
+        scratch: &mut [f64],
+    ) -> bool {
+        tg.dq.iter_mut().for_each(|x| *x = 0.0);
+        tg.dq[j] = h;
+        read(&self.model).retract_inplace(q, &tg.dq, &mut tg.q_tmp);
+        if !self.station_loads(&tg.q_tmp, &mut tg.loads) {
+            return false;
+        }
+        self.load_part(t, &tg.q_tmp, &tg.loads, zeros, scratch, &mut tg.r1);
+        true
+    }
+
     /// Decide whether to refresh the aerodynamic stiffness at `q`, and do it: the forward
     /// difference of the whole generalised aerodynamic load, so that both the lattice's
     /// response and the way a formulation applies a station load (ANCF's moments through the
@@ -437,21 +495,23 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         let mut scratch = vec![0.0; n];
         let loads_q = lock(&self.loads).clone();
         self.load_part(t, q, &loads_q, &zeros, &mut scratch, &mut tg.r0);
+        // The strips are cheap: a central difference (second order) instead of a forward one.
+        let central = self.strips.is_some();
+        // The backward loads of a central difference; the forward difference's base otherwise.
+        let mut back = if central { vec![0.0; n] } else { tg.r0.clone() };
         for j in 0..n {
             let h = self.fd_step / read(&self.model).increment_weight(j).max(1e-12);
-            tg.dq.iter_mut().for_each(|x| *x = 0.0);
-            tg.dq[j] = h;
-            read(&self.model).retract_inplace(q, &tg.dq, &mut tg.q_tmp);
-            if !self.station_loads(&tg.q_tmp, &mut tg.loads) {
-                // Keep the structural tangent alone in this column.
-                for i in 0..n {
-                    tg.k[i * n + j] = 0.0;
-                }
-                continue;
-            }
-            self.load_part(t, &tg.q_tmp, &tg.loads, &zeros, &mut scratch, &mut tg.r1);
-            for i in 0..n {
-                tg.k[i * n + j] = (tg.r1[i] - tg.r0[i]) / h;
+            let ok = self.load_part_at(t, q, j, h, tg, &zeros, &mut scratch)
+                && (!central || {
+                    std::mem::swap(&mut tg.r1, &mut back);
+                    let ok = self.load_part_at(t, q, j, -h, tg, &zeros, &mut scratch);
+                    std::mem::swap(&mut tg.r1, &mut back);
+                    ok
+                });
+            let step = if central { 2.0 * h } else { h };
+            for (i, (r1, b)) in tg.r1.iter().zip(&back).enumerate() {
+                // A column that failed keeps the structural tangent alone.
+                tg.k[i * n + j] = if ok { (r1 - b) / step } else { 0.0 };
             }
         }
         tg.speed2 = self.speed2;
@@ -659,6 +719,11 @@ pub fn equilibrium_at(
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
     let mut c = case.clone();
     c.statics = Some(crate::problem::StaticSettings::at(vec![aero.speed()], Some(wake)));
+    // Stability and gust linearise about the lattice's equilibrium whatever `aero.model` says
+    // (the static strips are the statics' diagnostic).
+    if let Some(a) = c.aero.as_mut() {
+        a.model = AeroModel::Uvlm;
+    }
     let out = run_static(&c, f);
     if let Some(e) = out.error {
         return Err(e);
@@ -844,9 +909,18 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
         Ok(s) => s,
         Err(e) => return failed_output(case, f, e),
     };
-    match StripPolars::of(case) {
-        Ok(p) => sys.set_polars(p),
+    let polars = match StripPolars::of(case) {
+        Ok(p) => p,
         Err(e) => return failed_output(case, f, e),
+    };
+    if aero.model == AeroModel::Strip {
+        // The strips read the polars themselves; the lattice's correction stays off.
+        match StripStatics::new(&map, aero, polars) {
+            Ok(s) => sys.set_strips(Some(s)),
+            Err(e) => return failed_output(case, f, e),
+        }
+    } else {
+        sys.set_polars(polars);
     }
     let mut solver = StaticSolver::new(&sys, static_params());
     let mut x = StaticSolution::guess(&sys, &q_ref);
@@ -1114,10 +1188,16 @@ pub(crate) fn point_at<S: Structure>(
     let v_inf = sys.aero.free_stream();
     let lift_dir = lift_direction(v_inf);
     let report = sys.strip_report();
-    let total = Vector3::from(uv_loads.total_force()) + report.total_delta;
+    let qdyn = 0.5 * rho * airspeed * airspeed;
+    // The static strips have no lattice: their report holds each strip's whole force.
+    let (total, strips) = if sys.has_strips() {
+        (report.total_delta, crate::strip_statics::strip_rows(map, &stations, &report, lift_dir, qdyn))
+    } else {
+        let total = Vector3::from(uv_loads.total_force()) + report.total_delta;
+        (total, strips_of(map, &stations, &uv_loads, &report, lift_dir, qdyn))
+    };
     let lift = total.dot(&lift_dir);
     let drag = total.dot(&Vector3::from(v_inf).normalize());
-    let strips = strips_of(map, &stations, &uv_loads, &report, lift_dir, 0.5 * rho * airspeed * airspeed);
     StaticPoint {
         airspeed,
         sideslip_deg: sys.sideslip_deg(),

@@ -486,6 +486,9 @@ pub(crate) fn trim_with<M: BuildModel>(base: &Problem, f: Formulation, t: &TrimS
     if let Err(e) = t.validate(base) {
         return failed(base, f, e);
     }
+    if let Err(e) = crate::section_polars::refuse_tip_loss(base, "trim") {
+        return failed(base, f, e);
+    }
     let Some(root) = free_body(base) else { return failed(base, f, "no free body".into()) };
     let x0 = first_guess(base, t);
     let p0 = held_problem(base, t, x0);

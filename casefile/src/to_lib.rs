@@ -7,8 +7,15 @@ use super::{Case, Formulation, RunSpec, StaticSettings};
 impl Case {
     /// The typed problem of this case for the analyses of [`aeroelastic`]: its structure, both
     /// formulations' settings and its aerodynamic, static, stability and gust settings (the
-    /// references, gate, sweep, convergence study and VTK output stay with the case).
+    /// references, gate, sweep, convergence study and VTK output stay with the case). Every
+    /// flared hinge's joint is placed on its hinge line (`hinge_line_y`,
+    /// [`Problem::with_hinge_lines`]).
     pub fn problem(&self) -> Problem {
+        self.problem_as_written().with_hinge_lines()
+    }
+
+    /// The problem with the bodies as the case writes them (the hinge lines not yet placed).
+    pub(crate) fn problem_as_written(&self) -> Problem {
         Problem {
             name: self.name.clone(),
             bodies: self.bodies.clone(),

@@ -339,6 +339,7 @@ impl Case {
                 Joint::Clamp { body: b, .. } | Joint::Free { body: b, .. } => body(format!("joints[{i}].body"), b)?,
             }
         }
+        self.problem_as_written().check_hinge_lines().map_err(|(field, msg)| format!("{field}: {msg}"))?;
         for (k, t) in self.thrust.iter().enumerate() {
             // the scene names the rest (`thrust[k].at`, `.direction`, `.magnitude`)
             body(format!("thrust[{k}].body"), &t.body)?;
@@ -483,6 +484,11 @@ impl Case {
             _ => {}
         }
         sideslip("aero.sideslip_deg", a.sideslip_deg)?;
+        if !a.strip_tip_loss.is_none() && a.model != aeroelastic::aero_settings::AeroModel::Strip {
+            return Err("aero.strip_tip_loss: a tip loss of the strips needs aero.model \"strip\" (the lattice has \
+                        its own three-dimensional flow)"
+                .into());
+        }
         if a.n_chordwise == 0 {
             return Err("aero.n_chordwise: must be at least 1".into());
         }

@@ -19,6 +19,7 @@ pub mod energy;
 pub mod fuzz;
 pub mod gate;
 pub mod gust_out;
+pub mod healy_readings;
 pub mod merge;
 pub mod metrics;
 pub mod plot;

@@ -278,6 +278,18 @@ struct BenchArgs {
     out: OutOpt,
 }
 
+/// `harness healy-readings`.
+#[derive(Args)]
+struct ReadingsArgs {
+    #[command(flatten)]
+    cases: CaseSource,
+    #[command(flatten)]
+    out: OutOpt,
+    /// Formulation (ANCF and GEBF agree on these equilibria to 1e-3°; one is enough).
+    #[arg(long, value_parser = Which::parser(), default_value = "gebf")]
+    formulation: Which,
+}
+
 /// `harness merge`.
 #[derive(Args)]
 struct MergeArgs {
@@ -327,6 +339,10 @@ enum Cmd {
     /// `aero`, the equilibria under its `static.point_loads` at `static.load_factors`); writes
     /// `<out>/<case>/static_{ancf,gebf}.csv`, `static_lift_*.csv`, `static_summary.json` and plots.
     Static(AnalysisArgs),
+    /// Healy's experiment under every reading of issue 37 (lattice / strips / strips with tip
+    /// loss × polars × geometry): RMS per curve, coast-angle change per 5° of pitch and the
+    /// level-coast pitch; writes `<out>/healy_readings.csv` and the report's section.
+    HealyReadings(ReadingsArgs),
     /// Merge the outputs of the shards of a sweep (`--shard`) into one report and summary; exits 1
     /// naming the runs no shard finished.
     Merge(MergeArgs),
@@ -858,6 +874,37 @@ fn cmd_static(a: &AnalysisArgs) -> Result<ExitCode> {
     })
 }
 
+/// `harness healy-readings`: the table of readings of Healy's experiment (exit 2 when a case
+/// file or reference is unreadable, 1 when a point of a reading failed).
+fn cmd_healy_readings(a: &ReadingsArgs) -> Result<ExitCode> {
+    let Some(&f) = a.formulation.formulations().first().filter(|_| a.formulation.formulations().len() == 1) else {
+        eprintln!("error: --formulation: give one formulation (ancf or gebf)");
+        return Ok(ExitCode::from(2));
+    };
+    let failed = healy_readings(&a.cases.cases, &a.out.out, f)?;
+    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// Compute and write the Healy readings; print the table; true when a point failed.
+fn healy_readings(cases: &Path, out: &Path, f: Formulation) -> Result<bool> {
+    use harness::healy_readings as hr;
+    let t = std::time::Instant::now();
+    let results = hr::run(cases, f)?;
+    let healy = hr::healy_model(cases)?;
+    hr::write(out, cases, &results, &healy, f)?;
+    let mut failed = false;
+    for r in &results {
+        let rms: Vec<String> = r.curves.iter().map(|c| c.rms_deg.map_or("-".into(), |x| format!("{x:.2}"))).collect();
+        println!("healy reading {}: RMS {} deg", r.reading.label(), rms.join(" / "));
+        for e in r.curves.iter().flat_map(|c| &c.failures).chain(&r.level_failures) {
+            failed = true;
+            println!("  FAILED: {e}");
+        }
+    }
+    println!("healy readings: {:.1} s; wrote {}", t.elapsed().as_secs_f64(), out.join("healy_readings.csv").display());
+    Ok(failed)
+}
+
 /// `harness stability`: every run of the case file through its stability sweep; exit 2 without a
 /// `stability` block, 1 when a point could not be analysed.
 fn cmd_stability(a: &AnalysisArgs) -> Result<ExitCode> {
@@ -1137,6 +1184,13 @@ fn all_analyses(
         harness::static_out::write(&out.join(&spec.name), &summary)?;
         n.static_failed += usize::from(report_static(&summary));
         println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+    }
+    // The readings of Healy's experiment (about a minute of CPU), where the three cases are.
+    let cases = &a.cases.cases;
+    let healy_here = harness::healy_readings::CASES.iter().all(|c| cases.join(format!("{c}.json")).is_file());
+    if !a.quick && p.plan.is_none() && healy_here {
+        progress.phase("the readings of Healy's experiment");
+        n.static_failed += usize::from(healy_readings(cases, out, Formulation::Gebf)?);
     }
     for spec in p.runs.iter().filter(|r| r.ancf.stability.is_some()) {
         progress.phase(&format!("stability sweep of {}", spec.name));
@@ -1461,6 +1515,7 @@ fn real_main() -> Result<ExitCode> {
         Cmd::Energy(a) => cmd_energy(a),
         Cmd::Bench(a) => cmd_bench(a),
         Cmd::Static(a) => cmd_static(a),
+        Cmd::HealyReadings(a) => cmd_healy_readings(a),
         Cmd::Merge(a) => cmd_merge(a),
         Cmd::Stability(a) => cmd_stability(a),
         Cmd::Gust(a) => cmd_gust(a),

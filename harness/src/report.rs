@@ -982,6 +982,15 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
             badge: None,
         });
     }
+    if let Ok(readings) = std::fs::read_to_string(out.join(crate::healy_readings::SECTION_FILE)) {
+        v.push(Section {
+            id: "healy-readings".into(),
+            title: "Healy's experiment: every reading".into(),
+            group: Group::Study,
+            html: readings,
+            badge: None,
+        });
+    }
     let stab = crate::stability_out::sections_html(out);
     if !stab.is_empty() {
         v.push(Section {

@@ -13,6 +13,7 @@ mod fuzz;
 mod gate;
 mod geometry;
 mod gust;
+mod healy_readings;
 mod honest;
 mod loads_lost;
 mod observer;
