@@ -196,7 +196,7 @@ impl LinearUvlm {
         let model = (&lats[..], &blocks[..], &p);
         let (force_gamma, force_gamma_dot, strip_gamma, strip_gamma_dot) = bound_derivatives(&mut fz, &mut ld, model);
         let rows = WakeRows { wakes: &wakes, closure, nrm: &nrm, n_rows: k_rows };
-        let (row_normalwash, force_row, strip_row) = rows.derivatives(&mut fz, &mut ld, model);
+        let [row_normalwash, force_row, strip_row] = rows.derivatives(&mut fz, &mut ld, model);
         Self {
             params: p,
             lattices: lats,
@@ -296,7 +296,7 @@ impl WakeRows<'_> {
         fz: &mut Frozen,
         ld: &mut LoadDerivative<'_>,
         model: (&[Lattice], &[SurfaceBlock], &UvlmParams),
-    ) -> (Vec<DMatrix<f64>>, Vec<DMatrix<f64>>, Vec<DMatrix<f64>>) {
+    ) -> [Vec<DMatrix<f64>>; 3] {
         let (lats, blocks, p) = model;
         let (nr, nf, n_cols) = (ld.gamma0.len(), ld.plus.len(), ld.g_te.len());
         let mut row_normalwash = Vec::with_capacity(self.n_rows);
@@ -328,6 +328,6 @@ impl WakeRows<'_> {
             force_row.push(f);
             strip_row.push(sf);
         }
-        (row_normalwash, force_row, strip_row)
+        [row_normalwash, force_row, strip_row]
     }
 }

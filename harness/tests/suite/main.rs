@@ -18,6 +18,7 @@ mod loads_lost;
 mod observer;
 mod planform;
 mod polars;
+mod polars_linear;
 mod properties;
 mod roll;
 mod send_sync;
