@@ -121,16 +121,16 @@ pub fn polars_by_body(polars: &[BodyPolar], n_bodies: usize) -> Result<Vec<Optio
     Ok(out)
 }
 
-/// Why `analysis` cannot run `problem` with section polars: the statics, the lattice's time march
-/// and the marched gust apply them (docs/section_aero.md §7); stability, the linear gust model,
-/// the trim, the march from a trim and the strip-theory march do not yet, and running them would
-/// ignore the polars.
+/// Why `analysis` cannot run `problem` with section polars: the statics, the lattice's time march,
+/// the marched gust, the lattice's stability and the linear gust model apply them
+/// (docs/section_aero.md §7); stability with Theodorsen strips, the trim, the march from a trim
+/// and the strip-theory march do not yet, and running them would ignore the polars.
 pub fn refuse_unwired(problem: &Problem, analysis: &str) -> Result<(), String> {
     let given = !problem.polars.is_empty() || problem.aero.as_ref().is_some_and(|a| !a.polars.is_empty());
     if given {
         return Err(format!(
-            "aero.polars: the section polars are wired into the statics and the lattice's time march (and so the \
-             marched gust) only so far; the {analysis} would ignore them (docs/section_aero.md §7)"
+            "aero.polars: the section polars are wired into the statics, the lattice's time march and the lattice's \
+             linear analyses only so far; the {analysis} would ignore them (docs/section_aero.md §7)"
         ));
     }
     Ok(())
