@@ -40,8 +40,11 @@ use formulation::Structure;
 use crate::aero::{SectionLoad, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::gust::Increments;
+use crate::polar_correction::{LinearCorrection, StripPolars};
 use crate::problem::{Formulation, Problem};
-use crate::stability::{MovedLattice, linear_wake, load_maps, lump, mode_step, reduce, zero_loads};
+use crate::stability::{
+    MovedLattice, linear_wake, load_maps, lump, mode_step, reduce, reference_correction, zero_loads,
+};
 
 type C64 = Complex<f64>;
 
@@ -94,8 +97,9 @@ fn run<S: Structure>(
     basis_modes: Option<usize>,
     wake_motion: bool,
 ) -> Result<LinearGustHistory, String> {
-    crate::section_polars::refuse_unwired(case, "linear gust model")?;
     let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    crate::section_polars::refuse_tip_loss(case, "linear gust model")?;
+    let polars = StripPolars::of(case)?;
     let spec = aero.gust.as_ref().ok_or("the case has no `aero.gust`")?;
     let map = station_map(case, aero)?;
     let v_inf = aero.free_stream();
@@ -107,8 +111,8 @@ fn run<S: Structure>(
     let settings = crate::factory::settings(case, f);
     let wake = linear_wake(case, f, u);
     let nb_req = basis_modes.or(case.stability.as_ref().and_then(|s| s.basis_modes)).unwrap_or(30);
-    let red =
-        reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, &map, aero, &wake, (nb_req, 0), None, None)?;
+    let lattice = (map.as_slice(), aero, polars.as_ref());
+    let red = reduce(build(case).map_err(|e| e.to_string())?, &q, &lam, &mu, lattice, &wake, (nb_req, 0), None, None)?;
     let nb = red.phi.ncols();
     let mut model = build(case).map_err(|e| e.to_string())?;
     let zero_loads = zero_loads(&map);
@@ -128,11 +132,14 @@ fn run<S: Structure>(
     let steady = uv.solve_steady().map_err(|e| format!("steady aerodynamics: {e}"))?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
     let f0: Vec<f64> = steady.nodal.iter().flatten().copied().collect();
-    let l0 = lump(&map, aero, &steady.positions, &origins, &f0);
+    let mut l0 = lump(&map, aero, &steady.positions, &origins, &f0);
+    if let Some(p) = &polars {
+        p.correct(&stations, &map, steady, |_, _| Vector3::from(v_inf), 1.0, &mut l0, &mut Default::default())?;
+    }
 
-    let (cl, h) = load_maps(&mut model, &q, &red.phi, (&map, aero), &zero_loads, &la, &origins)?;
+    let [cl, h, phi_p] = load_maps(&mut model, &q, &red.phi, (&map, aero), &zero_loads, &la, &origins)?;
     let mut outputs = Outputs { lm: settings.loads.as_ref(), fold: settings.fold_joint, ls: Default::default() };
-    let mut moved = MovedLattice::new(&la, &map, aero);
+    let mut moved = MovedLattice::new(&la, &map, aero, polars.as_ref());
     let d = mode_derivatives(&model, &q, &red.phi, &mut moved, &mut outputs, &l0)?;
     let yl = output_per_station_load(&model, &q, &mut outputs, &l0);
     let (nr, nf) = (la.n_rings(), la.n_force());
@@ -156,7 +163,12 @@ fn run<S: Structure>(
         drift_delays: Vec::new(),
         drift_r: DMatrix::zeros(nr, 0),
         drift_f: DMatrix::zeros(nf, 0),
+        strips: None,
     };
+    if let Some(p) = &polars {
+        let lc = reference_correction(p, &stations, &map, aero, &la)?;
+        parts.strips = Some(StripParts::new(&lc, &stations, &phi_p, (v_inf, u), front, gust_dir));
+    }
     if wake_motion {
         add_wake_motion(&mut parts, &la, &d.xte, (v_inf, u), front, gust_dir);
     }
@@ -247,9 +259,14 @@ fn mode_derivatives<S: Structure>(
         yv: DMatrix::zeros(N_OUT, nb),
         ya: DMatrix::zeros(N_OUT, nb),
     };
-    let mut eval = |qq: &[f64], vv: &[f64], with_vel: bool| -> Result<_, String> {
+    let eval = |moved: &mut MovedLattice<'_>, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<_, String> {
         let m = moved.at(model, qq, vv, with_vel)?;
         Ok((m.residual, flat(&m.loads), m.forces, m.te))
+    };
+    // The polars' correction of the station loads along a position or velocity, apart (its own
+    // step; the stations' loads, so no change of their application).
+    let correction = |moved: &mut MovedLattice<'_>, col: &[f64], velocity: bool| -> Result<_, String> {
+        Ok(moved.correction_pair(model, q, col, velocity)?.map(|c| diff(&flat(&c.plus), &flat(&c.minus), 0.5 / c.step)))
     };
     let span = chord.max(1e-3);
     let (mut qp, mut qm) = (vec![0.0; q.len()], vec![0.0; q.len()]);
@@ -260,16 +277,24 @@ fn mode_derivatives<S: Structure>(
         model.retract_inplace(q, &dq, &mut qp);
         let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
         model.retract_inplace(q, &dq, &mut qm);
-        let (r1, l1, f1, te1) = eval(&qp, &zeros, false)?;
-        let (r2, l2, f2, te2) = eval(&qm, &zeros, false)?;
+        let (r1, l1, f1, te1) = eval(moved, &qp, &zeros, false)?;
+        let (r2, l2, f2, te2) = eval(moved, &qm, &zeros, false)?;
         d.rx.set_column(i, &diff(&r1, &r2, 0.5 / eps));
         d.lx.set_column(i, &diff(&l1, &l2, 0.5 / eps));
+        if let Some(c) = correction(moved, &col, false)? {
+            let lx = d.lx.column(i) + c;
+            d.lx.set_column(i, &lx);
+        }
         d.fx.set_column(i, &diff(&f1, &f2, 0.5 / eps));
         d.xte.set_column(i, &diff(&te1, &te2, 0.5 / eps));
-        let (r1, l1, f1, _) = eval(q, &col, true)?;
-        let (r2, l2, f2, _) = eval(q, &neg, true)?;
+        let (r1, l1, f1, _) = eval(moved, q, &col, true)?;
+        let (r2, l2, f2, _) = eval(moved, q, &neg, true)?;
         d.rv.set_column(i, &diff(&r1, &r2, 0.5));
         d.lv.set_column(i, &diff(&l1, &l2, 0.5));
+        if let Some(c) = correction(moved, &col, true)? {
+            let lv = d.lv.column(i) + c;
+            d.lv.set_column(i, &lv);
+        }
         d.fv.set_column(i, &diff(&f1, &f2, 0.5));
         let (y1, y2) = (outputs.at(model, &qp, (&zeros, &zeros), l0), outputs.at(model, &qm, (&zeros, &zeros), l0));
         d.yx.set_column(i, &diff(&y1, &y2, 0.5 / eps));
@@ -329,9 +354,14 @@ fn add_wake_motion(
     let te_delay: Vec<f64> = te_nodes.iter().map(|x| vh.dot(&(Vector3::from(*x) - Vector3::from(front))) / u).collect();
     let n_rows = wd.residual.len();
     let (mut dr, mut df) = (DMatrix::zeros(nr, n_rows * n_te), DMatrix::zeros(nf, n_rows * n_te));
+    let n_s = if parts.strips.is_some() { wd.strip.first().map_or(0, DMatrix::nrows) } else { 0 };
+    let mut ds = DMatrix::zeros(n_s, n_rows * n_te);
     for k in 0..n_rows {
         parts.rw.push(&wd.residual[k] * xte);
         parts.fw.push(&wd.force[k] * xte);
+        if let Some(sp) = parts.strips.as_mut() {
+            sp.sw.push(&wd.strip[k] * xte);
+        }
         let tau = la.row_delays[k];
         for (j, &te_tau) in te_delay.iter().enumerate() {
             let c = k * n_te + j;
@@ -343,12 +373,18 @@ fn add_wake_motion(
                 for r in 0..nf {
                     df[(r, c)] += g * wd.force[k][(r, 3 * j + a)];
                 }
+                for r in 0..n_s {
+                    ds[(r, c)] += g * wd.strip[k][(r, 3 * j + a)];
+                }
             }
             parts.drift_delays.push(tau + te_tau);
         }
     }
     parts.drift_r = dr;
     parts.drift_f = df;
+    if let Some(sp) = parts.strips.as_mut() {
+        sp.drift = ds;
+    }
 }
 
 /// The lift of the nodal forces (`nf` components) as a row: their total along the lift
@@ -465,6 +501,74 @@ struct Parts {
     drift_delays: Vec<f64>,
     drift_r: DMatrix<f64>,
     drift_f: DMatrix<f64>,
+    /// The section polars' correction (none without polars).
+    strips: Option<StripParts>,
+}
+
+/// The section polars' strip correction in the linear gust model (docs/section_aero.md §7.7):
+/// the strip forces of the circulations, of the gust at fixed circulations and of the wake's
+/// motion change the station loads through each strip's lattice-force Jacobian (`K_c`), and the
+/// gust's velocity at each strip's quarter-chord midpoint changes its flow (`K_u`).
+struct StripParts {
+    /// `Φᵀ P` (modes × 6·stations).
+    phi_p: DMatrix<C64>,
+    /// `K_c` (6·stations × 3·strips) and `Φᵀ P K_c`.
+    kc: DMatrix<C64>,
+    hc: DMatrix<C64>,
+    /// Station loads per unit gust velocity at each strip (6·stations × strips), and each
+    /// strip's delay behind the gust's front.
+    flow: DMatrix<f64>,
+    flow_delays: Vec<f64>,
+    /// The wake's motion: per row, strip forces per mode; the gust's drift of its nodes, strip
+    /// forces per unit gust velocity (columns as `Parts::drift_f`).
+    sw: Vec<DMatrix<f64>>,
+    drift: DMatrix<f64>,
+    /// The lift per station load (1 × 6·stations).
+    lift: DMatrix<C64>,
+}
+
+impl StripParts {
+    /// The parts of the linearised correction `lc` on `stations`, the gust along `gust_dir` with
+    /// its front at `front` in the free stream `(v_inf, u)`.
+    fn new(
+        lc: &LinearCorrection,
+        stations: &[uvlm::SpanStation],
+        phi_p: &DMatrix<f64>,
+        (v_inf, u): ([f64; 3], f64),
+        front: [f64; 3],
+        gust_dir: Vector3<f64>,
+    ) -> Self {
+        let kc = lc.load_per_strip_force(stations);
+        let per_flow = lc.load_per_strip_flow(stations);
+        let vh = Vector3::from(v_inf) / u;
+        let points = lc.points();
+        let mut flow = DMatrix::zeros(per_flow.nrows(), points.len());
+        let mut flow_delays = vec![0.0; points.len()];
+        for (i, p) in points.iter().enumerate() {
+            let Some(p) = p else { continue };
+            flow.set_column(i, &(per_flow.columns(3 * i, 3) * gust_dir));
+            flow_delays[i] = vh.dot(&(p - Vector3::from(front))) / u;
+        }
+        let ns = stations.len();
+        let mut lift = DMatrix::zeros(1, 6 * ns);
+        for k in 0..ns {
+            for c in 0..3 {
+                let mut e = [0.0; 3];
+                e[c] = 1.0;
+                lift[(0, 6 * k + c)] = C64::from(uvlm::lift_drag_of(e, v_inf, [1.0, 0.0, 0.0]).0);
+            }
+        }
+        Self {
+            hc: (phi_p * &kc).map(C64::from),
+            phi_p: phi_p.map(C64::from),
+            kc: kc.map(C64::from),
+            flow,
+            flow_delays,
+            sw: Vec::new(),
+            drift: DMatrix::zeros(0, 0),
+            lift,
+        }
+    }
 }
 
 /// `Σ_k e^{−s τ_k} M_k`.
@@ -508,19 +612,57 @@ fn transfer(
     rhs.set_column(nb, &r_g);
     let x = lu.solve(&rhs).ok_or("the linear UVLM's normalwash matrix is singular")?;
     // Nodal forces of the circulations (δΓ = −N⁻¹ r) per η and per ŵ.
-    let fgam = -(la.force_matrix(s) * x);
+    let fgam = -(la.force_matrix(s) * &x);
     let f_eta_circ = fgam.columns(0, nb).into_owned();
     let f_wg = fgam.column(nb) + f_g;
     // D(s): the stability analysis's, −T N⁻¹ (R_x + s R_ẋ) being H times the circulations'
     // forces, plus the wake's motion (its residual in `f_eta_circ`, its forces `f_w`).
-    let d = red.structural(s) + &p.h * (&f_eta_circ + &f_w);
-    let eta = d.lu().solve(&(-(&p.h * &f_wg))).ok_or("the flutter matrix is singular")?;
+    let mut d = red.structural(s) + &p.h * (&f_eta_circ + &f_w);
+    let mut rhs = -(&p.h * &f_wg);
+    let strips = p.strips.as_ref().map(|sp| strip_terms(s, la, lg, p, sp, &x));
+    if let (Some(sp), Some((s_eta, s_wg, u_g))) = (&p.strips, &strips) {
+        d += &sp.hc * s_eta;
+        rhs -= &sp.hc * s_wg + &sp.phi_p * u_g;
+    }
+    let eta = d.lu().solve(&rhs).ok_or("the flutter matrix is singular")?;
     let f_eta_geo = p.fx.map(C64::from) + p.fv.map(|x| s * x) + &f_w;
     let nodal = &f_eta_circ * &eta + &f_wg + &f_eta_geo * &eta;
-    let station =
+    let mut station =
         &p.cl * (&f_eta_circ * &eta + &f_wg + &f_w * &eta) + (p.lx.map(C64::from) + p.lv.map(|x| s * x)) * &eta;
+    if let (Some(sp), Some((s_eta, s_wg, u_g))) = (&p.strips, &strips) {
+        station += &sp.kc * (s_eta * &eta + s_wg) + u_g;
+    }
     let y =
-        (p.yx.map(C64::from) + p.yv.map(|x| s * x) + p.ya.map(|x| s * s * x)) * &eta + p.yl.map(C64::from) * station;
-    let l = (&p.lift * nodal)[0];
+        (p.yx.map(C64::from) + p.yv.map(|x| s * x) + p.ya.map(|x| s * s * x)) * &eta + p.yl.map(C64::from) * &station;
+    // With polars the lift of the corrected station loads (the nodal forces' total without).
+    let l = match &p.strips {
+        Some(sp) => (&sp.lift * &station)[0],
+        None => (&p.lift * nodal)[0],
+    };
     Ok([y[0], y[1], y[2], y[3], l])
+}
+
+/// The strip forces of the polars' correction at `s` (`x` the circulations' solve per mode and
+/// per `ŵ`, `δΓ = −x`): per mode (circulations and the wake's motion), per `ŵ` (circulations,
+/// the gust at fixed circulations and its drift of the wake), and the station loads of the gust's
+/// velocity at the strips per `ŵ`.
+fn strip_terms(
+    s: C64,
+    la: &uvlm::LinearUvlm,
+    lg: &uvlm::LinearGust,
+    p: &Parts,
+    sp: &StripParts,
+    x: &DMatrix<C64>,
+) -> (DMatrix<C64>, DVector<C64>, DVector<C64>) {
+    let nb = x.ncols() - 1;
+    let sgam = -(la.strip_force_matrix(s) * x);
+    let mut s_eta = sgam.columns(0, nb).into_owned();
+    if !sp.sw.is_empty() {
+        s_eta += delayed_sum(s, &p.row_delays, &sp.sw, s_eta.nrows(), nb);
+    }
+    let mut s_wg = sgam.column(nb) + DVector::from_vec(lg.strip_force_at(s));
+    if !p.drift_delays.is_empty() {
+        s_wg += delayed_columns(s, &p.drift_delays, &sp.drift);
+    }
+    (s_eta, s_wg, delayed_columns(s, &sp.flow_delays, &sp.flow))
 }

@@ -12,7 +12,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use crate::aero::{SectionLoad, StationMap};
 use crate::problem::Problem;
@@ -93,6 +93,25 @@ impl StripPolars {
         out: &mut [SectionLoad],
         report: &mut StripReport,
     ) -> Result<(), String> {
+        self.correct_strips(stations, map, &loads.strip, flow, reynolds_factor, out, report)
+    }
+
+    /// [`StripPolars::correct`] of the lattice's strip forces `strips` (`uvlm::Loads::strip`, one
+    /// per panel column, surface after surface).
+    ///
+    /// # Errors
+    /// The polar's range errors, naming the strip and its body.
+    #[allow(clippy::too_many_arguments)] // the lattice (stations, map, strips), the flow, the output
+    pub fn correct_strips(
+        &self,
+        stations: &[uvlm::SpanStation],
+        map: &[StationMap],
+        strips: &[[f64; 3]],
+        flow: impl Fn(usize, Vector3<f64>) -> Vector3<f64>,
+        reynolds_factor: f64,
+        out: &mut [SectionLoad],
+        report: &mut StripReport,
+    ) -> Result<(), String> {
         let n = stations.len().saturating_sub(1);
         report.delta_force.clear();
         report.delta_force.resize(n, Vector3::zeros());
@@ -102,43 +121,108 @@ impl StripPolars {
         report.cl.resize(n, f64::NAN);
         report.total_delta = Vector3::zeros();
         report.profile_drag = 0.0;
-        for j in 0..n {
-            // Stations j and j + 1 bound a strip when they are on one lifting surface; the
-            // lattice's strips run surface after surface, one fewer than stations on each.
-            if map[j].lifting != map[j + 1].lifting {
-                continue;
-            }
-            let i = j - map[j].lifting;
-            let body = map[j + 1].body;
-            let Some(polar) = self.polar_of(body) else { continue };
-            let (a, b) = (&stations[j], &stations[j + 1]);
-            let (pa, pb) = (a.origin + a.arm(0.25), b.origin + b.arm(0.25));
-            let frame = strip_frame(&a.frame, &b.frame);
-            let p = 0.5 * (pa + pb);
-            let geometry =
-                StripGeometry { frame, chord: 0.5 * (a.chord + b.chord), width: (pb - pa).dot(&frame.column(0)).abs() };
-            let force = Vector3::from(loads.strip[i]);
+        for st in self.placed(stations, map) {
+            let g = StripGeometry { frame: st.frame, chord: st.chord, width: st.width };
             let (df, dm, c) = self
                 .correct_one(
-                    polar,
+                    st.polar,
                     &aerofoil::LatticeSection::THIN_PLATE,
-                    &geometry,
-                    flow(j, p),
+                    &g,
+                    flow(st.j, st.p),
                     reynolds_factor,
-                    force,
+                    Vector3::from(strips[st.i]),
                 )
-                .map_err(|e| format!("polar of strip {j} (body {body}): {e}"))?;
-            for (k, st) in [(j, a), (j + 1, b)] {
-                out[k].force += 0.5 * df;
-                out[k].moment += (p - st.origin).cross(&(0.5 * df)) + 0.5 * dm;
+                .map_err(|e| format!("polar of strip {} (body {}): {e}", st.j, st.body))?;
+            for (k, f, m) in shares(stations, (st.j, st.p), df, dm) {
+                out[k].force += f;
+                out[k].moment += m;
             }
-            report.delta_force[j] = df;
-            report.alpha[j] = c.alpha;
-            report.cl[j] = c.coefficients.cl;
+            report.delta_force[st.j] = df;
+            report.alpha[st.j] = c.alpha;
+            report.cl[st.j] = c.coefficients.cl;
             report.total_delta += df;
             report.profile_drag += c.profile_drag();
         }
         Ok(())
+    }
+
+    /// The correction linearised about the lattice solution with strip forces `strips` on
+    /// `stations` (driven as `map` says), each strip in the flow `flow(j, p)` (as
+    /// [`StripPolars::correct`], at the strips' own Reynolds numbers): per strip, the
+    /// derivatives of the change of its loads in its lattice force at fixed flow
+    /// (`Correction::force_jacobian`, `moment_jacobian`: the polar's local slopes over the
+    /// lattice's) and in its flow at fixed lattice force (`d_force_d_flow`, `d_moment_d_flow`),
+    /// in global axes.
+    ///
+    /// # Errors
+    /// The polar's range errors, naming the strip and its body.
+    pub fn linearise(
+        &self,
+        stations: &[uvlm::SpanStation],
+        map: &[StationMap],
+        strips: &[[f64; 3]],
+        flow: impl Fn(usize, Vector3<f64>) -> Vector3<f64>,
+    ) -> Result<LinearCorrection, String> {
+        let mut out = LinearCorrection { strips: Vec::new(), n_strips: strips.len(), n_stations: stations.len() };
+        for st in self.placed(stations, map) {
+            let c = self.correct_placed(&st, flow(st.j, st.p), Vector3::from(strips[st.i]))?;
+            let (r, rt) = (st.frame, st.frame.transpose());
+            out.strips.push(LinearStrip {
+                j: st.j,
+                i: st.i,
+                p: st.p,
+                force: r * (c.force_jacobian() - Matrix3::identity()) * rt,
+                moment: r * c.moment_jacobian() * rt,
+                force_flow: r * c.d_force_d_flow * rt,
+                moment_flow: r * c.d_moment_d_flow * rt,
+            });
+        }
+        Ok(out)
+    }
+
+    /// The strips of the lattice on `stations` whose body has a polar.
+    fn placed<'a>(
+        &'a self,
+        stations: &'a [uvlm::SpanStation],
+        map: &'a [StationMap],
+    ) -> impl Iterator<Item = PlacedStrip<'a>> + 'a {
+        let n = stations.len().saturating_sub(1);
+        (0..n).filter_map(move |j| {
+            // Stations j and j + 1 bound a strip when they are on one lifting surface; the
+            // lattice's strips run surface after surface, one fewer than stations on each.
+            if map[j].lifting != map[j + 1].lifting {
+                return None;
+            }
+            let body = map[j + 1].body;
+            let polar = self.by_body.get(body).and_then(Option::as_ref)?;
+            let (a, b) = (&stations[j], &stations[j + 1]);
+            let (pa, pb) = (a.origin + a.arm(0.25), b.origin + b.arm(0.25));
+            let frame = strip_frame(&a.frame, &b.frame);
+            Some(PlacedStrip {
+                j,
+                i: j - map[j].lifting,
+                body,
+                polar,
+                frame,
+                p: 0.5 * (pa + pb),
+                chord: 0.5 * (a.chord + b.chord),
+                width: (pb - pa).dot(&frame.column(0)).abs(),
+            })
+        })
+    }
+
+    /// The correction of strip `st` with the global flow `flow` and its lattice force `force`
+    /// (global), at the strip's own Reynolds number.
+    fn correct_placed(
+        &self,
+        st: &PlacedStrip<'_>,
+        flow: Vector3<f64>,
+        force: Vector3<f64>,
+    ) -> Result<aerofoil::Correction, String> {
+        let g = StripGeometry { frame: st.frame, chord: st.chord, width: st.width };
+        self.correct_one(st.polar, &aerofoil::LatticeSection::THIN_PLATE, &g, flow, 1.0, force)
+            .map(|(_, _, c)| c)
+            .map_err(|e| format!("polar of strip {} (body {}): {e}", st.j, st.body))
     }
 
     /// Correct one strip of geometry `g` whose uncorrected force `force` (global, N; no moment
@@ -183,6 +267,107 @@ pub struct StripGeometry {
     pub chord: f64,
     /// Width along `x̂`, m.
     pub width: f64,
+}
+
+/// A panel column of a body with a polar, between stations `j` and `j + 1`.
+struct PlacedStrip<'a> {
+    /// Its first station.
+    j: usize,
+    /// Its index among the lattice's strips (`uvlm::Loads::strip`).
+    i: usize,
+    body: usize,
+    polar: &'a aerofoil::Polar,
+    /// Span, chord (towards the leading edge) and normal, global.
+    frame: Matrix3<f64>,
+    /// The quarter-chord midpoint, m.
+    p: Vector3<f64>,
+    chord: f64,
+    width: f64,
+}
+
+/// The shares of the change `df`, `dm` (about the quarter-chord midpoint `p`) of the loads of
+/// the strip from station `j` to `j + 1`: half and half to its two stations, with the rigid-arm
+/// transfer; `(station, force, moment)`.
+fn shares(
+    stations: &[uvlm::SpanStation],
+    (j, p): (usize, Vector3<f64>),
+    df: Vector3<f64>,
+    dm: Vector3<f64>,
+) -> [(usize, Vector3<f64>, Vector3<f64>); 2] {
+    [j, j + 1].map(|k| (k, 0.5 * df, (p - stations[k].origin).cross(&(0.5 * df)) + 0.5 * dm))
+}
+
+/// One strip of a [`LinearCorrection`], global axes.
+#[derive(Debug, Clone, PartialEq)]
+struct LinearStrip {
+    /// Its first station and its index among the lattice's strips.
+    j: usize,
+    i: usize,
+    /// Its quarter-chord midpoint, about which `moment` and `moment_flow` act.
+    p: Vector3<f64>,
+    /// `∂ΔF/∂F_inv` and `∂ΔM/∂F_inv` at fixed flow.
+    force: Matrix3<f64>,
+    moment: Matrix3<f64>,
+    /// `∂ΔF/∂u` and `∂ΔM/∂u` at fixed lattice force.
+    force_flow: Matrix3<f64>,
+    moment_flow: Matrix3<f64>,
+}
+
+/// The strip correction linearised about a lattice solution ([`StripPolars::linearise`]): the
+/// change of the station loads per change of the strips' lattice forces and of their flows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearCorrection {
+    strips: Vec<LinearStrip>,
+    n_strips: usize,
+    n_stations: usize,
+}
+
+impl LinearCorrection {
+    /// Station loads `[F, M]` per station (6·stations) per unit lattice force of each strip
+    /// (3·strips, stacked as `uvlm::Loads::strip`), at fixed flow; `stations` those of the
+    /// linearisation (their origins are the moments' reference points).
+    pub fn load_per_strip_force(&self, stations: &[uvlm::SpanStation]) -> DMatrix<f64> {
+        self.map(stations, |s| (s.force, s.moment))
+    }
+
+    /// Station loads (6·stations) per unit flow velocity at each strip's quarter-chord midpoint
+    /// (3·strips, global axes), at fixed lattice forces.
+    pub fn load_per_strip_flow(&self, stations: &[uvlm::SpanStation]) -> DMatrix<f64> {
+        self.map(stations, |s| (s.force_flow, s.moment_flow))
+    }
+
+    /// The quarter-chord midpoint of every corrected strip, by its index among the lattice's
+    /// strips (`None`: no polar).
+    pub fn points(&self) -> Vec<Option<Vector3<f64>>> {
+        let mut out = vec![None; self.n_strips];
+        for s in &self.strips {
+            out[s.i] = Some(s.p);
+        }
+        out
+    }
+
+    /// The station loads per strip input of the 3 × 3 blocks `of(strip)` (force, moment about
+    /// the strip's point), shared as [`StripPolars::correct`] shares them.
+    fn map(
+        &self,
+        stations: &[uvlm::SpanStation],
+        of: impl Fn(&LinearStrip) -> (Matrix3<f64>, Matrix3<f64>),
+    ) -> DMatrix<f64> {
+        let mut k = DMatrix::zeros(6 * self.n_stations, 3 * self.n_strips);
+        for s in &self.strips {
+            let (f, m) = of(s);
+            for c in 0..3 {
+                let (df, dm) = (f.column(c).into_owned(), m.column(c).into_owned());
+                for (st, force, moment) in shares(stations, (s.j, s.p), df, dm) {
+                    for a in 0..3 {
+                        k[(6 * st + a, 3 * s.i + c)] += force[a];
+                        k[(6 * st + 3 + a, 3 * s.i + c)] += moment[a];
+                    }
+                }
+            }
+        }
+        k
+    }
 }
 
 /// The strip frame between two station frames (columns span, chord towards the leading edge,

@@ -135,15 +135,16 @@ pub fn refuse_tip_loss(problem: &Problem, analysis: &str) -> Result<(), String> 
 
 /// Why `analysis` cannot run `problem` with section polars or a strip tip loss (which only the
 /// statics apply): the statics, the time marches (the lattice's, the strip theory's, from a
-/// trim), the marched gust and the trim apply the polars (docs/section_aero.md §7); stability and
-/// the linear gust model do not yet, and running them would ignore the polars.
+/// trim), the marched gust, the trim, the lattice's stability and the linear gust model apply
+/// the polars (docs/section_aero.md §7); stability with Theodorsen strips does not yet, and
+/// running it would ignore the polars.
 pub fn refuse_unwired(problem: &Problem, analysis: &str) -> Result<(), String> {
     refuse_tip_loss(problem, analysis)?;
     let given = !problem.polars.is_empty() || problem.aero.as_ref().is_some_and(|a| !a.polars.is_empty());
     if given {
         return Err(format!(
-            "aero.polars: the section polars are wired into the statics, the trim and the time marches (and so the \
-             marched gust) only so far; the {analysis} would ignore them (docs/section_aero.md §7)"
+            "aero.polars: the section polars are wired into the statics, the trim, the time marches and the lattice's \
+             linear analyses only so far; the {analysis} would ignore them (docs/section_aero.md §7)"
         ));
     }
     Ok(())

@@ -36,6 +36,7 @@ use formulation::Structure;
 
 use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
+use crate::polar_correction::StripPolars;
 use crate::problem::{Formulation, Problem};
 
 pub use crate::stability_settings::{
@@ -554,16 +555,16 @@ pub(crate) fn load_part<S: Structure>(
 }
 
 /// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
-/// held fixed (central differences along the retraction); `None` when they vanish.
+/// (corrected by `polars`) held fixed (central differences along the retraction); `None` when
+/// they vanish.
 fn held_load_stiffness<S: Structure>(
     model: &mut S,
     q: &[f64],
-    map: &[StationMap],
-    aero: &AeroSettings,
+    (map, aero, polars): (&[StationMap], &AeroSettings, Option<&StripPolars>),
     zero: &[SectionLoad],
 ) -> Result<Option<DMatrix<f64>>, String> {
     let n = model.n_dof();
-    let Some(l0) = steady_station_loads(&*model, q, map, aero, None)? else { return Ok(None) };
+    let Some(l0) = steady_station_loads(&*model, q, map, aero, None, polars)? else { return Ok(None) };
     let mut k = DMatrix::zeros(n, n);
     let mut qq = vec![0.0; q.len()];
     let mut dq = vec![0.0; n];
@@ -583,14 +584,16 @@ fn held_load_stiffness<S: Structure>(
     Ok(Some(k))
 }
 
-/// The steady station loads of the lattice at `q` with `wake` (default: semi-infinite legs);
-/// `None` when they vanish.
+/// The steady station loads of the lattice at `q` with `wake` (default: semi-infinite legs),
+/// corrected by `polars` as the statics correct them (each strip in the free stream); `None`
+/// when they vanish.
 pub(crate) fn steady_station_loads<S: Structure>(
     model: &S,
     q: &[f64],
     map: &[StationMap],
     aero: &AeroSettings,
     wake: Option<uvlm::SteadyWake>,
+    polars: Option<&StripPolars>,
 ) -> Result<Option<Vec<SectionLoad>>, String> {
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = (Vec::new(), Vec::new(), Vec::new());
@@ -608,7 +611,12 @@ pub(crate) fn steady_station_loads<S: Structure>(
     }
     let f: Vec<f64> = loads.nodal.iter().flatten().copied().collect();
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    Ok(Some(lump(map, aero, &loads.positions, &origins, &f)))
+    let mut out = lump(map, aero, &loads.positions, &origins, &f);
+    if let Some(p) = polars {
+        let v = Vector3::from(aero.free_stream());
+        p.correct(&stations, map, loads, |_, _| v, 1.0, &mut out, &mut Default::default())?;
+    }
+    Ok(Some(out))
 }
 
 /// Station loads of stacked nodal forces `f` at `positions`, lumped about `origins` (the
@@ -681,8 +689,7 @@ fn modal_basis<S: Structure>(
     model: &mut S,
     q: &[f64],
     (lambda, mu): (&[f64], &[f64]),
-    map: &[StationMap],
-    aero: &AeroSettings,
+    lattice: (&[StationMap], &AeroSettings, Option<&StripPolars>),
     zero_loads: &[SectionLoad],
     (nb, n_rigid): (usize, usize),
 ) -> Result<ModalBasis, String> {
@@ -692,7 +699,7 @@ fn modal_basis<S: Structure>(
     // loads held fixed (their stiffness as each formulation applies them), so that they describe a
     // state in equilibrium; the flutter equation itself takes every aerodynamic term from the
     // geometric differences (the held-load stiffness is part of them).
-    let held = held_load_stiffness(model, q, map, aero, zero_loads)?;
+    let held = held_load_stiffness(model, q, lattice, zero_loads)?;
     if let Some(kl) = &held {
         lin.stiffness += kl;
         lin.reduced_stiffness = lin.null_space.transpose() * &lin.stiffness * &lin.null_space;
@@ -814,8 +821,9 @@ fn strip_model<S: Structure>(
 /// The load maps of a lattice `la` on `model` at `q`: the lumping `C_l` (6·stations × nodal
 /// forces: a unit force on each lattice node lumped about `origins` into `[F, M]` per station)
 /// and `H = Φᵀ P C_l` (basis modes × nodal forces), `P` the generalised load part per unit
-/// station load. Both rely on the linearity of the load part in the station loads and of the
-/// lumping in the nodal forces. Stability and the linear gust response share it.
+/// station load, and `Φᵀ P` (basis modes × 6·stations). Both rely on the linearity of the load
+/// part in the station loads and of the lumping in the nodal forces. Stability and the linear
+/// gust response share it.
 pub(crate) fn load_maps<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -824,7 +832,7 @@ pub(crate) fn load_maps<S: Structure>(
     zero_loads: &[SectionLoad],
     la: &uvlm::LinearUvlm,
     origins: &[[f64; 3]],
-) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+) -> Result<[DMatrix<f64>; 3], String> {
     let (nf, ns) = (la.n_force(), map.len());
     let ref_pos: Vec<[f64; 3]> = la.lattices().iter().flat_map(|l| l.ring_nodes().iter().copied()).collect();
     let mut cl = DMatrix::zeros(6 * ns, nf);
@@ -852,8 +860,9 @@ pub(crate) fn load_maps<S: Structure>(
             p.column_mut(6 * j + comp).copy_from_slice(&g);
         }
     }
-    let h = phi.transpose() * &p * &cl;
-    Ok((cl, h))
+    let phi_p = phi.transpose() * &p;
+    let h = &phi_p * &cl;
+    Ok([cl, h, phi_p])
 }
 
 /// The lattice of a linear UVLM moved with the structure, its reference circulations held: the
@@ -865,6 +874,8 @@ pub(crate) struct MovedLattice<'a> {
     lats: Vec<uvlm::Lattice>,
     map: &'a [StationMap],
     aero: &'a AeroSettings,
+    /// The section polars whose strip correction the loads get (docs/section_aero.md §7.7).
+    polars: Option<&'a StripPolars>,
     scratch: StationScratch,
 }
 
@@ -876,14 +887,34 @@ pub(crate) struct Moved {
     pub forces: Vec<f64>,
     /// The nodal forces lumped to station loads.
     pub loads: Vec<SectionLoad>,
+    /// The section polars' change of the station loads (empty without polars).
+    pub correction: Vec<SectionLoad>,
     /// Stacked trailing-edge node positions, surface after surface.
     pub te: Vec<f64>,
 }
 
+/// The polars' correction of the station loads at a state moved both ways along a direction
+/// ([`MovedLattice::correction_pair`]).
+pub(crate) struct CorrectionPair {
+    /// The states moved forward and back (the reference state for a velocity).
+    pub q_plus: Vec<f64>,
+    pub q_minus: Vec<f64>,
+    /// The corrections there.
+    pub plus: Vec<SectionLoad>,
+    pub minus: Vec<SectionLoad>,
+    /// The step: the derivative is `(plus − minus) / (2 step)`.
+    pub step: f64,
+}
+
 impl<'a> MovedLattice<'a> {
-    /// The lattice of `la` on the stations of `map`.
-    pub(crate) fn new(la: &'a uvlm::LinearUvlm, map: &'a [StationMap], aero: &'a AeroSettings) -> Self {
-        Self { la, lats: la.lattices().to_vec(), map, aero, scratch: StationScratch::default() }
+    /// The lattice of `la` on the stations of `map`, its loads corrected by `polars`.
+    pub(crate) fn new(
+        la: &'a uvlm::LinearUvlm,
+        map: &'a [StationMap],
+        aero: &'a AeroSettings,
+        polars: Option<&'a StripPolars>,
+    ) -> Self {
+        Self { la, lats: la.lattices().to_vec(), map, aero, polars, scratch: StationScratch::default() }
     }
 
     /// Number of trailing-edge nodes of every surface.
@@ -914,16 +945,68 @@ impl<'a> MovedLattice<'a> {
         stations_at(model, q, v, self.map, self.aero, None, &mut self.scratch, &mut st, &mut ve);
         let vel = if with_vel { Some(ve.as_slice()) } else { None };
         self.la.move_lattices(&mut self.lats, &st, vel).map_err(|e| format!("aerodynamic lattice: {e}"))?;
-        let (residual, forces) = match self.lats.as_slice() {
-            [one] => self.la.evaluate(one),
-            all => self.la.evaluate_surfaces(all),
+        let (residual, forces, strips) = match (self.polars, self.lats.as_slice()) {
+            (None, [one]) => self.la.evaluate(one).map(|(r, f)| (r, f, Vec::new())),
+            (None, all) => self.la.evaluate_surfaces(all).map(|(r, f)| (r, f, Vec::new())),
+            (Some(_), all) => self.la.evaluate_with_strips(all),
         }
         .map_err(|e| e.to_string())?;
         let org: Vec<[f64; 3]> = st.iter().map(|x| x.origin.into()).collect();
         let positions: Vec<[f64; 3]> = self.lats.iter().flat_map(|l| l.ring_nodes().iter().copied()).collect();
         let loads = lump(self.map, self.aero, &positions, &org, &forces);
         let te = self.lats.iter().flat_map(|l| l.trailing_edge_nodes().iter().flatten().copied()).collect();
-        Ok(Moved { residual, forces, loads, te })
+        let mut correction = Vec::new();
+        if let Some(p) = self.polars {
+            // Each strip's flow: the free stream less its motion (the mean of its two stations'
+            // rigid-arm velocities at its quarter-chord midpoint), as the time march's.
+            let v_inf = Vector3::from(self.aero.free_stream());
+            let flow = |j: usize, x: Vector3<f64>| match vel {
+                Some(v) => {
+                    let at = |k: usize| v[k].linear + v[k].angular.cross(&(x - st[k].origin));
+                    v_inf - 0.5 * (at(j) + at(j + 1))
+                }
+                None => v_inf,
+            };
+            let strip_forces: Vec<[f64; 3]> = strips.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            correction = zero_loads(self.map);
+            p.correct_strips(&st, self.map, &strip_forces, flow, 1.0, &mut correction, &mut Default::default())?;
+        }
+        Ok(Moved { residual, forces, loads, correction, te })
+    }
+
+    /// The polars' correction of the station loads about `q` moved forward and back along `dir`,
+    /// in position or (`velocity`) in velocity; `None` without polars. The step moves the
+    /// coordinates by 1e-4 chord (in velocity: 1e-4 of the airspeed): the correction is a
+    /// difference of nearly equal loads (zero for the lattice's own lift line), so the step is
+    /// larger than the lattice's 1e-6 chord to keep its rounding (1e-14 of the loads) out of the
+    /// derivative, and its truncation is of order 1e-8 (docs/section_aero.md §7.7).
+    pub(crate) fn correction_pair<S: Structure + ?Sized>(
+        &mut self,
+        model: &S,
+        q: &[f64],
+        dir: &[f64],
+        velocity: bool,
+    ) -> Result<Option<CorrectionPair>, String> {
+        if self.polars.is_none() {
+            return Ok(None);
+        }
+        let big = dir.iter().fold(0.0_f64, |a, x| a.max(x.abs())).max(1e-300);
+        let zeros = vec![0.0; dir.len()];
+        if velocity {
+            let step = 1e-4 * self.aero.speed() / big;
+            let (vp, vm): (Vec<f64>, Vec<f64>) = dir.iter().map(|x| (step * x, -step * x)).unzip();
+            let plus = self.at(model, q, &vp, true)?.correction;
+            let minus = self.at(model, q, &vm, true)?.correction;
+            return Ok(Some(CorrectionPair { q_plus: q.to_vec(), q_minus: q.to_vec(), plus, minus, step }));
+        }
+        let step = 1e-4 * self.chord().max(1e-3) / big;
+        let (mut q_plus, mut q_minus) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+        let (dp, dm): (Vec<f64>, Vec<f64>) = dir.iter().map(|x| (step * x, -step * x)).unzip();
+        model.retract_inplace(q, &dp, &mut q_plus);
+        model.retract_inplace(q, &dm, &mut q_minus);
+        let plus = self.at(model, &q_plus, &zeros, false)?.correction;
+        let minus = self.at(model, &q_minus, &zeros, false)?.correction;
+        Ok(Some(CorrectionPair { q_plus, q_minus, plus, minus, step }))
     }
 }
 
@@ -958,10 +1041,17 @@ fn geometric_terms<S: Structure>(
         xte: DMatrix::zeros(n_te, nb),
     };
     // Residual, generalised load part and trailing edge of the moved lattice.
-    let mut eval = |model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| -> Result<_, String> {
+    let eval = |moved: &mut MovedLattice<'_>, model: &mut S, qq: &[f64], vv: &[f64], with_vel: bool| {
         let m = moved.at(&*model, qq, vv, with_vel)?;
         let gl = load_part(model, qq, &m.loads, zero_loads)?;
-        Ok((m.residual, gl, m.te))
+        Ok::<_, String>((m.residual, gl, m.te))
+    };
+    // The polars' correction along a position or velocity, apart (its own step).
+    let correction = |moved: &mut MovedLattice<'_>, model: &mut S, col: &[f64], velocity: bool| {
+        let Some(c) = moved.correction_pair(&*model, q, col, velocity)? else { return Ok(None) };
+        let g1 = DVector::from_vec(load_part(model, &c.q_plus, &c.plus, zero_loads)?);
+        let g2 = DVector::from_vec(load_part(model, &c.q_minus, &c.minus, zero_loads)?);
+        Ok::<_, String>(Some(phi.transpose() * (g1 - g2) / (2.0 * c.step)))
     };
     for i in 0..nb {
         let (col, eps) = mode_step(phi, i, span);
@@ -971,24 +1061,30 @@ fn geometric_terms<S: Structure>(
         model.retract_inplace(q, &dq, &mut qp);
         let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
         model.retract_inplace(q, &dq, &mut qm);
-        let (r1, g1, te1) = eval(model, &qp, &zeros, false)?;
-        let (r2, g2, te2) = eval(model, &qm, &zeros, false)?;
+        let (r1, g1, te1) = eval(moved, model, &qp, &zeros, false)?;
+        let (r2, g2, te2) = eval(moved, model, &qm, &zeros, false)?;
         for a in 0..nr {
             g.rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
         }
         for a in 0..n_te {
             g.xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
         }
-        let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
+        let mut gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
+        if let Some(c) = correction(moved, model, &col, false)? {
+            gp += c;
+        }
         g.gx.set_column(i, &gp);
         // Velocity along the mode: the residual and the loads are linear in it.
-        let (r1, g1, _) = eval(model, q, &col, true)?;
+        let (r1, g1, _) = eval(moved, model, q, &col, true)?;
         let neg: Vec<f64> = col.iter().map(|x| -x).collect();
-        let (r2, g2, _) = eval(model, q, &neg, true)?;
+        let (r2, g2, _) = eval(moved, model, q, &neg, true)?;
         for a in 0..nr {
             g.rv[(a, i)] = 0.5 * (r1[a] - r2[a]);
         }
-        let gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) * 0.5;
+        let mut gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) * 0.5;
+        if let Some(c) = correction(moved, model, &col, true)? {
+            gp += c;
+        }
         g.gv.set_column(i, &gp);
     }
     Ok(g)
@@ -1031,15 +1127,15 @@ impl Reduced {
 /// `aero`, with `nb` basis modes (the first `n_rigid` the exact rigid-body motions of a free
 /// aircraft): the structural basis, optionally the mode shapes for the
 /// report, then either Theodorsen strips (`strip_case`) or the linear UVLM on the equilibrium's
-/// lattice with its geometric terms along the modes and the wake nodes' motion.
+/// lattice with its geometric terms along the modes and the wake nodes' motion, its loads
+/// corrected by the section polars `polars` (docs/section_aero.md §7.7).
 #[allow(clippy::too_many_arguments)] // model, state, multipliers, stations, settings, wake, basis, outputs
 pub fn reduce<S: Structure>(
     mut model: S,
     q: &[f64],
     lambda: &[f64],
     mu: &[f64],
-    map: &[StationMap],
-    aero: &AeroSettings,
+    (map, aero, polars): (&[StationMap], &AeroSettings, Option<&StripPolars>),
     wake: &uvlm::LinearWake,
     (nb, n_rigid): (usize, usize),
     shapes_out: Option<(&Problem, &mut Vec<ModeShape>)>,
@@ -1047,7 +1143,7 @@ pub fn reduce<S: Structure>(
 ) -> Result<Reduced, String> {
     let zero_loads = zero_loads(map);
     model.set_section_loads(&zero_loads).map_err(|e| e.to_string())?;
-    let basis = modal_basis(&mut model, q, (lambda, mu), map, aero, &zero_loads, (nb, n_rigid))?;
+    let basis = modal_basis(&mut model, q, (lambda, mu), (map, aero, polars), &zero_loads, (nb, n_rigid))?;
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = StationScratch::default();
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
@@ -1063,8 +1159,13 @@ pub fn reduce<S: Structure>(
         .map_err(|e| format!("aerodynamic lattice: {e}"))?;
     let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
-    let (_, h) = load_maps(&mut model, q, &basis.phi, (map, aero), &zero_loads, &la, &origins)?;
-    let mut moved = MovedLattice::new(&la, map, aero);
+    let [_, h, phi_p] = load_maps(&mut model, q, &basis.phi, (map, aero), &zero_loads, &la, &origins)?;
+    // The polars' correction of the circulations' loads: the generalised load per strip force.
+    let hc = match polars {
+        Some(p) => Some(&phi_p * reference_correction(p, &stations, map, aero, &la)?.load_per_strip_force(&stations)),
+        None => None,
+    };
+    let mut moved = MovedLattice::new(&la, map, aero, polars);
     let geo = geometric_terms(&mut model, q, &basis.phi, &mut moved, &zero_loads)?;
     // The wake's nodes follow the trailing edge's past motion, as the time march sheds them:
     // node (k, j) is where trailing-edge node j was τ_k ago. They matter only where the steady
@@ -1072,11 +1173,21 @@ pub fn reduce<S: Structure>(
     let (mut wake_r, mut wake_g) = (Vec::new(), Vec::new());
     if la.te_rings.iter().any(|&r| la.gamma0()[r] != 0.0) {
         let wd = la.wake_node_derivatives();
-        for (zr, zf) in wd.residual.iter().zip(&wd.force) {
+        for (k, (zr, zf)) in wd.residual.iter().zip(&wd.force).enumerate() {
             wake_r.push(zr * &geo.xte);
-            wake_g.push(&h * (zf * &geo.xte));
+            let mut g = &h * (zf * &geo.xte);
+            if let Some(hc) = &hc {
+                g += hc * (&wd.strip[k] * &geo.xte);
+            }
+            wake_g.push(g);
         }
     }
+    // T(s)'s parts: the nodal forces' and, with polars, the strip forces' through the correction.
+    let with_strips = |nodal: DMatrix<f64>, strips: &DMatrix<f64>| match &hc {
+        Some(hc) => nodal + hc * strips,
+        None => nodal,
+    };
+    let t_rows = la.force_row.iter().zip(&la.strip_row).map(|(f, sf)| with_strips(&h * f, sf)).collect();
     Ok(Reduced {
         m: basis.m,
         c: basis.c,
@@ -1090,9 +1201,9 @@ pub fn reduce<S: Structure>(
         w_rows: la.row_normalwash.clone(),
         delays: la.row_delays.clone(),
         te_rings: la.te_rings.clone(),
-        t_gamma: &h * &la.force_gamma,
-        t_gamma_dot: &h * &la.force_gamma_dot,
-        t_rows: la.force_row.iter().map(|f| &h * f).collect(),
+        t_gamma: with_strips(&h * &la.force_gamma, &la.strip_gamma),
+        t_gamma_dot: with_strips(&h * &la.force_gamma_dot, &la.strip_gamma_dot),
+        t_rows,
         wake_r,
         wake_g,
         strip: None,
@@ -1102,6 +1213,20 @@ pub fn reduce<S: Structure>(
         phi: basis.phi,
         skip: 0,
     })
+}
+
+/// The polars' correction linearised about the reference state of the linear UVLM `la` on
+/// `stations` (each strip in the free stream, as the statics' equilibrium).
+pub(crate) fn reference_correction(
+    polars: &StripPolars,
+    stations: &[uvlm::SpanStation],
+    map: &[StationMap],
+    aero: &AeroSettings,
+    la: &uvlm::LinearUvlm,
+) -> Result<crate::polar_correction::LinearCorrection, String> {
+    let strips: Vec<[f64; 3]> = la.reference_strips.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let v_inf = Vector3::from(aero.free_stream());
+    polars.linearise(stations, map, &strips, |_, _| v_inf)
 }
 
 /// The linear wake of `case` at `airspeed`: the stability block's, or the time-marching one.
@@ -1150,7 +1275,7 @@ fn cpu_now() -> f64 {
 /// Run the stability sweep of `case` with formulation `f`.
 pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
-    if let Err(e) = crate::section_polars::refuse_unwired(case, "stability analysis") {
+    if let Err(e) = refuse_strip_polars(case) {
         return empty_output(f, Some(e));
     }
     struct Sweep<'a>(&'a Problem, Formulation);
@@ -1163,6 +1288,16 @@ pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let mut out = dispatch(f, Sweep(case, f));
     out.wall_s = t0.elapsed().as_secs_f64();
     out
+}
+
+/// The Theodorsen strips (`stability.aerodynamics: "strip"`) have no section polars: a case with
+/// both is refused rather than run with the polars ignored (docs/section_aero.md §8).
+fn refuse_strip_polars(case: &Problem) -> Result<(), String> {
+    crate::section_polars::refuse_tip_loss(case, "stability analysis")?;
+    if case.stability.as_ref().is_some_and(|s| s.aerodynamics == AeroModel::Strip) {
+        crate::section_polars::refuse_unwired(case, "stability analysis with Theodorsen strips")?;
+    }
+    Ok(())
 }
 
 fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {
@@ -1213,7 +1348,13 @@ fn sweep<S: Structure>(
     let n_rigid = if st.about == About::Trim { crate::flight_modes::n_rigid(case) } else { 0 };
     // About a fixed state with a wake of fixed row lengths, the model is built once and scaled
     // with the airspeed (exact, see `Reduced::at_speed_ratio`).
-    let fixed = st.about == About::Undeformed && (st.wake.is_some() || st.aerodynamics == AeroModel::Strip);
+    // With section polars the slopes follow each airspeed's Reynolds numbers: rebuilt at every one.
+    let polars = match StripPolars::of(case) {
+        Ok(p) => p,
+        Err(e) => return empty_output(f, Some(e)),
+    };
+    let fixed =
+        st.about == About::Undeformed && (st.wake.is_some() || st.aerodynamics == AeroModel::Strip) && polars.is_none();
     let mut cache: Option<(f64, Reduced)> = None;
     let mut tracked: Option<Vec<(C64, DVector<C64>)>> = None;
     let mut prev: Option<Vec<(C64, DVector<C64>)>> = None;
@@ -1252,9 +1393,18 @@ fn sweep<S: Structure>(
             let shapes = if i == 0 { Some((case, &mut out.shapes)) } else { None };
             let strip = (st.aerodynamics == AeroModel::Strip).then_some(case);
             let nb = nb_req + n_rigid;
-            let reduced =
-                reduce(model, &state.q, &state.lambda, &state.mu, &map, &a, &wake, (nb, n_rigid), shapes, strip)
-                    .and_then(|r| crate::flight_modes::skip_rigid(r, n_rigid));
+            let reduced = reduce(
+                model,
+                &state.q,
+                &state.lambda,
+                &state.mu,
+                (&map, &a, polars.as_ref()),
+                &wake,
+                (nb, n_rigid),
+                shapes,
+                strip,
+            )
+            .and_then(|r| crate::flight_modes::skip_rigid(r, n_rigid));
             match reduced {
                 Ok(r) => cache = Some((u, r)),
                 Err(e) => {
@@ -1408,7 +1558,7 @@ fn trimmed<S: Structure>(
     let flight = crate::trim::flight_problem(&c, &out);
     let aero = flight.aero.as_ref().ok_or("no aero")?;
     let mut model = build(&flight).map_err(|e| e.to_string())?;
-    if let Some(loads) = steady_station_loads(&model, &out.q, &map, aero, Some(wake.steady_wake()))? {
+    if let Some(loads) = steady_station_loads(&model, &out.q, &map, aero, Some(wake.steady_wake()), None)? {
         model.set_section_loads(&loads).map_err(|e| e.to_string())?;
     }
     let (lambda, mu) = crate::flight_modes::rest_multipliers(&model, &out.q)?;
@@ -1574,4 +1724,61 @@ pub(crate) fn bounded_eigenvalues(a: DMatrix<C64>) -> Option<DVector<C64>> {
         return None;
     }
     nalgebra::Schur::try_new(a, f64::EPSILON, SCHUR_MAX_ITER).and_then(|t| t.eigenvalues())
+}
+
+/// The static aerodynamic stiffness of the flutter equation about the static equilibrium at the
+/// case's airspeed, `D(0) − K` in `nb` basis modes (`linear`), next to central differences along
+/// each mode of the generalised steady loads as the statics apply them (the lattice's steady
+/// solution in the analysis' wake, corrected by the section polars with
+/// [`StripPolars::correct`]; `differences`): the check of the linearised loads and of the
+/// polars' slopes in them (docs/section_aero.md §7.7). Modes × modes, `(linear, differences)`.
+///
+/// # Errors
+/// A case without `aero`, a failed equilibrium, reduction or steady solve.
+pub fn static_stiffness_check(case: &Problem, f: Formulation, nb: usize) -> Result<[DMatrix<f64>; 2], String> {
+    struct Check<'a>(&'a Problem, Formulation, usize);
+    impl ForModel for Check<'_> {
+        type Output = Result<[DMatrix<f64>; 2], String>;
+        fn run<M: BuildModel>(self) -> Self::Output {
+            stiffness_check(self.0, self.1, M::build, self.2)
+        }
+    }
+    dispatch(f, Check(case, f, nb))
+}
+
+fn stiffness_check<S: Structure>(
+    case: &Problem,
+    f: Formulation,
+    build: fn(&Problem) -> Result<S, crate::Error>,
+    nb: usize,
+) -> Result<[DMatrix<f64>; 2], String> {
+    let aero = case.aero.as_ref().ok_or("the case has no `aero` block")?;
+    let map = station_map(case, aero)?;
+    let u = aero.speed();
+    let ws = wake_settings(case, f, u);
+    let p = crate::statics::equilibrium_at(case, f, ws)?;
+    let (q, lambda, mu) = p.state.ok_or("no equilibrium state")?;
+    let polars = StripPolars::of(case)?;
+    let model = build(case).map_err(|e| e.to_string())?;
+    let lattice = (map.as_slice(), aero, polars.as_ref());
+    let red = reduce(model, &q, &lambda, &mu, lattice, &linear_wake(case, f, u), (nb, 0), None, None)?;
+    let linear = red.d(C64::new(0.0, 0.0)).map(|z| z.re) - &red.k;
+    let mut model = build(case).map_err(|e| e.to_string())?;
+    let zero = zero_loads(&map);
+    let span = aero.chord_extremes().1.max(1e-3);
+    let mut diff = DMatrix::zeros(red.phi.ncols(), red.phi.ncols());
+    for i in 0..red.phi.ncols() {
+        let (col, eps) = mode_step(&red.phi, i, span);
+        let mut g = Vec::new();
+        for sg in [1.0, -1.0] {
+            let dq: Vec<f64> = col.iter().map(|x| sg * eps * x).collect();
+            let mut qq = vec![0.0; q.len()];
+            model.retract_inplace(&q, &dq, &mut qq);
+            let loads = steady_station_loads(&model, &qq, &map, aero, Some(ws.steady_wake()), polars.as_ref())?
+                .unwrap_or_else(|| zero.clone());
+            g.push(DVector::from_vec(load_part(&mut model, &qq, &loads, &zero)?));
+        }
+        diff.set_column(i, &(red.phi.transpose() * (&g[0] - &g[1]) / (2.0 * eps)));
+    }
+    Ok([linear, diff])
 }

@@ -83,7 +83,7 @@ pub fn flap_effectiveness(e: f64) -> f64 {
 
 impl<'a> StripAero<'a> {
     /// The strips of the stations `map` (the aerodynamic settings `aero`), their lift read from
-    /// the section polars `polars` where a body has one (docs/section_aero.md §7.5).
+    /// the section polars `polars` where a body has one (docs/section_aero.md §7.6).
     pub fn new(map: &'a [StationMap], aero: &'a AeroSettings, polars: Option<&'a StripPolars>) -> Self {
         let columns: Vec<usize> =
             crate::lifting::surface_ranges(map).into_iter().flat_map(|r| r.start..r.end.saturating_sub(1)).collect();

@@ -118,6 +118,14 @@ pub struct LinearUvlm {
     /// `F_k` (3·n_nodes × n_columns): nodal forces per unit circulation of wake ring `(k, j)`
     /// (zero when `Γ₀ = 0`).
     pub force_row: Vec<DMatrix<f64>>,
+    /// `S_Γ` (3·n_strips × n_rings): the force on every strip ([`Loads::strip`](crate::Loads::strip),
+    /// panel column `j`; stacked in the trailing-edge column numbering
+    /// [`SurfaceBlock::te_columns`]) per unit `δΓ`, as `F_Γ` is the nodal forces'.
+    pub strip_gamma: DMatrix<f64>,
+    /// `S_Γ̇` (3·n_strips × n_rings): the strips' part of the unsteady term.
+    pub strip_gamma_dot: DMatrix<f64>,
+    /// `S_k` (3·n_strips × n_columns): the strip forces per unit circulation of wake ring `(k, j)`.
+    pub strip_row: Vec<DMatrix<f64>>,
     /// Global ring index of the trailing-edge ring of each trailing-edge column (`E`), surface
     /// after surface.
     pub te_rings: Vec<usize>,
@@ -126,6 +134,8 @@ pub struct LinearUvlm {
     pub reference_residual: Vec<f64>,
     /// Nodal forces of the reference state, N.
     pub reference_forces: Vec<f64>,
+    /// Strip forces of the reference state (3·n_strips), N.
+    pub reference_strips: Vec<f64>,
 }
 
 impl LinearUvlm {
@@ -266,6 +276,16 @@ impl LinearUvlm {
     /// ([`UvlmError::LengthMismatch`] of `"lattice rings"`, in [`UvlmError::InSurface`] with
     /// several surfaces).
     pub fn evaluate_surfaces(&self, lattices: &[Lattice]) -> Result<(Vec<f64>, Vec<f64>)> {
+        self.evaluate_with_strips(lattices).map(|(r, f, _)| (r, f))
+    }
+
+    /// [`LinearUvlm::evaluate_surfaces`] with the strip forces ([`Loads::strip`](crate::Loads::strip)
+    /// of every surface, stacked 3 per panel column in the trailing-edge column numbering
+    /// [`SurfaceBlock::te_columns`]) as the third vector.
+    ///
+    /// # Errors
+    /// As [`LinearUvlm::evaluate_surfaces`].
+    pub fn evaluate_with_strips(&self, lattices: &[Lattice]) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
         self.check_lattices(lattices)?;
         let mut fz = Frozen::default();
         fz.build(lattices, &self.gamma0, &self.wakes, self.closure, &self.params);
@@ -280,20 +300,11 @@ impl LinearUvlm {
         }
         let shed = self.reference_shed();
         let mut forces = vec![0.0; self.n_force()];
+        let mut strips = vec![0.0; 3 * self.te_rings.len()];
         let (v, u) = (&fz.v_mid, &fz.u_mid);
-        stacked_loads(
-            &mut fz.loads,
-            &fz.bs,
-            lattices,
-            &self.blocks,
-            v,
-            u,
-            None,
-            Some(&shed),
-            &self.params,
-            &mut forces,
-        );
-        Ok((residual, forces))
+        let out = (&mut forces[..], Some(&mut strips[..]));
+        stacked_loads(&mut fz.loads, &fz.bs, lattices, &self.blocks, v, u, None, Some(&shed), &self.params, out);
+        Ok((residual, forces, strips))
     }
 
     /// `lattices` has one lattice per surface, each of its reference's dimensions.
@@ -346,5 +357,11 @@ impl LinearUvlm {
     pub fn force_matrix(&self, s: Complex<f64>) -> DMatrix<Complex<f64>> {
         let base = self.force_gamma.map(Complex::from) + self.force_gamma_dot.map(|x| s * x);
         with_wake(&base, &self.force_row, &self.row_delays, &self.te_rings, s)
+    }
+
+    /// `S_Γ + s S_Γ̇ + Σ_k e^{−sτ_k} S_k E` (3·n_strips × n_rings): strip forces per unit `δΓ`.
+    pub fn strip_force_matrix(&self, s: Complex<f64>) -> DMatrix<Complex<f64>> {
+        let base = self.strip_gamma.map(Complex::from) + self.strip_gamma_dot.map(|x| s * x);
+        with_wake(&base, &self.strip_row, &self.row_delays, &self.te_rings, s)
     }
 }

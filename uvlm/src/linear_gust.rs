@@ -26,6 +26,9 @@ pub struct LinearGust {
     /// Nodal forces per unit gust velocity at each load segment's midpoint (3·n_nodes × n_mid);
     /// a midpoint loads its own surface only.
     pub force: DMatrix<f64>,
+    /// Strip forces ([`Loads::strip`](crate::Loads::strip), 3·n_strips, the trailing-edge column
+    /// numbering) per unit gust velocity at each load segment's midpoint (3·n_strips × n_mid).
+    pub strip_force: DMatrix<f64>,
     /// Delay of each load segment midpoint, s.
     pub midpoint_delays: Vec<f64>,
 }
@@ -38,8 +41,18 @@ impl LinearGust {
 
     /// Stacked nodal forces (3·n_nodes) per unit `ŵ(s)`, at fixed circulations.
     pub fn force_at(&self, s: Complex<f64>) -> Vec<Complex<f64>> {
-        let e: Vec<Complex<f64>> = self.midpoint_delays.iter().map(|tau| (-s * tau).exp()).collect();
-        (0..self.force.nrows()).map(|i| (0..self.force.ncols()).map(|m| e[m] * self.force[(i, m)]).sum()).collect()
+        Self::delayed(&self.force, &self.midpoint_delays, s)
+    }
+
+    /// Stacked strip forces (3·n_strips) per unit `ŵ(s)`, at fixed circulations.
+    pub fn strip_force_at(&self, s: Complex<f64>) -> Vec<Complex<f64>> {
+        Self::delayed(&self.strip_force, &self.midpoint_delays, s)
+    }
+
+    /// `Σ_m e^{−s τ_m} m[:, m]`.
+    fn delayed(m: &DMatrix<f64>, delays: &[f64], s: Complex<f64>) -> Vec<Complex<f64>> {
+        let e: Vec<Complex<f64>> = delays.iter().map(|tau| (-s * tau).exp()).collect();
+        (0..m.nrows()).map(|i| (0..m.ncols()).map(|c| e[c] * m[(i, c)]).sum()).collect()
     }
 }
 
@@ -74,24 +87,29 @@ impl LinearUvlm {
         let n_mid = fz.mid.len();
         debug_assert_eq!(n_mid, self.blocks.last().map_or(0, |b| b.midpoints.end));
         let midpoint_delays = (0..n_mid).map(|k| delay([fz.mid.x[k], fz.mid.y[k], fz.mid.z[k]])).collect();
-        let nf = self.n_force();
+        let (nf, ns) = (self.n_force(), 3 * self.te_rings.len());
         let mut force = DMatrix::zeros(nf, n_mid);
+        let mut strip_force = DMatrix::zeros(ns, n_mid);
         let (mut plus, mut minus) = (vec![0.0; nf], vec![0.0; nf]);
+        let (mut plus_s, mut minus_s) = (vec![0.0; ns], vec![0.0; ns]);
         let v_mid0 = fz.v_mid.clone();
         let mut v_pm = v_mid0.clone();
         for (k, (lat, b)) in lats.iter().zip(&self.blocks).enumerate() {
             for m in b.midpoints.clone() {
-                for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                for (sgn, buf, sbuf) in [(1.0, &mut plus, &mut plus_s), (-1.0, &mut minus, &mut minus_s)] {
                     v_pm[m] = [v_mid0[m][0] + sgn * d[0], v_mid0[m][1] + sgn * d[1], v_mid0[m][2] + sgn * d[2]];
-                    let (bs, u) = (&fz.bs, &fz.u_mid);
-                    surface_loads(&mut fz.loads, bs, (k, lat, b), &v_pm, u, None, Some(&shed), &self.params, buf);
+                    let (bs, u, out) = (&fz.bs, &fz.u_mid, (&mut buf[..], Some(&mut sbuf[..])));
+                    surface_loads(&mut fz.loads, bs, (k, lat, b), &v_pm, u, None, Some(&shed), &self.params, out);
                 }
                 v_pm[m] = v_mid0[m];
                 for i in b.forces() {
                     force[(i, m)] = 0.5 * (plus[i] - minus[i]);
                 }
+                for i in 3 * b.te_columns.start..3 * b.te_columns.end {
+                    strip_force[(i, m)] = 0.5 * (plus_s[i] - minus_s[i]);
+                }
             }
         }
-        Ok(LinearGust { normalwash, collocation_delays, force, midpoint_delays })
+        Ok(LinearGust { normalwash, collocation_delays, force, strip_force, midpoint_delays })
     }
 }

@@ -83,6 +83,13 @@ pub(crate) fn stack(loads: &Loads, out: &mut [f64]) {
     }
 }
 
+/// Strip forces of `loads` ([`Loads::strip`]) stacked into `out` (3 per panel column).
+pub(crate) fn stack_strips(loads: &Loads, out: &mut [f64]) {
+    for (k, f) in loads.strip.iter().enumerate() {
+        out[3 * k..3 * k + 3].copy_from_slice(f);
+    }
+}
+
 /// Work buffers of an evaluation with frozen circulations, over all surfaces.
 #[derive(Default)]
 pub(crate) struct Frozen {
@@ -169,7 +176,8 @@ impl Frozen {
 /// The nodal forces of every surface, stacked into `out` (`3·Σ nodes`), from the bound system
 /// `bs` as it carries its strengths: `v_mid`, `u_mid` at all midpoints (stacked), `gamma_dot`
 /// over all rings and `shed` over all trailing-edge columns (as [`compute_loads`] takes them per
-/// surface).
+/// surface); with `strips`, the strip forces too (3 per panel column, the stacked trailing-edge
+/// column numbering [`SurfaceBlock::te_columns`]).
 #[allow(clippy::too_many_arguments)] // the load routine's inputs, over the stacked surfaces
 pub(crate) fn stacked_loads(
     loads: &mut Loads,
@@ -181,15 +189,15 @@ pub(crate) fn stacked_loads(
     gamma_dot: Option<&[f64]>,
     shed: Option<&[f64]>,
     p: &UvlmParams,
-    out: &mut [f64],
+    (out, mut strips): (&mut [f64], Option<&mut [f64]>),
 ) {
     for (k, (lat, b)) in lats.iter().zip(blocks).enumerate() {
-        surface_loads(loads, bs, (k, lat, b), v_mid, u_mid, gamma_dot, shed, p, out);
+        surface_loads(loads, bs, (k, lat, b), v_mid, u_mid, gamma_dot, shed, p, (&mut *out, strips.as_deref_mut()));
     }
 }
 
-/// Surface `k`'s part of [`stacked_loads`]: its nodal forces into its entries of `out`, the
-/// others untouched.
+/// Surface `k`'s part of [`stacked_loads`]: its nodal forces into its entries of `out` (and its
+/// strip forces into its entries of `strips`), the others untouched.
 #[allow(clippy::too_many_arguments)] // the load routine's inputs, over the stacked surfaces
 pub(crate) fn surface_loads(
     loads: &mut Loads,
@@ -200,13 +208,16 @@ pub(crate) fn surface_loads(
     gamma_dot: Option<&[f64]>,
     shed: Option<&[f64]>,
     p: &UvlmParams,
-    out: &mut [f64],
+    (out, strips): (&mut [f64], Option<&mut [f64]>),
 ) {
     let (v, u) = (&v_mid[b.midpoints.clone()], &u_mid[b.midpoints.clone()]);
     let gd = gamma_dot.map(|g| &g[b.rings.clone()]);
     let sh = shed.map(|s| &s[b.te_columns.clone()]);
     compute_loads(loads, lat, bs, k, v, u, gd, sh, p);
     stack(loads, &mut out[b.forces()]);
+    if let Some(st) = strips {
+        stack_strips(loads, &mut st[3 * b.te_columns.start..3 * b.te_columns.end]);
+    }
 }
 
 /// The filaments of wake ring `(k, j)` with unit circulation, exactly as

@@ -79,6 +79,8 @@ struct LoadDerivative<'a> {
     v_mid0: &'a [[f64; 3]],
     plus: Vec<f64>,
     minus: Vec<f64>,
+    plus_strips: Vec<f64>,
+    minus_strips: Vec<f64>,
     u_pm: Vec<[f64; 3]>,
     gamma_pm: Vec<f64>,
     shed_pm: Vec<f64>,
@@ -93,6 +95,8 @@ impl<'a> LoadDerivative<'a> {
             v_mid0,
             plus: vec![0.0; nf],
             minus: vec![0.0; nf],
+            plus_strips: vec![0.0; 3 * g_te.len()],
+            minus_strips: vec![0.0; 3 * g_te.len()],
             u_pm: vec![[0.0; 3]; u_mid0.len()],
             gamma_pm: vec![0.0; gamma0.len()],
             shed_pm: g_te.to_vec(),
@@ -101,7 +105,8 @@ impl<'a> LoadDerivative<'a> {
 
     /// The derivative along a unit step of ring `dgamma`, of the newest wake ring of column
     /// `dshed` (its direct load on the trailing-edge segment, with `te_segment_force`) and of the
-    /// induced velocity at the midpoints by `du`, into `out`.
+    /// induced velocity at the midpoints by `du`, into `out` (nodal forces) and `out_strips`
+    /// (strip forces).
     #[allow(clippy::too_many_arguments)] // the model (buffers, surfaces, parameters) and the step
     fn eval(
         &mut self,
@@ -110,10 +115,11 @@ impl<'a> LoadDerivative<'a> {
         dgamma: Option<usize>,
         dshed: Option<usize>,
         du: &[[f64; 3]],
-        out: &mut [f64],
+        (out, out_strips): (&mut [f64], &mut [f64]),
     ) {
-        let Self { gamma0, g_te, u_mid0, v_mid0, plus, minus, u_pm, gamma_pm, shed_pm } = self;
-        for (sgn, buf) in [(1.0, &mut *plus), (-1.0, &mut *minus)] {
+        let Self { gamma0, g_te, u_mid0, v_mid0, plus, minus, plus_strips, minus_strips, u_pm, gamma_pm, shed_pm } =
+            self;
+        for (sgn, buf, sbuf) in [(1.0, &mut *plus, &mut *plus_strips), (-1.0, &mut *minus, &mut *minus_strips)] {
             gamma_pm.copy_from_slice(gamma0);
             if let Some(r) = dgamma {
                 gamma_pm[r] += sgn;
@@ -128,10 +134,13 @@ impl<'a> LoadDerivative<'a> {
                     u[q] = u_mid0[s][q] + sgn * du[s][q];
                 }
             }
-            stacked_loads(&mut fz.loads, &fz.bs, lats, blocks, v_mid0, u_pm, None, Some(shed_pm), p, buf);
+            stacked_loads(&mut fz.loads, &fz.bs, lats, blocks, v_mid0, u_pm, None, Some(shed_pm), p, (buf, Some(sbuf)));
         }
         for k in 0..out.len() {
             out[k] = 0.5 * (plus[k] - minus[k]);
+        }
+        for k in 0..out_strips.len() {
+            out_strips[k] = 0.5 * (plus_strips[k] - minus_strips[k]);
         }
     }
 }
@@ -177,15 +186,17 @@ impl LinearUvlm {
         // reference state, whose newest wake row holds the trailing-edge circulation.
         let nf = blocks.last().map_or(0, |b| 3 * b.nodes.end);
         let mut reference_forces = vec![0.0; nf];
+        let mut reference_strips = vec![0.0; 3 * g_te.len()];
         let (bs, loads) = (&fz.bs, &mut fz.loads);
-        stacked_loads(loads, bs, &lats, &blocks, &v_mid0, &u_mid0, None, Some(&g_te), &p, &mut reference_forces);
+        let out = (&mut reference_forces[..], Some(&mut reference_strips[..]));
+        stacked_loads(loads, bs, &lats, &blocks, &v_mid0, &u_mid0, None, Some(&g_te), &p, out);
 
         let aic = influence_matrix(&lats, &nrm, &mut fz, &p);
         let mut ld = LoadDerivative::new(&gamma0, &g_te, &u_mid0, &v_mid0, nf);
         let model = (&lats[..], &blocks[..], &p);
-        let (force_gamma, force_gamma_dot) = bound_derivatives(&mut fz, &mut ld, model);
+        let (force_gamma, force_gamma_dot, strip_gamma, strip_gamma_dot) = bound_derivatives(&mut fz, &mut ld, model);
         let rows = WakeRows { wakes: &wakes, closure, nrm: &nrm, n_rows: k_rows };
-        let (row_normalwash, force_row) = rows.derivatives(&mut fz, &mut ld, model);
+        let [row_normalwash, force_row, strip_row] = rows.derivatives(&mut fz, &mut ld, model);
         Self {
             params: p,
             lattices: lats,
@@ -199,9 +210,13 @@ impl LinearUvlm {
             force_gamma,
             force_gamma_dot,
             force_row,
+            strip_gamma,
+            strip_gamma_dot,
+            strip_row,
             te_rings,
             reference_residual,
             reference_forces,
+            reference_strips,
         }
     }
 }
@@ -223,18 +238,22 @@ fn influence_matrix(lats: &[Lattice], nrm: &[[f64; 3]], fz: &mut Frozen, p: &Uvl
 }
 
 /// The bound rings' load derivatives `F_Γ` (through the loads' circulations and the velocity
-/// each ring induces at every midpoint) and `F_Γ̇` (the unsteady term), one ring at a time.
+/// each ring induces at every midpoint) and `F_Γ̇` (the unsteady term), one ring at a time, and
+/// the same of the strip forces.
 fn bound_derivatives(
     fz: &mut Frozen,
     ld: &mut LoadDerivative<'_>,
     model: (&[Lattice], &[SurfaceBlock], &UvlmParams),
-) -> (DMatrix<f64>, DMatrix<f64>) {
+) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
     let (lats, blocks, p) = model;
-    let (nr, nf) = (ld.gamma0.len(), ld.plus.len());
+    let (nr, nf, ns) = (ld.gamma0.len(), ld.plus.len(), ld.plus_strips.len());
     let mut force_gamma = DMatrix::zeros(nf, nr);
     let mut force_gamma_dot = DMatrix::zeros(nf, nr);
+    let mut strip_gamma = DMatrix::zeros(ns, nr);
+    let mut strip_gamma_dot = DMatrix::zeros(ns, nr);
     let mut unit = vec![0.0; nr];
     let mut col = vec![0.0; nf];
+    let mut scol = vec![0.0; ns];
     let zero_gamma = vec![0.0; nr];
     let zeros_mid = vec![[0.0; 3]; ld.u_mid0.len()];
     for r in 0..nr {
@@ -246,14 +265,17 @@ fn bound_derivatives(
         induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blocks);
         fz.mid = mid;
         let du = fz.u_mid.clone();
-        ld.eval(fz, model, Some(r), None, &du, &mut col);
+        ld.eval(fz, model, Some(r), None, &du, (&mut col, &mut scol));
         force_gamma.column_mut(r).copy_from_slice(&col);
+        strip_gamma.column_mut(r).copy_from_slice(&scol);
         fz.bs.set_strengths(&zero_gamma);
         let v_mid0 = ld.v_mid0;
-        stacked_loads(&mut fz.loads, &fz.bs, lats, blocks, v_mid0, &zeros_mid, Some(&unit), None, p, &mut col);
+        let out = (&mut col[..], Some(&mut scol[..]));
+        stacked_loads(&mut fz.loads, &fz.bs, lats, blocks, v_mid0, &zeros_mid, Some(&unit), None, p, out);
         force_gamma_dot.column_mut(r).copy_from_slice(&col);
+        strip_gamma_dot.column_mut(r).copy_from_slice(&scol);
     }
-    (force_gamma, force_gamma_dot)
+    (force_gamma, force_gamma_dot, strip_gamma, strip_gamma_dot)
 }
 
 /// The frozen wakes' rows, for their derivatives.
@@ -266,23 +288,26 @@ struct WakeRows<'a> {
 }
 
 impl WakeRows<'_> {
-    /// `W_k` and `F_k`, one unit wake ring at a time, built as the wake builder builds it (same
-    /// edges, cores and images) but with only its own four corners; columns in the stacked
-    /// trailing-edge numbering.
+    /// `W_k` and `F_k` (and the strip forces' `S_k`), one unit wake ring at a time, built as the
+    /// wake builder builds it (same edges, cores and images) but with only its own four corners;
+    /// columns in the stacked trailing-edge numbering.
     fn derivatives(
         &self,
         fz: &mut Frozen,
         ld: &mut LoadDerivative<'_>,
         model: (&[Lattice], &[SurfaceBlock], &UvlmParams),
-    ) -> (Vec<DMatrix<f64>>, Vec<DMatrix<f64>>) {
+    ) -> [Vec<DMatrix<f64>>; 3] {
         let (lats, blocks, p) = model;
         let (nr, nf, n_cols) = (ld.gamma0.len(), ld.plus.len(), ld.g_te.len());
         let mut row_normalwash = Vec::with_capacity(self.n_rows);
         let mut force_row = Vec::with_capacity(self.n_rows);
+        let mut strip_row = Vec::with_capacity(self.n_rows);
         let mut col = vec![0.0; nf];
+        let mut scol = vec![0.0; 3 * n_cols];
         for k in 0..self.n_rows {
             let mut w = DMatrix::zeros(nr, n_cols);
             let mut f = DMatrix::zeros(nf, n_cols);
+            let mut sf = DMatrix::zeros(3 * n_cols, n_cols);
             for ((lat, b), wake) in lats.iter().zip(blocks).zip(self.wakes) {
                 let te = lat.trailing_edge_nodes();
                 for (j, c) in b.te_columns.clone().enumerate() {
@@ -294,13 +319,15 @@ impl WakeRows<'_> {
                         w[(r, c)] = (0..3).map(|q| fz.u_col[r][q] * self.nrm[r][q]).sum();
                     }
                     let du = fz.u_mid.clone();
-                    ld.eval(fz, model, None, (k == 0).then_some(c), &du, &mut col);
+                    ld.eval(fz, model, None, (k == 0).then_some(c), &du, (&mut col, &mut scol));
                     f.column_mut(c).copy_from_slice(&col);
+                    sf.column_mut(c).copy_from_slice(&scol);
                 }
             }
             row_normalwash.push(w);
             force_row.push(f);
+            strip_row.push(sf);
         }
-        (row_normalwash, force_row)
+        [row_normalwash, force_row, strip_row]
     }
 }

@@ -21,6 +21,10 @@ pub struct WakeNodeDerivatives {
     /// Per wake row `k`: the stacked nodal forces per unit displacement of the same nodes
     /// (3·n_nodes × 3·n_te_nodes).
     pub force: Vec<DMatrix<f64>>,
+    /// Per wake row `k`: the stacked strip forces ([`Loads::strip`](crate::Loads::strip), the
+    /// trailing-edge column numbering) per unit displacement of the same nodes
+    /// (3·n_strips × 3·n_te_nodes).
+    pub strip: Vec<DMatrix<f64>>,
 }
 
 /// The (up to four) rings of a wake of `rows` rows and `n` columns with a corner at node
@@ -71,10 +75,17 @@ impl LinearUvlm {
         let mut fil = Filaments::default();
         let (mut du_col, mut du_mid) = (vec![[0.0; 3]; fz.col.len()], vec![[0.0; 3]; fz.mid.len()]);
         let mut u_pm = u_mid0.clone();
+        let ns = 3 * g_te.len();
         let (mut plus, mut minus) = (vec![0.0; nf], vec![0.0; nf]);
-        let mut out = WakeNodeDerivatives { residual: Vec::with_capacity(rows), force: Vec::with_capacity(rows) };
+        let (mut plus_s, mut minus_s) = (vec![0.0; ns], vec![0.0; ns]);
+        let mut out = WakeNodeDerivatives {
+            residual: Vec::with_capacity(rows),
+            force: Vec::with_capacity(rows),
+            strip: Vec::with_capacity(rows),
+        };
         for k in 0..rows {
             let (mut zr, mut zf) = (DMatrix::zeros(nr, 3 * n_te), DMatrix::zeros(nf, 3 * n_te));
+            let mut zs = DMatrix::zeros(ns, 3 * n_te);
             for (s, (lat, b)) in lats.iter().zip(&self.blocks).enumerate() {
                 let te = lat.trailing_edge_nodes();
                 let n = lat.n_spanwise();
@@ -116,23 +127,27 @@ impl LinearUvlm {
                             zr[(r, c)] = (0..3).map(|q| du_col[r][q] * nrm[r][q]).sum();
                         }
                         fz.bs.set_strengths(&self.gamma0);
-                        for (sgn, buf) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                        for (sgn, buf, sbuf) in [(1.0, &mut plus, &mut plus_s), (-1.0, &mut minus, &mut minus_s)] {
                             for (s, u) in u_pm.iter_mut().enumerate() {
                                 for q in 0..3 {
                                     u[q] = u_mid0[s][q] + sgn * du_mid[s][q];
                                 }
                             }
-                            let (bs, blocks) = (&fz.bs, &self.blocks);
-                            stacked_loads(&mut fz.loads, bs, lats, blocks, &v_mid0, &u_pm, None, Some(&shed), p, buf);
+                            let (bs, blocks, o) = (&fz.bs, &self.blocks, (&mut buf[..], Some(&mut sbuf[..])));
+                            stacked_loads(&mut fz.loads, bs, lats, blocks, &v_mid0, &u_pm, None, Some(&shed), p, o);
                         }
                         for i in 0..nf {
                             zf[(i, c)] = 0.5 * (plus[i] - minus[i]);
+                        }
+                        for i in 0..ns {
+                            zs[(i, c)] = 0.5 * (plus_s[i] - minus_s[i]);
                         }
                     }
                 }
             }
             out.residual.push(zr);
             out.force.push(zf);
+            out.strip.push(zs);
         }
         out
     }

@@ -20,6 +20,7 @@ mod observer;
 mod planform;
 mod polars;
 mod polars_flight;
+mod polars_linear;
 mod properties;
 mod roll;
 mod send_sync;

@@ -9,6 +9,7 @@ mod hinge;
 mod linear;
 mod linear_baseline;
 mod linear_gust;
+mod linear_strips;
 mod linear_surfaces;
 mod multi_surface;
 mod multi_surface_baseline;
