@@ -220,12 +220,20 @@ fn columns(r: &Row) -> [(&'static str, f64); 12] {
     ]
 }
 
-/// The largest difference of every column of `b` from `a` over the run, relative to the
-/// column's largest magnitude in `a`.
+/// The largest difference of every column of [`columns`] of `b` from `a` over the run.
 fn worst_columns(a: &RunOutput, b: &RunOutput) -> Vec<(&'static str, f64)> {
+    worst_of(a, b, columns)
+}
+
+/// The largest difference of every column that `columns` picks from a row of `b` from `a` over
+/// the run, relative to the column's largest magnitude in `a`.
+pub(crate) fn worst_of<const N: usize>(
+    a: &RunOutput,
+    b: &RunOutput,
+    columns: fn(&Row) -> [(&'static str, f64); N],
+) -> Vec<(&'static str, f64)> {
     assert_eq!(a.rows.len(), b.rows.len());
-    let n = columns(&a.rows[0]).len();
-    (0..n)
+    (0..N)
         .map(|k| {
             let scale = a.rows.iter().map(|r| columns(r)[k].1.abs()).fold(0.0, f64::max).max(1e-300);
             let diff =

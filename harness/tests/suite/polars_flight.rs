@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use crate::common::root;
-use crate::polars::{AR20_CASE, expand, polars_set, rel, scratch, stalling, write_polar};
+use crate::polars::{AR20_CASE, expand, polars_set, rel, scratch, stalling, worst_of, write_polar};
 use aeroelastic::trim::{TrimOutput, run_trim};
 use harness::case::{Formulation, RunSpec};
 use harness::metrics::FormulationMetrics;
@@ -154,17 +154,10 @@ fn strip_columns(r: &Row) -> [(&'static str, f64); 8] {
     ]
 }
 
-/// The largest difference of every column of `b` from `a`, relative to the column's peak in `a`.
+/// The largest difference of every column of [`strip_columns`] of `b` from `a`, relative to the
+/// column's peak in `a`.
 fn worst(a: &RunOutput, b: &RunOutput) -> Vec<(&'static str, f64)> {
-    assert_eq!(a.rows.len(), b.rows.len());
-    (0..strip_columns(&a.rows[0]).len())
-        .map(|k| {
-            let col = |r: &Row| strip_columns(r)[k].1;
-            let scale = a.rows.iter().map(|r| col(r).abs()).fold(0.0, f64::max).max(1e-300);
-            let diff = a.rows.iter().zip(&b.rows).map(|(x, y)| (col(x) - col(y)).abs()).fold(0.0, f64::max);
-            (strip_columns(&a.rows[0])[k].0, diff / scale)
-        })
-        .collect()
+    worst_of(a, b, strip_columns)
 }
 
 /// cl = 2πα, cd = cm = 0 on the four wing bodies of the roll rig in the strip march (ailerons
