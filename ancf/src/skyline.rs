@@ -265,6 +265,24 @@ impl SkylineLu {
     /// Factorise the envelope held in `uval` (U columns with the diagonal) and, unless
     /// `symmetric`, `lval` (L rows); false on a tiny pivot.
     fn factor_in_place(&mut self, symmetric: bool) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.factor_in_place_avx2(symmetric) };
+        }
+        self.factor_in_place_generic(symmetric)
+    }
+
+    /// [`Self::factor_in_place`] compiled with AVX2: wider vectors, no FMA, so the same
+    /// arithmetic in the same order and the same factors bit for bit.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn factor_in_place_avx2(&mut self, symmetric: bool) -> bool {
+        self.factor_in_place_generic(symmetric)
+    }
+
+    #[inline(always)]
+    fn factor_in_place_generic(&mut self, symmetric: bool) -> bool {
         let n = self.n;
         self.pivot_floors(symmetric);
         if symmetric {
@@ -310,6 +328,7 @@ impl SkylineLu {
     /// (1e-9 against 1e9 on SHARPy's Horten wing) read as zero and sent every factorisation to
     /// the dense LU. For the other rows the floor is at most the old one (`a_ik² ≤ a_ii a_kk`
     /// for the positive definite structural blocks), so no pivot accepted before is refused.
+    #[inline(always)]
     fn pivot_floors(&mut self, symmetric: bool) {
         let n = self.n;
         if self.floor.len() != n {
@@ -335,6 +354,7 @@ impl SkylineLu {
     /// are taken together (columns in fours, else pairs; rows in pairs), so that each loaded value
     /// serves several products (the node-ordered ANCF unknowns come in runs of 12 with a common
     /// start).
+    #[inline(always)]
     fn factorize_symmetric(&mut self) -> bool {
         let n = self.n;
         let mut j = 0;
@@ -360,6 +380,7 @@ impl SkylineLu {
     /// greedy pairing over `first[j] .. j` leaves row `j - 1` alone while it could pair with row
     /// `j`. Then [`symmetric_column_quad`](Self::symmetric_column_quad) sums exactly like two
     /// [`symmetric_column_pair`](Self::symmetric_column_pair) calls.
+    #[inline(always)]
     fn quad_pairs_rows_like_pairs(&self, j: usize) -> bool {
         let f = self.first[j];
         if j == f || self.first[j - 1] != f {
@@ -373,6 +394,7 @@ impl SkylineLu {
     }
 
     /// Pivot `j` of the symmetric factorisation from its reduced diagonal entry.
+    #[inline(always)]
     fn set_pivot(&mut self, j: usize, d: f64) -> bool {
         if !d.is_finite() || d.abs() <= self.floor[j] {
             return false;
@@ -382,6 +404,7 @@ impl SkylineLu {
     }
 
     /// Column `j` alone (see [`factorize_symmetric`](Self::factorize_symmetric)).
+    #[inline(always)]
     fn symmetric_column(&mut self, j: usize) -> bool {
         let fj = self.first[j];
         let (lpj, upj) = (self.lptr[j], self.uptr[j]);
@@ -419,6 +442,7 @@ impl SkylineLu {
     }
 
     /// Columns `j` and `j + 1` with the same profile start `f` together.
+    #[inline(always)]
     fn symmetric_column_pair(&mut self, j: usize) -> bool {
         let floor_j = self.floor[j];
         let f = self.first[j];
@@ -476,6 +500,7 @@ impl SkylineLu {
     /// 4 × 4 diagonal block as two column pairs. Every product is summed in the same order as
     /// in [`symmetric_column_pair`](Self::symmetric_column_pair) on the pairs `(j, j + 1)` and
     /// `(j + 2, j + 3)`, so both give the same factors bit for bit.
+    #[inline(always)]
     fn symmetric_column_quad(&mut self, j: usize) -> bool {
         let floors = [self.floor[j], self.floor[j + 1], self.floor[j + 2], self.floor[j + 3]];
         let f = self.first[j];
@@ -552,7 +577,7 @@ impl SkylineLu {
 /// column `u0` (L row `l0`, length `m`), row `m` of column `u1` (giving `l1[m]`), pivot `m + 1`
 /// of `u1` (L row `l1`, length `m + 1`). The inverse pivots, or `None` for a pivot at or below
 /// its floor.
-#[inline]
+#[inline(always)]
 fn pair_diagonal(
     l0: &[f64],
     l1: &mut [f64],
@@ -580,7 +605,7 @@ fn pair_diagonal(
 
 /// `[l0·u0, l0·u1, l0·u2, l0·u3, l1·u0, …, l1·u3]` over the length of `l0`, each product summed
 /// as in [`dot2x2`] (even and odd terms apart, then the odd last term).
-#[inline]
+#[inline(always)]
 fn dot4x2(l0: &[f64], l1: &[f64], u: [&[f64]; 4]) -> [f64; 8] {
     let n = l0.len();
     let l1 = &l1[..n];
@@ -617,7 +642,7 @@ fn dot4x2(l0: &[f64], l1: &[f64], u: [&[f64]; 4]) -> [f64; 8] {
 }
 
 /// `[l·u0, l·u1, l·u2, l·u3]` over the length of `l`, each summed as in [`dot2`].
-#[inline]
+#[inline(always)]
 fn dot4x1(l: &[f64], u: [&[f64]; 4]) -> [f64; 4] {
     let n = l.len();
     let [u0, u1, u2, u3] = u.map(|c| &c[..n]);
@@ -648,7 +673,7 @@ fn dot4x1(l: &[f64], u: [&[f64]; 4]) -> [f64; 4] {
 }
 
 /// `[l0·u0, l0·u1, l1·u0, l1·u1]` over the length of `u0`.
-#[inline]
+#[inline(always)]
 fn dot2x2(l0: &[f64], l1: &[f64], u0: &[f64], u1: &[f64]) -> [f64; 4] {
     let n = u0.len();
     let (l0, l1, u1) = (&l0[..n], &l1[..n], &u1[..n]);
@@ -681,7 +706,7 @@ fn dot2x2(l0: &[f64], l1: &[f64], u0: &[f64], u1: &[f64]) -> [f64; 4] {
 }
 
 /// `(a·c, b·c)` over the length of `c`.
-#[inline]
+#[inline(always)]
 fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     let n = c.len();
     let (a, b) = (&a[..n], &b[..n]);
@@ -701,7 +726,7 @@ fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     (s0, s1)
 }
 
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     // four independent accumulators so that the compiler can vectorise the short dot products
     let n = a.len().min(b.len());
@@ -911,6 +936,28 @@ impl LinearSolver for SkylineLu {
             self.dense.solve_in_place(b);
             return;
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            unsafe { self.solve_skyline_avx2(b) };
+            return;
+        }
+        self.solve_skyline(b)
+    }
+}
+
+impl SkylineLu {
+    /// [`Self::solve_skyline`] compiled with AVX2 (the same arithmetic, see
+    /// [`Self::factor_in_place_avx2`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn solve_skyline_avx2(&mut self, b: &mut [f64]) {
+        self.solve_skyline(b)
+    }
+
+    /// Forward and backward substitution with the skyline factors.
+    #[inline(always)]
+    fn solve_skyline(&mut self, b: &mut [f64]) {
         let n = self.n;
         let y = &mut self.work;
         // L y = P b, rows with a common profile start in fours or pairs (fours only where they

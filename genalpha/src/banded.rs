@@ -69,7 +69,7 @@ impl BandedBorder {
 
 /// `Σ a_i b_i` with four partial sums: independent chains that pipeline and vectorise, where a
 /// single running sum would wait for every addition in turn.
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
@@ -91,7 +91,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// Index of the first non-zero of `x`. Tested eight at a time without an early exit inside a
 /// group (a comparison and an `or` that vectorise), since most scanned rows and columns of the
 /// border are entirely zero.
-#[inline]
+#[inline(always)]
 fn first_nonzero(x: &[f64]) -> Option<usize> {
     let chunks = x.chunks_exact(8);
     let tail = x.len() - chunks.remainder().len();
@@ -104,7 +104,7 @@ fn first_nonzero(x: &[f64]) -> Option<usize> {
 }
 
 /// Index of the last non-zero of `x`, eight at a time from the end (see [`first_nonzero`]).
-#[inline]
+#[inline(always)]
 fn last_nonzero(x: &[f64]) -> Option<usize> {
     let chunks = x.rchunks_exact(8);
     let head = chunks.remainder().len();
@@ -117,7 +117,7 @@ fn last_nonzero(x: &[f64]) -> Option<usize> {
 }
 
 /// `y −= s x`.
-#[inline]
+#[inline(always)]
 fn sub_scaled(y: &mut [f64], s: f64, x: &[f64]) {
     for (a, b) in y.iter_mut().zip(x) {
         *a -= s * b;
@@ -204,6 +204,7 @@ impl Block {
 
     /// In-place LU without pivoting (right-looking, by columns, inside the envelope); false if
     /// a pivot is tiny.
+    #[inline(always)]
     fn factorize(&mut self) -> bool {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
@@ -252,6 +253,7 @@ impl Block {
     }
 
     /// Overwrite the vector `y` (length m) with `L⁻¹ y`, by column sweeps.
+    #[inline(always)]
     fn forward_vec(&self, y: &mut [f64]) {
         if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
             return nb.forward(y, 0);
@@ -268,6 +270,7 @@ impl Block {
     }
 
     /// Overwrite the vector `y` (length m) with `U⁻¹ y`, by column sweeps.
+    #[inline(always)]
     fn backward_vec(&self, y: &mut [f64]) {
         if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
             return nb.backward(y);
@@ -286,6 +289,7 @@ impl Block {
     /// column is zero before its first non-zero, so its sweep starts there). The sweep runs over
     /// the rows outside and the columns inside, so that the columns' independent update chains
     /// overlap.
+    #[inline(always)]
     fn forward_cols(&mut self) {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
@@ -315,6 +319,7 @@ impl Block {
     /// zero before `row_range[r].0`). Left-looking, so that each step reads a contiguous column
     /// of `U`: `z_j = (f_j − Σ_{i<j} z_i U_ij) / U_jj`; the rows run inside, so that their
     /// independent chains overlap.
+    #[inline(always)]
     fn right_solve_rows(&mut self) {
         let (m, w) = (self.m, self.w);
         let ld = 2 * w + 1;
@@ -737,6 +742,24 @@ impl BorderedBandLu {
 
     /// Factorise the gathered or directly assembled storage (band, `E`, `F`, `G` in `s`).
     pub fn factorize_gathered(&mut self) -> Result<(), usize> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.factorize_gathered_avx2() };
+        }
+        self.factorize_gathered_generic()
+    }
+
+    /// [`Self::factorize_gathered`] compiled with AVX2: wider vectors, no FMA, so the same
+    /// arithmetic in the same order and the same factors bit for bit.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn factorize_gathered_avx2(&mut self) -> Result<(), usize> {
+        self.factorize_gathered_generic()
+    }
+
+    #[inline(always)]
+    fn factorize_gathered_generic(&mut self) -> Result<(), usize> {
         let nb = self.border.len();
         for blk in &mut self.blocks {
             let (first, m) = (blk.first, blk.m);
@@ -812,6 +835,24 @@ impl BorderedBandLu {
 
     /// Overwrite `b` with `A⁻¹ b`.
     pub fn solve_in_place(&mut self, b: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            unsafe { self.solve_avx2(b) };
+            return;
+        }
+        self.solve_generic(b)
+    }
+
+    /// [`Self::solve_in_place`] compiled with AVX2 (the same arithmetic).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn solve_avx2(&mut self, b: &mut [f64]) {
+        self.solve_generic(b)
+    }
+
+    #[inline(always)]
+    fn solve_generic(&mut self, b: &mut [f64]) {
         let nb = self.border.len();
         // c = L⁻¹ b on the blocks, and b_B − Z c into tmp.
         for (t, &bi) in self.tmp.iter_mut().zip(&self.border) {

@@ -202,6 +202,7 @@ impl NodeBand {
     }
 
     /// In-place block LU without pivoting; false if a pivot is at most `tiny` in magnitude.
+    #[inline(always)]
     pub fn factorize(&mut self, tiny: f64) -> bool {
         let (nn, kb) = (self.nn, self.kb);
         for i in 0..nn {
@@ -298,6 +299,7 @@ impl NodeBand {
     }
 
     /// Overwrite `y` with `L⁻¹ y`; `y` is zero before unknown `start`.
+    #[inline(always)]
     pub fn forward(&self, y: &mut [f64], start: usize) {
         let (nn, kb) = (self.nn, self.kb);
         let n0 = start / P;
@@ -321,6 +323,7 @@ impl NodeBand {
     }
 
     /// Overwrite `y` with `U⁻¹ y`.
+    #[inline(always)]
     pub fn backward(&self, y: &mut [f64]) {
         let (nn, kb) = (self.nn, self.kb);
         for i in (0..nn).rev() {
@@ -344,6 +347,7 @@ impl NodeBand {
     }
 
     /// Overwrite the row vector `z` with `z U⁻¹`; `z` is zero before unknown `start`.
+    #[inline(always)]
     pub fn right_solve(&self, z: &mut [f64], start: usize) {
         let (nn, kb) = (self.nn, self.kb);
         let n0 = start / P;
