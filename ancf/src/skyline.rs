@@ -39,6 +39,8 @@ pub struct SkylineLu {
     inv_diag: Vec<f64>,
     /// Per-row pivot floors of the factorisation in hand ([`SkylineLu::pivot_floors`]).
     floor: Vec<f64>,
+    /// `|a_ii|` of the matrix being factorised (scratch of [`SkylineLu::pivot_floors`]).
+    diag_abs: Vec<f64>,
     work: Vec<f64>,
     is_multiplier: Vec<bool>,
     last_coupled: Vec<usize>,
@@ -334,18 +336,15 @@ impl SkylineLu {
         if self.floor.len() != n {
             self.floor.resize(n, 0.0);
         }
+        self.diag_abs.resize(n, 0.0);
+        for (i, d) in self.diag_abs.iter_mut().enumerate() {
+            *d = self.uval[self.uptr[i] + (i - self.first[i])].abs();
+        }
         for i in 0..n {
             let (fi, up) = (self.first[i], self.uptr[i]);
-            let mut s = self.uval[up + (i - fi)].abs();
-            for k in fi..i {
-                let akk = self.uval[self.uptr[k] + (k - self.first[k])].abs();
-                if akk > 0.0 {
-                    let u = self.uval[up + (k - fi)]; // A[k][i]
-                    let l = if symmetric { u } else { self.lval[self.lptr[i] + (k - fi)] }; // A[i][k]
-                    s = s.max((l * u).abs() / akk);
-                }
-            }
-            self.floor[i] = 1e-13 * s;
+            let u = &self.uval[up..up + (i - fi)]; // A[fi..i][i]
+            let l = if symmetric { u } else { &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)] }; // A[i][fi..i]
+            self.floor[i] = 1e-13 * self.diag_abs[i].max(largest_elimination_term(l, u, &self.diag_abs[fi..i]));
         }
     }
 
@@ -571,6 +570,29 @@ impl SkylineLu {
         (self.inv_diag[j + 2], self.inv_diag[j + 3]) = (dj2, dj3);
         true
     }
+}
+
+/// `max_k |l_k u_k| / d_k` over the `k` with `d_k > 0` (0 if there is none; a NaN term is
+/// skipped as `f64::max` skips it). Four running maxima without branches, so that consecutive
+/// divisions overlap instead of waiting for each other through one maximum (the maximum does not
+/// depend on the order).
+#[inline(always)]
+fn largest_elimination_term(l: &[f64], u: &[f64], d: &[f64]) -> f64 {
+    let term = |l: f64, u: f64, d: f64| if d > 0.0 { (l * u).abs() / d } else { 0.0 };
+    let mut m = [0.0_f64; 4];
+    let (lc, uc, dc) = (l.chunks_exact(4), u.chunks_exact(4), d.chunks_exact(4));
+    let (lr, ur, dr) = (lc.remainder(), uc.remainder(), dc.remainder());
+    for ((l, u), d) in lc.zip(uc).zip(dc) {
+        for c in 0..4 {
+            let x = term(l[c], u[c], d[c]);
+            m[c] = if x > m[c] { x } else { m[c] };
+        }
+    }
+    for ((&l, &u), &d) in lr.iter().zip(ur).zip(dr) {
+        let x = term(l, u, d);
+        m[0] = if x > m[0] { x } else { m[0] };
+    }
+    m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
 /// The 2 × 2 diagonal block of a column pair whose rows above it are reduced: pivot `m` of
@@ -883,6 +905,7 @@ impl LinearSolver for SkylineLu {
         self.work = vec![0.0; n];
         self.inv_diag = vec![0.0; n];
         self.floor = vec![0.0; n];
+        self.diag_abs = vec![0.0; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
         self.contiguous = vec![false; n];
