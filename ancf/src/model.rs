@@ -885,17 +885,18 @@ impl Model {
     /// Add a node tie's 9×9 matrix (the node's `r_x`, `r_y`, `r_z` from `first`) through the
     /// chosen form.
     fn scatter_tie(&self, first: usize, t: &TieMatrix, k: &mut MatView<'_>) {
+        if let SolvePath::Dae = self.options.path {
+            // The tie's matrix is symmetric (its lower triangle is a copy of the upper): one
+            // block, given by its upper triangle, instead of 81 single entries.
+            k.add_symmetric_upper(first, t);
+            return;
+        }
         for b in 0..9 {
             for a in 0..9 {
                 let x = t[(a, b)];
-                match self.options.path {
-                    SolvePath::Dae => k.add(first + a, first + b, x),
-                    SolvePath::Ode => {
-                        for &(za, ca) in self.reduction.row(first + a) {
-                            for &(zb, cb) in self.reduction.row(first + b) {
-                                k.add(za, zb, ca * cb * x);
-                            }
-                        }
+                for &(za, ca) in self.reduction.row(first + a) {
+                    for &(zb, cb) in self.reduction.row(first + b) {
+                        k.add(za, zb, ca * cb * x);
                     }
                 }
             }
