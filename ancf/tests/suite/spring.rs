@@ -1,7 +1,7 @@
 //! Hinge springs and dampers (docs/ancf.md §11): analytic tangents against finite differences,
 //! the small-oscillation frequency √(k/J) of a stiff body, and springs wound past ±180°. The
 //! energy balance with a damper is checked for every formulation in
-//! `aeroelastic/tests/cross_formulation.rs`.
+//! `aeroelastic/tests/suite/cross_formulation.rs`.
 use ancf::{BodySpec, ForceElement, JointSpec, Model, Options, RigidPose, Scene, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix, IntegratorParams, State};
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};

@@ -1,7 +1,7 @@
 //! Thrust, a follower force (docs/ancf.md §14): its analytic tangent against finite differences
 //! on twisted, deformed and rotated bodies, on both paths. The exact answers (small-load tip
 //! deflection, the follower condition under a large load, the agreement with GEBF) and the
-//! energy balance are in `aeroelastic/tests/thrust.rs`.
+//! energy balance are in `aeroelastic/tests/suite/thrust.rs`.
 use ancf::{BodySpec, ForceElement, Model, Options, RigidPose, Scene, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use nalgebra::{Rotation3, Unit, Vector3};

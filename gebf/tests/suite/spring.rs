@@ -6,7 +6,7 @@
 //! * a stiff body on a ground hinge with a spring oscillates at `√(k/J)`, J about the hinge axis
 //!   from `BodySpec::reference_inertia()`, and about the rest angle;
 //! * (the paper's pendulum with a damper, `E(t) + ∫ c θ̇² dt` constant: for every formulation
-//!   in `aeroelastic/tests/cross_formulation.rs`);
+//!   in `aeroelastic/tests/suite/cross_formulation.rs`);
 //! * springs through ±180° (ground and flared hinge): the angle and the force are continuous,
 //!   the energy conserved.
 

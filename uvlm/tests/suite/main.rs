@@ -1,5 +1,7 @@
 //! The uvlm crate's integration tests, one module per file, built as one test binary (one
-//! link instead of one per file); the allocation tests stay separate binaries because they install a counting global allocator.
+//! link instead of one per file). The binary installs the counting allocator for the allocation
+//! tests: it counts only the calling thread's allocations inside `alloc_count::count`, so the
+//! other tests running beside them do not disturb the counts.
 
 mod common;
 mod flap;
@@ -13,6 +15,7 @@ mod linear_strips;
 mod linear_surfaces;
 mod multi_surface;
 mod multi_surface_baseline;
+mod no_alloc;
 mod properties;
 mod reuse;
 mod send_sync;
@@ -20,3 +23,6 @@ mod steady;
 mod steady_finite_wake;
 mod theodorsen;
 mod unsteady;
+
+#[global_allocator]
+static GLOBAL: alloc_count::Counting = alloc_count::Counting;

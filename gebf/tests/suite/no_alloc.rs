@@ -5,8 +5,6 @@
 use gebf::{ForceElement, Model, Options, PointMass, Scene, samples};
 use genalpha::{GenAlpha, IntegratorParams};
 use nalgebra::Vector3;
-#[global_allocator]
-static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn time_steps_do_not_allocate() {

@@ -4,7 +4,7 @@
 //! 8 × 4 behind it; 40-row prescribed wake, the lattice moved every step (the AIC rebuilt and
 //! refactorised each time, as in a flexible run), single thread. Thread CPU time of runs of 100
 //! steps, the cases interleaved in nine rounds: minimum and median.
-//! Run: `cargo run --release -p uvlm --example multi_surface_timing`.
+//! Run: `cargo run --release -p perf --example uvlm_multi_surface_timing`.
 use uvlm::samples::{SpanSpacing, rectangular_wing};
 use uvlm::*;
 

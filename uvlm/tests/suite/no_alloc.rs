@@ -7,8 +7,6 @@
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 
-#[global_allocator]
-static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn step_does_not_allocate() {

@@ -3,8 +3,6 @@
 use ancf::{ForceElement, Model, Options, PointLoad, PointMass, Scene, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix};
 use nalgebra::Vector3;
-#[global_allocator]
-static GLOBAL: alloc_count::Counting = alloc_count::Counting;
 
 #[test]
 fn per_step_primitives_do_not_allocate() {
