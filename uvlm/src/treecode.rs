@@ -134,8 +134,10 @@ pub struct Treecode {
     samples: MomentSamples,
     /// Gauss–Legendre points on [0, 1] and weights (summing to 1).
     gauss: Vec<(f64, f64)>,
-    /// The shift of moments to a parent's centre: `(k, j, k − j, C(k, j))` for every `j ≤ k`.
-    shift: Vec<(u32, u32, [u8; 3], f64)>,
+    /// The shift of moments to a parent's centre: `(j, k − j, C(k, j))` for every `j ≤ k`,
+    /// grouped by `k`; `shift_rows[k]` is the range of `k`'s entries.
+    shift: Vec<(u32, [u8; 3], f64)>,
+    shift_rows: Vec<(u32, u32)>,
     /// Segment order of the tree (indices into the source set).
     perm: Vec<u32>,
     mid: Vec<[f64; 3]>,
@@ -238,15 +240,17 @@ impl Treecode {
                 binom[n][k] = binom[n - 1][k - 1] + if k < n { binom[n - 1][k] } else { 0.0 };
             }
         }
-        let mut shift = Vec::new();
+        let (mut shift, mut shift_rows) = (Vec::new(), Vec::new());
         for (kp, k) in mom_idx.k.iter().enumerate() {
+            let start = shift.len() as u32;
             for (jp, j) in mom_idx.k.iter().enumerate().take(kp + 1) {
                 if (0..3).all(|q| j[q] <= k[q]) {
                     let e = [k[0] - j[0], k[1] - j[1], k[2] - j[2]];
                     let c = (0..3).map(|q| binom[k[q] as usize][j[q] as usize]).product();
-                    shift.push((kp as u32, jp as u32, e, c));
+                    shift.push((jp as u32, e, c));
                 }
             }
+            shift_rows.push((start, shift.len() as u32));
         }
         Self {
             order,
@@ -258,6 +262,7 @@ impl Treecode {
             rec,
             up,
             shift,
+            shift_rows,
             ..Self::default()
         }
     }
@@ -419,7 +424,6 @@ impl Treecode {
         self.moments.clear();
         self.moments.resize(self.clusters.len() * nm, [0.0; 3]);
         let p = self.order;
-        let mut pw = [[0.0; MAX_ORDER + 1]; 3];
         let sm = &mut self.samples;
         sm.mono.resize(nm, [0.0; LANES]);
         sm.acc.resize(nm, [[0.0; LANES]; 3]);
@@ -471,13 +475,17 @@ impl Treecode {
                 }
             }
         }
+        // M_k(parent) = Σ_children Σ_{j ≤ k} C(k, j) δ^{k − j} M_j(child), both children in one
+        // sweep of the table, each k summed in registers (the table is grouped by k).
+        let mut pw2 = [[[0.0; MAX_ORDER + 1]; 3]; 2];
         for ci in (0..self.clusters.len()).rev() {
             let c = self.clusters[ci];
             if c.child == NONE {
                 continue;
             }
-            for ch in [c.child as usize, c.child as usize + 1] {
-                let cc = self.clusters[ch].center;
+            let ch = c.child as usize;
+            for (h, pw) in pw2.iter_mut().enumerate() {
+                let cc = self.clusters[ch + h].center;
                 let delta = [cc[0] - c.center[0], cc[1] - c.center[1], cc[2] - c.center[2]];
                 for q in 0..3 {
                     pw[q][0] = 1.0;
@@ -485,17 +493,23 @@ impl Treecode {
                         pw[q][e] = pw[q][e - 1] * delta[q];
                     }
                 }
-                let (lo, hi) = self.moments.split_at_mut(ch * nm);
-                let parent = &mut lo[ci * nm..(ci + 1) * nm];
-                let child = &hi[..nm];
-                // M_k(parent) += Σ_{j ≤ k} C(k, j) δ^{k − j} M_j(child).
-                for &(kp, jp, e, coef) in &self.shift {
-                    let f = coef * pw[0][e[0] as usize] * pw[1][e[1] as usize] * pw[2][e[2] as usize];
-                    let m = child[jp as usize];
-                    let o = &mut parent[kp as usize];
-                    o[0] += f * m[0];
-                    o[1] += f * m[1];
-                    o[2] += f * m[2];
+            }
+            let (lo, hi) = self.moments.split_at_mut(ch * nm);
+            let parent = &mut lo[ci * nm..(ci + 1) * nm];
+            let (c0, c1) = (&hi[..nm], &hi[nm..2 * nm]);
+            for (kp, &(start, end)) in self.shift_rows.iter().enumerate() {
+                let mut acc = [0.0; 3];
+                for &(jp, e, coef) in &self.shift[start as usize..end as usize] {
+                    let (e0, e1, e2) = (e[0] as usize, e[1] as usize, e[2] as usize);
+                    let f0 = coef * pw2[0][0][e0] * pw2[0][1][e1] * pw2[0][2][e2];
+                    let f1 = coef * pw2[1][0][e0] * pw2[1][1][e1] * pw2[1][2][e2];
+                    let (m0, m1) = (c0[jp as usize], c1[jp as usize]);
+                    for q in 0..3 {
+                        acc[q] += f0 * m0[q] + f1 * m1[q];
+                    }
+                }
+                for q in 0..3 {
+                    parent[kp][q] += acc[q];
                 }
             }
         }
