@@ -329,22 +329,14 @@ impl Treecode {
         let mut c = 0;
         while c < self.clusters.len() {
             let (start, end) = (self.clusters[c].start as usize, self.clusters[c].end as usize);
-            let (center, radius) = bounding_ball(fil, &self.perm[start..end]);
+            let (center, radius, lo, hi) = bounding_ball(fil, &self.perm[start..end]);
             self.clusters[c].center = center;
             self.clusters[c].radius = radius;
             if end - start <= self.leaf_size {
                 self.clusters[c].leaf = self.n_leaves as u32;
                 self.n_leaves += 1;
             } else {
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for &s in &self.perm[start..end] {
-                    let m = self.mid[s as usize];
-                    for q in 0..3 {
-                        lo[q] = lo[q].min(m[q]);
-                        hi[q] = hi[q].max(m[q]);
-                    }
-                }
+                // Split the midpoints along the longest side of the ends' bounding box.
                 let axis = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b]))).unwrap_or(0);
                 let half = (end - start) / 2;
                 let mid = &self.mid;
@@ -809,17 +801,20 @@ fn moments_avx512(up: &[(u32, u8)], sm: &mut MomentSamples) {
     moments_body(up, sm);
 }
 
-/// Centre of the bounding box of the segments' ends and the largest distance of an end from it.
-fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64) {
+/// Centre of the bounding box of the segments' ends, the largest distance of an end from it,
+/// and the box's lower and upper corners.
+fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64, [f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
+    // Plain comparisons rather than f64::min/max: the nodes are finite, and these compile to
+    // single min/max instructions.
     for &s in segs {
         let (a, b) = fil.segment_nodes(s as usize);
         for n in [a, b] {
             let p = fil.node(n as usize);
             for q in 0..3 {
-                lo[q] = lo[q].min(p[q]);
-                hi[q] = hi[q].max(p[q]);
+                lo[q] = if p[q] < lo[q] { p[q] } else { lo[q] };
+                hi[q] = if p[q] > hi[q] { p[q] } else { hi[q] };
             }
         }
     }
@@ -829,10 +824,11 @@ fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64) {
         let (a, b) = fil.segment_nodes(s as usize);
         for n in [a, b] {
             let p = fil.node(n as usize);
-            r2 = r2.max((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2));
+            let d2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
+            r2 = if d2 > r2 { d2 } else { r2 };
         }
     }
-    (c, r2.sqrt())
+    (c, r2.sqrt(), lo, hi)
 }
 
 /// Gauss–Legendre points and weights on [0, 1] (weights sum to 1), `n` points, exact for
