@@ -497,7 +497,7 @@ fn fill_avx2(fil: &Filaments, px: &[f64; LANES], py: &[f64; LANES], pz: &[f64; L
 
 /// Instruction set chosen at run time for the block kernels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Isa {
+pub(crate) enum Isa {
     Generic,
     #[cfg(target_arch = "x86_64")]
     Avx2,
@@ -505,7 +505,7 @@ enum Isa {
     Avx512,
 }
 
-fn isa() -> Isa {
+pub(crate) fn isa() -> Isa {
     static ISA: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
     *ISA.get_or_init(|| {
         #[cfg(target_arch = "x86_64")]

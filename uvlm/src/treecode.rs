@@ -33,7 +33,7 @@
 //! a point lies within the core radius of the segment's axis line, where the singular induction
 //! is itself of the order of the core radius.
 
-use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, velocity_block};
+use crate::biot_savart::{Filaments, Isa, LANES, NodeBlock, fill_block, isa, velocity_block};
 use crate::induce::{Points, use_threads};
 use crate::params::Parallel;
 use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
@@ -128,18 +128,30 @@ pub struct Treecode {
     grad: Vec<([u32; 3], [f64; 3])>,
     /// Per Taylor coefficient: (2n − 1)/n and (n − 1)/n.
     rec: Vec<(f64, f64)>,
+    /// Per moment m ≠ 0: the position of m − e_i and i, for the first i with m_i > 0.
+    up: Vec<(u32, u8)>,
+    /// The leaf moments' samples and lane accumulators.
+    samples: MomentSamples,
     /// Gauss–Legendre points on [0, 1] and weights (summing to 1).
     gauss: Vec<(f64, f64)>,
-    /// The shift of moments to a parent's centre: `(k, j, k − j, C(k, j))` for every `j ≤ k`.
-    shift: Vec<(u32, u32, [u8; 3], f64)>,
+    /// The shift of moments to a parent's centre: `(j, k − j, C(k, j))` for every `j ≤ k`,
+    /// grouped by `k`; `shift_rows[k]` is the range of `k`'s entries.
+    shift: Vec<(u32, [u8; 3], f64)>,
+    shift_rows: Vec<(u32, u32)>,
     /// Segment order of the tree (indices into the source set).
     perm: Vec<u32>,
     mid: Vec<[f64; 3]>,
     clusters: Vec<Cluster>,
     /// `clusters.len() × n_moments` vector moments.
     moments: Vec<[f64; 3]>,
-    /// Each leaf's segments as a set of its own (nodes duplicated) for the block kernels.
+    /// Each leaf's segments as a set of its own (each node of the leaf once) for the block
+    /// kernels.
     leaves: Vec<Filaments>,
+    /// Per node of the source set: the last leaf fill that copied it (`stamp_gen`), and its
+    /// index in that leaf.
+    node_stamp: Vec<u64>,
+    node_slot: Vec<u32>,
+    stamp_gen: u64,
     n_leaves: usize,
     /// The set's legs, summed directly.
     legs: Filaments,
@@ -151,6 +163,20 @@ pub struct Treecode {
     /// The threaded loop's velocities and direct pairs per point block, scattered to the points
     /// after the loop.
     block_out: Vec<BlockOut>,
+}
+
+/// One leaf's (segment, Gauss point) samples, padded to whole blocks of [`LANES`], and the
+/// per-lane monomials and moment sums of the leaf.
+#[derive(Debug, Clone, Default)]
+struct MomentSamples {
+    ax: Vec<f64>,
+    ay: Vec<f64>,
+    az: Vec<f64>,
+    xx: Vec<f64>,
+    xy: Vec<f64>,
+    xz: Vec<f64>,
+    mono: Vec<[f64; LANES]>,
+    acc: Vec<[[f64; LANES]; 3]>,
 }
 
 /// The velocities at one block's points and the point–filament pairs summed directly.
@@ -198,6 +224,15 @@ impl Treecode {
                 if n == 0.0 { (0.0, 0.0) } else { ((2.0 * n - 1.0) / n, (n - 1.0) / n) }
             })
             .collect();
+        let up = mom_idx
+            .k
+            .iter()
+            .enumerate()
+            .map(|(kp, m)| match (0..3).find(|&i| m[i] > 0) {
+                Some(i) => (mom_idx.down1[kp][i], i as u8),
+                None => (NONE, 0),
+            })
+            .collect();
         let mut binom = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
         for n in 0..=MAX_ORDER {
             binom[n][0] = 1.0;
@@ -205,15 +240,17 @@ impl Treecode {
                 binom[n][k] = binom[n - 1][k - 1] + if k < n { binom[n - 1][k] } else { 0.0 };
             }
         }
-        let mut shift = Vec::new();
+        let (mut shift, mut shift_rows) = (Vec::new(), Vec::new());
         for (kp, k) in mom_idx.k.iter().enumerate() {
+            let start = shift.len() as u32;
             for (jp, j) in mom_idx.k.iter().enumerate().take(kp + 1) {
                 if (0..3).all(|q| j[q] <= k[q]) {
                     let e = [k[0] - j[0], k[1] - j[1], k[2] - j[2]];
                     let c = (0..3).map(|q| binom[k[q] as usize][j[q] as usize]).product();
-                    shift.push((kp as u32, jp as u32, e, c));
+                    shift.push((jp as u32, e, c));
                 }
             }
+            shift_rows.push((start, shift.len() as u32));
         }
         Self {
             order,
@@ -223,7 +260,9 @@ impl Treecode {
             taylor_idx,
             grad,
             rec,
+            up,
             shift,
+            shift_rows,
             ..Self::default()
         }
     }
@@ -290,22 +329,14 @@ impl Treecode {
         let mut c = 0;
         while c < self.clusters.len() {
             let (start, end) = (self.clusters[c].start as usize, self.clusters[c].end as usize);
-            let (center, radius) = bounding_ball(fil, &self.perm[start..end]);
+            let (center, radius, lo, hi) = bounding_ball(fil, &self.perm[start..end]);
             self.clusters[c].center = center;
             self.clusters[c].radius = radius;
             if end - start <= self.leaf_size {
                 self.clusters[c].leaf = self.n_leaves as u32;
                 self.n_leaves += 1;
             } else {
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for &s in &self.perm[start..end] {
-                    let m = self.mid[s as usize];
-                    for q in 0..3 {
-                        lo[q] = lo[q].min(m[q]);
-                        hi[q] = hi[q].max(m[q]);
-                    }
-                }
+                // Split the midpoints along the longest side of the ends' bounding box.
                 let axis = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b]))).unwrap_or(0);
                 let half = (end - start) / 2;
                 let mid = &self.mid;
@@ -338,17 +369,33 @@ impl Treecode {
         if self.leaves.len() < self.n_leaves {
             self.leaves.resize(self.n_leaves, Filaments::default());
         }
+        if self.node_stamp.len() < fil.n_nodes() {
+            self.node_stamp.resize(fil.n_nodes(), 0);
+            self.node_slot.resize(fil.n_nodes(), 0);
+        }
         for c in &self.clusters {
             if c.leaf == NONE {
                 continue;
             }
             let leaf = &mut self.leaves[c.leaf as usize];
             leaf.clear();
+            // A node shared by segments of the leaf is copied once (`stamp` marks the nodes
+            // already copied into this leaf, `slot` their index in it).
+            self.stamp_gen += 1;
+            let (stamp, slot, generation) = (&mut self.node_stamp, &mut self.node_slot, self.stamp_gen);
+            let mut copy = |n: u32, leaf: &mut Filaments| -> u32 {
+                let n = n as usize;
+                if stamp[n] != generation {
+                    stamp[n] = generation;
+                    slot[n] = leaf.push_node(fil.node(n));
+                }
+                slot[n]
+            };
             for &s in &self.perm[c.start as usize..c.end as usize] {
                 let s = s as usize;
                 let (a, b) = fil.segment_nodes(s);
-                let ia = leaf.push_node(fil.node(a as usize));
-                let ib = leaf.push_node(fil.node(b as usize));
+                let ia = copy(a, leaf);
+                let ib = copy(b, leaf);
                 leaf.seg_a.push(ia);
                 leaf.seg_b.push(ib);
                 leaf.seg_g.push(fil.seg_g[s]);
@@ -360,17 +407,26 @@ impl Treecode {
 
     /// Leaf moments from Gauss points, then shifted to the parents (children follow their
     /// parents in `clusters`, so a reverse sweep sees every child first).
+    ///
+    /// A leaf's (segment, Gauss point) samples go [`LANES`] at a time: each monomial of the
+    /// moment table is its parent's times one coordinate (`up`), accumulated per lane and
+    /// summed over the lanes once per leaf.
     fn compute_moments(&mut self, fil: &Filaments) {
         let nm = self.mom_idx.k.len();
         self.moments.clear();
         self.moments.resize(self.clusters.len() * nm, [0.0; 3]);
         let p = self.order;
-        let mut pw = [[0.0; MAX_ORDER + 1]; 3];
+        let sm = &mut self.samples;
+        sm.mono.resize(nm, [0.0; LANES]);
+        sm.acc.resize(nm, [[0.0; LANES]; 3]);
         for (ci, c) in self.clusters.iter().enumerate() {
             if c.leaf == NONE {
                 continue;
             }
-            let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
+            // The samples: weights Γ w (B − A) and positions relative to the centre.
+            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
+                v.clear();
+            }
             for &s in &self.perm[c.start as usize..c.end as usize] {
                 let s = s as usize;
                 let (a, b) = fil.segment_nodes(s);
@@ -378,30 +434,50 @@ impl Treecode {
                 let l = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
                 for &(t, w) in &self.gauss {
                     let gw = fil.seg_g[s] * w;
-                    let alpha = [gw * l[0], gw * l[1], gw * l[2]];
-                    for q in 0..3 {
-                        let xi = pa[q] + t * l[q] - c.center[q];
-                        pw[q][0] = 1.0;
-                        for e in 1..=p {
-                            pw[q][e] = pw[q][e - 1] * xi;
-                        }
-                    }
-                    for (mm, k) in mom.iter_mut().zip(&self.mom_idx.k) {
-                        let x = pw[0][k[0] as usize] * pw[1][k[1] as usize] * pw[2][k[2] as usize];
-                        mm[0] += alpha[0] * x;
-                        mm[1] += alpha[1] * x;
-                        mm[2] += alpha[2] * x;
-                    }
+                    sm.ax.push(gw * l[0]);
+                    sm.ay.push(gw * l[1]);
+                    sm.az.push(gw * l[2]);
+                    sm.xx.push(pa[0] + t * l[0] - c.center[0]);
+                    sm.xy.push(pa[1] + t * l[1] - c.center[1]);
+                    sm.xz.push(pa[2] + t * l[2] - c.center[2]);
+                }
+            }
+            // Pad to whole blocks with zero weights.
+            let n = sm.ax.len().div_ceil(LANES) * LANES;
+            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
+                v.resize(n, 0.0);
+            }
+            for a in sm.acc.iter_mut() {
+                *a = [[0.0; LANES]; 3];
+            }
+            sm.mono[0] = [1.0; LANES];
+            match isa() {
+                Isa::Generic => moments_generic(&self.up, sm),
+                // SAFETY: the features were detected at run time.
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => unsafe { moments_avx2(&self.up, sm) },
+                // SAFETY: the features were detected at run time.
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 => unsafe { moments_avx512(&self.up, sm) },
+            }
+            let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
+            for (mm, acc) in mom.iter_mut().zip(&sm.acc) {
+                for q in 0..3 {
+                    mm[q] = acc[q].iter().sum();
                 }
             }
         }
+        // M_k(parent) = Σ_children Σ_{j ≤ k} C(k, j) δ^{k − j} M_j(child), both children in one
+        // sweep of the table, each k summed in registers (the table is grouped by k).
+        let mut pw2 = [[[0.0; MAX_ORDER + 1]; 3]; 2];
         for ci in (0..self.clusters.len()).rev() {
             let c = self.clusters[ci];
             if c.child == NONE {
                 continue;
             }
-            for ch in [c.child as usize, c.child as usize + 1] {
-                let cc = self.clusters[ch].center;
+            let ch = c.child as usize;
+            for (h, pw) in pw2.iter_mut().enumerate() {
+                let cc = self.clusters[ch + h].center;
                 let delta = [cc[0] - c.center[0], cc[1] - c.center[1], cc[2] - c.center[2]];
                 for q in 0..3 {
                     pw[q][0] = 1.0;
@@ -409,17 +485,23 @@ impl Treecode {
                         pw[q][e] = pw[q][e - 1] * delta[q];
                     }
                 }
-                let (lo, hi) = self.moments.split_at_mut(ch * nm);
-                let parent = &mut lo[ci * nm..(ci + 1) * nm];
-                let child = &hi[..nm];
-                // M_k(parent) += Σ_{j ≤ k} C(k, j) δ^{k − j} M_j(child).
-                for &(kp, jp, e, coef) in &self.shift {
-                    let f = coef * pw[0][e[0] as usize] * pw[1][e[1] as usize] * pw[2][e[2] as usize];
-                    let m = child[jp as usize];
-                    let o = &mut parent[kp as usize];
-                    o[0] += f * m[0];
-                    o[1] += f * m[1];
-                    o[2] += f * m[2];
+            }
+            let (lo, hi) = self.moments.split_at_mut(ch * nm);
+            let parent = &mut lo[ci * nm..(ci + 1) * nm];
+            let (c0, c1) = (&hi[..nm], &hi[nm..2 * nm]);
+            for (kp, &(start, end)) in self.shift_rows.iter().enumerate() {
+                let mut acc = [0.0; 3];
+                for &(jp, e, coef) in &self.shift[start as usize..end as usize] {
+                    let (e0, e1, e2) = (e[0] as usize, e[1] as usize, e[2] as usize);
+                    let f0 = coef * pw2[0][0][e0] * pw2[0][1][e1] * pw2[0][2][e2];
+                    let f1 = coef * pw2[1][0][e0] * pw2[1][1][e1] * pw2[1][2][e2];
+                    let (m0, m1) = (c0[jp as usize], c1[jp as usize]);
+                    for q in 0..3 {
+                        acc[q] += f0 * m0[q] + f1 * m1[q];
+                    }
+                }
+                for q in 0..3 {
+                    parent[kp][q] += acc[q];
                 }
             }
         }
@@ -538,7 +620,16 @@ impl Treecode {
                 let nm = self.mom_idx.k.len();
                 let (ci, c) = (ci as usize, c.center);
                 let mom = &self.moments[ci * nm..(ci + 1) * nm];
-                expansion_lanes(&self.taylor_idx, &self.rec, &self.grad, mom, c, px, py, pz, &mut sc.taylor, u);
+                let (idx, rec, grad, a) = (&self.taylor_idx, &self.rec[..], &self.grad[..], &mut sc.taylor[..]);
+                match isa() {
+                    Isa::Generic => expansion_generic(idx, rec, grad, mom, c, px, py, pz, a, u),
+                    // SAFETY: the features were detected at run time.
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx2 => unsafe { expansion_avx2(idx, rec, grad, mom, c, px, py, pz, a, u) },
+                    // SAFETY: the features were detected at run time.
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx512 => unsafe { expansion_avx512(idx, rec, grad, mom, c, px, py, pz, a, u) },
+                }
                 sc.stats.n_expansions += LANES as u64;
             } else if c.leaf != NONE {
                 let leaf = &self.leaves[c.leaf as usize];
@@ -578,8 +669,32 @@ fn scatter(order: &[u32], b: usize, u: &[[f64; LANES]; 3], out: &mut [[f64; 3]])
     }
 }
 
+/// [`expansion_lanes`] compiled for each instruction set, chosen at run time.
+macro_rules! expansion_variants {
+    ($($name:ident $(, $feat:literal)?);*) => {$(
+        $(#[cfg(target_arch = "x86_64")] #[target_feature(enable = $feat)])?
+        #[allow(clippy::too_many_arguments)] // as expansion_lanes
+        fn $name(
+            idx: &Indices,
+            rec: &[(f64, f64)],
+            grad: &[([u32; 3], [f64; 3])],
+            mom: &[[f64; 3]],
+            c: [f64; 3],
+            px: &[f64; LANES],
+            py: &[f64; LANES],
+            pz: &[f64; LANES],
+            a: &mut [[f64; LANES]],
+            u: &mut [[f64; LANES]; 3],
+        ) {
+            expansion_lanes(idx, rec, grad, mom, c, px, py, pz, a, u);
+        }
+    )*};
+}
+expansion_variants!(expansion_generic; expansion_avx2, "avx2,fma"; expansion_avx512, "avx512f,avx2,fma");
+
 /// Taylor coefficients at the block's points and the sum over the moments, lane by lane.
 #[allow(clippy::too_many_arguments)] // tables, moments, centre, points, scratch and output
+#[inline(always)]
 fn expansion_lanes(
     idx: &Indices,
     rec: &[(f64, f64)],
@@ -637,17 +752,69 @@ fn expansion_lanes(
     }
 }
 
-/// Centre of the bounding box of the segments' ends and the largest distance of an end from it.
-fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64) {
+/// Every block of a leaf's moment samples: the monomials `x^k` (each its parent `up[k].0` times
+/// coordinate `up[k].1`; `mono[0] = 1`) weighted by the samples' `alpha`, added to `acc` lane by
+/// lane.
+#[inline(always)]
+fn moments_body(up: &[(u32, u8)], sm: &mut MomentSamples) {
+    let (mono, acc) = (&mut sm.mono, &mut sm.acc);
+    for b in (0..sm.ax.len()).step_by(LANES) {
+        let lanes = |v: &[f64]| -> [f64; LANES] { v[b..b + LANES].try_into().expect("a block of lanes") };
+        let alpha = [lanes(&sm.ax), lanes(&sm.ay), lanes(&sm.az)];
+        let x = [lanes(&sm.xx), lanes(&sm.xy), lanes(&sm.xz)];
+        for q in 0..3 {
+            for l in 0..LANES {
+                acc[0][q][l] += alpha[q][l];
+            }
+        }
+        for k in 1..up.len() {
+            let (parent, axis) = (up[k].0 as usize, up[k].1 as usize);
+            let prev = mono[parent];
+            let mut m = [0.0; LANES];
+            for l in 0..LANES {
+                m[l] = prev[l] * x[axis][l];
+            }
+            mono[k] = m;
+            let a = &mut acc[k];
+            for q in 0..3 {
+                for l in 0..LANES {
+                    a[q][l] += alpha[q][l] * m[l];
+                }
+            }
+        }
+    }
+}
+
+fn moments_generic(up: &[(u32, u8)], sm: &mut MomentSamples) {
+    moments_body(up, sm);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn moments_avx2(up: &[(u32, u8)], sm: &mut MomentSamples) {
+    moments_body(up, sm);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx2,fma")]
+fn moments_avx512(up: &[(u32, u8)], sm: &mut MomentSamples) {
+    moments_body(up, sm);
+}
+
+/// Centre of the bounding box of the segments' ends, the largest distance of an end from it,
+/// and the box's lower and upper corners.
+fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64, [f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
+    // Plain comparisons rather than f64::min/max: the nodes are finite, and these compile to
+    // single min/max instructions.
     for &s in segs {
         let (a, b) = fil.segment_nodes(s as usize);
         for n in [a, b] {
             let p = fil.node(n as usize);
             for q in 0..3 {
-                lo[q] = lo[q].min(p[q]);
-                hi[q] = hi[q].max(p[q]);
+                lo[q] = if p[q] < lo[q] { p[q] } else { lo[q] };
+                hi[q] = if p[q] > hi[q] { p[q] } else { hi[q] };
             }
         }
     }
@@ -657,10 +824,11 @@ fn bounding_ball(fil: &Filaments, segs: &[u32]) -> ([f64; 3], f64) {
         let (a, b) = fil.segment_nodes(s as usize);
         for n in [a, b] {
             let p = fil.node(n as usize);
-            r2 = r2.max((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2));
+            let d2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
+            r2 = if d2 > r2 { d2 } else { r2 };
         }
     }
-    (c, r2.sqrt())
+    (c, r2.sqrt(), lo, hi)
 }
 
 /// Gauss–Legendre points and weights on [0, 1] (weights sum to 1), `n` points, exact for
