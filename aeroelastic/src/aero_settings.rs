@@ -86,8 +86,9 @@ pub struct AeroSettings {
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub gust: Option<GustSpec>,
     /// Sum the wake through the UVLM's treecode, within 1e-6 of the free-stream speed at every
-    /// point (docs/uvlm.md §14); default false (every wake filament summed directly: on the
-    /// paper's wing the treecode did not beat the direct sum up to 320 wake rows).
+    /// point (docs/uvlm.md §14); default false (every wake filament summed directly: at the
+    /// cases' 40 wake rows the direct sum is faster, at 320 rows the treecode's step is 1.4–1.9×
+    /// faster on the paper's and Healy's wings, docs/outputs.md).
     #[cfg_attr(feature = "serde", serde(default))]
     pub wake_aggregation: bool,
     /// Section polars (issue 37, docs/section_aero.md): the lattice's loads on the strips of
