@@ -400,8 +400,18 @@ impl Reduced {
     /// Newton's method on `D(s) η = 0`, `cᴴ η = 1` from `(s, η)`; returns the root and its vector.
     /// `dD/ds` is a central difference, kept between iterations while they contract (a chord
     /// method: one evaluation of `D` per iteration) and refreshed when they do not.
+    ///
+    /// `D(s)` is real for real `s`, so from a real start with a real vector every iterate stays
+    /// on the real axis and only a real root can be reached. A real start that does not converge
+    /// there (the real pair of a statically unstable mode has met and turned complex) is retried
+    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector.
     pub fn newton(&self, s: C64, eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
-        newton_of(|x| self.d(x), s, eta, count)
+        let real_start = s.im == 0.0 && eta.iter().all(|x| x.im == 0.0);
+        let e0 = if real_start { Some(eta.clone()) } else { None };
+        match (newton_of(|x| self.d(x), s, eta, count), e0) {
+            ((_, _, false), Some(e0)) => newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count),
+            (found, _) => found,
+        }
     }
 }
 
