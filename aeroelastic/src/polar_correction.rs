@@ -36,6 +36,9 @@ pub struct StripReport {
     pub alpha: Vec<f64>,
     /// Section lift coefficient of the polar at that incidence (NaN without a polar).
     pub cl: Vec<f64>,
+    /// The polar's lift slope `dcl/dα` at that incidence, 1/rad (NaN without a polar; filled by
+    /// [`StripPolars::correct`] and [`StripPolars::correct_strips`] only).
+    pub cl_slope: Vec<f64>,
     /// Sum of the change of force over the strips, N.
     pub total_delta: Vector3<f64>,
     /// Sum of the profile drag `cd qS` over the strips, N.
@@ -119,6 +122,8 @@ impl StripPolars {
         report.alpha.resize(n, f64::NAN);
         report.cl.clear();
         report.cl.resize(n, f64::NAN);
+        report.cl_slope.clear();
+        report.cl_slope.resize(n, f64::NAN);
         report.total_delta = Vector3::zeros();
         report.profile_drag = 0.0;
         for st in self.placed(stations, map) {
@@ -140,6 +145,7 @@ impl StripPolars {
             report.delta_force[st.j] = df;
             report.alpha[st.j] = c.alpha;
             report.cl[st.j] = c.coefficients.cl;
+            report.cl_slope[st.j] = c.coefficients.dcl;
             report.total_delta += df;
             report.profile_drag += c.profile_drag();
         }

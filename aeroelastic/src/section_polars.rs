@@ -135,9 +135,9 @@ pub fn refuse_tip_loss(problem: &Problem, analysis: &str) -> Result<(), String> 
 
 /// Why `analysis` cannot run `problem` with section polars or a strip tip loss (which only the
 /// statics apply): the statics, the time marches (the lattice's, the strip theory's, from a
-/// trim), the marched gust, the trim, the lattice's stability and the linear gust model apply
-/// the polars (docs/section_aero.md §7); stability with Theodorsen strips does not yet, and
-/// running it would ignore the polars.
+/// trim), the marched gust, the trim, the stability analysis (lattice or Theodorsen strips) and
+/// the linear gust model apply the polars (docs/section_aero.md §7); an analysis that does not
+/// would ignore them.
 pub fn refuse_unwired(problem: &Problem, analysis: &str) -> Result<(), String> {
     refuse_tip_loss(problem, analysis)?;
     let given = !problem.polars.is_empty() || problem.aero.as_ref().is_some_and(|a| !a.polars.is_empty());

@@ -400,8 +400,18 @@ impl Reduced {
     /// Newton's method on `D(s) η = 0`, `cᴴ η = 1` from `(s, η)`; returns the root and its vector.
     /// `dD/ds` is a central difference, kept between iterations while they contract (a chord
     /// method: one evaluation of `D` per iteration) and refreshed when they do not.
+    ///
+    /// `D(s)` is real for real `s`, so from a real start with a real vector every iterate stays
+    /// on the real axis and only a real root can be reached. A real start that does not converge
+    /// there (the real pair of a statically unstable mode has met and turned complex) is retried
+    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector.
     pub fn newton(&self, s: C64, eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
-        newton_of(|x| self.d(x), s, eta, count)
+        let real_start = s.im == 0.0 && eta.iter().all(|x| x.im == 0.0);
+        let e0 = if real_start { Some(eta.clone()) } else { None };
+        match (newton_of(|x| self.d(x), s, eta, count), e0) {
+            ((_, _, false), Some(e0)) => newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count),
+            (found, _) => found,
+        }
     }
 }
 
@@ -489,6 +499,9 @@ pub struct Strips {
     a: Vec<f64>,
     /// `cos Λ` of each strip (1 unswept).
     cos_sweep: Vec<f64>,
+    /// Lift slope of each strip over 2π: the section polar's `cl'` at the strip's effective
+    /// incidence in the corrected steady state (1 without a polar).
+    slope: Vec<f64>,
     rho: f64,
     speed: f64,
 }
@@ -502,6 +515,8 @@ impl Strips {
         let mut q = DMatrix::zeros(nb, nb);
         for j in 0..self.width.len() {
             let (w, b, a) = (self.width[j], self.b[j], self.a[j]);
+            // The circulatory lift's `2π`, the polar's slope with polars (`2π · 1` is exact).
+            let two_pi = 2.0 * pi * self.slope[j];
             let u = self.speed * ratio * self.cos_sweep[j];
             let p = s * b / u;
             // Without normal flow (`U_n = 0`, a strip along the stream) the circulatory terms
@@ -516,8 +531,7 @@ impl Strips {
                 let th = C64::from(self.theta[(j, k)]);
                 let al = C64::from(self.alpha[(j, k)]);
                 let circ = c * (s * h + u * al + b * (0.5 - a) * s * th);
-                let l =
-                    pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * th) + 2.0 * pi * rho * u * b * circ;
+                let l = pi * rho * b * b * (s * s * h + u * s * al - b * a * s * s * th) + two_pi * rho * u * b * circ;
                 // `baU_n α̇_n − ½U_n b θ̇` written as Theodorsen's `−U_n b(½ − a)θ̇` plus the
                 // bending slope's part `baU_n(α̇_n − θ̇)`, which vanishes unswept.
                 let m = pi
@@ -526,7 +540,7 @@ impl Strips {
                     * b
                     * (b * a * s * s * h - u * b * (0.5 - a) * s * th + b * a * u * s * (al - th)
                         - b * b * (0.125 + a * a) * s * s * th)
-                    + 2.0 * pi * rho * u * b * b * (a + 0.5) * circ;
+                    + two_pi * rho * u * b * b * (a + 0.5) * circ;
                 for i in 0..nb {
                     q[(i, k)] += w * (l * self.z[(j, i)] + m * self.theta[(j, i)]);
                 }
@@ -758,6 +772,7 @@ fn strip_model<S: Structure>(
     stations: &[uvlm::SpanStation],
     phi: &DMatrix<f64>,
     (map, aero, case): (&[StationMap], &AeroSettings, &Problem),
+    slope: Vec<f64>,
 ) -> Strips {
     let zeros = vec![0.0; model.n_dof()];
     let mut scratch = StationScratch::default();
@@ -815,7 +830,40 @@ fn strip_model<S: Structure>(
     let b: Vec<f64> = stations.iter().map(|st| 0.5 * st.chord).collect();
     let a = stations.iter().zip(&b).map(|(st, b)| (st.le_offset - b) / b).collect();
     let cos_sweep = axes.iter().map(|(_, lateral)| lateral.norm()).collect();
-    Strips { z, theta, alpha, width, b, a, cos_sweep, rho: aero.rho, speed: aero.airspeed.unwrap_or(0.0) }
+    Strips { z, theta, alpha, width, b, a, cos_sweep, slope, rho: aero.rho, speed: aero.airspeed.unwrap_or(0.0) }
+}
+
+/// Each station's lift slope over 2π for the Theodorsen strips (docs/stability.md §4.2): the
+/// mean of the polar's `cl'` over the lattice strips on either side of the station (strips
+/// without a polar left out), each at its effective incidence in the corrected steady solution
+/// of the lattice `la` (each strip in the free stream, as the statics' equilibrium); 1 where no
+/// strip beside the station has a polar, and everywhere without `polars`.
+fn strip_slopes(
+    polars: Option<&StripPolars>,
+    stations: &[uvlm::SpanStation],
+    (map, aero): (&[StationMap], &AeroSettings),
+    la: Option<&uvlm::LinearUvlm>,
+) -> Result<Vec<f64>, String> {
+    let ns = stations.len();
+    let (Some(p), Some(la)) = (polars, la) else { return Ok(vec![1.0; ns]) };
+    let strips: Vec<[f64; 3]> = la.reference_strips.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let v_inf = Vector3::from(aero.free_stream());
+    let mut out = zero_loads(map);
+    let mut report = crate::polar_correction::StripReport::default();
+    p.correct_strips(stations, map, &strips, |_, _| v_inf, 1.0, &mut out, &mut report)?;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    Ok((0..ns)
+        .map(|j| {
+            let beside = [j.checked_sub(1), Some(j)];
+            let k: Vec<f64> = beside
+                .iter()
+                .flatten()
+                .filter_map(|&i| report.cl_slope.get(i).copied())
+                .filter(|x| x.is_finite())
+                .collect();
+            if k.is_empty() { 1.0 } else { k.iter().sum::<f64>() / (two_pi * k.len() as f64) }
+        })
+        .collect())
 }
 
 /// The load maps of a lattice `la` on `model` at `q`: the lumping `C_l` (6·stations × nodal
@@ -1151,13 +1199,19 @@ pub fn reduce<S: Structure>(
     if let Some((case, out)) = shapes_out {
         out.extend(mode_shapes(&mut model, q, &stations, &basis, (map, aero, case)));
     }
+    let lattice = || -> Result<uvlm::LinearUvlm, String> {
+        let mut uv = crate::lifting::new_uvlm(map, aero, &stations, aero.uvlm_params(aero.free_stream()))
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))
+    };
     if let Some(case) = strip_case {
-        let strips = strip_model(&mut model, q, &stations, &basis.phi, (map, aero, case));
+        // With polars the strips' slopes are read at the lattice's corrected steady incidences.
+        let la = if polars.is_some() { Some(lattice()?) } else { None };
+        let slope = strip_slopes(polars, &stations, (map, aero), la.as_ref())?;
+        let strips = strip_model(&mut model, q, &stations, &basis.phi, (map, aero, case), slope);
         return Ok(Reduced::of_strips(basis, strips));
     }
-    let mut uv = crate::lifting::new_uvlm(map, aero, &stations, aero.uvlm_params(aero.free_stream()))
-        .map_err(|e| format!("aerodynamic lattice: {e}"))?;
-    let la = uv.linearise(wake).map_err(|e| format!("linear UVLM: {e}"))?;
+    let la = lattice()?;
     let origins: Vec<[f64; 3]> = stations.iter().map(|x| x.origin.into()).collect();
     let [_, h, phi_p] = load_maps(&mut model, q, &basis.phi, (map, aero), &zero_loads, &la, &origins)?;
     // The polars' correction of the circulations' loads: the generalised load per strip force.
@@ -1275,7 +1329,8 @@ fn cpu_now() -> f64 {
 /// Run the stability sweep of `case` with formulation `f`.
 pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let t0 = Instant::now();
-    if let Err(e) = refuse_strip_polars(case) {
+    // A strip tip loss is the statics' alone; the polars are applied (docs/section_aero.md §7.7).
+    if let Err(e) = crate::section_polars::refuse_tip_loss(case, "stability analysis") {
         return empty_output(f, Some(e));
     }
     struct Sweep<'a>(&'a Problem, Formulation);
@@ -1288,16 +1343,6 @@ pub fn run_stability(case: &Problem, f: Formulation) -> StabilityOutput {
     let mut out = dispatch(f, Sweep(case, f));
     out.wall_s = t0.elapsed().as_secs_f64();
     out
-}
-
-/// The Theodorsen strips (`stability.aerodynamics: "strip"`) have no section polars: a case with
-/// both is refused rather than run with the polars ignored (docs/section_aero.md §8).
-fn refuse_strip_polars(case: &Problem) -> Result<(), String> {
-    crate::section_polars::refuse_tip_loss(case, "stability analysis")?;
-    if case.stability.as_ref().is_some_and(|s| s.aerodynamics == AeroModel::Strip) {
-        crate::section_polars::refuse_unwired(case, "stability analysis with Theodorsen strips")?;
-    }
-    Ok(())
 }
 
 fn empty_output(f: Formulation, err: Option<String>) -> StabilityOutput {

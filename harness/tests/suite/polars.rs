@@ -194,12 +194,6 @@ fn bad_polar_input_names_the_field() {
     assert!(e.contains("aero.polars[0].file") && e.contains("40 m/s") && e.contains("bounds.re"), "{e}");
     let clamp = format!(r#"aero.polars=[{{"bodies":[0,1],"file":"{}","bounds":{{"re":"clamp"}}}}]"#, good.display());
     assert!(healy(&["static.airspeeds=[12,40]".into(), clamp]).is_ok());
-    // The analyses not wired yet refuse a case with polars instead of ignoring them: stability
-    // with Theodorsen strips, the strip-theory march.
-    let set = [polars_set(&good, "[0,1]"), r#"stability={"airspeeds":[20],"modes":2,"aerodynamics":"strip"}"#.into()];
-    let spec = healy(&set).unwrap();
-    let stab = harness::stability::run_stability(&spec.gebf.problem(), Formulation::Gebf);
-    assert!(stab.error.as_deref().is_some_and(|e| e.contains("aero.polars")), "{:?}", stab.error);
 }
 
 /// The columns of a time-history row that the march's comparisons check.
