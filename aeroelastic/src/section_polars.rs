@@ -132,20 +132,3 @@ pub fn refuse_tip_loss(problem: &Problem, analysis: &str) -> Result<(), String> 
     }
     Ok(())
 }
-
-/// Why `analysis` cannot run `problem` with section polars or a strip tip loss (which only the
-/// statics apply): the statics, the time marches (the lattice's, the strip theory's, from a
-/// trim), the marched gust, the trim, the stability analysis (lattice or Theodorsen strips) and
-/// the linear gust model apply the polars (docs/section_aero.md §7); an analysis that does not
-/// would ignore them.
-pub fn refuse_unwired(problem: &Problem, analysis: &str) -> Result<(), String> {
-    refuse_tip_loss(problem, analysis)?;
-    let given = !problem.polars.is_empty() || problem.aero.as_ref().is_some_and(|a| !a.polars.is_empty());
-    if given {
-        return Err(format!(
-            "aero.polars: the section polars are wired into the statics, the trim, the time marches and the lattice's \
-             linear analyses only so far; the {analysis} would ignore them (docs/section_aero.md §7)"
-        ));
-    }
-    Ok(())
-}
