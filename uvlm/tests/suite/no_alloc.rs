@@ -7,7 +7,6 @@
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 
-
 #[test]
 fn step_does_not_allocate() {
     for (convection, disturbed) in [
