@@ -2,6 +2,7 @@
 //! each with its wake, in one influence system.
 
 use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
+use crate::axis_extension::bound_induction_at_load_points;
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
@@ -84,6 +85,8 @@ pub struct Uvlm {
     wpts: Points,
     u_col: Vec<[f64; 3]>,
     u_mid: Vec<[f64; 3]>,
+    /// The bound filaments' part of `u_mid` (work buffer).
+    u_bound_mid: Vec<[f64; 3]>,
     u_wake: Vec<[f64; 3]>,
     v_col: Vec<[f64; 3]>,
     v_mid: Vec<[f64; 3]>,
@@ -146,6 +149,7 @@ impl Uvlm {
             wpts: Points::default(),
             u_col: vec![[0.0; 3]; nr],
             u_mid: Vec::new(),
+            u_bound_mid: Vec::new(),
             u_wake: Vec::new(),
             v_col: vec![[0.0; 3]; nr],
             v_mid: Vec::new(),
@@ -426,40 +430,30 @@ impl Uvlm {
         }
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
         let tol = self.aggregation_tolerance();
+        // The bound filaments by the load points' kernel, regular on their axis extensions
+        // (axis_extension.rs, docs/uvlm.md §3); the known wake by the block kernels.
         let pairs = if with_known_wake && self.known_tree.applies(&self.known) {
-            let bound = induced_velocity_inplace(
-                &[&self.bound.fil],
+            self.u_mid.fill([0.0; 3]);
+            self.known_tree.add_velocity(
+                &self.known,
                 &self.mid,
+                tol,
                 &mut self.u_mid,
                 self.params.parallel,
                 &mut self.blocks,
-            );
-            bound
-                + self.known_tree.add_velocity(
-                    &self.known,
-                    &self.mid,
-                    tol,
-                    &mut self.u_mid,
-                    self.params.parallel,
-                    &mut self.blocks,
-                )
+            )
         } else if with_known_wake {
-            induced_velocity_inplace(
-                &[&self.bound.fil, &self.known],
-                &self.mid,
-                &mut self.u_mid,
-                self.params.parallel,
-                &mut self.blocks,
-            )
+            induced_velocity_inplace(&[&self.known], &self.mid, &mut self.u_mid, self.params.parallel, &mut self.blocks)
         } else {
-            induced_velocity_inplace(
-                &[&self.bound.fil],
-                &self.mid,
-                &mut self.u_mid,
-                self.params.parallel,
-                &mut self.blocks,
-            )
+            self.u_mid.fill([0.0; 3]);
+            0
         };
+        let mut bound = vec![[0.0; 3]; 0];
+        std::mem::swap(&mut bound, &mut self.u_bound_mid);
+        bound.resize(self.mid.len(), [0.0; 3]);
+        let pairs = pairs + bound_induction_at_load_points(&self.bound.fil, &self.mid, &mut bound);
+        add_to(&mut self.u_mid, &bound);
+        self.u_bound_mid = bound;
         self.stats.n_pair_evaluations += pairs;
         if with_known_wake && self.params.wake_reuse == WakeReuse::Frozen {
             if !self.far_ready {

@@ -11,6 +11,7 @@ mod linear_baseline;
 mod linear_gust;
 mod linear_strips;
 mod linear_surfaces;
+mod load_derivative;
 mod multi_surface;
 mod multi_surface_baseline;
 mod properties;
