@@ -21,7 +21,7 @@
 //! a semi-infinite leg's start (`d·r < 0`) as `(d × r)|d×r|² / ((|d×r|² + r_c²) |r| (|r| − d·r))`.
 //! Inside the segment (or downstream along a leg) it is the crate's kernel, cut-off included.
 
-use crate::biot_savart::{Filaments, LANES};
+use crate::biot_savart::Filaments;
 use crate::induce::Points;
 
 /// The factor `k` of a segment pair (`u = Γ/4π · k · r₁×r₂`) for the load points.
@@ -65,32 +65,132 @@ pub(crate) fn leg_factor(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> ([f
     if h > cut2 && rn > 0.0 { (c, (rn + dr) / ((h + core2) * rn)) } else { (c, 0.0) }
 }
 
-/// Overwrite `out[p]` with the induction of the filaments `fil` at point `p` of `pts` (module
-/// doc). Returns the point–filament pairs counted as the block kernels count them.
-pub(crate) fn bound_induction_at_load_points(fil: &Filaments, pts: &Points, out: &mut [[f64; 3]]) -> u64 {
-    for (p, o) in out.iter_mut().enumerate().take(pts.len()) {
-        let x = [pts.x[p], pts.y[p], pts.z[p]];
-        let mut u = [0.0; 3];
-        for s in 0..fil.n_segments() {
-            let (a, b) = (fil.node(fil.seg_a[s] as usize), fil.node(fil.seg_b[s] as usize));
-            let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
-            let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
-            let (c, k) = segment_factor(r1, r2, fil.seg_core2[s], fil.seg_cut2[s]);
-            let gk = fil.seg_g[s] * k;
-            for q in 0..3 {
-                u[q] += gk * c[q];
+/// One surface's place in the bound system, for [`correct_axis_extensions`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SurfaceLayout {
+    /// Its first segment and its number of load segments (load points, in segment order).
+    pub(crate) seg0: usize,
+    pub(crate) n_load: usize,
+    /// Its lattice segments (a finite steady wake's legs follow them).
+    pub(crate) n_lattice_seg: usize,
+    /// Chordwise and spanwise panels.
+    pub(crate) m: usize,
+    pub(crate) n: usize,
+    /// Its first semi-infinite leg.
+    pub(crate) leg0: usize,
+    /// Whether its trailing legs are the segments of a finite steady wake.
+    pub(crate) finite: bool,
+}
+
+/// The bound system's layout: surfaces, base filaments and image copies.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ExtensionLayout {
+    pub(crate) surfaces: Vec<SurfaceLayout>,
+    pub(crate) n_base_seg: usize,
+    pub(crate) n_base_leg: usize,
+    pub(crate) n_copies: usize,
+}
+
+/// The crate kernel's factor of a segment pair, with the block kernels' arithmetic (so that the
+/// term they added is removed exactly).
+#[inline]
+fn kernel_segment(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> f64 {
+    let cx = r1[1] * r2[2] - r1[2] * r2[1];
+    let cy = r1[2] * r2[0] - r1[0] * r2[2];
+    let cz = r1[0] * r2[1] - r1[1] * r2[0];
+    let h2 = cx * cx + cy * cy + cz * cz + core2;
+    let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
+    let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
+    let n12 = n1 * n2;
+    let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
+    let num = (n1 + n2) * (n12 - dot);
+    if h2 > cut2 && n12 > 0.0 { num / (n12 * h2) } else { 0.0 }
+}
+
+/// The crate kernel's factor of a leg pair, with the block kernels' arithmetic.
+#[inline]
+fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
+    let cx = d[1] * r[2] - d[2] * r[1];
+    let cy = d[2] * r[0] - d[0] * r[2];
+    let cz = d[0] * r[1] - d[1] * r[0];
+    let h2 = cx * cx + cy * cy + cz * cz;
+    let rn = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let dot = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
+    if h2 > cut2 && rn > 0.0 { (rn + dot) / ((h2 + core2) * rn) } else { 0.0 }
+}
+
+/// Replace, in the bound filaments' induction `u` at the load points `pts` (every surface's
+/// lattice segment midpoints, as [`crate::Uvlm`] lists them), the block kernels' term of every
+/// filament whose axis passes along the point's row or column — the segments of its row (a
+/// spanwise point) or column (a chordwise point) with their image copies, and its column's
+/// trailing leg — by the regular form of [`segment_factor`] and [`leg_factor`] where the point
+/// lies outside the segment (module doc). Other filaments are never collinear with a load point
+/// of a ring lattice by construction, and keep the block kernels' value.
+pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
+    let mut p = 0;
+    for sl in &layout.surfaces {
+        let (m, n) = (sl.m, sl.n);
+        let nc = n + 1;
+        for s in 0..sl.n_load {
+            let x = [pts.x[p], pts.y[p], pts.z[p]];
+            let o = &mut u[p];
+            p += 1;
+            for c in 0..layout.n_copies {
+                let seg = |b: usize| c * layout.n_base_seg + b;
+                if s < m * n || s >= m * n + m * nc {
+                    // A spanwise point: the segments of its row.
+                    let i = if s < m * n { s / n } else { m };
+                    let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
+                    for b in first..first + n {
+                        fix_segment(fil, seg(b), x, o);
+                    }
+                } else {
+                    // A chordwise point: the segments of its column and its trailing leg.
+                    let j = (s - m * n) % nc;
+                    for i in 0..m {
+                        fix_segment(fil, seg(sl.seg0 + m * n + i * nc + j), x, o);
+                    }
+                    if sl.finite {
+                        fix_segment(fil, seg(sl.seg0 + sl.n_lattice_seg + j), x, o);
+                    } else if layout.n_base_leg > 0 {
+                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
+                    }
+                }
             }
         }
-        for l in 0..fil.n_legs() {
-            let a = fil.node(fil.leg_a[l] as usize);
-            let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
-            let (c, k) = leg_factor(r, fil.leg_d[l], fil.leg_core2[l], fil.leg_cut2[l]);
-            let gk = fil.leg_g[l] * k;
-            for q in 0..3 {
-                u[q] += gk * c[q];
-            }
-        }
-        *o = u;
     }
-    (pts.len().div_ceil(LANES) * LANES * fil.n_filaments()) as u64
+}
+
+/// Replace segment `f`'s block-kernel term at `x` in `o` by the regular form when `x` lies
+/// outside the segment.
+fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
+    let (a, b) = (fil.node(fil.seg_a[f] as usize), fil.node(fil.seg_b[f] as usize));
+    let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
+    if r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2] <= 0.0 {
+        return;
+    }
+    let (core2, cut2, g) = (fil.seg_core2[f], fil.seg_cut2[f], fil.seg_g[f]);
+    let (cv, k) = segment_factor(r1, r2, core2, cut2);
+    let (gk_old, gk_new) = (g * kernel_segment(r1, r2, core2, cut2), g * k);
+    for q in 0..3 {
+        o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
+    }
+}
+
+/// Replace leg `l`'s block-kernel term at `x` in `o` by the regular form when `x` lies upstream
+/// of its start.
+fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3]) {
+    let a = fil.node(fil.leg_a[l] as usize);
+    let d = fil.leg_d[l];
+    let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    if d[0] * r[0] + d[1] * r[1] + d[2] * r[2] >= 0.0 {
+        return;
+    }
+    let (core2, cut2, g) = (fil.leg_core2[l], fil.leg_cut2[l], fil.leg_g[l]);
+    let (cv, k) = leg_factor(r, d, core2, cut2);
+    let (gk_old, gk_new) = (g * kernel_leg(r, d, core2, cut2), g * k);
+    for q in 0..3 {
+        o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
+    }
 }
