@@ -6,9 +6,11 @@
 //! UVLM solve (semi-infinite wake legs along the free stream, [`uvlm::Uvlm::solve_steady`], or the
 //! finite frozen wake of `static.wake`) at the current coordinates added to its residual
 //! ([`AeroStatic`]). Its tangent is the structure's
-//! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, a forward difference of the
-//! generalised aerodynamic force, one steady solve per tangent coordinate. That costs one
-//! lattice solve per unknown, so the aerodynamic part is kept between iterations and between
+//! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, from the lattice's analytic load
+//! derivative ([`uvlm::Uvlm::steady_load_derivative`]) composed with central differences of the
+//! smooth maps without a lattice solve (stations, lumping, polar correction, the formulation's
+//! load; docs/statics.md §2), or on request a forward difference of steady solves. It is still
+//! a few hundred evaluations, so the aerodynamic part is kept between iterations and between
 //! airspeeds (scaled by V², the exact scaling at fixed geometry) and refreshed only when Newton
 //! stops contracting. The generic Newton iteration of `genalpha::analysis` does the rest
 //! (constraints, multipliers, convergence tests).
