@@ -634,39 +634,48 @@ impl<S: Structure> AeroStatic<'_, S> {
         let nv = x0.len();
         let (mut xp, mut xm) = (Vec::with_capacity(nv), Vec::with_capacity(nv));
         let (mut qp, mut qm) = (tg.q_tmp.clone(), tg.q_tmp.clone());
-        let mut dx = nalgebra::DVector::zeros(3 * nv);
-        let (mut fp, mut fm) = (vec![[0.0; 3]; nv], vec![[0.0; 3]; nv]);
-        let (mut sp, mut sm) = (vec![[0.0; 3]; d.strip.len()], vec![[0.0; 3]; d.strip.len()]);
+        // Smooth maps only: a step of 1e-6 of the span in the increment weights.
+        let steps: Vec<f64> =
+            (0..n).map(|j| 10.0 * self.fd_step / read(&self.model).increment_weight(j).max(1e-12)).collect();
+        let sides = |j: usize, dq: &mut [f64], qp: &mut [f64], qm: &mut [f64]| {
+            dq.iter_mut().for_each(|x| *x = 0.0);
+            dq[j] = steps[j];
+            read(&self.model).retract_inplace(q, dq, qp);
+            dq[j] = -steps[j];
+            read(&self.model).retract_inplace(q, dq, qm);
+        };
+        // The ring nodes' derivative, one column per coordinate, then the forces' (two products).
+        let mut dx = nalgebra::DMatrix::zeros(3 * nv, n);
         for j in 0..n {
-            // Smooth maps only: a step of 1e-6 of the span in the increment weights.
-            let h = 10.0 * self.fd_step / read(&self.model).increment_weight(j).max(1e-12);
-            tg.dq.iter_mut().for_each(|x| *x = 0.0);
-            tg.dq[j] = h;
-            read(&self.model).retract_inplace(q, &tg.dq, &mut qp);
-            tg.dq[j] = -h;
-            read(&self.model).retract_inplace(q, &tg.dq, &mut qm);
+            sides(j, &mut tg.dq, &mut qp, &mut qm);
             st.geometry_at(&*read(&self.model), &qp, self.map, &self.aero, &mut xp)?;
             st.geometry_at(&*read(&self.model), &qm, self.map, &self.aero, &mut xm)?;
             for v in 0..nv {
                 for a in 0..3 {
-                    dx[3 * v + a] = (xp[v][a] - xm[v][a]) / (2.0 * h);
+                    dx[(3 * v + a, j)] = (xp[v][a] - xm[v][a]) / (2.0 * steps[j]);
                 }
             }
-            let dn = &d.d_nodal * &dx;
-            let ds = &d.d_strip * &dx;
+        }
+        let dn = &d.d_nodal * &dx;
+        let ds = &d.d_strip * &dx;
+        let (mut fp, mut fm) = (vec![[0.0; 3]; nv], vec![[0.0; 3]; nv]);
+        let (mut sp, mut sm) = (vec![[0.0; 3]; d.strip.len()], vec![[0.0; 3]; d.strip.len()]);
+        for j in 0..n {
+            let h = steps[j];
             for v in 0..nv {
                 for a in 0..3 {
-                    fp[v][a] = d.nodal[v][a] + h * dn[3 * v + a];
-                    fm[v][a] = d.nodal[v][a] - h * dn[3 * v + a];
+                    fp[v][a] = d.nodal[v][a] + h * dn[(3 * v + a, j)];
+                    fm[v][a] = d.nodal[v][a] - h * dn[(3 * v + a, j)];
                 }
             }
             for k in 0..sp.len() {
                 for a in 0..3 {
-                    sp[k][a] = d.strip[k][a] + h * ds[3 * k + a];
-                    sm[k][a] = d.strip[k][a] - h * ds[3 * k + a];
+                    sp[k][a] = d.strip[k][a] + h * ds[(3 * k + a, j)];
+                    sm[k][a] = d.strip[k][a] - h * ds[(3 * k + a, j)];
                 }
             }
-            // Minus side at the current geometry, then the plus side.
+            sides(j, &mut tg.dq, &mut qp, &mut qm);
+            st.geometry_at(&*read(&self.model), &qm, self.map, &self.aero, &mut xm)?;
             st.loads_of(self.map, (&xm, &fm, &sm), polars, &mut tg.loads)?;
             self.load_part(t, &qm, &tg.loads, zeros, scratch, &mut tg.r0);
             st.geometry_at(&*read(&self.model), &qp, self.map, &self.aero, &mut xp)?;
@@ -1081,6 +1090,7 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
     } else {
         sys.set_polars(polars);
     }
+    sys.set_difference_tangent(st.difference_tangent);
     let mut solver = StaticSolver::new(&sys, static_params());
     let mut x = StaticSolution::guess(&sys, &q_ref);
     let loads_model = LoadModel::new(case, f);
