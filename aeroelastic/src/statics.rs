@@ -42,6 +42,9 @@ use crate::strip_statics::StripStatics;
 /// correction, or the static strips in its place, each with the factor on its Reynolds numbers.
 type Sources<'a> = (Option<(&'a StripPolars, f64)>, Option<(&'a StripStatics, f64)>);
 
+/// Ring nodes (stacked over the surfaces), the nodal forces on them and the strip forces.
+type LatticeForces<'a> = (&'a [[f64; 3]], &'a [[f64; 3]], &'a [[f64; 3]]);
+
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
     uv: uvlm::Uvlm,
@@ -161,7 +164,7 @@ impl SteadyAero {
     fn loads_of(
         &mut self,
         map: &[StationMap],
-        (nodes, nodal, strip): (&[[f64; 3]], &[[f64; 3]], &[[f64; 3]]),
+        (nodes, nodal, strip): LatticeForces<'_>,
         polars: Option<(&StripPolars, f64)>,
         out: &mut [SectionLoad],
     ) -> Result<(), String> {

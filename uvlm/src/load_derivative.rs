@@ -293,7 +293,7 @@ impl Bound {
         }
         let v = uv.flow().free_stream();
         let vn = dot(v, v).sqrt();
-        if !(vn > 0.0) {
+        if vn.is_nan() || vn <= 0.0 {
             return Err(UvlmError::InvalidParameter { field: "v_inf", value: vn });
         }
         let dir = [v[0] / vn, v[1] / vn, v[2] / vn];
