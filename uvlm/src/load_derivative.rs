@@ -441,8 +441,8 @@ impl Uvlm {
             nodal: vec![[0.0; 3]; nv],
             strip: vec![[0.0; 3]; n_strips],
             d_gamma,
-            d_nodal: DMatrix::zeros(3 * nv, 3 * nv),
-            d_strip: DMatrix::zeros(3 * n_strips, 3 * nv),
+            d_nodal: DMatrix::zeros(0, 0),
+            d_strip: DMatrix::zeros(0, 0),
         };
         segment_loads(self, &b, v_inf, &mut out);
         Ok(out)
@@ -564,9 +564,12 @@ fn segment_loads(uv: &Uvlm, b: &Bound, v_inf: [f64; 3], out: &mut SteadyLoadDeri
     let nf = fil.n_segments() + fil.n_legs();
     let (nr, nv) = (b.n_rings, out.n_vertices());
     let n_strips = out.strip.len();
-    // ∂(nodal, strip)/∂Γ at fixed geometry.
-    let mut p_nodal = DMatrix::zeros(3 * nv, nr);
-    let mut p_strip = DMatrix::zeros(3 * n_strips, nr);
+    // ∂(nodal, strip)/∂Γ at fixed geometry, and the geometric parts, row-major while the rows
+    // are accumulated.
+    let mut p_nodal = RowMajor::zeros(3 * nv, nr);
+    let mut p_strip = RowMajor::zeros(3 * n_strips, nr);
+    let mut x_nodal = RowMajor::zeros(3 * nv, 3 * nv);
+    let mut x_strip = RowMajor::zeros(3 * n_strips, 3 * nv);
     let mut fx = DMatrix::zeros(3, 3 * nv);
     let mut fg = DMatrix::zeros(3, nr);
     let mut pi = PointInduction::new(nf);
@@ -656,26 +659,44 @@ fn segment_loads(uv: &Uvlm, b: &Bound, v_inf: [f64; 3], out: &mut SteadyLoadDeri
                     out.strip[j][q] += sh * force[q];
                 }
                 for (row, wgt) in [(3 * va + q, 0.5), (3 * vb + q, 0.5)] {
-                    add_scaled_row(&mut out.d_nodal, row, &fx, q, wgt);
-                    add_scaled_row(&mut p_nodal, row, &fg, q, wgt);
+                    x_nodal.add_scaled_row(row, &fx, q, wgt);
+                    p_nodal.add_scaled_row(row, &fg, q, wgt);
                 }
                 for &(j, sh) in &shares {
-                    add_scaled_row(&mut out.d_strip, 3 * j + q, &fx, q, sh);
-                    add_scaled_row(&mut p_strip, 3 * j + q, &fg, q, sh);
+                    x_strip.add_scaled_row(3 * j + q, &fx, q, sh);
+                    p_strip.add_scaled_row(3 * j + q, &fg, q, sh);
                 }
             }
         }
         v0 += lat.n_nodes();
         j0 += n;
     }
-    out.d_nodal += &p_nodal * &out.d_gamma;
-    out.d_strip += &p_strip * &out.d_gamma;
+    out.d_nodal = x_nodal.into_matrix() + p_nodal.into_matrix() * &out.d_gamma;
+    out.d_strip = x_strip.into_matrix() + p_strip.into_matrix() * &out.d_gamma;
 }
 
-/// `out[row, :] += w · src[q, :]`.
-fn add_scaled_row(out: &mut DMatrix<f64>, row: usize, src: &DMatrix<f64>, q: usize, w: f64) {
-    for c in 0..src.ncols() {
-        out[(row, c)] += w * src[(q, c)];
+/// A dense matrix stored row by row (rows are what the segment loop accumulates).
+struct RowMajor {
+    n_cols: usize,
+    data: Vec<f64>,
+}
+
+impl RowMajor {
+    fn zeros(n_rows: usize, n_cols: usize) -> Self {
+        Self { n_cols, data: vec![0.0; n_rows * n_cols] }
+    }
+
+    /// `self[row, :] += w · src[q, :]`.
+    fn add_scaled_row(&mut self, row: usize, src: &DMatrix<f64>, q: usize, w: f64) {
+        let dst = &mut self.data[row * self.n_cols..(row + 1) * self.n_cols];
+        for (c, d) in dst.iter_mut().enumerate() {
+            *d += w * src[(q, c)];
+        }
+    }
+
+    fn into_matrix(self) -> DMatrix<f64> {
+        let n_rows = self.data.len() / self.n_cols.max(1);
+        DMatrix::from_row_slice(n_rows, self.n_cols, &self.data)
     }
 }
 
