@@ -264,6 +264,7 @@ fn bound_derivatives(
         fz.u_mid.resize(mid.len(), [0.0; 3]);
         induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blocks);
         fz.mid = mid;
+        fz.correct_bound_at_midpoints();
         let du = fz.u_mid.clone();
         ld.eval(fz, model, Some(r), None, &du, (&mut col, &mut scol));
         force_gamma.column_mut(r).copy_from_slice(&col);
