@@ -890,4 +890,19 @@ mod tests {
         let e = parse_case(&v).unwrap().validate_for(&[Formulation::Ancf]).unwrap_err();
         assert!(e.starts_with("ancf.rho_inf"), "{e}");
     }
+
+    /// A start from the trim (and stability about it) holds the free body, which changes the
+    /// coordinates of ANCF's ODE path: refused naming `ancf.path` when ANCF runs, and only then.
+    #[test]
+    fn a_trim_start_refuses_ancfs_ode_path_only_when_ancf_runs() {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/horten_flying_wing.json");
+        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+        set_path(&mut v, "initial", json!("trim")).unwrap();
+        parse_case(&v).unwrap().validate().unwrap();
+        set_path(&mut v, "ancf.path", json!("ode")).unwrap();
+        let c = parse_case(&v).unwrap();
+        let e = c.validate().unwrap_err();
+        assert!(e.starts_with("initial") && e.contains("ancf.path \"dae\""), "{e}");
+        c.validate_for(&[Formulation::Gebf]).unwrap();
+    }
 }

@@ -80,10 +80,7 @@ impl Case {
         if self.initial.is_trim() && self.trim.is_none() {
             return Err(format!("initial: \"{initial}\" needs a `trim` block"));
         }
-        if self.initial.is_trim()
-            && fs.contains(&Formulation::Ancf)
-            && self.ancf.path == aeroelastic::problem::AncfPath::Ode
-        {
+        if self.initial.is_trim() && self.runs_ancf_ode(fs) {
             return Err(format!(
                 "initial: \"{initial}\" needs ancf.path \"dae\" (the trim holds the free body, which changes the ODE \
                  path's coordinates)"
@@ -108,7 +105,7 @@ impl Case {
                         "stability.aerodynamics: \"strip\" is not available about a trim (the lattice is)".into()
                     );
                 }
-                if fs.contains(&Formulation::Ancf) && self.ancf.path == aeroelastic::problem::AncfPath::Ode {
+                if self.runs_ancf_ode(fs) {
                     return Err("stability.about: \"trim\" needs ancf.path \"dae\" (the trim holds the free body, \
                                 which changes the ODE path's coordinates)"
                         .into());
@@ -116,6 +113,12 @@ impl Case {
             }
         }
         self.check_gate()
+    }
+
+    /// Whether one of the formulations `fs` runs ANCF on its ODE path, whose coordinates a trim's
+    /// held free body changes.
+    fn runs_ancf_ode(&self, fs: &[Formulation]) -> bool {
+        fs.iter().any(|f| f.pick(self.ancf.path == aeroelastic::problem::AncfPath::Ode, false))
     }
 
     /// The name is a folder under the output directory (and a sweep adds `__key=value`).

@@ -759,17 +759,15 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
     }
 
-    /// One Newton solve for a step of the current size `self.c.h`.
-    fn attempt<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
+    /// The step's predictor: `v̇_{n+1} = v̇_n`, or extrapolated from `v̇_{n−1}` when the last step
+    /// was contiguous and of the same size (in the Chung–Hulbert form, the same for `v̇_α`); the
+    /// start of the Newton iteration, with `q_n`, `δ` and `h δ` set.
+    fn predict<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) {
         let c = self.c;
-        let (h, n, n_h, n_v) = (c.h, self.n, self.n_h, self.n_v);
+        let (h, n) = (c.h, self.n);
         let np = self.params.newton;
-        let t1 = s.t + h;
-
-        // Predictor: v̇_{n+1} = v̇_n, or extrapolated from v̇_{n−1} when the last step was
-        // contiguous and of the same size (in the Chung–Hulbert form, the same for v̇_α).
+        let weighted = self.weighted;
         self.q_n.copy_from_slice(&s.q);
-        let (t_n, weighted) = (s.t, self.weighted);
         if weighted {
             self.v_n.copy_from_slice(&s.v);
         }
@@ -799,6 +797,136 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.hdelta[i] = h * self.delta[i];
         }
         sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+    }
+
+    /// Back to the step's predictor, with the factorisation dropped.
+    fn restart_from_predictor(&mut self, s: &mut State) {
+        let (h, n) = (self.c.h, self.n);
+        copy_state(&self.predictor, s);
+        self.delta.copy_from_slice(&self.predictor_delta);
+        for i in 0..n {
+            self.hdelta[i] = h * self.delta[i];
+        }
+        self.have_factorization = false;
+    }
+
+    /// The Newton increment: the scaled residuals of the dynamic rows and the constraints' as
+    /// the right-hand side, solved in place with the current factorisation.
+    fn solve_increment(&mut self, c_vdot: f64) {
+        let (n, n_h, n_v, c) = (self.n, self.n_h, self.n_v, self.c);
+        let inv_c_vdot = 1.0 / c_vdot;
+        for (b, r) in self.rhs[..n].iter_mut().zip(&self.r) {
+            *b = -r * inv_c_vdot;
+        }
+        for i in 0..n_h {
+            self.rhs[n + i] = -self.phi[i];
+        }
+        for i in 0..n_v {
+            self.rhs[n + n_h + i] = -self.psi[i] / c.gamma_prime;
+        }
+        self.solver.solve_in_place(&mut self.rhs);
+    }
+
+    /// Apply the solved increment to the step's unknowns and multipliers and retract the
+    /// coordinates; the increment's weighted norm.
+    fn apply_increment<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State, c_vdot: f64) -> f64 {
+        let (n, n_h, n_v, c) = (self.n, self.n_h, self.n_v, self.c);
+        let (h, np) = (c.h, self.params.newton);
+        let (inv_h, inv_beta_h2) = (1.0 / h, 1.0 / (c.beta * h * h)); // no divisions in the loop
+        let dxs = &self.rhs[..n];
+        for (((d, hd), dx), (v, (v_dot, a))) in self
+            .delta
+            .iter_mut()
+            .zip(self.hdelta.iter_mut())
+            .zip(dxs)
+            .zip(s.v.iter_mut().zip(s.v_dot.iter_mut().zip(s.a.iter_mut())))
+        {
+            *d += dx * inv_h;
+            *hd = h * *d;
+            *v += c.gamma_prime * dx;
+            *v_dot += c_vdot * dx;
+            *a += dx * inv_beta_h2;
+        }
+        let inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
+        for i in 0..n_h {
+            s.lambda[i] += c_vdot * self.rhs[n + i];
+        }
+        for i in 0..n_v {
+            s.mu[i] += c_vdot * self.rhs[n + n_h + i];
+        }
+        sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+        inc_norm
+    }
+
+    /// A converged step: the refresh count, the extrapolating predictor's history, the time and
+    /// the system's post-step hook.
+    fn accept<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State, t1: f64) {
+        self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);
+        if self.params.newton.predictor == Predictor::ExtrapolatedAcceleration {
+            std::mem::swap(&mut self.v_dot_previous, &mut self.v_dot_n);
+            self.last_step = Some((t1, self.c.h.to_bits()));
+        }
+        s.t = t1;
+        sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
+    }
+
+    /// The dynamic residual at the current iterate (or its weighted state) with the constraint
+    /// forces, and the iteration matrix when `need` says it is refactorised here (one pass over
+    /// the elements).
+    fn residual_at<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t_n: f64,
+        t1: f64,
+        s: &mut State,
+        need: bool,
+    ) {
+        let weighted = self.weighted;
+        if weighted {
+            self.set_weighted_state(sys, t_n, s);
+        }
+        self.update_jacobians(sys, t1, &s.q, need);
+        if need {
+            self.assemble_with_residual(sys, t1, s, true);
+        } else if weighted {
+            sys.residual_inplace(self.t_alpha, &self.q_alpha, &self.v_alpha, &s.v_dot, &mut self.r);
+        } else {
+            sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
+        }
+        self.stats.n_residual_evals += 1;
+        self.add_constraint_forces(&s.lambda, &s.mu);
+    }
+
+    /// One Newton iteration's record for the trace, when one is kept.
+    fn record_iteration(&mut self, t1: f64, iter: usize, need: bool, res_norm: f64, stats: &StepStats, inc_norm: f64) {
+        let (n, h, np) = (self.n, self.c.h, self.params.newton);
+        if let Some(trace) = &mut self.trace {
+            let dxs = &self.rhs[..n];
+            let ratio = |i: usize| increment_ratio(dxs[i], self.weights[i], self.hdelta[i], np.atol, np.rtol);
+            let worst_unknown = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
+            trace.push(IterationRecord {
+                t: t1,
+                h,
+                iter,
+                factorized: need,
+                residual_norm: res_norm,
+                phi_norm: stats.phi_norm,
+                psi_norm: stats.psi_norm,
+                increment_norm: inc_norm,
+                worst_unknown,
+            });
+        }
+    }
+
+    /// One Newton solve for a step of the current size `self.c.h`.
+    fn attempt<S: ConstrainedSystem + ?Sized>(&mut self, sys: &mut S, s: &mut State) -> Result<StepStats, Error> {
+        let c = self.c;
+        let h = c.h;
+        let np = self.params.newton;
+        let t1 = s.t + h;
+
+        let (t_n, weighted) = (s.t, self.weighted);
+        self.predict(sys, s);
         let keep_predictor = np.reuse_factorization;
         if keep_predictor {
             copy_state(s, &mut self.predictor);
@@ -842,13 +970,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                     && theta / (1.0 - theta) * inc_norm <= 1.0);
             if iter > 1 && small && phi_norm <= np.phi_tol && psi_norm <= np.psi_tol {
                 stats.n_newton_iters = iter - 1;
-                self.refresh_steps_left = self.refresh_steps_left.saturating_sub(1);
-                if np.predictor == Predictor::ExtrapolatedAcceleration {
-                    std::mem::swap(&mut self.v_dot_previous, &mut self.v_dot_n);
-                    self.last_step = Some((t1, h.to_bits()));
-                }
-                s.t = t1;
-                sys.post_step(t1, &mut s.q, &mut s.v, &mut s.v_dot, &mut s.a);
+                self.accept(sys, s, t1);
                 return Ok(stats);
             }
             // A fresh matrix whose increments grew twice in a row: give up early (the caller
@@ -864,12 +986,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             if keep_predictor && contraction > 1.0 && !factorized_this_step {
                 // Diverging with a matrix from an earlier step: the iterate may already be
                 // spoiled, so restart from the predictor with a fresh matrix.
-                copy_state(&self.predictor, s);
-                self.delta.copy_from_slice(&self.predictor_delta);
-                for i in 0..n {
-                    self.hdelta[i] = h * self.delta[i];
-                }
-                self.have_factorization = false;
+                self.restart_from_predictor(s);
                 self.refresh_steps_left = REFRESH_STEPS;
                 inc_norm = f64::INFINITY;
                 prev_inc = f64::INFINITY;
@@ -898,19 +1015,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 || (iter > 4 && !fresh && iterations_to_converge(inc_norm, contraction) > MAX_MORE_ITERATIONS);
             // Dynamic residual at the current iterate (or its weighted state), with the iteration
             // matrix when it is refactorised here (one pass over the elements).
-            if weighted {
-                self.set_weighted_state(sys, t_n, s);
-            }
-            self.update_jacobians(sys, t1, &s.q, need);
-            if need {
-                self.assemble_with_residual(sys, t1, s, true);
-            } else if weighted {
-                sys.residual_inplace(self.t_alpha, &self.q_alpha, &self.v_alpha, &s.v_dot, &mut self.r);
-            } else {
-                sys.residual_inplace(t1, &s.q, &s.v, &s.v_dot, &mut self.r);
-            }
-            self.stats.n_residual_evals += 1;
-            self.add_constraint_forces(&s.lambda, &s.mu);
+            self.residual_at(sys, t_n, t1, s, need);
             let res_norm = inf_norm(&self.r) / c_vdot;
             stats.residual_norm = res_norm;
             if !res_norm.is_finite() {
@@ -933,17 +1038,7 @@ impl<L: LinearSolver> GenAlpha<L> {
                 self.previous_delta.copy_from_slice(&self.delta);
             }
             step_back = false;
-            let inv_c_vdot = 1.0 / c_vdot;
-            for (b, r) in self.rhs[..n].iter_mut().zip(&self.r) {
-                *b = -r * inv_c_vdot;
-            }
-            for i in 0..n_h {
-                self.rhs[n + i] = -self.phi[i];
-            }
-            for i in 0..n_v {
-                self.rhs[n + n_h + i] = -self.psi[i] / c.gamma_prime;
-            }
-            self.solver.solve_in_place(&mut self.rhs);
+            self.solve_increment(c_vdot);
             if np.broyden && np.reuse_factorization {
                 if need {
                     self.forget_broyden_steps(); // the sequence restarts from the new matrix
@@ -956,44 +1051,8 @@ impl<L: LinearSolver> GenAlpha<L> {
             // Update.
             prev_prev_inc = prev_inc;
             prev_inc = inc_norm;
-            let (inv_h, inv_beta_h2) = (1.0 / h, 1.0 / (c.beta * h * h)); // no divisions in the loop
-            let dxs = &self.rhs[..n];
-            for (((d, hd), dx), (v, (v_dot, a))) in self
-                .delta
-                .iter_mut()
-                .zip(self.hdelta.iter_mut())
-                .zip(dxs)
-                .zip(s.v.iter_mut().zip(s.v_dot.iter_mut().zip(s.a.iter_mut())))
-            {
-                *d += dx * inv_h;
-                *hd = h * *d;
-                *v += c.gamma_prime * dx;
-                *v_dot += c_vdot * dx;
-                *a += dx * inv_beta_h2;
-            }
-            inc_norm = increment_norm(dxs, &self.weights, &self.hdelta, np.atol, np.rtol);
-            if let Some(trace) = &mut self.trace {
-                let ratio = |i: usize| increment_ratio(dxs[i], self.weights[i], self.hdelta[i], np.atol, np.rtol);
-                let worst_unknown = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
-                trace.push(IterationRecord {
-                    t: t1,
-                    h,
-                    iter,
-                    factorized: need,
-                    residual_norm: res_norm,
-                    phi_norm: stats.phi_norm,
-                    psi_norm: stats.psi_norm,
-                    increment_norm: inc_norm,
-                    worst_unknown,
-                });
-            }
-            for i in 0..n_h {
-                s.lambda[i] += c_vdot * self.rhs[n + i];
-            }
-            for i in 0..n_v {
-                s.mu[i] += c_vdot * self.rhs[n + n_h + i];
-            }
-            sys.retract_inplace(&self.q_n, &self.hdelta, &mut s.q);
+            inc_norm = self.apply_increment(sys, s, c_vdot);
+            self.record_iteration(t1, iter, need, res_norm, &stats, inc_norm);
         }
         Err(Error::NewtonDiverged {
             t: t1,

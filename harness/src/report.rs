@@ -965,6 +965,54 @@ pub fn case_section(out: &Path, r: &CaseResult) -> Section {
     }
 }
 
+/// One section per refinement ladder under `out/converge/`, in name order.
+fn converge_sections(out: &Path) -> Vec<Section> {
+    let mut v = Vec::new();
+    let conv = out.join("converge");
+    let mut names: Vec<String> = std::fs::read_dir(&conv)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter(|e| e.path().join("work_precision.svg").exists())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    for n in &names {
+        let d = conv.join(n);
+        let mut s = String::from(
+            "<p>Each formulation refined in time (fixed elements), in space (small fixed step) and in both (diagonal). \
+             Error: the largest tip distance over the window to the ladder's truth, named in the column <code>against</code> \
+             (the finest rung, or a converged external reference). Cost: the thread CPU time of each rung, run one after \
+             another on one core.</p>\n",
+        );
+        if let Some(t) = csv_table(&d.join("converge.csv")) {
+            s.push_str(&t);
+        }
+        let _ = writeln!(
+            s,
+            "<p>Data: <a href=\"converge/{0}/converge.csv\">converge.csv</a>, <a href=\"converge/{0}/converge.json\">converge.json</a></p>",
+            esc(n)
+        );
+        s.push_str(&figure(
+            &format!("converge/{n}/work_precision.svg"),
+            "Work-precision, log–log: largest tip error against CPU time, one marker per rung; peer codes as single points where measured.",
+        ));
+        s.push_str(&figure(
+            &format!("converge/{n}/convergence.svg"),
+            "Error against time step (time ladder) and against elements of the first body (space ladder), log–log.",
+        ));
+        v.push(Section {
+            id: format!("converge-{n}"),
+            title: format!("Refinement: {n}"),
+            group: Group::Study,
+            html: s,
+            badge: None,
+        });
+    }
+    v
+}
+
 /// The sections of the studies found on disk under `out`: the static equilibria
 /// (`<case>/static_section.html`), the gust sweeps (`<case>/gust_section.html`), `converge/<case>/`, `energy/`, `bench/` and `stress/` (each
 /// table first, then its figures).
@@ -1030,48 +1078,7 @@ pub fn study_sections(out: &Path) -> Vec<Section> {
             badge: None,
         });
     }
-    let conv = out.join("converge");
-    let mut names: Vec<String> = std::fs::read_dir(&conv)
-        .map(|rd| {
-            rd.filter_map(|e| e.ok())
-                .filter(|e| e.path().join("work_precision.svg").exists())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    names.sort();
-    for n in &names {
-        let d = conv.join(n);
-        let mut s = String::from(
-            "<p>Each formulation refined in time (fixed elements), in space (small fixed step) and in both (diagonal). \
-             Error: the largest tip distance over the window to the ladder's truth, named in the column <code>against</code> \
-             (the finest rung, or a converged external reference). Cost: the thread CPU time of each rung, run one after \
-             another on one core.</p>\n",
-        );
-        if let Some(t) = csv_table(&d.join("converge.csv")) {
-            s.push_str(&t);
-        }
-        let _ = writeln!(
-            s,
-            "<p>Data: <a href=\"converge/{0}/converge.csv\">converge.csv</a>, <a href=\"converge/{0}/converge.json\">converge.json</a></p>",
-            esc(n)
-        );
-        s.push_str(&figure(
-            &format!("converge/{n}/work_precision.svg"),
-            "Work-precision, log–log: largest tip error against CPU time, one marker per rung; peer codes as single points where measured.",
-        ));
-        s.push_str(&figure(
-            &format!("converge/{n}/convergence.svg"),
-            "Error against time step (time ladder) and against elements of the first body (space ladder), log–log.",
-        ));
-        v.push(Section {
-            id: format!("converge-{n}"),
-            title: format!("Refinement: {n}"),
-            group: Group::Study,
-            html: s,
-            badge: None,
-        });
-    }
+    v.extend(converge_sections(out));
     if out.join("energy/energy.svg").exists() {
         let mut s = String::from(
             "<p>No aerodynamics and no numerical dissipation (ρ<sub>∞</sub> = 1): the exact energy (with the dampers' work for the sprung case) is constant, so its change divided by the peak kinetic energy is the scheme's error. Each formulation in the Arnold–Brüls form (forces at the end of the step: the trapezoidal rule) and in the Chung–Hulbert form (forces at the α-weighted state: the implicit midpoint rule), every step recorded, at the case's dt and at dt/2.</p>\n",
