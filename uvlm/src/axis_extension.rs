@@ -21,8 +21,10 @@
 //! a semi-infinite leg's start (`d·r < 0`) as `(d × r)|d×r|² / ((|d×r|² + r_c²) |r| (|r| − d·r))`.
 //! Inside the segment (or downstream along a leg) it is the crate's kernel, cut-off included.
 
-use crate::biot_savart::Filaments;
+use crate::aic::WakePart;
+use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI};
 use crate::induce::Points;
+use crate::wake::Wake;
 
 /// The factor `k` of a segment pair (`u = Γ/4π · k · r₁×r₂`) for the load points.
 #[inline]
@@ -161,16 +163,112 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
     }
 }
 
+/// Replace, at every chordwise load point of `layout` (a point on the axis extension of its
+/// column's streamwise filaments, and of the wake's filaments leaving that column's trailing-edge
+/// node when the chord is along the stream), the block kernels' term of every filament of the
+/// wake set `wake` by the regular form where the point lies outside it: the linear model's frozen
+/// wake and its unit rings then take the terms the steady solve's trailing legs (or finite wake)
+/// take (docs/uvlm.md §3). A filament off the point's axis changes by rounding only.
+pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
+    let mut p = 0;
+    for sl in &layout.surfaces {
+        let (m, n) = (sl.m, sl.n);
+        for s in 0..sl.n_load {
+            let i = p;
+            p += 1;
+            if s < m * n || s >= m * n + m * (n + 1) {
+                continue;
+            }
+            let x = [pts.x[i], pts.y[i], pts.z[i]];
+            for f in 0..wake.n_segments() {
+                fix_segment(wake, f, x, &mut u[i]);
+            }
+            for l in 0..wake.n_legs() {
+                fix_leg(wake, l, x, &mut u[i]);
+            }
+        }
+    }
+}
+
+/// One surface's known wake as [`crate::aic::append_known_wake`] lays it out, for
+/// [`correct_wake_columns`].
+pub(crate) struct WakeColumns<'a> {
+    /// The trailing-edge nodes (node row 0), the wake and its closure direction.
+    pub(crate) te: &'a [[f64; 3]],
+    pub(crate) wake: &'a Wake,
+    pub(crate) closure: Option<[f64; 3]>,
+    pub(crate) core: &'a CoreModel,
+    pub(crate) part: WakePart,
+}
+
+/// The time march's counterpart of [`correct_wake_extensions`] without a pass over the whole
+/// wake: at the chordwise load points of surface `sl` (from `p0` in `pts`), the streamwise
+/// filaments of their own column in the part `w.part` of the wake (the chordwise legs from node
+/// row k − 1 to k and the closure leg, with the strengths, cores and arithmetic of
+/// [`crate::aic::append_known_wake`]) take the regular form where the point lies outside them.
+/// Those are the filaments whose axis passes near the point: the steady solve's trailing leg (or
+/// finite wake) of that column, cut into rows.
+pub(crate) fn correct_wake_columns(
+    sl: &SurfaceLayout,
+    p0: usize,
+    w: &WakeColumns<'_>,
+    pts: &Points,
+    u: &mut [[f64; 3]],
+) {
+    let (wake, len) = (w.wake, w.wake.n_rows());
+    let (m, n) = (sl.m, sl.n);
+    let nc = n + 1;
+    if len == 0 || sl.n_load < m * n + m * nc {
+        return;
+    }
+    let rows = match w.part {
+        WakePart::All => 1..=len,
+        WakePart::Near => 1..=1,
+        WakePart::Far => 2..=len,
+    };
+    let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
+    let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
+    for s in m * n..m * n + m * nc {
+        let j = (s - m * n) % nc;
+        let i = p0 + s;
+        let x = [pts.x[i], pts.y[i], pts.z[i]];
+        for k in rows.clone() {
+            let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
+            if gamma != 0.0 {
+                let (a, b) = (pos(k - 1, j), pos(k, j));
+                let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
+                let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
+                fix_segment_at(a, b, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
+            }
+        }
+        if let Some(dir) = w.closure
+            && w.part != WakePart::Near
+        {
+            let gamma = g(len - 1, j as isize - 1) - g(len - 1, j as isize);
+            if gamma != 0.0 {
+                let (a, b) = (pos(len, j), pos(len - 1, j));
+                let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                let (core2, cut2) = w.core.leg_coefficients(l);
+                fix_leg_at(a, dir, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
+            }
+        }
+    }
+}
+
 /// Replace segment `f`'s block-kernel term at `x` in `o` by the regular form when `x` lies
 /// outside the segment.
 fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
     let (a, b) = (fil.node(fil.seg_a[f] as usize), fil.node(fil.seg_b[f] as usize));
+    fix_segment_at(a, b, (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]), x, o);
+}
+
+/// [`fix_segment`] of the segment `a → b` with `(Γ/4π, core2, cut2)`.
+fn fix_segment_at(a: [f64; 3], b: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
     let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
     let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
     if r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2] <= 0.0 {
         return;
     }
-    let (core2, cut2, g) = (fil.seg_core2[f], fil.seg_cut2[f], fil.seg_g[f]);
     let (cv, k) = segment_factor(r1, r2, core2, cut2);
     let (gk_old, gk_new) = (g * kernel_segment(r1, r2, core2, cut2), g * k);
     for q in 0..3 {
@@ -182,12 +280,15 @@ fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
 /// of its start.
 fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3]) {
     let a = fil.node(fil.leg_a[l] as usize);
-    let d = fil.leg_d[l];
+    fix_leg_at(a, fil.leg_d[l], (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]), x, o);
+}
+
+/// [`fix_leg`] of the leg from `a` along `d` with `(Γ/4π, core2, cut2)`.
+fn fix_leg_at(a: [f64; 3], d: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
     let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
     if d[0] * r[0] + d[1] * r[1] + d[2] * r[2] >= 0.0 {
         return;
     }
-    let (core2, cut2, g) = (fil.leg_core2[l], fil.leg_cut2[l], fil.leg_g[l]);
     let (cv, k) = leg_factor(r, d, core2, cut2);
     let (gk_old, gk_new) = (g * kernel_leg(r, d, core2, cut2), g * k);
     for q in 0..3 {

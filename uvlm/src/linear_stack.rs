@@ -11,7 +11,7 @@
 use std::ops::Range;
 
 use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
-use crate::axis_extension::{ExtensionLayout, SurfaceLayout, correct_axis_extensions};
+use crate::axis_extension::{ExtensionLayout, SurfaceLayout, correct_axis_extensions, correct_wake_extensions};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::flow::Flow;
 use crate::images::append_images;
@@ -177,14 +177,21 @@ impl Frozen {
         let known = std::mem::take(&mut self.known);
         self.induce(&[&bsf, &known]);
         self.bs.fil = bsf;
-        self.known = known;
         self.correct_bound_at_midpoints();
+        self.correct_wake_at_midpoints(&known);
+        self.known = known;
     }
 
     /// The bound filaments' regular terms on their axis extensions at the midpoints, as the
     /// solver's loads take them (docs/uvlm.md §3).
     pub(crate) fn correct_bound_at_midpoints(&mut self) {
         correct_axis_extensions(&self.bs.fil, &self.ext, &self.mid, &mut self.u_mid);
+    }
+
+    /// The wake filaments `wake`'s regular terms at the chordwise midpoints, as the solver's
+    /// steady legs and time march take them (docs/uvlm.md §3).
+    pub(crate) fn correct_wake_at_midpoints(&mut self, wake: &Filaments) {
+        correct_wake_extensions(wake, &self.ext, &self.mid, &mut self.u_mid);
     }
 
     /// The free stream `v_inf` at the collocation points (`v_col`) and midpoints (`v_mid`).

@@ -315,6 +315,7 @@ impl WakeRows<'_> {
                     unit_wake_ring(&mut fz.known, te, wake, k, j, self.closure, p);
                     let known = std::mem::take(&mut fz.known);
                     fz.induce(&[&known]);
+                    fz.correct_wake_at_midpoints(&known);
                     fz.known = known;
                     for r in 0..nr {
                         w[(r, c)] = (0..3).map(|q| fz.u_col[r][q] * self.nrm[r][q]).sum();

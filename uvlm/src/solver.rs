@@ -2,7 +2,9 @@
 //! each with its wake, in one influence system.
 
 use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
-use crate::axis_extension::{ExtensionLayout, SurfaceLayout, correct_axis_extensions};
+use crate::axis_extension::{
+    ExtensionLayout, SurfaceLayout, WakeColumns, correct_axis_extensions, correct_wake_columns,
+};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
@@ -469,8 +471,13 @@ impl Uvlm {
         let mut layout = std::mem::take(&mut self.ext_layout);
         self.load_layout(&mut layout);
         correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid);
-        self.ext_layout = layout;
-        if with_known_wake && self.params.wake_reuse == WakeReuse::Frozen {
+        let frozen = self.params.wake_reuse == WakeReuse::Frozen;
+        if with_known_wake {
+            // The known wake's streamwise filaments on the same footing (as the steady legs).
+            let part = if frozen { WakePart::Near } else { WakePart::All };
+            self.correct_wake_at_midpoints(&layout, part, false);
+        }
+        if with_known_wake && frozen {
             if !self.far_ready {
                 self.u_far_mid.clear();
                 self.u_far_mid.resize(self.mid.len(), [0.0; 3]);
@@ -482,9 +489,11 @@ impl Uvlm {
                     self.params.parallel,
                     &mut self.blocks,
                 );
+                self.correct_wake_at_midpoints(&layout, WakePart::Far, true);
             }
             add_to(&mut self.u_mid, &self.u_far_mid);
         }
+        self.ext_layout = layout;
         self.v_mid.resize(self.mid.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
         let gd = unsteady && self.params.unsteady_term;
@@ -506,6 +515,23 @@ impl Uvlm {
         }
         if self.surfaces.len() > 1 {
             concatenate_loads(&mut self.loads, self.surfaces.iter().map(|s| &s.loads));
+        }
+    }
+
+    /// The regular form of the known wake's part `part` (its streamwise filaments, column by
+    /// column) at the chordwise load points, in `u_far_mid` (`far`) or `u_mid`
+    /// (axis_extension.rs, docs/uvlm.md §3): the time march's wake rows take the terms the steady
+    /// solve's legs take, so that a steady solution is the march's equilibrium.
+    fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool) {
+        let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+        let u = if far { &mut self.u_far_mid } else { &mut self.u_mid };
+        let mut p0 = 0;
+        for (sl, s) in layout.surfaces.iter().zip(&self.surfaces) {
+            let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
+            let te = &s.lattice.ring_nodes()[m * (n + 1)..];
+            let w = WakeColumns { te, wake: &s.wake, closure, core: &self.params.wake_core, part };
+            correct_wake_columns(sl, p0, &w, &self.mid, u);
+            p0 += sl.n_load;
         }
     }
 
