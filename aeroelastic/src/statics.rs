@@ -1236,7 +1236,7 @@ pub(crate) fn solve_rounds<S: Structure>(
             Ok(()) if !x.residual_norm.is_finite() => {
                 return Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into()));
             }
-            Ok(()) => return Ok(()),
+            Ok(()) => return polish(sys, solver, x),
             Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
             // A kept aerodynamic stiffness can send the first iterate past the lattice's
             // limits: start again from the same estimate with a fresh one.
@@ -1248,6 +1248,49 @@ pub(crate) fn solve_rounds<S: Structure>(
         }
     }
     Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
+}
+
+/// Newton iterations of [`polish`] at most.
+const POLISH_ITERATIONS: usize = 10;
+/// The increment [`polish`] iterates down to (m in the increment weights): a few hundred ulp of
+/// a structure of metres, a thousandth of [`static_params`]' `tol`.
+const POLISH_TOL: f64 = 1e-13;
+
+/// Iterate an equilibrium `x` that [`solve_rounds`] accepted (increment below `tol` = 1e-10 m)
+/// on, with the aerodynamic stiffness it ended with, down to [`POLISH_TOL`], so that the last
+/// iterate is the equilibrium to rounding rather than within `tol` of it along a path that
+/// depends on the tangent. The equilibrium's derived quantities need it: the flutter equation's
+/// geometric terms are central differences about it (a step of 1e-6, which turns 1e-11 of the
+/// state into 1e-5 of a root), and a polar that reproduces the lattice must give the lattice's
+/// equilibrium and roots to rounding although its tangent differs by its own differences. Where
+/// the increment stalls at round-off above [`POLISH_TOL`], the better of the two iterates (by
+/// the residual) is kept and finished once more with the usual settings.
+fn polish<S: Structure>(
+    sys: &mut AeroStatic<'_, S>,
+    solver: &mut StaticSolver,
+    x: &mut StaticSolution,
+) -> Result<(), String> {
+    let coarse = *solver.params();
+    let mut y = x.clone();
+    solver.set_params(StaticParams { max_iter: POLISH_ITERATIONS, tol: POLISH_TOL, rel_residual_tol: 0.0 });
+    sys.begin_solve(false);
+    let s: &AeroStatic<'_, S> = sys;
+    let fine = solver.solve_normalised(s, 0.0, &mut y, |q| read(&s.model).normalise(q));
+    solver.set_params(coarse);
+    if fine.is_ok() && y.residual_norm.is_finite() {
+        *x = y;
+        return Ok(());
+    }
+    if y.residual_norm.is_finite() && y.residual_norm < x.residual_norm {
+        *x = y;
+    }
+    sys.begin_solve(false);
+    let s: &AeroStatic<'_, S> = sys;
+    match solver.solve_normalised(s, 0.0, x, |q| read(&s.model).normalise(q)) {
+        Ok(()) if x.residual_norm.is_finite() => Ok(()),
+        Ok(()) => Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into())),
+        Err(e) => Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
+    }
 }
 
 /// The first equilibrium, at airspeed `top`, by load stepping from the unloaded reference:
