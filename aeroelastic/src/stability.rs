@@ -1697,6 +1697,8 @@ fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], t
     if suspects.is_empty() {
         return;
     }
+    // The roots the suspects' own starts converged to (a root two starts share among them).
+    let first: Vec<(C64, DVector<C64>, bool)> = suspects.iter().map(|&m| found[m].clone()).collect();
     for &m in &suspects {
         found[m].2 = false;
     }
@@ -1722,6 +1724,14 @@ fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], t
     }
     for i in pending {
         let m = suspects[i];
+        // A root that this mode's start converged to and no mode holds now is the mode's: its
+        // path lost it (a real path cannot follow a statically unstable mode's real pair once
+        // the pair has met and turned complex, and jumps to another branch).
+        let (s1, e1, ok1) = &first[i];
+        if *ok1 && !found.iter().any(|f| f.2 && same_root(f.0, *s1)) {
+            found[m] = (*s1, e1.clone(), true);
+            continue;
+        }
         let claimed = |s: C64| found.iter().any(|f| f.2 && same_root(f.0, s));
         if let Some((s, e)) = red.restart_from_path(&paths[i], n_evaluations, claimed) {
             found[m] = (s, e, true);
