@@ -404,12 +404,25 @@ impl Reduced {
     /// `D(s)` is real for real `s`, so from a real start with a real vector every iterate stays
     /// on the real axis and only a real root can be reached. A real start that does not converge
     /// there (the real pair of a statically unstable mode has met and turned complex) is retried
-    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector.
+    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector; so
+    /// is one that converges on the real axis farther than half the start's size from it, and
+    /// the root nearer the start is kept (the real iteration then jumped to another branch).
     pub fn newton(&self, s: C64, eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
         let real_start = s.im == 0.0 && eta.iter().all(|x| x.im == 0.0);
         let e0 = if real_start { Some(eta.clone()) } else { None };
+        let off_axis =
+            |e0, count: &mut usize| newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count);
         match (newton_of(|x| self.d(x), s, eta, count), e0) {
-            ((_, _, false), Some(e0)) => newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count),
+            ((_, _, false), Some(e0)) => off_axis(e0, count),
+            // A real root far from the start may be another branch's (the mode's real pair has
+            // met and turned complex, which the real axis cannot follow): the nearer of the two.
+            ((r, e, true), Some(e0)) => {
+                let far = (r - s).norm() > 0.5 * s.norm().max(1e-3);
+                match far.then(|| off_axis(e0, count)) {
+                    Some((r2, e2, true)) if (r2 - s).norm() < (r - s).norm() => (r2, e2, true),
+                    _ => (r, e, true),
+                }
+            }
             (found, _) => found,
         }
     }
