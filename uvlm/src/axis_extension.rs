@@ -144,18 +144,18 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
                     let i = if s < m * n { s / n } else { m };
                     let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
                     for b in first..first + n {
-                        fix_segment(fil, seg(b), x, o, false);
+                        fix_segment(fil, seg(b), x, o);
                     }
                 } else {
                     // A chordwise point: the segments of its column and its trailing leg.
                     let j = (s - m * n) % nc;
                     for i in 0..m {
-                        fix_segment(fil, seg(sl.seg0 + m * n + i * nc + j), x, o, false);
+                        fix_segment(fil, seg(sl.seg0 + m * n + i * nc + j), x, o);
                     }
                     if sl.finite {
-                        fix_segment(fil, seg(sl.seg0 + sl.n_lattice_seg + j), x, o, false);
+                        fix_segment(fil, seg(sl.seg0 + sl.n_lattice_seg + j), x, o);
                     } else if layout.n_base_leg > 0 {
-                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o, false);
+                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
                     }
                 }
             }
@@ -166,10 +166,9 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
 /// Replace, at every chordwise load point of `layout` (a point on the axis extension of its
 /// column's streamwise filaments, and of the wake's filaments leaving that column's trailing-edge
 /// node when the chord is along the stream), the block kernels' term of every filament of the
-/// wake set `wake` by the regular form where the point lies outside it and the kernel cut it off
-/// (within the cut-off radius of its axis): the linear model's frozen wake and its unit rings
-/// then take the terms the steady solve's trailing legs (or finite wake) take (docs/uvlm.md §3).
-/// Outside the cut-off the two forms differ by rounding only, and the kernel's value is kept.
+/// wake set `wake` by the regular form where the point lies outside it: the linear model's frozen
+/// wake and its unit rings then take the terms the steady solve's trailing legs (or finite wake)
+/// take (docs/uvlm.md §3). A filament off the point's axis changes by rounding only.
 pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
     let mut p = 0;
     for sl in &layout.surfaces {
@@ -182,10 +181,10 @@ pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout
             }
             let x = [pts.x[i], pts.y[i], pts.z[i]];
             for f in 0..wake.n_segments() {
-                fix_segment(wake, f, x, &mut u[i], true);
+                fix_segment(wake, f, x, &mut u[i]);
             }
             for l in 0..wake.n_legs() {
-                fix_leg(wake, l, x, &mut u[i], true);
+                fix_leg(wake, l, x, &mut u[i]);
             }
         }
     }
@@ -206,9 +205,9 @@ pub(crate) struct WakeColumns<'a> {
 /// wake: at the chordwise load points of surface `sl` (from `p0` in `pts`), the streamwise
 /// filaments of their own column in the part `w.part` of the wake (the chordwise legs from node
 /// row k − 1 to k and the closure leg, with the strengths, cores and arithmetic of
-/// [`crate::aic::append_known_wake`]) take the regular form where the point lies outside them
-/// and the kernel cut them off. Those are the filaments whose axis passes near the point: the
-/// steady solve's trailing leg (or finite wake) of that column, cut into rows.
+/// [`crate::aic::append_known_wake`]) take the regular form where the point lies outside them.
+/// Those are the filaments whose axis passes near the point: the steady solve's trailing leg (or
+/// finite wake) of that column, cut into rows.
 pub(crate) fn correct_wake_columns(
     sl: &SurfaceLayout,
     p0: usize,
@@ -239,7 +238,7 @@ pub(crate) fn correct_wake_columns(
                 let (a, b) = (pos(k - 1, j), pos(k, j));
                 let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
                 let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
-                fix_segment_at(a, b, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i], true);
+                fix_segment_at(a, b, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
             }
         }
         if let Some(dir) = w.closure
@@ -250,7 +249,7 @@ pub(crate) fn correct_wake_columns(
                 let (a, b) = (pos(len, j), pos(len - 1, j));
                 let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
                 let (core2, cut2) = w.core.leg_coefficients(l);
-                fix_leg_at(a, dir, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i], true);
+                fix_leg_at(a, dir, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
             }
         }
     }
@@ -258,31 +257,20 @@ pub(crate) fn correct_wake_columns(
 
 /// Replace segment `f`'s block-kernel term at `x` in `o` by the regular form when `x` lies
 /// outside the segment.
-fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3], cut_only: bool) {
+fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
     let (a, b) = (fil.node(fil.seg_a[f] as usize), fil.node(fil.seg_b[f] as usize));
-    fix_segment_at(a, b, (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]), x, o, cut_only);
+    fix_segment_at(a, b, (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]), x, o);
 }
 
 /// [`fix_segment`] of the segment `a → b` with `(Γ/4π, core2, cut2)`.
-fn fix_segment_at(
-    a: [f64; 3],
-    b: [f64; 3],
-    (g, core2, cut2): (f64, f64, f64),
-    x: [f64; 3],
-    o: &mut [f64; 3],
-    cut_only: bool,
-) {
+fn fix_segment_at(a: [f64; 3], b: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
     let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
     let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
     if r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2] <= 0.0 {
         return;
     }
-    let k_old = kernel_segment(r1, r2, core2, cut2);
-    if cut_only && k_old != 0.0 {
-        return;
-    }
     let (cv, k) = segment_factor(r1, r2, core2, cut2);
-    let (gk_old, gk_new) = (g * k_old, g * k);
+    let (gk_old, gk_new) = (g * kernel_segment(r1, r2, core2, cut2), g * k);
     for q in 0..3 {
         o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
     }
@@ -290,30 +278,19 @@ fn fix_segment_at(
 
 /// Replace leg `l`'s block-kernel term at `x` in `o` by the regular form when `x` lies upstream
 /// of its start.
-fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3], cut_only: bool) {
+fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3]) {
     let a = fil.node(fil.leg_a[l] as usize);
-    fix_leg_at(a, fil.leg_d[l], (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]), x, o, cut_only);
+    fix_leg_at(a, fil.leg_d[l], (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]), x, o);
 }
 
 /// [`fix_leg`] of the leg from `a` along `d` with `(Γ/4π, core2, cut2)`.
-fn fix_leg_at(
-    a: [f64; 3],
-    d: [f64; 3],
-    (g, core2, cut2): (f64, f64, f64),
-    x: [f64; 3],
-    o: &mut [f64; 3],
-    cut_only: bool,
-) {
+fn fix_leg_at(a: [f64; 3], d: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
     let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
     if d[0] * r[0] + d[1] * r[1] + d[2] * r[2] >= 0.0 {
         return;
     }
-    let k_old = kernel_leg(r, d, core2, cut2);
-    if cut_only && k_old != 0.0 {
-        return;
-    }
     let (cv, k) = leg_factor(r, d, core2, cut2);
-    let (gk_old, gk_new) = (g * k_old, g * k);
+    let (gk_old, gk_new) = (g * kernel_leg(r, d, core2, cut2), g * k);
     for q in 0..3 {
         o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
     }
