@@ -565,6 +565,11 @@ impl Strips {
 
 /// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`; the model's refusal of
 /// a load names its station.
+///
+/// `r` is affine in the loads, so the difference is taken with the loads scaled by
+/// [`LOAD_SCALE`] and divided back: the internal forces common to both residuals (up to 1e5 N in
+/// ANCF's axial terms at a 1 N load) then round at `2⁻²⁰` of their share, and the load part
+/// keeps its own precision. The scale is a power of two, so the scaling itself is exact.
 pub(crate) fn load_part<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -574,12 +579,19 @@ pub(crate) fn load_part<S: Structure>(
     let n = model.n_dof();
     let z = vec![0.0; n];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-    model.set_section_loads(loads).map_err(|e| e.to_string())?;
+    let scaled: Vec<SectionLoad> = loads
+        .iter()
+        .map(|l| SectionLoad { force: l.force * LOAD_SCALE, moment: l.moment * LOAD_SCALE, ..*l })
+        .collect();
+    model.set_section_loads(&scaled).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut a);
     model.set_section_loads(zero).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut b);
-    Ok(a.iter().zip(&b).map(|(x, y)| x - y).collect())
+    Ok(a.iter().zip(&b).map(|(x, y)| (x - y) / LOAD_SCALE).collect())
 }
+
+/// The factor of [`load_part`]'s scaled loads, `2²⁰`.
+const LOAD_SCALE: f64 = 1_048_576.0;
 
 /// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
 /// (corrected by `polars`) held fixed (central differences along the retraction); `None` when
@@ -1082,7 +1094,15 @@ struct Geometric {
     xte: DMatrix<f64>,
 }
 
-/// [`Geometric`] by central differences along each mode of `phi` (a step of `1e-6` chord).
+/// The step of [`geometric_terms`]' position differences: the largest coordinate moves by this
+/// fraction of the chord. Fourth-order differences at `1e-4` chord truncate at about `1e-14` of
+/// the terms and round at `1e-16 / 1e-4` of the loads over their derivatives, where second-order
+/// ones at `1e-6` rounded at `1e-10` and moved the soft fold roots by up to `5e-8` under a change
+/// of the equilibrium by rounding (docs/stability.md §3).
+const GEOMETRIC_STEP: f64 = 1e-4;
+
+/// [`Geometric`] by fourth-order central differences along each mode of `phi` (a step of
+/// [`GEOMETRIC_STEP`] chord).
 fn geometric_terms<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -1114,23 +1134,28 @@ fn geometric_terms<S: Structure>(
         let g2 = DVector::from_vec(load_part(model, &c.q_minus, &c.minus, zero_loads)?);
         Ok::<_, String>(Some(phi.transpose() * (g1 - g2) / (2.0 * c.step)))
     };
+    let mut qq = vec![0.0; q.len()];
     for i in 0..nb {
-        let (col, eps) = mode_step(phi, i, span);
-        let mut qp = vec![0.0; q.len()];
-        let mut qm = vec![0.0; q.len()];
-        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
-        model.retract_inplace(q, &dq, &mut qp);
-        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
-        model.retract_inplace(q, &dq, &mut qm);
-        let (r1, g1, te1) = eval(moved, model, &qp, &zeros, false)?;
-        let (r2, g2, te2) = eval(moved, model, &qm, &zeros, false)?;
+        let (col, eps) = mode_step(phi, i, GEOMETRIC_STEP / 1e-6 * span);
+        // Fourth-order central differences: `(8 (f₁ − f₋₁) − (f₂ − f₋₂)) / 12ε`.
+        let (mut rx, mut gx, mut xte) = (vec![0.0; nr], vec![0.0; model.n_dof()], vec![0.0; n_te]);
+        for (k, w) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
+            let dq: Vec<f64> = col.iter().map(|x| k * eps * x).collect();
+            model.retract_inplace(q, &dq, &mut qq);
+            let (r, gl, te) = eval(moved, model, &qq, &zeros, false)?;
+            let acc = |sum: &mut [f64], f: &[f64]| sum.iter_mut().zip(f).for_each(|(s, f)| *s += w * f);
+            acc(&mut rx, &r);
+            acc(&mut gx, &gl);
+            acc(&mut xte, &te);
+        }
+        let d = 12.0 * eps;
         for a in 0..nr {
-            g.rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
+            g.rx[(a, i)] = rx[a] / d;
         }
         for a in 0..n_te {
-            g.xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
+            g.xte[(a, i)] = xte[a] / d;
         }
-        let mut gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
+        let mut gp = phi.transpose() * DVector::from_vec(gx) / d;
         if let Some(c) = correction(moved, model, &col, false)? {
             gp += c;
         }
