@@ -1095,10 +1095,10 @@ struct Geometric {
 }
 
 /// The step of [`geometric_terms`]' position differences: the largest coordinate moves by this
-/// fraction of the chord. Fourth-order differences at `1e-4` chord truncate at about `1e-14` of
-/// the terms and round at `1e-16 / 1e-4` of the loads over their derivatives, where second-order
-/// ones at `1e-6` rounded at `1e-10` and moved the soft fold roots by up to `5e-8` under a change
-/// of the equilibrium by rounding (docs/stability.md §3).
+/// fraction of the chord. Fourth-order differences at `1e-4` and `4e-4` chord give every root of
+/// the Healy wing to 1e-10 (truncation), and round 100 times less than second-order ones at
+/// `1e-6`, which moved the soft fold roots by up to `5e-8` under a change of the equilibrium by
+/// rounding (docs/stability.md §1).
 const GEOMETRIC_STEP: f64 = 1e-4;
 
 /// [`Geometric`] by fourth-order central differences along each mode of `phi` (a step of
