@@ -90,13 +90,23 @@ pub struct StaticSettings {
     /// Sideslip angles of a sideslip sweep, degrees (at the one airspeed of `airspeeds`); empty:
     /// the sweep is over `airspeeds` at the aerodynamic settings' own sideslip.
     pub sideslips_deg: Vec<f64>,
+    /// Take the lattice's aerodynamic stiffness by forward differences of steady solves instead
+    /// of its analytic load derivative (docs/statics.md §2; for comparison, not a case field).
+    pub difference_tangent: bool,
 }
 
 impl StaticSettings {
     /// An aeroelastic sweep over `airspeeds` with the steady wake `wake` (semi-infinite legs
     /// when `None`).
     pub fn at(airspeeds: Vec<f64>, wake: Option<WakeSettings>) -> Self {
-        Self { airspeeds, point_loads: Vec::new(), load_factors: Vec::new(), wake, sideslips_deg: Vec::new() }
+        Self {
+            airspeeds,
+            point_loads: Vec::new(),
+            load_factors: Vec::new(),
+            wake,
+            sideslips_deg: Vec::new(),
+            difference_tangent: false,
+        }
     }
 
     /// The points of the sweep in the case's order, `(airspeed m/s, sideslip degrees)`: each

@@ -404,12 +404,25 @@ impl Reduced {
     /// `D(s)` is real for real `s`, so from a real start with a real vector every iterate stays
     /// on the real axis and only a real root can be reached. A real start that does not converge
     /// there (the real pair of a statically unstable mode has met and turned complex) is retried
-    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector.
+    /// from the start moved off the axis by its own size, `s₀(1 + i)`, with the same vector; so
+    /// is one that converges on the real axis farther than half the start's size from it, and
+    /// the root nearer the start is kept (the real iteration then jumped to another branch).
     pub fn newton(&self, s: C64, eta: DVector<C64>, count: &mut usize) -> (C64, DVector<C64>, bool) {
         let real_start = s.im == 0.0 && eta.iter().all(|x| x.im == 0.0);
         let e0 = if real_start { Some(eta.clone()) } else { None };
+        let off_axis =
+            |e0, count: &mut usize| newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count);
         match (newton_of(|x| self.d(x), s, eta, count), e0) {
-            ((_, _, false), Some(e0)) => newton_of(|x| self.d(x), C64::new(s.re, s.re.abs().max(1e-3)), e0, count),
+            ((_, _, false), Some(e0)) => off_axis(e0, count),
+            // A real root far from the start may be another branch's (the mode's real pair has
+            // met and turned complex, which the real axis cannot follow): the nearer of the two.
+            ((r, e, true), Some(e0)) => {
+                let far = (r - s).norm() > 0.5 * s.norm().max(1e-3);
+                match far.then(|| off_axis(e0, count)) {
+                    Some((r2, e2, true)) if (r2 - s).norm() < (r - s).norm() => (r2, e2, true),
+                    _ => (r, e, true),
+                }
+            }
             (found, _) => found,
         }
     }
@@ -552,6 +565,11 @@ impl Strips {
 
 /// Generalised load `r(q, L) − r(q, 0)` of station loads `loads` at `q`; the model's refusal of
 /// a load names its station.
+///
+/// `r` is affine in the loads, so the difference is taken with the loads scaled by
+/// [`LOAD_SCALE`] and divided back: the internal forces common to both residuals (up to 1e5 N in
+/// ANCF's axial terms at a 1 N load) then round at `2⁻²⁰` of their share, and the load part
+/// keeps its own precision. The scale is a power of two, so the scaling itself is exact.
 pub(crate) fn load_part<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -561,12 +579,19 @@ pub(crate) fn load_part<S: Structure>(
     let n = model.n_dof();
     let z = vec![0.0; n];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-    model.set_section_loads(loads).map_err(|e| e.to_string())?;
+    let scaled: Vec<SectionLoad> = loads
+        .iter()
+        .map(|l| SectionLoad { force: l.force * LOAD_SCALE, moment: l.moment * LOAD_SCALE, ..*l })
+        .collect();
+    model.set_section_loads(&scaled).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut a);
     model.set_section_loads(zero).map_err(|e| e.to_string())?;
     model.residual_inplace(0.0, q, &z, &z, &mut b);
-    Ok(a.iter().zip(&b).map(|(x, y)| x - y).collect())
+    Ok(a.iter().zip(&b).map(|(x, y)| (x - y) / LOAD_SCALE).collect())
 }
+
+/// The factor of [`load_part`]'s scaled loads, `2²⁰`.
+const LOAD_SCALE: f64 = 1_048_576.0;
 
 /// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
 /// (corrected by `polars`) held fixed (central differences along the retraction); `None` when
@@ -1069,7 +1094,15 @@ struct Geometric {
     xte: DMatrix<f64>,
 }
 
-/// [`Geometric`] by central differences along each mode of `phi` (a step of `1e-6` chord).
+/// The step of [`geometric_terms`]' position differences: the largest coordinate moves by this
+/// fraction of the chord. Fourth-order differences at `1e-4` and `4e-4` chord give every root of
+/// the Healy wing to 1e-10 (truncation), and round 100 times less than second-order ones at
+/// `1e-6`, which moved the soft fold roots by up to `5e-8` under a change of the equilibrium by
+/// rounding (docs/stability.md §1).
+const GEOMETRIC_STEP: f64 = 1e-4;
+
+/// [`Geometric`] by fourth-order central differences along each mode of `phi` (a step of
+/// [`GEOMETRIC_STEP`] chord).
 fn geometric_terms<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -1101,23 +1134,28 @@ fn geometric_terms<S: Structure>(
         let g2 = DVector::from_vec(load_part(model, &c.q_minus, &c.minus, zero_loads)?);
         Ok::<_, String>(Some(phi.transpose() * (g1 - g2) / (2.0 * c.step)))
     };
+    let mut qq = vec![0.0; q.len()];
     for i in 0..nb {
-        let (col, eps) = mode_step(phi, i, span);
-        let mut qp = vec![0.0; q.len()];
-        let mut qm = vec![0.0; q.len()];
-        let dq: Vec<f64> = col.iter().map(|x| eps * x).collect();
-        model.retract_inplace(q, &dq, &mut qp);
-        let dq: Vec<f64> = col.iter().map(|x| -eps * x).collect();
-        model.retract_inplace(q, &dq, &mut qm);
-        let (r1, g1, te1) = eval(moved, model, &qp, &zeros, false)?;
-        let (r2, g2, te2) = eval(moved, model, &qm, &zeros, false)?;
+        let (col, eps) = mode_step(phi, i, GEOMETRIC_STEP / 1e-6 * span);
+        // Fourth-order central differences: `(8 (f₁ − f₋₁) − (f₂ − f₋₂)) / 12ε`.
+        let (mut rx, mut gx, mut xte) = (vec![0.0; nr], vec![0.0; model.n_dof()], vec![0.0; n_te]);
+        for (k, w) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
+            let dq: Vec<f64> = col.iter().map(|x| k * eps * x).collect();
+            model.retract_inplace(q, &dq, &mut qq);
+            let (r, gl, te) = eval(moved, model, &qq, &zeros, false)?;
+            let acc = |sum: &mut [f64], f: &[f64]| sum.iter_mut().zip(f).for_each(|(s, f)| *s += w * f);
+            acc(&mut rx, &r);
+            acc(&mut gx, &gl);
+            acc(&mut xte, &te);
+        }
+        let d = 12.0 * eps;
         for a in 0..nr {
-            g.rx[(a, i)] = (r1[a] - r2[a]) / (2.0 * eps);
+            g.rx[(a, i)] = rx[a] / d;
         }
         for a in 0..n_te {
-            g.xte[(a, i)] = (te1[a] - te2[a]) / (2.0 * eps);
+            g.xte[(a, i)] = xte[a] / d;
         }
-        let mut gp = phi.transpose() * (DVector::from_vec(g1) - DVector::from_vec(g2)) / (2.0 * eps);
+        let mut gp = phi.transpose() * DVector::from_vec(gx) / d;
         if let Some(c) = correction(moved, model, &col, false)? {
             gp += c;
         }
@@ -1697,6 +1735,8 @@ fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], t
     if suspects.is_empty() {
         return;
     }
+    // The roots the suspects' own starts converged to (a root two starts share among them).
+    let first: Vec<(C64, DVector<C64>, bool)> = suspects.iter().map(|&m| found[m].clone()).collect();
     for &m in &suspects {
         found[m].2 = false;
     }
@@ -1722,6 +1762,14 @@ fn follow_suspects(red: &mut Reduced, found: &mut [(C64, DVector<C64>, bool)], t
     }
     for i in pending {
         let m = suspects[i];
+        // A root that this mode's start converged to and no mode holds now is the mode's: its
+        // path lost it (a real path cannot follow a statically unstable mode's real pair once
+        // the pair has met and turned complex, and jumps to another branch).
+        let (s1, e1, ok1) = &first[i];
+        if *ok1 && !found.iter().any(|f| f.2 && same_root(f.0, *s1)) {
+            found[m] = (*s1, e1.clone(), true);
+            continue;
+        }
         let claimed = |s: C64| found.iter().any(|f| f.2 && same_root(f.0, s));
         if let Some((s, e)) = red.restart_from_path(&paths[i], n_evaluations, claimed) {
             found[m] = (s, e, true);

@@ -6,9 +6,11 @@
 //! UVLM solve (semi-infinite wake legs along the free stream, [`uvlm::Uvlm::solve_steady`], or the
 //! finite frozen wake of `static.wake`) at the current coordinates added to its residual
 //! ([`AeroStatic`]). Its tangent is the structure's
-//! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, a forward difference of the
-//! generalised aerodynamic force, one steady solve per tangent coordinate. That costs one
-//! lattice solve per unknown, so the aerodynamic part is kept between iterations and between
+//! (loads held) plus the aerodynamic stiffness `−∂Q_aero/∂q`, from the lattice's analytic load
+//! derivative ([`uvlm::Uvlm::steady_load_derivative`]) composed with central differences of the
+//! smooth maps without a lattice solve (stations, lumping, polar correction, the formulation's
+//! load; docs/statics.md §2), or on request a forward difference of steady solves. It is still
+//! a few hundred evaluations, so the aerodynamic part is kept between iterations and between
 //! airspeeds (scaled by V², the exact scaling at fixed geometry) and refreshed only when Newton
 //! stops contracting. The generic Newton iteration of `genalpha::analysis` does the rest
 //! (constraints, multipliers, convergence tests).
@@ -39,6 +41,9 @@ use crate::strip_statics::StripStatics;
 /// What turns a lattice solve into station loads besides the lattice: the section polars'
 /// correction, or the static strips in its place, each with the factor on its Reynolds numbers.
 type Sources<'a> = (Option<(&'a StripPolars, f64)>, Option<(&'a StripStatics, f64)>);
+
+/// Ring nodes (stacked over the surfaces), the nodal forces on them and the strip forces.
+type LatticeForces<'a> = (&'a [[f64; 3]], &'a [[f64; 3]], &'a [[f64; 3]]);
 
 /// The steady aerodynamics of a lattice that follows the structure.
 struct SteadyAero {
@@ -132,6 +137,64 @@ impl SteadyAero {
     }
 }
 
+impl SteadyAero {
+    /// Move the lattice to the stations of `model` at `q` (geometry only, no solve) and put its
+    /// ring nodes, surface after surface, into `out`.
+    fn geometry_at<S: Structure>(
+        &mut self,
+        model: &S,
+        q: &[f64],
+        map: &[StationMap],
+        aero: &AeroSettings,
+        out: &mut Vec<[f64; 3]>,
+    ) -> Result<(), String> {
+        stations_at(model, q, &self.zeros, map, aero, None, &mut self.scratch, &mut self.stations, &mut self.vel);
+        crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, None)
+            .map_err(|e| format!("aerodynamic lattice: {e}"))?;
+        out.clear();
+        for s in self.uv.surfaces() {
+            out.extend_from_slice(s.lattice().ring_nodes());
+        }
+        Ok(())
+    }
+
+    /// Station loads of the lattice forces `nodal` (on the ring nodes, stacked) and `strip` at
+    /// the geometry of the last [`SteadyAero::geometry_at`] (ring nodes `nodes`): lumped to the
+    /// stations and corrected by `polars` as [`SteadyAero::loads_at`] does.
+    fn loads_of(
+        &mut self,
+        map: &[StationMap],
+        (nodes, nodal, strip): LatticeForces<'_>,
+        polars: Option<(&StripPolars, f64)>,
+        out: &mut [SectionLoad],
+    ) -> Result<(), String> {
+        self.origins.clear();
+        self.origins.extend(self.stations.iter().map(|x| [x.origin.x, x.origin.y, x.origin.z]));
+        let mut v0 = 0;
+        for (r, surf) in self.ranges.iter().zip(self.uv.surfaces()) {
+            let nn = surf.lattice().n_nodes();
+            uvlm::lump_columns(
+                &nodes[v0..v0 + nn],
+                &nodal[v0..v0 + nn],
+                &self.origins[r.clone()],
+                &mut self.fbuf[r.clone()],
+                &mut self.mbuf[r.clone()],
+            );
+            v0 += nn;
+        }
+        for (j, t) in out.iter_mut().enumerate() {
+            t.force = Vector3::from(self.fbuf[j]);
+            t.moment = Vector3::from(self.mbuf[j]);
+        }
+        if let Some((p, re_factor)) = polars {
+            let v = Vector3::from(self.uv.params().v_inf);
+            let mut report = StripReport::default();
+            p.correct_strips(&self.stations, map, strip, |_, _| v, re_factor, out, &mut report)?;
+        }
+        Ok(())
+    }
+}
+
 /// A one-ring lattice that stands in until the real one is built (keeps `SteadyAero::new`
 /// free of `Option`s).
 fn placeholder_uvlm() -> Result<uvlm::Uvlm, String> {
@@ -187,6 +250,9 @@ pub struct AeroStatic<'a, S: Structure> {
     reynolds_airspeed: Option<f64>,
     /// The static strips that replace the lattice (`aero.model: "strip"`; none: the lattice).
     strips: Option<StripStatics>,
+    /// Take the lattice's aerodynamic stiffness by forward differences of steady solves instead
+    /// of the analytic load derivative (docs/statics.md §2).
+    difference_tangent: bool,
 }
 
 impl<'a, S: Structure> AeroStatic<'a, S> {
@@ -234,6 +300,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
             polars: None,
             reynolds_airspeed: None,
             strips: None,
+            difference_tangent: false,
         })
     }
 
@@ -244,6 +311,14 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         self.strips = strips;
         self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).valid = false;
         self.begin_solve(true);
+    }
+
+    /// Take the lattice's aerodynamic stiffness by forward differences of steady solves (one per
+    /// coordinate) when `on`, instead of the analytic load derivative (the default; for
+    /// comparison).
+    pub fn set_difference_tangent(&mut self, on: bool) {
+        self.difference_tangent = on;
+        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).valid = false;
     }
 
     /// Whether the static strips replace the lattice.
@@ -494,6 +569,19 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         let zeros = vec![0.0; n];
         let mut scratch = vec![0.0; n];
         let loads_q = lock(&self.loads).clone();
+        if self.strips.is_none() && !self.difference_tangent {
+            // The analytic load derivative; the differences below where it does not apply (a
+            // core sized by the panels, a lattice that folded at a side point).
+            let done = self.analytic_tangent(t, q, tg, &zeros, &mut scratch);
+            if done.is_ok() {
+                tg.speed2 = self.speed2;
+                tg.valid = true;
+                if let Err(e) = write(&self.model).set_section_loads(&loads_q) {
+                    *lock(&self.error) = Some(e.to_string());
+                }
+                return;
+            }
+        }
         self.load_part(t, q, &loads_q, &zeros, &mut scratch, &mut tg.r0);
         // The strips are cheap: a central difference (second order) instead of a forward one.
         let central = self.strips.is_some();
@@ -520,6 +608,89 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         if let Err(e) = write(&self.model).set_section_loads(&loads_q) {
             *lock(&self.error) = Some(e.to_string());
         }
+    }
+}
+
+impl<S: Structure> AeroStatic<'_, S> {
+    /// The aerodynamic stiffness at `q` from the lattice's analytic load derivative
+    /// (docs/statics.md §2): with `D = ∂(nodal, strip forces)/∂X` of the steady solution at `q`
+    /// and `E(q, F)` the generalised load of the lattice forces `F` placed on the geometry of
+    /// `q` (lumped to the stations, corrected by the polars, applied by the formulation), column
+    /// `j` is the central difference of `E(q ± h e_j, F₀ ± h D δX_j)` with `δX_j` the central
+    /// difference of the ring nodes: every quotient is of a smooth map without a lattice solve.
+    fn analytic_tangent(
+        &self,
+        t: f64,
+        q: &[f64],
+        tg: &mut AeroTangent,
+        zeros: &[f64],
+        scratch: &mut [f64],
+    ) -> Result<(), String> {
+        let n = self.n_dof();
+        let re_factor = self.reynolds_airspeed.map_or(1.0, |u| u / self.speed2.sqrt());
+        let polars = self.polars.as_ref().map(|p| (p, re_factor));
+        let mut st = lock(&self.aero_state);
+        let mut x0 = Vec::new();
+        st.geometry_at(&*read(&self.model), q, self.map, &self.aero, &mut x0)?;
+        let d = st.uv.steady_load_derivative().map_err(|e| format!("load derivative: {e}"))?;
+        st.n_solves += 1;
+        let nv = x0.len();
+        let (mut xp, mut xm) = (Vec::with_capacity(nv), Vec::with_capacity(nv));
+        let (mut qp, mut qm) = (tg.q_tmp.clone(), tg.q_tmp.clone());
+        // Smooth maps only: a step of 1e-6 of the span in the increment weights.
+        let steps: Vec<f64> =
+            (0..n).map(|j| 10.0 * self.fd_step / read(&self.model).increment_weight(j).max(1e-12)).collect();
+        let sides = |j: usize, dq: &mut [f64], qp: &mut [f64], qm: &mut [f64]| {
+            dq.iter_mut().for_each(|x| *x = 0.0);
+            dq[j] = steps[j];
+            read(&self.model).retract_inplace(q, dq, qp);
+            dq[j] = -steps[j];
+            read(&self.model).retract_inplace(q, dq, qm);
+        };
+        // The ring nodes' derivative, one column per coordinate, then the forces' (two products).
+        let mut dx = nalgebra::DMatrix::zeros(3 * nv, n);
+        for j in 0..n {
+            sides(j, &mut tg.dq, &mut qp, &mut qm);
+            st.geometry_at(&*read(&self.model), &qp, self.map, &self.aero, &mut xp)?;
+            st.geometry_at(&*read(&self.model), &qm, self.map, &self.aero, &mut xm)?;
+            for v in 0..nv {
+                for a in 0..3 {
+                    dx[(3 * v + a, j)] = (xp[v][a] - xm[v][a]) / (2.0 * steps[j]);
+                }
+            }
+        }
+        let dn = &d.d_nodal * &dx;
+        let ds = &d.d_strip * &dx;
+        let (mut fp, mut fm) = (vec![[0.0; 3]; nv], vec![[0.0; 3]; nv]);
+        let (mut sp, mut sm) = (vec![[0.0; 3]; d.strip.len()], vec![[0.0; 3]; d.strip.len()]);
+        for j in 0..n {
+            let h = steps[j];
+            for v in 0..nv {
+                for a in 0..3 {
+                    fp[v][a] = d.nodal[v][a] + h * dn[(3 * v + a, j)];
+                    fm[v][a] = d.nodal[v][a] - h * dn[(3 * v + a, j)];
+                }
+            }
+            for k in 0..sp.len() {
+                for a in 0..3 {
+                    sp[k][a] = d.strip[k][a] + h * ds[(3 * k + a, j)];
+                    sm[k][a] = d.strip[k][a] - h * ds[(3 * k + a, j)];
+                }
+            }
+            sides(j, &mut tg.dq, &mut qp, &mut qm);
+            st.geometry_at(&*read(&self.model), &qm, self.map, &self.aero, &mut xm)?;
+            st.loads_of(self.map, (&xm, &fm, &sm), polars, &mut tg.loads)?;
+            self.load_part(t, &qm, &tg.loads, zeros, scratch, &mut tg.r0);
+            st.geometry_at(&*read(&self.model), &qp, self.map, &self.aero, &mut xp)?;
+            st.loads_of(self.map, (&xp, &fp, &sp), polars, &mut tg.loads)?;
+            self.load_part(t, &qp, &tg.loads, zeros, scratch, &mut tg.r1);
+            for i in 0..n {
+                tg.k[i * n + j] = (tg.r1[i] - tg.r0[i]) / (2.0 * h);
+            }
+        }
+        // The lattice back at q.
+        st.geometry_at(&*read(&self.model), q, self.map, &self.aero, &mut x0)?;
+        if tg.k.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("non-finite load derivative".into()) }
     }
 }
 
@@ -922,6 +1093,7 @@ fn sweep<S: Structure>(case: &Problem, f: Formulation, build: fn(&Problem) -> Re
     } else {
         sys.set_polars(polars);
     }
+    sys.set_difference_tangent(st.difference_tangent);
     let mut solver = StaticSolver::new(&sys, static_params());
     let mut x = StaticSolution::guess(&sys, &q_ref);
     let loads_model = LoadModel::new(case, f);
@@ -1064,7 +1236,7 @@ pub(crate) fn solve_rounds<S: Structure>(
             Ok(()) if !x.residual_norm.is_finite() => {
                 return Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into()));
             }
-            Ok(()) => return Ok(()),
+            Ok(()) => return polish(sys, solver, x),
             Err(e @ genalpha::Error::StaticNotConverged { .. }) => last = e.to_string(),
             // A kept aerodynamic stiffness can send the first iterate past the lattice's
             // limits: start again from the same estimate with a fresh one.
@@ -1076,6 +1248,49 @@ pub(crate) fn solve_rounds<S: Structure>(
         }
     }
     Err(format!("{last} ({ROUNDS} rounds of {ROUND_ITERATIONS} iterations)"))
+}
+
+/// Newton iterations of [`polish`] at most.
+const POLISH_ITERATIONS: usize = 10;
+/// The increment [`polish`] iterates down to (m in the increment weights): a few hundred ulp of
+/// a structure of metres, a thousandth of [`static_params`]' `tol`.
+const POLISH_TOL: f64 = 1e-13;
+
+/// Iterate an equilibrium `x` that [`solve_rounds`] accepted (increment below `tol` = 1e-10 m)
+/// on, with the aerodynamic stiffness it ended with, down to [`POLISH_TOL`], so that the last
+/// iterate is the equilibrium to rounding rather than within `tol` of it along a path that
+/// depends on the tangent. The equilibrium's derived quantities need it: the flutter equation's
+/// geometric terms are central differences about it (a step of 1e-6, which turns 1e-11 of the
+/// state into 1e-5 of a root), and a polar that reproduces the lattice must give the lattice's
+/// equilibrium and roots to rounding although its tangent differs by its own differences. Where
+/// the increment stalls at round-off above [`POLISH_TOL`], the better of the two iterates (by
+/// the residual) is kept and finished once more with the usual settings.
+fn polish<S: Structure>(
+    sys: &mut AeroStatic<'_, S>,
+    solver: &mut StaticSolver,
+    x: &mut StaticSolution,
+) -> Result<(), String> {
+    let coarse = *solver.params();
+    let mut y = x.clone();
+    solver.set_params(StaticParams { max_iter: POLISH_ITERATIONS, tol: POLISH_TOL, rel_residual_tol: 0.0 });
+    sys.begin_solve(false);
+    let s: &AeroStatic<'_, S> = sys;
+    let fine = solver.solve_normalised(s, 0.0, &mut y, |q| read(&s.model).normalise(q));
+    solver.set_params(coarse);
+    if fine.is_ok() && y.residual_norm.is_finite() {
+        *x = y;
+        return Ok(());
+    }
+    if y.residual_norm.is_finite() && y.residual_norm < x.residual_norm {
+        *x = y;
+    }
+    sys.begin_solve(false);
+    let s: &AeroStatic<'_, S> = sys;
+    match solver.solve_normalised(s, 0.0, x, |q| read(&s.model).normalise(q)) {
+        Ok(()) if x.residual_norm.is_finite() => Ok(()),
+        Ok(()) => Err(sys.error().unwrap_or_else(|| "non-finite residual at the equilibrium".into())),
+        Err(e) => Err(sys.error().map_or_else(|| e.to_string(), |a| format!("{e} ({a})"))),
+    }
 }
 
 /// The first equilibrium, at airspeed `top`, by load stepping from the unloaded reference:
@@ -1271,4 +1486,81 @@ fn write<T>(l: &RwLock<T>) -> RwLockWriteGuard<'_, T> {
 }
 fn lock<T>(l: &Mutex<T>) -> MutexGuard<'_, T> {
     l.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// The analytic aerodynamic stiffness (docs/statics.md §2) at the first equilibrium of `case`'s
+/// sweep, checked against central differences of the generalised aerodynamic load (each side a
+/// steady solve, with the section polars' correction when the case has them): for every step of
+/// `steps` (a fraction of the span, in the increment weights) the largest difference over the
+/// largest entry.
+///
+/// # Errors
+/// A case without an equilibrium at its first airspeed, or a failed lattice solve.
+pub fn aero_stiffness_check(case: &Problem, f: Formulation, steps: &[f64]) -> Result<Vec<f64>, String> {
+    let out = run_static(case, f);
+    if let Some(e) = out.error {
+        return Err(e);
+    }
+    let p = out.points.first().ok_or("no point")?;
+    let (q, _, _) = p.state.clone().ok_or_else(|| p.error.clone().unwrap_or_default())?;
+    struct Check<'a>(&'a Problem, f64, Vec<f64>, &'a [f64]);
+    impl ForModel for Check<'_> {
+        type Output = Result<Vec<f64>, String>;
+        fn run<M: BuildModel>(self) -> Self::Output {
+            stiffness_check(self.0, M::build, self.1, &self.2, self.3)
+        }
+    }
+    dispatch(f, Check(case, p.airspeed, q, steps))
+}
+
+/// [`aero_stiffness_check`] of the model `build` makes, at airspeed `u` and coordinates `q`.
+fn stiffness_check<S: Structure>(
+    case: &Problem,
+    build: fn(&Problem) -> Result<S, Error>,
+    u: f64,
+    q: &[f64],
+    steps: &[f64],
+) -> Result<Vec<f64>, String> {
+    let (aero, st) = case.aero.as_ref().zip(case.statics.as_ref()).ok_or("no `aero` and `static` blocks")?;
+    let map = station_map(case, aero)?;
+    let model = build(case).map_err(|e| e.to_string())?;
+    let mut a0 = aero.clone();
+    a0.airspeed = Some(u);
+    let wake = st.wake.as_ref().map_or(uvlm::SteadyWake::SemiInfinite, |w| w.steady_wake());
+    let mut sys = AeroStatic::new(model, q, &map, &a0, wake, case.span())?;
+    sys.set_polars(StripPolars::of(case)?);
+    let n = sys.n_dof();
+    if !sys.apply_loads(q) {
+        return Err(sys.error().unwrap_or_default());
+    }
+    sys.update_tangent(0.0, q);
+    let k = lock(&sys.tangent).k.clone();
+    let zeros = vec![0.0; n];
+    let (mut scratch, mut rp, mut rm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut dq = vec![0.0; n];
+    let mut qs = q.to_vec();
+    let mut loads = sys.zero_loads.clone();
+    let mut worst = Vec::new();
+    for &step in steps {
+        let (mut diff, mut big) = (0.0f64, 0.0f64);
+        for j in 0..n {
+            let h = step * case.span() / sys.model().increment_weight(j).max(1e-12);
+            for (r, sign) in [(&mut rp, 1.0), (&mut rm, -1.0)] {
+                dq.fill(0.0);
+                dq[j] = sign * h;
+                sys.model().retract_inplace(q, &dq, &mut qs);
+                if !sys.station_loads(&qs, &mut loads) {
+                    return Err(sys.error().unwrap_or_default());
+                }
+                sys.load_part(0.0, &qs, &loads, &zeros, &mut scratch, r);
+            }
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                diff = diff.max((k[i * n + j] - fd).abs());
+                big = big.max(fd.abs());
+            }
+        }
+        worst.push(diff / big);
+    }
+    Ok(worst)
 }

@@ -52,6 +52,7 @@ impl StaticSettings {
             load_factors: self.load_factors.clone(),
             wake: self.wake,
             sideslips_deg: self.sideslips_deg.clone(),
+            difference_tangent: false,
         }
     }
 }

@@ -113,6 +113,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod aic;
+mod axis_extension;
 pub mod biot_savart;
 mod dense_lu;
 mod error;
@@ -127,6 +128,7 @@ mod linear;
 mod linear_gust;
 mod linear_stack;
 mod linearise;
+mod load_derivative;
 mod loads;
 mod params;
 pub mod samples;
@@ -150,6 +152,7 @@ pub use lattice::{ChordwiseSpacing, HingeColumn, Lattice, LatticeSpec};
 pub use linear::{LinearUvlm, LinearWake, with_wake};
 pub use linear_gust::LinearGust;
 pub use linear_stack::SurfaceBlock;
+pub use load_derivative::SteadyLoadDerivative;
 pub use loads::{Loads, lift_drag_of, lump_columns};
 pub use params::{PARALLEL_MIN_PAIRS, Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
 pub use solver::Uvlm;

@@ -11,6 +11,7 @@
 use std::ops::Range;
 
 use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
+use crate::axis_extension::{ExtensionLayout, SurfaceLayout, correct_axis_extensions, correct_wake_extensions};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::flow::Flow;
 use crate::images::append_images;
@@ -104,6 +105,8 @@ pub(crate) struct Frozen {
     /// The Biot–Savart loops' workspace (serial here).
     pub(crate) blocks: ScratchPool<NodeBlock>,
     pub(crate) loads: Loads,
+    /// Where the load points and their collinear bound filaments sit (axis_extension.rs).
+    pub(crate) ext: ExtensionLayout,
 }
 
 impl Frozen {
@@ -134,9 +137,23 @@ impl Frozen {
             }
         }
         self.mid.clear();
+        self.ext.surfaces.clear();
+        let n_copies = crate::images::copy_signs(p.images.len()).len();
+        self.ext.n_copies = n_copies;
+        self.ext.n_base_seg = self.bs.fil.n_segments() / n_copies;
+        self.ext.n_base_leg = 0;
         for k in 0..lats.len() {
             let r = self.bs.surface(k);
             let n_mid = if p.te_segment_force { r.n_lattice_seg } else { r.n_lattice_seg - r.n_te_seg };
+            self.ext.surfaces.push(SurfaceLayout {
+                seg0: r.seg0,
+                n_load: n_mid,
+                n_lattice_seg: r.n_lattice_seg,
+                m: lats[k].n_chordwise(),
+                n: lats[k].n_spanwise(),
+                leg0: 0,
+                finite: false,
+            });
             for s in r.seg0..r.seg0 + n_mid {
                 let (a, b) = self.bs.fil.segment_nodes(s);
                 let (pa, pb) = (self.bs.fil.node(a as usize), self.bs.fil.node(b as usize));
@@ -160,7 +177,21 @@ impl Frozen {
         let known = std::mem::take(&mut self.known);
         self.induce(&[&bsf, &known]);
         self.bs.fil = bsf;
+        self.correct_bound_at_midpoints();
+        self.correct_wake_at_midpoints(&known);
         self.known = known;
+    }
+
+    /// The bound filaments' regular terms on their axis extensions at the midpoints, as the
+    /// solver's loads take them (docs/uvlm.md §3).
+    pub(crate) fn correct_bound_at_midpoints(&mut self) {
+        correct_axis_extensions(&self.bs.fil, &self.ext, &self.mid, &mut self.u_mid);
+    }
+
+    /// The wake filaments `wake`'s regular terms at the chordwise midpoints, as the solver's
+    /// steady legs and time march take them (docs/uvlm.md §3).
+    pub(crate) fn correct_wake_at_midpoints(&mut self, wake: &Filaments) {
+        correct_wake_extensions(wake, &self.ext, &self.mid, &mut self.u_mid);
     }
 
     /// The free stream `v_inf` at the collocation points (`v_col`) and midpoints (`v_mid`).

@@ -264,6 +264,7 @@ fn bound_derivatives(
         fz.u_mid.resize(mid.len(), [0.0; 3]);
         induced_velocity_inplace(&[&fz.bs.fil], &mid, &mut fz.u_mid, crate::Parallel::Off, &mut fz.blocks);
         fz.mid = mid;
+        fz.correct_bound_at_midpoints();
         let du = fz.u_mid.clone();
         ld.eval(fz, model, Some(r), None, &du, (&mut col, &mut scol));
         force_gamma.column_mut(r).copy_from_slice(&col);
@@ -314,6 +315,7 @@ impl WakeRows<'_> {
                     unit_wake_ring(&mut fz.known, te, wake, k, j, self.closure, p);
                     let known = std::mem::take(&mut fz.known);
                     fz.induce(&[&known]);
+                    fz.correct_wake_at_midpoints(&known);
                     fz.known = known;
                     for r in 0..nr {
                         w[(r, c)] = (0..3).map(|q| fz.u_col[r][q] * self.nrm[r][q]).sum();

@@ -2,6 +2,9 @@
 //! each with its wake, in one influence system.
 
 use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
+use crate::axis_extension::{
+    ExtensionLayout, SurfaceLayout, WakeColumns, correct_axis_extensions, correct_wake_columns,
+};
 use crate::biot_savart::{Filaments, NodeBlock};
 use crate::dense_lu::DenseLu;
 use crate::error::{Result, UvlmError};
@@ -84,6 +87,8 @@ pub struct Uvlm {
     wpts: Points,
     u_col: Vec<[f64; 3]>,
     u_mid: Vec<[f64; 3]>,
+    /// Where the load points and their collinear filaments sit (axis_extension.rs).
+    ext_layout: ExtensionLayout,
     u_wake: Vec<[f64; 3]>,
     v_col: Vec<[f64; 3]>,
     v_mid: Vec<[f64; 3]>,
@@ -146,6 +151,7 @@ impl Uvlm {
             wpts: Points::default(),
             u_col: vec![[0.0; 3]; nr],
             u_mid: Vec::new(),
+            ext_layout: ExtensionLayout::default(),
             u_wake: Vec::new(),
             v_col: vec![[0.0; 3]; nr],
             v_mid: Vec::new(),
@@ -461,7 +467,17 @@ impl Uvlm {
             )
         };
         self.stats.n_pair_evaluations += pairs;
-        if with_known_wake && self.params.wake_reuse == WakeReuse::Frozen {
+        // The bound filaments' regular induction on their axis extensions (docs/uvlm.md §3).
+        let mut layout = std::mem::take(&mut self.ext_layout);
+        self.load_layout(&mut layout);
+        correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid);
+        let frozen = self.params.wake_reuse == WakeReuse::Frozen;
+        if with_known_wake {
+            // The known wake's streamwise filaments on the same footing (as the steady legs).
+            let part = if frozen { WakePart::Near } else { WakePart::All };
+            self.correct_wake_at_midpoints(&layout, part, false);
+        }
+        if with_known_wake && frozen {
             if !self.far_ready {
                 self.u_far_mid.clear();
                 self.u_far_mid.resize(self.mid.len(), [0.0; 3]);
@@ -473,9 +489,11 @@ impl Uvlm {
                     self.params.parallel,
                     &mut self.blocks,
                 );
+                self.correct_wake_at_midpoints(&layout, WakePart::Far, true);
             }
             add_to(&mut self.u_mid, &self.u_far_mid);
         }
+        self.ext_layout = layout;
         self.v_mid.resize(self.mid.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.mid, t, &mut self.v_mid);
         let gd = unsteady && self.params.unsteady_term;
@@ -498,6 +516,52 @@ impl Uvlm {
         if self.surfaces.len() > 1 {
             concatenate_loads(&mut self.loads, self.surfaces.iter().map(|s| &s.loads));
         }
+    }
+
+    /// The regular form of the known wake's part `part` (its streamwise filaments, column by
+    /// column) at the chordwise load points, in `u_far_mid` (`far`) or `u_mid`
+    /// (axis_extension.rs, docs/uvlm.md §3): the time march's wake rows take the terms the steady
+    /// solve's legs take, so that a steady solution is the march's equilibrium.
+    fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool) {
+        let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+        let u = if far { &mut self.u_far_mid } else { &mut self.u_mid };
+        let mut p0 = 0;
+        for (sl, s) in layout.surfaces.iter().zip(&self.surfaces) {
+            let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
+            let te = &s.lattice.ring_nodes()[m * (n + 1)..];
+            let w = WakeColumns { te, wake: &s.wake, closure, core: &self.params.wake_core, part };
+            correct_wake_columns(sl, p0, &w, &self.mid, u);
+            p0 += sl.n_load;
+        }
+    }
+
+    /// Where every surface's load points and filaments sit in the bound system (the load points
+    /// of [`Uvlm::update_loads`], surface after surface).
+    fn load_layout(&self, out: &mut ExtensionLayout) {
+        let n_copies = crate::images::copy_signs(self.params.images.len()).len();
+        let surfaces = &mut out.surfaces;
+        surfaces.clear();
+        let mut leg0 = 0;
+        for (k, s) in self.surfaces.iter().enumerate() {
+            let r = self.bound.surface(k);
+            let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
+            surfaces.push(SurfaceLayout {
+                seg0: r.seg0,
+                n_load: self.n_load_segments(k),
+                n_lattice_seg: r.n_lattice_seg,
+                m,
+                n,
+                leg0,
+                finite: matches!(self.bound_mode, Some(Mode::Steady))
+                    && matches!(self.params.steady_wake, SteadyWake::Finite { .. }),
+            });
+            if self.bound.fil.n_legs() > 0 {
+                leg0 += n + 1;
+            }
+        }
+        out.n_base_seg = self.bound.fil.n_segments() / n_copies;
+        out.n_base_leg = self.bound.fil.n_legs() / n_copies;
+        out.n_copies = n_copies;
     }
 
     /// Number of surface `k`'s lattice segments that carry loads: the trailing-edge segments are

@@ -210,6 +210,11 @@ impl StaticSolver {
         &self.params
     }
 
+    /// Replace the settings (the same system: the buffers are kept).
+    pub fn set_params(&mut self, params: StaticParams) {
+        self.params = params;
+    }
+
     /// Newton from the estimate `x` to the equilibrium of `system` at time `t` (forces as the
     /// system currently defines them), with the exact tangent and, where that fails or stalls on
     /// a system with a matrix at rest, again from `x` with that matrix (module documentation).

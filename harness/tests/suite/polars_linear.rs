@@ -50,6 +50,16 @@ fn healy_stability(extra: &[String]) -> RunSpec {
     expand(&root().join("cases/healy_ffwt_flare10_aoa5.json"), &set)
 }
 
+/// The density changes of the rounding controls, in units of `ε` (ulp-sized steps of 1.225).
+/// Each control is one sample of how far rounding moves the analysis; the tests take the largest
+/// of five, since one sample can fall several times under the others.
+const NUDGES: [f64; 5] = [-4.0, -2.0, 2.0, 4.0, 8.0];
+
+/// The override setting the density to 1.225 moved by `k ε`.
+fn nudged_rho(k: f64) -> String {
+    format!("aero.rho={:.17e}", 1.225 * (1.0 + k * f64::EPSILON))
+}
+
 /// Largest `|s_a − s_b| / |s_b|` over the tracked roots of every point (both converged).
 fn root_difference(a: &StabilityOutput, b: &StabilityOutput) -> f64 {
     assert!(a.error.is_none() && b.error.is_none(), "{:?} {:?}", a.error, b.error);
@@ -114,10 +124,10 @@ fn same_equilibrium<M: BuildModel>(plain: &Problem, corrected: &Problem) -> f64 
 /// * about one equilibrium (the plain case's at 20 m/s), the flutter equation with the polar's
 ///   correction gives the lattice's roots within 1e-9 relative;
 /// * through the whole analysis (each its own statics, 16.5 and 24 m/s), the roots differ by as
-///   much as the lattice's own when its density is changed by a few ulp (the control): the
-///   equilibria then differ at 1e-14 and the geometric terms' central differences (a step of
-///   1e-6 chord, residuals of ~1e5 N in ANCF's axial terms) turn that into ~1e-6 of `G_x`. The
-///   test holds them to 1e-9 or twice the control, whichever is larger.
+///   much as the lattice's own when its density is changed by a few ulp (the control): GEBF's
+///   under 1e-9, ANCF's fold root by a few 1e-9 (its equilibria differ by rounding, and its
+///   soft fold mode sits on stiff axial and shear terms). The test holds them to 1e-9 or twice
+///   the largest control, whichever is larger.
 #[test]
 fn a_linear_polar_reproduces_the_lattice_stability() {
     let dir = scratch("stab");
@@ -125,10 +135,7 @@ fn a_linear_polar_reproduces_the_lattice_stability() {
     write_polar(&file, |a| (2.0 * PI * a, 0.0, 0.0));
     let plain = healy_stability(&[]);
     let corrected = healy_stability(&[polars_set(&file, "[0,1]", "")]);
-    let controls: Vec<RunSpec> = [-2.0, 2.0, 4.0]
-        .iter()
-        .map(|k| healy_stability(&[format!("aero.rho={:.17e}", 1.225 * (1.0 + k * f64::EPSILON))]))
-        .collect();
+    let controls: Vec<RunSpec> = NUDGES.iter().map(|k| healy_stability(&[nudged_rho(*k)])).collect();
     for f in Formulation::ALL {
         let (p0, p1) = (plain.case(f).problem(), corrected.case(f).problem());
         let one = match f {
@@ -144,7 +151,7 @@ fn a_linear_polar_reproduces_the_lattice_stability() {
             .iter()
             .map(|c| root_difference(&run_stability(&c.case(f).problem(), f), &a))
             .fold(0.0f64, f64::max);
-        println!("{f}: whole analysis {worst:.1e}, control (ρ by −2, 2, 4 ulp) {worst_control:.1e}");
+        println!("{f}: whole analysis {worst:.1e}, control (ρ by −4, −2, 2, 4, 8 ulp) {worst_control:.1e}");
         assert!(worst < 1e-9_f64.max(2.0 * worst_control), "{f}: {worst:.2e} (control {worst_control:.2e})");
     }
 }
@@ -295,7 +302,7 @@ fn healy_strip_stability(extra: &[String]) -> RunSpec {
 
 /// Theodorsen strips with section polars (docs/stability.md §4.2): with cl = 2πα every strip's
 /// slope is 2π, so the roots equal the uncorrected strips' within 1e-9 relative (or twice their
-/// own change when the density moves by 2 ulp, as for the lattice); with the NACA 0015 polar
+/// own largest change when the density moves by a few ulp, as for the lattice); with the NACA 0015 polar
 /// every root converges in both formulations and they agree within 1 % of |s|.
 #[test]
 fn strip_stability_takes_the_polars_slope() {
@@ -304,14 +311,14 @@ fn strip_stability_takes_the_polars_slope() {
     write_polar(&file, |a| (2.0 * PI * a, 0.0, 0.0));
     let plain = healy_strip_stability(&[]);
     let linear = healy_strip_stability(&[polars_set(&file, "[0,1]", "")]);
-    let control = healy_strip_stability(&[format!("aero.rho={:.17e}", 1.225 * (1.0 + 2.0 * f64::EPSILON))]);
+    let controls: Vec<RunSpec> = NUDGES.iter().map(|k| healy_strip_stability(&[nudged_rho(*k)])).collect();
     let run = |s: &RunSpec, f: Formulation| run_stability(&s.case(f).problem(), f);
     let all_converged = |o: &StabilityOutput| o.points.iter().all(|p| p.roots.iter().all(|r| r.converged));
     for f in Formulation::ALL {
         let a = run(&plain, f);
         assert!(all_converged(&a), "{f}: a strip root did not converge");
         let worst = root_difference(&run(&linear, f), &a);
-        let worst_control = root_difference(&run(&control, f), &a);
+        let worst_control = controls.iter().map(|c| root_difference(&run(c, f), &a)).fold(0.0f64, f64::max);
         println!("{f}: strips with cl = 2πα {worst:.1e} (control {worst_control:.1e})");
         assert!(worst < 1e-9_f64.max(2.0 * worst_control), "{f}: {worst:.2e} (control {worst_control:.2e})");
     }

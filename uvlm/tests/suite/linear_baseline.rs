@@ -78,9 +78,11 @@ pub fn one_surface_linear(te_segment_force: bool, closure: bool) -> u64 {
 }
 
 /// The hashes of [`one_surface_linear`] for (te_segment_force, closure) = (false, false),
-/// (true, false), (false, true), (true, true), on main before several surfaces (e70b6a9), with
-/// the AVX-512 kernels (other instruction sets round differently).
-const MAIN_AVX512: [u64; 4] = [0xf40c6d92945992ec, 0x242923c925e25eb0, 0x86f64c0cfc9b4b98, 0x3c9ce18bc441639a];
+/// (true, false), (false, true), (true, true), on main before several surfaces (e70b6a9),
+/// re-recorded when the load points took the regular terms on the filaments' axis extensions
+/// (docs/uvlm.md §3), and again when the frozen wake's filaments took them too, with the AVX-512
+/// kernels (other instruction sets round differently).
+const MAIN_AVX512: [u64; 4] = [0xeb2dce4980b3aef1, 0xd0ed6fe9a98fe02a, 0x067712d2d35790a7, 0xca9b1fc45bb83bf6];
 
 fn avx512() -> bool {
     #[cfg(target_arch = "x86_64")]

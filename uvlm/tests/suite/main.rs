@@ -13,6 +13,7 @@ mod linear_baseline;
 mod linear_gust;
 mod linear_strips;
 mod linear_surfaces;
+mod load_derivative;
 mod multi_surface;
 mod multi_surface_baseline;
 mod no_alloc;

@@ -2,7 +2,9 @@
 //! every circulation, nodal load, hinge moment and probe velocity of a run that touches every
 //! option (flap, hinge column, image plane, free wake with a core, disturbance, trailing-edge
 //! segment force, frozen far wake with sub-iterations, steady solve, finite steady wake,
-//! prefilled wake), recorded on main before the change (commit ac75eb7).
+//! prefilled wake), recorded on main before the change (commit ac75eb7) and re-recorded when the
+//! load points' induction took the regular form on the filaments' axis extensions
+//! (`axis_extension.rs`, docs/uvlm.md §3).
 
 use uvlm::samples::FlaredWing;
 use uvlm::*;
@@ -69,9 +71,10 @@ pub fn one_surface_run(build: impl Fn(Lattice, UvlmParams) -> Uvlm, free: bool, 
     h
 }
 
-/// The hashes of [`one_surface_run`] on main before several surfaces existed (ac75eb7), with the
+/// The hashes of [`one_surface_run`] (re-recorded with the load points' regular kernel, and again
+/// when the march's wake filaments took it at the load points), with the
 /// AVX-512 kernels (the dispatch of `biot_savart.rs`; other instruction sets round differently).
-const MAIN_AVX512: [u64; 4] = [0x38e5170b871f3df6, 0xc333a2fb4d3c4e6d, 0x962d4ac72d46afd5, 0xa3b64cc7b1286601];
+const MAIN_AVX512: [u64; 4] = [0x0e566fbb8bdc9289, 0x55e113d74778c53e, 0x5c478372197e3fea, 0xa563e898f0a79a32];
 
 fn avx512() -> bool {
     #[cfg(target_arch = "x86_64")]

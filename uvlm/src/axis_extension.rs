@@ -1,0 +1,297 @@
+//! The bound filaments' induction at the load points, regular on the filaments' axis extensions.
+//!
+//! The kernel of [`crate::biot_savart`] writes a segment's factor as
+//! `(|r₁|+|r₂|)(|r₁||r₂| − r₁·r₂) / (|r₁||r₂| (|r₁×r₂|² + r_c²|r₀|²))` and zeroes it closer than
+//! the cut-off radius to the segment's *axis*. On the axis beyond the segment's end points
+//! (`r₁·r₂ > 0`) the law is regular and vanishes linearly with the distance `d` to the axis, but
+//! there `|r₁||r₂| − r₁·r₂ ≈ |r₁×r₂|²/(2|r₁||r₂|)` cancels (relative rounding error
+//! `ε |r₁|²|r₂|²/|r₁×r₂|²`), and the cut-off zeroes it within `r_c` of the axis. Every load point
+//! of a ring lattice (a segment's midpoint) lies on the axis extensions of the other segments of
+//! its row and column (and of its column's trailing leg when the chord is along the stream), so
+//! on a nearly straight row the loads jumped by `O(r_c)` where a point crossed the cut-off
+//! cylinder and carried rounding noise of order `ε/d` just outside it: they were not
+//! differentiable at the scale of the structure's difference quotients (docs/uvlm.md §3).
+//!
+//! Here, outside the segment (`r₁·r₂ > 0`) the same law is evaluated in its regular form
+//!
+//! $$ u = \frac{\Gamma}{4\pi}\,(r_1\times r_2)\,\frac{(|r_1|+|r_2|)\,|r_1\times r_2|^2}
+//!        {|r_1||r_2|\,(|r_1||r_2| + r_1\cdot r_2)\,(|r_1\times r_2|^2 + r_c^2|r_0|^2)} $$
+//!
+//! (no cancellation; no cut-off unless an end point is within the cut-off radius), and upstream of
+//! a semi-infinite leg's start (`d·r < 0`) as `(d × r)|d×r|² / ((|d×r|² + r_c²) |r| (|r| − d·r))`.
+//! Inside the segment (or downstream along a leg) it is the crate's kernel, cut-off included.
+
+use crate::aic::WakePart;
+use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI};
+use crate::induce::Points;
+use crate::wake::Wake;
+
+/// The factor `k` of a segment pair (`u = Γ/4π · k · r₁×r₂`) for the load points.
+#[inline]
+pub(crate) fn segment_factor(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> ([f64; 3], f64) {
+    let c = [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
+    let h = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
+    let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
+    let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
+    let n12 = n1 * n2;
+    let l2 = (r1[0] - r2[0]).powi(2) + (r1[1] - r2[1]).powi(2) + (r1[2] - r2[2]).powi(2);
+    if dot > 0.0 {
+        // Outside the segment: the cut-off radius round the end points only.
+        let rc2 = if l2 > 0.0 { cut2 / l2 } else { f64::INFINITY };
+        if n1 * n1 <= rc2 || n2 * n2 <= rc2 {
+            return (c, 0.0);
+        }
+        let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
+        return (c, (n1 + n2) / (n12 * (n12 + dot)) * core);
+    }
+    let h2 = h + core2;
+    if h2 > cut2 && n12 > 0.0 { (c, (n1 + n2) * (n12 - dot) / (n12 * h2)) } else { (c, 0.0) }
+}
+
+/// The factor `k` of a semi-infinite leg pair (`u = Γ/4π · k · d×r`) for the load points.
+#[inline]
+pub(crate) fn leg_factor(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> ([f64; 3], f64) {
+    let c = [d[1] * r[2] - d[2] * r[1], d[2] * r[0] - d[0] * r[2], d[0] * r[1] - d[1] * r[0]];
+    let h = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let rn = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let dr = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
+    if dr < 0.0 {
+        // Upstream of the start: |r| + d·r = |d×r|² / (|r| − d·r).
+        if rn * rn <= cut2 {
+            return (c, 0.0);
+        }
+        let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
+        return (c, core / (rn * (rn - dr)));
+    }
+    if h > cut2 && rn > 0.0 { (c, (rn + dr) / ((h + core2) * rn)) } else { (c, 0.0) }
+}
+
+/// One surface's place in the bound system, for [`correct_axis_extensions`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SurfaceLayout {
+    /// Its first segment and its number of load segments (load points, in segment order).
+    pub(crate) seg0: usize,
+    pub(crate) n_load: usize,
+    /// Its lattice segments (a finite steady wake's legs follow them).
+    pub(crate) n_lattice_seg: usize,
+    /// Chordwise and spanwise panels.
+    pub(crate) m: usize,
+    pub(crate) n: usize,
+    /// Its first semi-infinite leg.
+    pub(crate) leg0: usize,
+    /// Whether its trailing legs are the segments of a finite steady wake.
+    pub(crate) finite: bool,
+}
+
+/// The bound system's layout: surfaces, base filaments and image copies.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ExtensionLayout {
+    pub(crate) surfaces: Vec<SurfaceLayout>,
+    pub(crate) n_base_seg: usize,
+    pub(crate) n_base_leg: usize,
+    pub(crate) n_copies: usize,
+}
+
+/// The crate kernel's factor of a segment pair, with the block kernels' arithmetic (so that the
+/// term they added is removed exactly).
+#[inline]
+fn kernel_segment(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> f64 {
+    let cx = r1[1] * r2[2] - r1[2] * r2[1];
+    let cy = r1[2] * r2[0] - r1[0] * r2[2];
+    let cz = r1[0] * r2[1] - r1[1] * r2[0];
+    let h2 = cx * cx + cy * cy + cz * cz + core2;
+    let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
+    let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
+    let n12 = n1 * n2;
+    let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
+    let num = (n1 + n2) * (n12 - dot);
+    if h2 > cut2 && n12 > 0.0 { num / (n12 * h2) } else { 0.0 }
+}
+
+/// The crate kernel's factor of a leg pair, with the block kernels' arithmetic.
+#[inline]
+fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
+    let cx = d[1] * r[2] - d[2] * r[1];
+    let cy = d[2] * r[0] - d[0] * r[2];
+    let cz = d[0] * r[1] - d[1] * r[0];
+    let h2 = cx * cx + cy * cy + cz * cz;
+    let rn = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let dot = d[0] * r[0] + d[1] * r[1] + d[2] * r[2];
+    if h2 > cut2 && rn > 0.0 { (rn + dot) / ((h2 + core2) * rn) } else { 0.0 }
+}
+
+/// Replace, in the bound filaments' induction `u` at the load points `pts` (every surface's
+/// lattice segment midpoints, as [`crate::Uvlm`] lists them), the block kernels' term of every
+/// filament whose axis passes along the point's row or column — the segments of its row (a
+/// spanwise point) or column (a chordwise point) with their image copies, and its column's
+/// trailing leg — by the regular form of [`segment_factor`] and [`leg_factor`] where the point
+/// lies outside the segment (module doc). Other filaments are never collinear with a load point
+/// of a ring lattice by construction, and keep the block kernels' value.
+pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
+    let mut p = 0;
+    for sl in &layout.surfaces {
+        let (m, n) = (sl.m, sl.n);
+        let nc = n + 1;
+        for s in 0..sl.n_load {
+            let x = [pts.x[p], pts.y[p], pts.z[p]];
+            let o = &mut u[p];
+            p += 1;
+            for c in 0..layout.n_copies {
+                let seg = |b: usize| c * layout.n_base_seg + b;
+                if s < m * n || s >= m * n + m * nc {
+                    // A spanwise point: the segments of its row.
+                    let i = if s < m * n { s / n } else { m };
+                    let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
+                    for b in first..first + n {
+                        fix_segment(fil, seg(b), x, o);
+                    }
+                } else {
+                    // A chordwise point: the segments of its column and its trailing leg.
+                    let j = (s - m * n) % nc;
+                    for i in 0..m {
+                        fix_segment(fil, seg(sl.seg0 + m * n + i * nc + j), x, o);
+                    }
+                    if sl.finite {
+                        fix_segment(fil, seg(sl.seg0 + sl.n_lattice_seg + j), x, o);
+                    } else if layout.n_base_leg > 0 {
+                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Replace, at every chordwise load point of `layout` (a point on the axis extension of its
+/// column's streamwise filaments, and of the wake's filaments leaving that column's trailing-edge
+/// node when the chord is along the stream), the block kernels' term of every filament of the
+/// wake set `wake` by the regular form where the point lies outside it: the linear model's frozen
+/// wake and its unit rings then take the terms the steady solve's trailing legs (or finite wake)
+/// take (docs/uvlm.md §3). A filament off the point's axis changes by rounding only.
+pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
+    let mut p = 0;
+    for sl in &layout.surfaces {
+        let (m, n) = (sl.m, sl.n);
+        for s in 0..sl.n_load {
+            let i = p;
+            p += 1;
+            if s < m * n || s >= m * n + m * (n + 1) {
+                continue;
+            }
+            let x = [pts.x[i], pts.y[i], pts.z[i]];
+            for f in 0..wake.n_segments() {
+                fix_segment(wake, f, x, &mut u[i]);
+            }
+            for l in 0..wake.n_legs() {
+                fix_leg(wake, l, x, &mut u[i]);
+            }
+        }
+    }
+}
+
+/// One surface's known wake as [`crate::aic::append_known_wake`] lays it out, for
+/// [`correct_wake_columns`].
+pub(crate) struct WakeColumns<'a> {
+    /// The trailing-edge nodes (node row 0), the wake and its closure direction.
+    pub(crate) te: &'a [[f64; 3]],
+    pub(crate) wake: &'a Wake,
+    pub(crate) closure: Option<[f64; 3]>,
+    pub(crate) core: &'a CoreModel,
+    pub(crate) part: WakePart,
+}
+
+/// The time march's counterpart of [`correct_wake_extensions`] without a pass over the whole
+/// wake: at the chordwise load points of surface `sl` (from `p0` in `pts`), the streamwise
+/// filaments of their own column in the part `w.part` of the wake (the chordwise legs from node
+/// row k − 1 to k and the closure leg, with the strengths, cores and arithmetic of
+/// [`crate::aic::append_known_wake`]) take the regular form where the point lies outside them.
+/// Those are the filaments whose axis passes near the point: the steady solve's trailing leg (or
+/// finite wake) of that column, cut into rows.
+pub(crate) fn correct_wake_columns(
+    sl: &SurfaceLayout,
+    p0: usize,
+    w: &WakeColumns<'_>,
+    pts: &Points,
+    u: &mut [[f64; 3]],
+) {
+    let (wake, len) = (w.wake, w.wake.n_rows());
+    let (m, n) = (sl.m, sl.n);
+    let nc = n + 1;
+    if len == 0 || sl.n_load < m * n + m * nc {
+        return;
+    }
+    let rows = match w.part {
+        WakePart::All => 1..=len,
+        WakePart::Near => 1..=1,
+        WakePart::Far => 2..=len,
+    };
+    let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
+    let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
+    for s in m * n..m * n + m * nc {
+        let j = (s - m * n) % nc;
+        let i = p0 + s;
+        let x = [pts.x[i], pts.y[i], pts.z[i]];
+        for k in rows.clone() {
+            let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
+            if gamma != 0.0 {
+                let (a, b) = (pos(k - 1, j), pos(k, j));
+                let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
+                let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
+                fix_segment_at(a, b, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
+            }
+        }
+        if let Some(dir) = w.closure
+            && w.part != WakePart::Near
+        {
+            let gamma = g(len - 1, j as isize - 1) - g(len - 1, j as isize);
+            if gamma != 0.0 {
+                let (a, b) = (pos(len, j), pos(len - 1, j));
+                let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                let (core2, cut2) = w.core.leg_coefficients(l);
+                fix_leg_at(a, dir, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
+            }
+        }
+    }
+}
+
+/// Replace segment `f`'s block-kernel term at `x` in `o` by the regular form when `x` lies
+/// outside the segment.
+fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
+    let (a, b) = (fil.node(fil.seg_a[f] as usize), fil.node(fil.seg_b[f] as usize));
+    fix_segment_at(a, b, (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]), x, o);
+}
+
+/// [`fix_segment`] of the segment `a → b` with `(Γ/4π, core2, cut2)`.
+fn fix_segment_at(a: [f64; 3], b: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
+    let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
+    if r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2] <= 0.0 {
+        return;
+    }
+    let (cv, k) = segment_factor(r1, r2, core2, cut2);
+    let (gk_old, gk_new) = (g * kernel_segment(r1, r2, core2, cut2), g * k);
+    for q in 0..3 {
+        o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
+    }
+}
+
+/// Replace leg `l`'s block-kernel term at `x` in `o` by the regular form when `x` lies upstream
+/// of its start.
+fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3]) {
+    let a = fil.node(fil.leg_a[l] as usize);
+    fix_leg_at(a, fil.leg_d[l], (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]), x, o);
+}
+
+/// [`fix_leg`] of the leg from `a` along `d` with `(Γ/4π, core2, cut2)`.
+fn fix_leg_at(a: [f64; 3], d: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
+    let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    if d[0] * r[0] + d[1] * r[1] + d[2] * r[2] >= 0.0 {
+        return;
+    }
+    let (cv, k) = leg_factor(r, d, core2, cut2);
+    let (gk_old, gk_new) = (g * kernel_leg(r, d, core2, cut2), g * k);
+    for q in 0..3 {
+        o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
+    }
+}
