@@ -1149,12 +1149,8 @@ fn geometric_terms<S: Structure>(
             acc(&mut xte, &te);
         }
         let d = 12.0 * eps;
-        for a in 0..nr {
-            g.rx[(a, i)] = rx[a] / d;
-        }
-        for a in 0..n_te {
-            g.xte[(a, i)] = xte[a] / d;
-        }
+        g.rx.set_column(i, &(DVector::from_vec(rx) / d));
+        g.xte.set_column(i, &(DVector::from_vec(xte) / d));
         let mut gp = phi.transpose() * DVector::from_vec(gx) / d;
         if let Some(c) = correction(moved, model, &col, false)? {
             gp += c;
