@@ -171,9 +171,11 @@ fn paper_wing_roots_agree_on_the_papers_lattice() {
 /// formulations (within 0.5 % + 0.01 1/s). Among them are the strongly damped fold roots a start
 /// lands on a neighbour's root for, found by following the mode up from low speed: at AoA 5°
 /// −6.93 + 4.80i 1/s (ζ = 0.82), at AoA 0° the over-damped −1.086 1/s (ANCF −1.0856, GEBF
-/// −1.0852). At AoA 10° the first two are −4.74 1/s and −5.37 + 3.19i 1/s with both (measured
-/// ANCF −4.7412 and −5.3697 + 3.1902i, GEBF −4.7471 and −5.3658 + 3.1935i); they differed while
-/// a start in the lower half plane was flipped up without conjugating its vector.
+/// −1.0852). At AoA 10° the first two are the fold mode's −0.674 + 2.329i 1/s and −5.37 + 3.19i
+/// 1/s with both (measured ANCF −0.6743 + 2.3289i and −5.3710 + 3.1908i, GEBF −0.6735 + 2.3300i
+/// and −5.3671 + 3.1940i); they differed while a start in the lower half plane was flipped up
+/// without conjugating its vector, and while a fold path that lost its root on the real axis took
+/// the over-damped −4.74 1/s in one formulation only (docs/stability.md §3).
 #[test]
 fn every_paper_wing_root_converges_and_the_strongly_damped_ones_agree() {
     for aoa in [0, 5, 10] {
