@@ -22,7 +22,7 @@
 //! Inside the segment (or downstream along a leg) it is the crate's kernel, cut-off included.
 
 use crate::aic::WakePart;
-use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI};
+use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI, Isa, isa};
 use crate::induce::Points;
 use crate::wake::Wake;
 
@@ -143,9 +143,7 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
                     // A spanwise point: the segments of its row.
                     let i = if s < m * n { s / n } else { m };
                     let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
-                    for b in first..first + n {
-                        fix_segment(fil, seg(b), x, o);
-                    }
+                    fix_run((first..first + n).map(|b| filament(fil, seg(b))), x, o);
                 } else {
                     // A chordwise point: the segments of its column and its trailing leg.
                     let j = (s - m * n) % nc;
@@ -180,9 +178,7 @@ pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout
                 continue;
             }
             let x = [pts.x[i], pts.y[i], pts.z[i]];
-            for f in 0..wake.n_segments() {
-                fix_segment(wake, f, x, &mut u[i]);
-            }
+            fix_run((0..wake.n_segments()).map(|f| filament(wake, f)), x, &mut u[i]);
             for l in 0..wake.n_legs() {
                 fix_leg(wake, l, x, &mut u[i]);
             }
@@ -232,15 +228,16 @@ pub(crate) fn correct_wake_columns(
         let j = (s - m * n) % nc;
         let i = p0 + s;
         let x = [pts.x[i], pts.y[i], pts.z[i]];
-        for k in rows.clone() {
+        let column = rows.clone().filter_map(|k| {
             let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
-            if gamma != 0.0 {
+            (gamma != 0.0).then(|| {
                 let (a, b) = (pos(k - 1, j), pos(k, j));
                 let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
                 let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
-                fix_segment_at(a, b, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
-            }
-        }
+                (a, b, (gamma * INV_FOUR_PI, core2, cut2))
+            })
+        });
+        fix_run(column, x, &mut u[i]);
         if let Some(dir) = w.closure
             && w.part != WakePart::Near
         {
@@ -275,6 +272,133 @@ fn fix_segment_at(a: [f64; 3], b: [f64; 3], (g, core2, cut2): (f64, f64, f64), x
         o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
     }
 }
+
+/// Segments per chunk of [`fix_run`].
+const RUN: usize = 32;
+
+/// A chunk of segments of [`fix_run`] seen from one point, laid out by lanes so that
+/// [`run_factors`] compiles to vector instructions: the inputs (`r₁`, `r₂`, `Γ/4π`, `core2`,
+/// `cut2`) and what it writes (`r₁·r₂`, `r₁×r₂` and the kernel's and the regular form's `Γk/4π`).
+struct RunChunk {
+    r1: [[f64; RUN]; 3],
+    r2: [[f64; RUN]; 3],
+    g: [f64; RUN],
+    core2: [f64; RUN],
+    cut2: [f64; RUN],
+    dot: [f64; RUN],
+    c: [[f64; RUN]; 3],
+    old: [f64; RUN],
+    new: [f64; RUN],
+}
+
+/// A segment `a → b` with `(Γ/4π, core2, cut2)`.
+type Segment = ([f64; 3], [f64; 3], (f64, f64, f64));
+
+/// Segment `f` of `fil`.
+#[inline]
+fn filament(fil: &Filaments, f: usize) -> Segment {
+    (
+        fil.node(fil.seg_a[f] as usize),
+        fil.node(fil.seg_b[f] as usize),
+        (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]),
+    )
+}
+
+/// [`fix_segment_at`] over the segments `segs` at `x`, in their order, a chunk of [`RUN`]
+/// at a time through the vectorised [`run_factors`]: the same arithmetic per segment and the
+/// same order of the updates of `o`, so the result is bit for bit [`fix_segment_at`]'s.
+fn fix_run(segs: impl Iterator<Item = Segment>, x: [f64; 3], o: &mut [f64; 3]) {
+    let mut ch = RunChunk {
+        r1: [[0.0; RUN]; 3],
+        r2: [[0.0; RUN]; 3],
+        g: [0.0; RUN],
+        core2: [0.0; RUN],
+        cut2: [0.0; RUN],
+        dot: [0.0; RUN],
+        c: [[0.0; RUN]; 3],
+        old: [0.0; RUN],
+        new: [0.0; RUN],
+    };
+    let mut k = 0;
+    for (a, b, (g, core2, cut2)) in segs {
+        for q in 0..3 {
+            ch.r1[q][k] = x[q] - a[q];
+            ch.r2[q][k] = x[q] - b[q];
+        }
+        (ch.g[k], ch.core2[k], ch.cut2[k]) = (g, core2, cut2);
+        k += 1;
+        if k == RUN {
+            flush_run(&mut ch, k, o);
+            k = 0;
+        }
+    }
+    if k > 0 {
+        flush_run(&mut ch, k, o);
+    }
+}
+
+/// The factors of the first `k` lanes of `ch`, and their updates of `o` in lane order (lanes
+/// whose point lies on the segment, `r₁·r₂ ≤ 0`, are left as the block kernels summed them).
+fn flush_run(ch: &mut RunChunk, k: usize, o: &mut [f64; 3]) {
+    match isa() {
+        Isa::Generic => run_factors_generic(ch),
+        // SAFETY: the features were detected at run time.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { run_factors_avx2(ch) },
+        // SAFETY: the features were detected at run time.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { run_factors_avx512(ch) },
+    }
+    for j in 0..k {
+        if ch.dot[j] <= 0.0 {
+            continue;
+        }
+        for q in 0..3 {
+            o[q] = o[q] - ch.old[j] * ch.c[q][j] + ch.new[j] * ch.c[q][j];
+        }
+    }
+}
+
+/// [`segment_factor`] and [`kernel_segment`] of every lane of a [`RunChunk`], branch-free (both
+/// forms are computed and selected; a lane on its segment is skipped by [`flush_run`]), compiled
+/// once per instruction set. Rust does not contract multiplications and additions into fused
+/// ones, so every lane rounds as the scalar functions do.
+macro_rules! run_factors {
+    ($($attr:meta)?; $name:ident) => {
+        $(#[$attr])?
+        fn $name(ch: &mut RunChunk) {
+            for j in 0..RUN {
+                let (r1, r2) = ([ch.r1[0][j], ch.r1[1][j], ch.r1[2][j]], [ch.r2[0][j], ch.r2[1][j], ch.r2[2][j]]);
+                let (core2, cut2) = (ch.core2[j], ch.cut2[j]);
+                let c = [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
+                let h = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+                let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
+                let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
+                let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
+                let n12 = n1 * n2;
+                let l2 = (r1[0] - r2[0]).powi(2) + (r1[1] - r2[1]).powi(2) + (r1[2] - r2[2]).powi(2);
+                // The regular form outside the segment (segment_factor's `dot > 0` branch).
+                let rc2 = if l2 > 0.0 { cut2 / l2 } else { f64::INFINITY };
+                let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
+                let regular = (n1 + n2) / (n12 * (n12 + dot)) * core;
+                let new = if n1 * n1 <= rc2 || n2 * n2 <= rc2 { 0.0 } else { regular };
+                // The block kernels' factor (kernel_segment).
+                let h2 = h + core2;
+                let kernel = (n1 + n2) * (n12 - dot) / (n12 * h2);
+                let old = if h2 > cut2 && n12 > 0.0 { kernel } else { 0.0 };
+                ch.dot[j] = dot;
+                (ch.c[0][j], ch.c[1][j], ch.c[2][j]) = (c[0], c[1], c[2]);
+                (ch.old[j], ch.new[j]) = (ch.g[j] * old, ch.g[j] * new);
+            }
+        }
+    };
+}
+
+run_factors!(; run_factors_generic);
+#[cfg(target_arch = "x86_64")]
+run_factors!(target_feature(enable = "avx2,fma"); run_factors_avx2);
+#[cfg(target_arch = "x86_64")]
+run_factors!(target_feature(enable = "avx512f,avx2,fma"); run_factors_avx512);
 
 /// Replace leg `l`'s block-kernel term at `x` in `o` by the regular form when `x` lies upstream
 /// of its start.
