@@ -13,12 +13,14 @@ use crate::report::{CaseResult, index_html, summary_markdown, write_case};
 use crate::run::{NoObserver, Observer, Row, RunOutput, Snapshot};
 use crate::scene::run_formulation_observed;
 
-/// All `*.json` case files in a folder, sorted by name (`*.schema.json` excluded).
+/// All `*.json` case files in a folder, sorted by name (`*.schema.json` and hidden files, whose
+/// names start with a dot, excluded).
 pub fn discover(dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let rd = std::fs::read_dir(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
     let mut v: Vec<PathBuf> = rd
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "json") && !p.to_string_lossy().ends_with(".schema.json"))
+        .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')))
         .collect();
     v.sort();
     Ok(v)

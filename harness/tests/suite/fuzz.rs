@@ -25,7 +25,7 @@ const LIMITS: Limits = Limits { memory_bytes: 2e9, seconds: 10.0 };
 #[test]
 fn mutated_case_files_never_panic_and_every_refusal_names_the_file() {
     let seeds = seeds(&cases()).unwrap();
-    let path = cases().join("fuzz-input.json");
+    let path = cases().join(".fuzz-input.json");
     let mut counts: BTreeMap<Class, usize> = BTreeMap::new();
     let mut crashes = Vec::new();
     // 3,000 inputs, a fixed seed: the same mutants on every machine.
@@ -123,7 +123,7 @@ fn a_campaign_over_cases_without_references_counts_every_input() {
 fn every_command_is_fuzzed_analyses_included_issue_38() {
     use harness::fuzz::{FuzzCommand, check_command, input_command};
     let seeds = seeds(&cases()).unwrap();
-    let path = cases().join("fuzz-command-input.json");
+    let path = cases().join(".fuzz-command-input.json");
     let limits = Limits { memory_bytes: 2e9, seconds: 3.0 };
     let mut counts: BTreeMap<(FuzzCommand, Class), usize> = BTreeMap::new();
     let mut crashes = Vec::new();
