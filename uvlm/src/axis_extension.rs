@@ -26,9 +26,13 @@ use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI, Isa, isa};
 use crate::induce::Points;
 use crate::wake::Wake;
 
-/// The factor `k` of a segment pair (`u = Γ/4π · k · r₁×r₂`) for the load points.
-#[inline]
-pub(crate) fn segment_factor(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> ([f64; 3], f64) {
+/// A segment pair seen from a load point (`u = Γ/4π · k · r₁×r₂`): `r₁×r₂`, `r₁·r₂`, the block
+/// kernels' factor `k` (their arithmetic, so that the term they added is removed exactly) and the
+/// regular form's `k` outside the segment (`r₁·r₂ > 0`; zero only within the cut-off radius of an
+/// end point). Branch-free, so that [`run_factors`] compiles to vector instructions; the caller
+/// uses the regular factor only outside the segment.
+#[inline(always)]
+fn pair_factors(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> ([f64; 3], f64, f64, f64) {
     let c = [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
     let h = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
     let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
@@ -36,17 +40,14 @@ pub(crate) fn segment_factor(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) 
     let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
     let n12 = n1 * n2;
     let l2 = (r1[0] - r2[0]).powi(2) + (r1[1] - r2[1]).powi(2) + (r1[2] - r2[2]).powi(2);
-    if dot > 0.0 {
-        // Outside the segment: the cut-off radius round the end points only.
-        let rc2 = if l2 > 0.0 { cut2 / l2 } else { f64::INFINITY };
-        if n1 * n1 <= rc2 || n2 * n2 <= rc2 {
-            return (c, 0.0);
-        }
-        let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
-        return (c, (n1 + n2) / (n12 * (n12 + dot)) * core);
-    }
+    let rc2 = if l2 > 0.0 { cut2 / l2 } else { f64::INFINITY };
+    let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
+    let regular = (n1 + n2) / (n12 * (n12 + dot)) * core;
+    let new = if n1 * n1 <= rc2 || n2 * n2 <= rc2 { 0.0 } else { regular };
     let h2 = h + core2;
-    if h2 > cut2 && n12 > 0.0 { (c, (n1 + n2) * (n12 - dot) / (n12 * h2)) } else { (c, 0.0) }
+    let kernel = (n1 + n2) * (n12 - dot) / (n12 * h2);
+    let old = if h2 > cut2 && n12 > 0.0 { kernel } else { 0.0 };
+    (c, dot, old, new)
 }
 
 /// The factor `k` of a semi-infinite leg pair (`u = Γ/4π · k · d×r`) for the load points.
@@ -93,22 +94,6 @@ pub(crate) struct ExtensionLayout {
     pub(crate) n_copies: usize,
 }
 
-/// The crate kernel's factor of a segment pair, with the block kernels' arithmetic (so that the
-/// term they added is removed exactly).
-#[inline]
-fn kernel_segment(r1: [f64; 3], r2: [f64; 3], core2: f64, cut2: f64) -> f64 {
-    let cx = r1[1] * r2[2] - r1[2] * r2[1];
-    let cy = r1[2] * r2[0] - r1[0] * r2[2];
-    let cz = r1[0] * r2[1] - r1[1] * r2[0];
-    let h2 = cx * cx + cy * cy + cz * cz + core2;
-    let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
-    let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
-    let n12 = n1 * n2;
-    let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
-    let num = (n1 + n2) * (n12 - dot);
-    if h2 > cut2 && n12 > 0.0 { num / (n12 * h2) } else { 0.0 }
-}
-
 /// The crate kernel's factor of a leg pair, with the block kernels' arithmetic.
 #[inline]
 fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
@@ -125,7 +110,7 @@ fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
 /// lattice segment midpoints, as [`crate::Uvlm`] lists them), the block kernels' term of every
 /// filament whose axis passes along the point's row or column — the segments of its row (a
 /// spanwise point) or column (a chordwise point) with their image copies, and its column's
-/// trailing leg — by the regular form of [`segment_factor`] and [`leg_factor`] where the point
+/// trailing leg — by the regular form of [`pair_factors`] and [`leg_factor`] where the point
 /// lies outside the segment (module doc). Other filaments are never collinear with a load point
 /// of a ring lattice by construction, and keep the block kernels' value.
 pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
@@ -147,12 +132,10 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
                 } else {
                     // A chordwise point: the segments of its column and its trailing leg.
                     let j = (s - m * n) % nc;
-                    for i in 0..m {
-                        fix_segment(fil, seg(sl.seg0 + m * n + i * nc + j), x, o);
-                    }
-                    if sl.finite {
-                        fix_segment(fil, seg(sl.seg0 + sl.n_lattice_seg + j), x, o);
-                    } else if layout.n_base_leg > 0 {
+                    let column = (0..m).map(|i| sl.seg0 + m * n + i * nc + j);
+                    let finite = sl.finite.then_some(sl.seg0 + sl.n_lattice_seg + j);
+                    fix_run(column.chain(finite).map(|b| filament(fil, seg(b))), x, o);
+                    if !sl.finite && layout.n_base_leg > 0 {
                         fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
                     }
                 }
@@ -252,27 +235,6 @@ pub(crate) fn correct_wake_columns(
     }
 }
 
-/// Replace segment `f`'s block-kernel term at `x` in `o` by the regular form when `x` lies
-/// outside the segment.
-fn fix_segment(fil: &Filaments, f: usize, x: [f64; 3], o: &mut [f64; 3]) {
-    let (a, b) = (fil.node(fil.seg_a[f] as usize), fil.node(fil.seg_b[f] as usize));
-    fix_segment_at(a, b, (fil.seg_g[f], fil.seg_core2[f], fil.seg_cut2[f]), x, o);
-}
-
-/// [`fix_segment`] of the segment `a → b` with `(Γ/4π, core2, cut2)`.
-fn fix_segment_at(a: [f64; 3], b: [f64; 3], (g, core2, cut2): (f64, f64, f64), x: [f64; 3], o: &mut [f64; 3]) {
-    let r1 = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
-    let r2 = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
-    if r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2] <= 0.0 {
-        return;
-    }
-    let (cv, k) = segment_factor(r1, r2, core2, cut2);
-    let (gk_old, gk_new) = (g * kernel_segment(r1, r2, core2, cut2), g * k);
-    for q in 0..3 {
-        o[q] = o[q] - gk_old * cv[q] + gk_new * cv[q];
-    }
-}
-
 /// Segments per chunk of [`fix_run`].
 const RUN: usize = 32;
 
@@ -304,9 +266,10 @@ fn filament(fil: &Filaments, f: usize) -> Segment {
     )
 }
 
-/// [`fix_segment_at`] over the segments `segs` at `x`, in their order, a chunk of [`RUN`]
-/// at a time through the vectorised [`run_factors`]: the same arithmetic per segment and the
-/// same order of the updates of `o`, so the result is bit for bit [`fix_segment_at`]'s.
+/// Replace the block kernels' term of each segment of `segs` at `x` in `o` by the regular form
+/// where `x` lies outside it, in their order, a chunk of [`RUN`] at a time through the vectorised
+/// [`run_factors`] (Rust does not fuse multiplications and additions, so each lane rounds as the
+/// scalar [`pair_factors`] does).
 fn fix_run(segs: impl Iterator<Item = Segment>, x: [f64; 3], o: &mut [f64; 3]) {
     let mut ch = RunChunk {
         r1: [[0.0; RUN]; 3],
@@ -359,33 +322,15 @@ fn flush_run(ch: &mut RunChunk, k: usize, o: &mut [f64; 3]) {
     }
 }
 
-/// [`segment_factor`] and [`kernel_segment`] of every lane of a [`RunChunk`], branch-free (both
-/// forms are computed and selected; a lane on its segment is skipped by [`flush_run`]), compiled
-/// once per instruction set. Rust does not contract multiplications and additions into fused
-/// ones, so every lane rounds as the scalar functions do.
+/// [`pair_factors`] of every lane of a [`RunChunk`] (a lane on its segment is skipped by
+/// [`flush_run`]), compiled once per instruction set.
 macro_rules! run_factors {
     ($($attr:meta)?; $name:ident) => {
         $(#[$attr])?
         fn $name(ch: &mut RunChunk) {
             for j in 0..RUN {
                 let (r1, r2) = ([ch.r1[0][j], ch.r1[1][j], ch.r1[2][j]], [ch.r2[0][j], ch.r2[1][j], ch.r2[2][j]]);
-                let (core2, cut2) = (ch.core2[j], ch.cut2[j]);
-                let c = [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
-                let h = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-                let n1 = (r1[0] * r1[0] + r1[1] * r1[1] + r1[2] * r1[2]).sqrt();
-                let n2 = (r2[0] * r2[0] + r2[1] * r2[1] + r2[2] * r2[2]).sqrt();
-                let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
-                let n12 = n1 * n2;
-                let l2 = (r1[0] - r2[0]).powi(2) + (r1[1] - r2[1]).powi(2) + (r1[2] - r2[2]).powi(2);
-                // The regular form outside the segment (segment_factor's `dot > 0` branch).
-                let rc2 = if l2 > 0.0 { cut2 / l2 } else { f64::INFINITY };
-                let core = if core2 > 0.0 { h / (h + core2) } else { 1.0 };
-                let regular = (n1 + n2) / (n12 * (n12 + dot)) * core;
-                let new = if n1 * n1 <= rc2 || n2 * n2 <= rc2 { 0.0 } else { regular };
-                // The block kernels' factor (kernel_segment).
-                let h2 = h + core2;
-                let kernel = (n1 + n2) * (n12 - dot) / (n12 * h2);
-                let old = if h2 > cut2 && n12 > 0.0 { kernel } else { 0.0 };
+                let (c, dot, old, new) = pair_factors(r1, r2, ch.core2[j], ch.cut2[j]);
                 ch.dot[j] = dot;
                 (ch.c[0][j], ch.c[1][j], ch.c[2][j]) = (c[0], c[1], c[2]);
                 (ch.old[j], ch.new[j]) = (ch.g[j] * old, ch.g[j] * new);
