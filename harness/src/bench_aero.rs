@@ -9,8 +9,10 @@
 //!   observer reads the process's CPU time at every step, and the figure is the mean over the
 //!   last 20 steps (process time, so that the lattice's own threads count).
 //! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
-//!   Healy's static sweep per formulation, the Goland wing's 21-speed flutter sweep, and Healy's
-//!   gust sweep (both formulations, run as `harness all` runs it).
+//!   Healy's static sweep per formulation, each also with the committed NACA 0015 polars on both
+//!   bodies (`cases/polars/`; the summary gives the ratio of their CPU times), the Goland wing's
+//!   21-speed flutter sweep, and Healy's gust sweep (both formulations, run as `harness all` runs
+//!   it).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -29,6 +31,8 @@ use aeroelastic::run::{Observer, Row, Snapshot};
 pub const WAKE_ROWS: [usize; 5] = [20, 40, 80, 160, 320];
 /// Steps timed once the wake is full.
 const TIMED_STEPS: usize = 20;
+/// The ending of the name of an analysis run with section polars.
+const POLARS_SUFFIX: &str = ", NACA 0015 polars";
 
 /// One timed step.
 #[derive(Debug, Clone, Serialize)]
@@ -149,20 +153,28 @@ fn timed(analysis: &str, formulation: &str, work: impl FnOnce() -> Option<String
     }
 }
 
+/// The override giving both bodies the committed NACA 0015 polars (`cases/polars/`), flat-plate
+/// beyond the table's incidences as Healy's readings use them, and the table's nearest Reynolds
+/// number beyond its range (the paper's wing flies at 1.7e6 at sea-level viscosity): the cost is
+/// what is timed here.
+const NACA0015: &str = r#"aero.polars=[{"bodies":[0,1],"file":"polars/naca0015_neuralfoil.csv","bounds":{"alpha":"flat_plate","re":"clamp"}}]"#;
+
 /// The whole analyses of the module docs.
 fn analyses(cases: &Path) -> Result<Vec<AnalysisRow>, Error> {
     let mut out = Vec::new();
-    let wing = spec(cases, "wing_aoa5.json", &[])?;
-    let healy = spec(cases, "healy_ffwt_flare10_aoa5.json", &[])?;
-    for f in Formulation::ALL {
-        let p = wing.case(f).problem();
-        out.push(timed(&format!("{} s run of the paper's wing", p.t_end), &f.to_string(), || {
-            aeroelastic::factory::run_formulation(&p, f).error
-        }));
-        let p = healy.case(f).problem();
-        out.push(timed("Healy static sweep (12 airspeeds)", &f.to_string(), || {
-            aeroelastic::statics::run_static(&p, f).points.iter().find_map(|x| x.error.clone())
-        }));
+    for (suffix, sets) in [("", vec![]), (POLARS_SUFFIX, vec![NACA0015.to_string()])] {
+        let wing = spec(cases, "wing_aoa5.json", &sets)?;
+        let healy = spec(cases, "healy_ffwt_flare10_aoa5.json", &sets)?;
+        for f in Formulation::ALL {
+            let p = wing.case(f).problem();
+            out.push(timed(&format!("{} s run of the paper's wing{suffix}", p.t_end), &f.to_string(), || {
+                aeroelastic::factory::run_formulation(&p, f).error
+            }));
+            let p = healy.case(f).problem();
+            out.push(timed(&format!("Healy static sweep (12 airspeeds){suffix}"), &f.to_string(), || {
+                aeroelastic::statics::run_static(&p, f).points.iter().find_map(|x| x.error.clone())
+            }));
+        }
     }
     let goland = spec(cases, "goland_flutter.json", &[])?;
     for f in Formulation::ALL {
@@ -219,6 +231,19 @@ pub fn scaling(b: &AeroBench) -> Vec<(String, bool, f64)> {
     out
 }
 
+/// The CPU time of each analysis run with polars over the same analysis without, per
+/// formulation: `(analysis, formulation, ratio)`.
+pub fn polar_cost(b: &AeroBench) -> Vec<(String, String, f64)> {
+    let mut out = Vec::new();
+    for a in &b.analyses {
+        let Some(plain) = a.analysis.strip_suffix(POLARS_SUFFIX) else { continue };
+        if let Some(p) = b.analyses.iter().find(|x| x.analysis == plain && x.formulation == a.formulation) {
+            out.push((plain.to_string(), a.formulation.clone(), a.cpu_s / p.cpu_s));
+        }
+    }
+    out
+}
+
 /// The markdown summary.
 pub fn markdown(b: &AeroBench) -> String {
     let mut s = String::from("# Aerodynamic benchmark\n\nCPU time per coupled step (GEBF) with the wake full, ms:\n\n");
@@ -255,6 +280,11 @@ pub fn markdown(b: &AeroBench) -> String {
             a.wall_s,
             a.error.as_deref().unwrap_or("")
         );
+    }
+    s.push_str("\nCPU time with the section polars over the time without:\n\n");
+    s.push_str("| analysis | formulation | with / without |\n|---|---|---|\n");
+    for (analysis, formulation, ratio) in polar_cost(b) {
+        let _ = writeln!(s, "| {analysis} | {formulation} | {ratio:.3} |");
     }
     s
 }
@@ -350,21 +380,26 @@ mod tests {
             steps.push(step("wing", *rows, false, 1.0 + k as f64));
             steps.push(step("wing", *rows, true, 2.0 * (1.0 + k as f64).sqrt()));
         }
-        let b = AeroBench {
-            steps,
-            analyses: vec![AnalysisRow {
-                analysis: "a run".into(),
-                formulation: "gebf".into(),
-                cpu_s: 1.5,
-                wall_s: 2.0,
-                error: None,
-            }],
+        let row = |analysis: &str, formulation: &str, cpu_s: f64| AnalysisRow {
+            analysis: analysis.into(),
+            formulation: formulation.into(),
+            cpu_s,
+            wall_s: 2.0,
+            error: None,
         };
+        let analyses = vec![
+            row("a run", "gebf", 1.5),
+            row("a run", "ancf", 2.0),
+            row(&format!("a run{POLARS_SUFFIX}"), "ancf", 2.5),
+        ];
+        let b = AeroBench { steps, analyses };
+        assert_eq!(polar_cost(&b), vec![("a run".to_string(), "ancf".to_string(), 1.25)]);
         let ratios = scaling(&b);
         assert_eq!(ratios.len(), 2);
         assert!((ratios[0].2 - 5.0 / 2.0).abs() < 1e-12, "{ratios:?}");
         let md = markdown(&b);
         assert!(md.contains("| wing | direct | 1.00 | 2.00 | 3.00 | 4.00 | 5.00 | 2.50× |"), "{md}");
+        assert!(md.contains("| a run | ancf | 1.250 |"), "{md}");
         let dir = std::env::temp_dir().join(format!("flexmb-bench-aero-{}", std::process::id()));
         write(&dir, &b).unwrap();
         for f in ["aero.csv", "aero.md", "aero.json", "aero_wake.svg"] {
