@@ -211,6 +211,94 @@ fn placeholder_uvlm() -> Result<uvlm::Uvlm, String> {
         .map_err(|e| e.to_string())
 }
 
+/// The shortest step (m in the increment weights) along which [`Secant`] corrects the kept
+/// aerodynamic stiffness: the loads' difference must stand well above its round-off (1e-16 of
+/// ANCF's 1e5 N axial terms against a stiffness of order 10 N/m times the step).
+const SECANT_MIN_STEP: f64 = 1e-8;
+
+/// Broyden's rank-one correction of the kept aerodynamic stiffness `K` along the static
+/// solver's steps: with `s` the last step (tangent space) and `y` the change of the
+/// generalised aerodynamic load along it, `K ← K + (y − K s) (W² s)ᵀ / (sᵀ W² s)` with `W` the
+/// increment weights, so that the kept stiffness reproduces the load's change along the step
+/// (the secant condition) and is unchanged across it. A kept stiffness then converges
+/// superlinearly instead of linearly (Dennis & Moré 1977; Kelley, *Iterative Methods for
+/// Linear and Nonlinear Equations*, SIAM 1995, ch. 7).
+#[derive(Debug)]
+struct Secant {
+    /// Coordinates and generalised aerodynamic load of the last evaluation.
+    q: Vec<f64>,
+    g: Vec<f64>,
+    has_g: bool,
+    /// The solver's step since: its start and its tangent vector.
+    from: Vec<f64>,
+    step: Vec<f64>,
+    has_step: bool,
+    zeros: Vec<f64>,
+    residual: Vec<f64>,
+}
+
+impl Secant {
+    fn new(n: usize, n_coords: usize) -> Self {
+        Self {
+            q: vec![0.0; n_coords],
+            g: vec![0.0; n],
+            has_g: false,
+            from: vec![0.0; n_coords],
+            step: vec![0.0; n],
+            has_step: false,
+            zeros: vec![0.0; n],
+            residual: vec![0.0; n],
+        }
+    }
+
+    /// Start afresh (a new solve, a new lattice or airspeed: the load is another function).
+    fn forget(&mut self) {
+        self.has_g = false;
+        self.has_step = false;
+    }
+
+    fn note_step(&mut self, from: &[f64], step: &[f64]) {
+        self.from.copy_from_slice(from);
+        self.step.copy_from_slice(step);
+        self.has_step = true;
+    }
+
+    /// The generalised load `g` at `q`, for the next update.
+    fn remember(&mut self, q: &[f64], g: &[f64]) {
+        self.q.copy_from_slice(q);
+        self.g.copy_from_slice(g);
+        self.has_g = true;
+        self.has_step = false;
+    }
+
+    /// Correct `k` (row-major n × n, used times `scale`) with the load `g` at the end of the
+    /// noted step, if that step left the remembered state and is long enough.
+    fn update(&mut self, k: &mut [f64], scale: f64, g: &[f64], weight: impl Fn(usize) -> f64) {
+        if !(self.has_g && self.has_step && self.from == self.q) {
+            return;
+        }
+        let n = self.g.len();
+        let size = self.step.iter().enumerate().fold(0.0_f64, |m, (j, s)| m.max((s * weight(j)).abs()));
+        if !(size > SECANT_MIN_STEP && scale.is_finite() && scale > 0.0) {
+            return;
+        }
+        let denom: f64 = self.step.iter().enumerate().map(|(j, s)| (s * weight(j)).powi(2)).sum();
+        for i in 0..n {
+            let ks: f64 = k[i * n..(i + 1) * n].iter().zip(&self.step).map(|(a, s)| a * s).sum();
+            self.residual[i] = (g[i] - self.g[i]) / scale - ks;
+        }
+        for i in 0..n {
+            let c = self.residual[i] / denom;
+            if c == 0.0 {
+                continue;
+            }
+            for (j, (a, s)) in k[i * n..(i + 1) * n].iter_mut().zip(&self.step).enumerate() {
+                *a += c * s * weight(j).powi(2);
+            }
+        }
+    }
+}
+
 /// The aerodynamic stiffness and when to refresh it.
 struct AeroTangent {
     /// `−∂Q_aero/∂q` (row-major, n × n) at airspeed² `speed2`.
@@ -220,6 +308,8 @@ struct AeroTangent {
     /// Re-evaluate at the next assembly.
     refresh: bool,
     n_refresh: usize,
+    /// The secant (Broyden) updates of `k` along the static solver's steps.
+    secant: Secant,
     // work buffers
     dq: Vec<f64>,
     q_tmp: Vec<f64>,
@@ -279,6 +369,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
             valid: false,
             refresh: false,
             n_refresh: 0,
+            secant: Secant::new(n, model.n_coords()),
             dq: vec![0.0; n],
             q_tmp: vec![0.0; model.n_coords()],
             r0: vec![0.0; n],
@@ -387,7 +478,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// Drop the kept aerodynamic stiffness: the next assembly evaluates it afresh (a walk that
     /// goes back to an earlier equilibrium must not start from the stiffness of a far one).
     pub fn forget_tangent(&mut self) {
-        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).valid = false;
+        let tg = self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner);
+        tg.valid = false;
+        tg.secant.forget();
     }
 
     /// The sideslip angle, degrees.
@@ -404,7 +497,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
     /// Start a solve: re-evaluate the aerodynamic stiffness at the next assembly when `refresh`
     /// (it is evaluated at the first assembly in any case).
     pub fn begin_solve(&mut self, refresh: bool) {
-        self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner).refresh = refresh;
+        let tg = self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner);
+        tg.refresh = refresh;
+        tg.secant.forget();
         *self.error.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
     }
 
@@ -516,7 +611,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         if c_k == 0.0 {
             return;
         }
+        let refreshes = lock(&self.tangent).n_refresh;
         self.update_tangent(t, q);
+        self.secant_update(t, q, r, refreshes);
         let tg = lock(&self.tangent);
         let n = self.n_dof();
         let scale = c_k * self.speed2 / tg.speed2;
@@ -528,6 +625,42 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
                 }
             }
         }
+    }
+
+    /// Correct the kept aerodynamic stiffness along the solver's last step (Broyden's update in
+    /// the increment weights' metric), from the generalised aerodynamic load at `q` (`r`, the
+    /// residual with the loads of `q`, minus the residual without them) and at the state the
+    /// step left. Not after a refresh at `q` (`refreshes` was the count before it), nor along a
+    /// step too short for the difference of the loads to rise above their round-off.
+    fn secant_update(&self, t: f64, q: &[f64], r: &[f64], refreshes: usize) {
+        let mut tg = lock(&self.tangent);
+        let tg = &mut *tg;
+        if !tg.valid {
+            return;
+        }
+        {
+            let mut m = write(&self.model);
+            let loads = lock(&self.loads);
+            let unloaded = m
+                .set_section_loads(&self.zero_loads)
+                .map(|()| m.residual_inplace(t, q, &tg.secant.zeros, &tg.secant.zeros, &mut tg.r0))
+                .and_then(|()| m.set_section_loads(&loads));
+            if let Err(e) = unloaded {
+                *lock(&self.error) = Some(e.to_string());
+                tg.secant.forget();
+                return;
+            }
+        }
+        for ((g, a), b) in tg.r1.iter_mut().zip(r).zip(&tg.r0) {
+            *g = a - b;
+        }
+        let model = read(&self.model);
+        let weight = |j: usize| model.increment_weight(j);
+        let scale = self.speed2 / tg.speed2;
+        if tg.n_refresh == refreshes {
+            tg.secant.update(&mut tg.k, scale, &tg.r1, weight);
+        }
+        tg.secant.remember(q, &tg.r1);
     }
 
     /// The generalised aerodynamic load at `q` moved by `h` along coordinate `j`, into `tg.r1`;
@@ -695,6 +828,10 @@ impl<S: Structure> AeroStatic<'_, S> {
 }
 
 impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
+    fn note_static_step(&self, q_from: &[f64], dq: &[f64]) {
+        lock(&self.tangent).secant.note_step(q_from, dq);
+    }
+
     fn n_coords(&self) -> usize {
         read(&self.model).n_coords()
     }

@@ -75,6 +75,12 @@ pub trait ConstrainedSystem {
         self.iteration_matrix_inplace(t, q, v, v_dot, c_m, c_c, c_k, k);
     }
 
+    /// Told by the static solver ([`crate::analysis::StaticSolver`]) that it moved from `q_from`
+    /// to `q_from ∘ exp(dq)`, before it evaluates the system there: a system that keeps part
+    /// of its matrix from an earlier state can correct that part along the step (a secant
+    /// update). Default: nothing.
+    fn note_static_step(&self, _q_from: &[f64], _dq: &[f64]) {}
+
     /// Holonomic constraint residual Φ(q) (length `n_holonomic`).
     fn phi_inplace(&self, _t: f64, _q: &[f64], _phi: &mut [f64]) {}
     /// `j += Φ_q`, an `n_holonomic × n_dof` view.

@@ -361,6 +361,7 @@ impl StaticSolver {
         self.rhs[..n].iter_mut().zip(&self.step[..n]).for_each(|(r, d)| *r = alpha * d);
         system.retract_inplace(&self.q_prev, &self.rhs[..n], &mut x.q);
         normalise(&mut x.q);
+        system.note_static_step(&self.q_prev, &self.rhs[..n]);
         for ((l, p), d) in x.lambda.iter_mut().chain(x.mu.iter_mut()).zip(&self.nu_prev).zip(&self.step[n..]) {
             *l = p + alpha * d;
         }

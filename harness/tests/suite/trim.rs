@@ -6,6 +6,7 @@ use std::process::Command;
 
 use crate::common::{case, root};
 use aeroelastic::Formulation;
+use aeroelastic::flight_modes::FlightRoot;
 use aeroelastic::trim::run_trim;
 
 /// SHARPy's trim of the Horten wing at 28 m/s, ρ 1.02 (docs/source/content/example_notebooks/
@@ -154,7 +155,10 @@ fn the_horten_wing_holds_level_flight_from_its_trim() {
 /// short period, Dutch roll, roll subsidence and spiral found and named by their symmetry, every
 /// root mostly rigid, and ANCF and GEBF within 0.5 % on the phugoid and Dutch roll and 3 % on
 /// the short period and roll subsidence (ANCF's shear-soft in-plane modes couple in). The
-/// neutral roots (position, heading) are left out.
+/// neutral roots (position, heading) are left out. The root search can also find a fast, real,
+/// symmetric root that is 97 % rigid (GEBF −19.278175 1/s, the same value from whichever start
+/// reaches it); whether a start reaches it depends on rounding (the density moved by a few ulp
+/// adds or removes it), so such a root is allowed but not required.
 #[test]
 fn the_horten_wing_flies_its_phugoid_and_dutch_roll_about_trim() {
     let spec = crate::common::case("flight/horten_level_flight.json", &["stability.airspeeds=[30]"]);
@@ -164,20 +168,24 @@ fn the_horten_wing_flies_its_phugoid_and_dutch_roll_about_trim() {
         assert!(out.error.is_none(), "{f}: {:?}", out.error);
         let p = &out.points[0];
         assert!(p.error.is_none(), "{f}: {:?}", p.error);
-        let names: Vec<&str> = p.flight_roots.iter().map(|r| r.name.as_str()).collect();
+        let fast_longitudinal = |r: &FlightRoot| {
+            r.name == "longitudinal" && r.imag == 0.0 && r.real < -10.0 && r.symmetric > 0.99 && r.rigid > 0.9
+        };
+        let flight_roots: Vec<FlightRoot> = p.flight_roots.iter().filter(|r| !fast_longitudinal(r)).cloned().collect();
+        let names: Vec<&str> = flight_roots.iter().map(|r| r.name.as_str()).collect();
         assert_eq!(names, ["phugoid", "short_period", "dutch_roll", "roll_subsidence", "spiral"], "{f}");
-        for r in &p.flight_roots {
+        for r in &flight_roots {
             assert!(r.rigid > 0.99, "{f}: {r:?}");
             let longitudinal = r.name == "phugoid" || r.name == "short_period";
             assert!((r.symmetric - if longitudinal { 1.0 } else { 0.0 }).abs() < 1e-4, "{f}: {r:?}");
             assert!(r.real.hypot(r.imag) > 1e-3, "{f}: a neutral root was kept: {r:?}");
         }
-        let phugoid = &p.flight_roots[0];
+        let phugoid = &flight_roots[0];
         assert!((phugoid.period_s() - 20.7).abs() < 0.1 * 20.7, "{f}: phugoid period {}", phugoid.period_s());
         // Lightly damped (ζ of the order of 1/(√2 L/D) with the lattice's induced drag alone).
         assert!(phugoid.real < 0.0 && phugoid.damping_ratio() < 0.01, "{f}: {phugoid:?}");
         eprintln!("{f}: {:?}", p.flight_roots);
-        roots.push(p.flight_roots.clone());
+        roots.push(flight_roots);
     }
     let close = |k: usize, tol: f64| {
         let (a, g) = (&roots[0][k], &roots[1][k]);
