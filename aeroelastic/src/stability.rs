@@ -593,9 +593,14 @@ pub(crate) fn load_part<S: Structure>(
 /// The factor of [`load_part`]'s scaled loads, `2²⁰`.
 const LOAD_SCALE: f64 = 1_048_576.0;
 
+/// Step of [`held_load_stiffness`]'s differences, m in the increment weights: the held loads'
+/// generalised force is a smooth function of the coordinates (no lattice in it), so fourth-order
+/// differences can take a step where their round-off is small.
+const HELD_STEP: f64 = 1e-4;
+
 /// Stiffness `∂(r(q, L₀) − r(q, 0))/∂q` of the steady station loads `L₀` of the lattice at `q`
-/// (corrected by `polars`) held fixed (central differences along the retraction); `None` when
-/// they vanish.
+/// (corrected by `polars`) held fixed (five-point central differences along the retraction);
+/// `None` when they vanish.
 fn held_load_stiffness<S: Structure>(
     model: &mut S,
     q: &[f64],
@@ -608,16 +613,16 @@ fn held_load_stiffness<S: Structure>(
     let mut qq = vec![0.0; q.len()];
     let mut dq = vec![0.0; n];
     for j in 0..n {
-        let h = 1e-6 / model.increment_weight(j).max(1e-12);
-        dq.fill(0.0);
-        dq[j] = h;
-        model.retract_inplace(q, &dq, &mut qq);
-        let gp = load_part(model, &qq, &l0, zero)?;
-        dq[j] = -h;
-        model.retract_inplace(q, &dq, &mut qq);
-        let gm = load_part(model, &qq, &l0, zero)?;
+        let h = HELD_STEP / model.increment_weight(j).max(1e-12);
+        let mut at = |m: f64| -> Result<Vec<f64>, String> {
+            dq.fill(0.0);
+            dq[j] = m * h;
+            model.retract_inplace(q, &dq, &mut qq);
+            load_part(model, &qq, &l0, zero)
+        };
+        let (p1, m1, p2, m2) = (at(1.0)?, at(-1.0)?, at(2.0)?, at(-2.0)?);
         for i in 0..n {
-            k[(i, j)] = (gp[i] - gm[i]) / (2.0 * h);
+            k[(i, j)] = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
         }
     }
     Ok(Some(k))
