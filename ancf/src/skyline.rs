@@ -43,6 +43,8 @@ pub struct SkylineLu {
     /// of [`SkylineLu::pivot_floors`].
     diag_abs: Vec<f64>,
     inv_diag_abs: Vec<f64>,
+    /// Width of the column group starting at each column ([`SkylineLu::column_groups`]).
+    group_width: Vec<u8>,
     work: Vec<f64>,
     is_multiplier: Vec<bool>,
     last_coupled: Vec<usize>,
@@ -252,6 +254,7 @@ impl SkylineLu {
         }
         self.lptr[n] = lsize;
         self.uptr[n] = usize_;
+        self.column_groups();
         // Profiles larger than a third of the matrix go to the dense LU; the envelope storage
         // grows to what the profile needs (never n²).
         if lsize > n * n / 6 + n || usize_ > n * n / 6 + 2 * n {
@@ -357,26 +360,45 @@ impl SkylineLu {
     /// rows of `L` above. Consecutive columns, and consecutive rows, with the same profile start
     /// are taken together (columns in fours, else pairs; rows in pairs), so that each loaded value
     /// serves several products (the node-ordered ANCF unknowns come in runs of 12 with a common
-    /// start).
+    /// start). The grouping is [`column_groups`](Self::column_groups), fixed with the profile.
     #[inline(always)]
     fn factorize_symmetric(&mut self) -> bool {
         let n = self.n;
         let mut j = 0;
         while j < n {
-            let f = self.first[j];
-            let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
-            let (ok, width) = match run {
-                4 if self.quad_pairs_rows_like_pairs(j) => (self.symmetric_column_quad(j), 4),
-                4 => (self.symmetric_column_pair(j), 2),
-                2 | 3 => (self.symmetric_column_pair(j), 2),
-                _ => (self.symmetric_column(j), 1),
+            let width = self.group_width[j];
+            let ok = match width {
+                4 => self.symmetric_column_quad(j),
+                2 => self.symmetric_column_pair(j),
+                _ => self.symmetric_column(j),
             };
             if !ok {
                 return false;
             }
-            j += width;
+            j += width as usize;
         }
         true
+    }
+
+    /// The column groups of [`factorize_symmetric`](Self::factorize_symmetric) from the profile:
+    /// `group_width[j]` is 4, 2 or 1 at the first column `j` of each group (runs of four with a
+    /// common start whose rows pair like two pairs, else pairs, else single columns). Computed
+    /// with the profile ([`set_pointers`](Self::set_pointers)), not per factorisation.
+    fn column_groups(&mut self) {
+        let n = self.n;
+        self.group_width.resize(n, 1);
+        let mut j = 0;
+        while j < n {
+            let f = self.first[j];
+            let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
+            let width = match run {
+                4 if self.quad_pairs_rows_like_pairs(j) => 4,
+                2..=4 => 2,
+                _ => 1,
+            };
+            self.group_width[j] = width;
+            j += width as usize;
+        }
     }
 
     /// Whether the rows above column `j` pair up (consecutive rows with a common profile
@@ -913,6 +935,7 @@ impl LinearSolver for SkylineLu {
         self.floor = vec![0.0; n];
         self.diag_abs = vec![0.0; n];
         self.inv_diag_abs = vec![0.0; n];
+        self.group_width = vec![1; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
         self.contiguous = vec![false; n];
