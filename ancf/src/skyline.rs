@@ -601,7 +601,7 @@ impl SkylineLu {
 
 /// `max_k |l_k u_k| inv_k` with `inv_k = 1 / d_k` (0 where `d_k` is 0; a NaN term is skipped
 /// as `f64::max` skips it). The reciprocals are taken once per row, not once per profile entry:
-/// a division per entry cost about a sixth of the factorisation, and the floor only decides
+/// a division per entry cost about an eighth of the factorisation, and the floor only decides
 /// between this LU and the dense one, so its last bit does not matter. Four running maxima
 /// without branches (the maximum does not depend on the order).
 #[inline(always)]
