@@ -62,6 +62,9 @@ fn relative_blocks(e: &[f64]) -> [[f64; 3]; N_BLOCKS] {
 type Lanes<const L: usize> = [f64; L];
 /// 8×8 block-level matrix of `L` elements.
 type BlockMatrix<const L: usize> = [[Lanes<L>; N_BLOCKS]; N_BLOCKS];
+/// 24×24 element matrices of `L` elements, column-major (`m[j][i][l]` is entry (i, j) of
+/// element `l`).
+pub type LaneMatrix<const L: usize> = [[Lanes<L>; ELEMENT_DOF]; ELEMENT_DOF];
 
 /// Upper triangle of the Gram matrix `e_a·e_b` of the nodal 3-vectors of `L` elements, with the
 /// diagonal halved (`½ e_a·e_a`), so that every strain is `s = Σ_{a≤b} h g[a][b]` over its
@@ -118,7 +121,9 @@ fn symmetric_times<const L: usize>(
     }
 }
 
-/// The tangent terms of the `M` strains of one group on its `NB` (compact, padded) blocks:
+/// The tangent terms of the `M` strains of one group on its `NB` (compact, padded) blocks, for
+/// `L` elements in the lanes of every quantity (each lane gets the operations of one element, in
+/// the same order whatever `L`):
 ///
 /// 1. the gradients `u_m = (a_m ⊗ I₃) x` on the group's blocks, from the compact Hessians
 ///    (register accumulators, no scatter), and the strains `s_m = ½ x·u_m`;
@@ -126,71 +131,94 @@ fn symmetric_times<const L: usize>(
 /// 3. the rank-one terms `K_ab += Σ_m c C_m u_m[a] u_m[b]ᵀ`, one 3×3 block `(a, b)` (`a < b`;
 ///    diagonal blocks `a = b` on and above their diagonal only) at a time with fixed-size loops.
 #[inline(always)]
-fn add_group_tangent<const M: usize, const NB: usize, const MODE: u8>(
+fn add_group_tangent<const M: usize, const NB: usize, const MODE: u8, const L: usize>(
     plan: &StrainPlan,
     group: &StrainGroup,
-    x: &[[f64; 3]; N_BLOCKS],
+    x: &[[[f64; 3]; N_BLOCKS]; L],
     c: f64,
-    geometric: &mut [[f64; N_BLOCKS]; N_BLOCKS],
-    cols: &mut [[f64; ELEMENT_DOF]; ELEMENT_DOF],
+    geometric: &mut BlockMatrix<L>,
+    cols: &mut LaneMatrix<L>,
 ) {
     let blocks: [usize; NB] = std::array::from_fn(|i| group.blocks[i]);
     // positions component by component, so that the gradient loops run over the blocks
-    let xt: [[f64; NB]; 3] = std::array::from_fn(|k| blocks.map(|b| x[b][k]));
+    let xt: [[Lanes<L>; NB]; 3] = std::array::from_fn(|k| blocks.map(|b| std::array::from_fn(|l| x[l][b][k])));
     let hessians = &plan.group_hessians[group.hessian_start..][..M * NB * NB];
-    let mut u = [[[0.0; 3]; NB]; M]; // ∂s_m/∂x on the group's blocks
-    let mut wu = [[[0.0; 3]; NB]; M]; // c C_m ∂s_m/∂x
+    let mut u = [[[[0.0; L]; 3]; NB]; M]; // ∂s_m/∂x on the group's blocks
+    let mut wu = [[[[0.0; L]; 3]; NB]; M]; // c C_m ∂s_m/∂x
     for (m, h) in hessians.chunks_exact(NB * NB).enumerate() {
         let s = &plan.strains[group.members[m]];
         // u_k = a x_k for each component k (a symmetric: row j is column j)
-        let mut ut = [[0.0; NB]; 3];
+        let mut ut = [[[0.0; L]; NB]; 3];
         for (j, col) in h.chunks_exact(NB).enumerate() {
             for (uk, xk) in ut.iter_mut().zip(&xt) {
                 for (ui, aij) in uk.iter_mut().zip(col) {
-                    *ui += aij * xk[j];
+                    for l in 0..L {
+                        ui[l] += aij * xk[j][l];
+                    }
                 }
             }
         }
-        let mut value = 0.0; // s = ½ x·u
+        let mut value = [0.0; L]; // s = ½ x·u
         for (i, um) in u[m].iter_mut().enumerate() {
             *um = [ut[0][i], ut[1][i], ut[2][i]];
-            value += 0.5 * (xt[0][i] * um[0] + xt[1][i] * um[1] + xt[2][i] * um[2]);
+            for l in 0..L {
+                value[l] += 0.5 * (xt[0][i][l] * um[0][l] + xt[1][i][l] * um[1][l] + xt[2][i][l] * um[2][l]);
+            }
         }
         let w = c * s.stiffness;
-        let mut d = value - s.reference;
-        if MODE != EXACT && newton_drops_geometric(s.kind, d, MODE) {
-            d = 0.0;
+        let mut wd = [0.0; L];
+        for l in 0..L {
+            let mut d = value[l] - s.reference;
+            if MODE != EXACT && newton_drops_geometric(s.kind, d, MODE) {
+                d = 0.0;
+            }
+            wd[l] = w * d;
         }
-        let wd = w * d;
         for &(a, b, h) in &s.pairs[..s.n_pairs] {
-            geometric[a][b] += wd * h;
+            for l in 0..L {
+                geometric[a][b][l] += wd[l] * h;
+            }
         }
-        wu[m] = u[m].map(|v| v.map(|x| w * x));
+        for (wv, v) in wu[m].iter_mut().zip(&u[m]) {
+            for (wx, x) in wv.iter_mut().zip(v) {
+                for l in 0..L {
+                    wx[l] = w * x[l];
+                }
+            }
+        }
     }
     for (j, &b) in blocks.iter().enumerate() {
         for (i, &a) in blocks[..j].iter().enumerate() {
             for (jj, col) in cols[3 * b..3 * b + 3].iter_mut().enumerate() {
-                let mut acc = [0.0; 3];
+                let mut acc = [[0.0; L]; 3];
                 for m in 0..M {
                     for (ac, ua) in acc.iter_mut().zip(&u[m][i]) {
-                        *ac += wu[m][j][jj] * ua;
+                        for l in 0..L {
+                            ac[l] += wu[m][j][jj][l] * ua[l];
+                        }
                     }
                 }
                 for (k, ac) in col[3 * a..3 * a + 3].iter_mut().zip(acc) {
-                    *k += ac;
+                    for l in 0..L {
+                        k[l] += ac[l];
+                    }
                 }
             }
         }
         // the diagonal block on and above its diagonal
         for (jj, col) in cols[3 * b..3 * b + 3].iter_mut().enumerate() {
-            let mut acc = [0.0; 3];
+            let mut acc = [[0.0; L]; 3];
             for m in 0..M {
                 for (ac, ua) in acc[..=jj].iter_mut().zip(&u[m][j]) {
-                    *ac += wu[m][j][jj] * ua;
+                    for l in 0..L {
+                        ac[l] += wu[m][j][jj][l] * ua[l];
+                    }
                 }
             }
             for (k, ac) in col[3 * b..=3 * b + jj].iter_mut().zip(acc) {
-                *k += ac;
+                for l in 0..L {
+                    k[l] += ac[l];
+                }
             }
         }
     }
@@ -369,36 +397,51 @@ impl Element {
 
     #[inline]
     fn add_tangent_upper<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
+        // SAFETY: an `ElementMatrix` stores its 24 × 24 entries column-major in one array,
+        // `[[f64; 24]; 24]`, which has the layout of `LaneMatrix<1>`.
+        let k = unsafe { &mut *(k.data.0.as_mut_ptr().cast::<LaneMatrix<1>>()) };
+        self.add_tangent_upper_lanes::<MODE, 1>([e], c, k)
+    }
+
+    /// `k[l] += c · K_el(e[l])` on and above the diagonal (Newton's matrix of a time step, as
+    /// [`Self::add_newton_tangent_upper`]) for `L` elements sharing this kernel, evaluated
+    /// together: every loop over the strain plan serves all lanes, and each lane gets the same
+    /// operations as the single element.
+    pub fn add_newton_tangent_upper_lanes<const L: usize>(&self, e: [&[f64]; L], c: f64, k: &mut LaneMatrix<L>) {
+        self.add_tangent_upper_lanes::<TIME_STEP, L>(e, c, k)
+    }
+
+    #[inline]
+    fn add_tangent_upper_lanes<const MODE: u8, const L: usize>(&self, e: [&[f64]; L], c: f64, k: &mut LaneMatrix<L>) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            unsafe { self.tangent_avx2::<MODE>(e, c, k) };
+            unsafe { self.tangent_avx2::<MODE, L>(e, c, k) };
             return;
         }
-        self.tangent_generic::<MODE>(e, c, k)
+        self.tangent_generic::<MODE, L>(e, c, k)
     }
 
     /// [`Self::add_elastic_tangent_upper`] compiled with AVX2 (see the module documentation).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn tangent_avx2<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        self.tangent_generic::<MODE>(e, c, k)
+    fn tangent_avx2<const MODE: u8, const L: usize>(&self, e: [&[f64]; L], c: f64, k: &mut LaneMatrix<L>) {
+        self.tangent_generic::<MODE, L>(e, c, k)
     }
 
     #[inline(always)]
-    fn tangent_generic<const MODE: u8>(&self, e: &[f64], c: f64, k: &mut ElementMatrix) {
-        let x = relative_blocks(e);
-        let mut geometric = [[0.0; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
-        let cols = &mut k.data.0; // column-major: cols[j][i] = K(i, j)
+    fn tangent_generic<const MODE: u8, const L: usize>(&self, e: [&[f64]; L], c: f64, cols: &mut LaneMatrix<L>) {
+        let x = e.map(relative_blocks);
+        let mut geometric = [[[0.0; L]; N_BLOCKS]; N_BLOCKS]; // Σ c C (s − s⁰) a, upper triangle
         for group in &self.plan.groups {
             let (plan, g) = (&self.plan, &mut geometric);
             macro_rules! members {
                 ($nb:literal) => {
                     match group.n_members {
-                        1 => add_group_tangent::<1, $nb, MODE>(plan, group, &x, c, g, cols),
-                        2 => add_group_tangent::<2, $nb, MODE>(plan, group, &x, c, g, cols),
-                        3 => add_group_tangent::<3, $nb, MODE>(plan, group, &x, c, g, cols),
-                        _ => add_group_tangent::<MAX_GROUP, $nb, MODE>(plan, group, &x, c, g, cols),
+                        1 => add_group_tangent::<1, $nb, MODE, L>(plan, group, &x, c, g, cols),
+                        2 => add_group_tangent::<2, $nb, MODE, L>(plan, group, &x, c, g, cols),
+                        3 => add_group_tangent::<3, $nb, MODE, L>(plan, group, &x, c, g, cols),
+                        _ => add_group_tangent::<MAX_GROUP, $nb, MODE, L>(plan, group, &x, c, g, cols),
                     }
                 };
             }
@@ -413,9 +456,13 @@ impl Element {
         for b in 0..N_BLOCKS {
             for a in 0..=b {
                 let x = geometric[a][b];
-                if x != 0.0 {
-                    for i in 0..3 {
-                        cols[3 * b + i][3 * a + i] += x;
+                for i in 0..3 {
+                    let k = &mut cols[3 * b + i][3 * a + i];
+                    for l in 0..L {
+                        // a zero weight adds nothing (not even to the sign of a zero entry)
+                        if x[l] != 0.0 {
+                            k[l] += x[l];
+                        }
                     }
                 }
             }
@@ -623,14 +670,41 @@ mod tests {
             let (mut f, mut f_base) = ([[0.0; 24]; 4], [[0.0; 24]; 4]);
             assert_eq!(el.elastic_forces(e, &mut f), el.forces_generic(e, &mut f_base), "{c:?}");
             assert_eq!(f, f_base, "{c:?}");
-            let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+            let as_lanes = |k: &ElementMatrix| -> LaneMatrix<1> { k.data.0.map(|col| col.map(|x| [x])) };
+            let (mut k, mut k_base) = (ElementMatrix::zeros(), [[[0.0; 1]; 24]; 24]);
             el.add_elastic_tangent_upper(&es[1], 0.7, &mut k);
-            el.tangent_generic::<EXACT>(&es[1], 0.7, &mut k_base);
-            assert_eq!(k, k_base, "{c:?}");
-            let (mut k, mut k_base) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+            el.tangent_generic::<EXACT, 1>([&es[1]], 0.7, &mut k_base);
+            assert_eq!(as_lanes(&k), k_base, "{c:?}");
+            let (mut k, mut k_base) = (ElementMatrix::zeros(), [[[0.0; 1]; 24]; 24]);
             el.add_newton_tangent_upper(&es[1], 0.7, &mut k);
-            el.tangent_generic::<TIME_STEP>(&es[1], 0.7, &mut k_base);
-            assert_eq!(k, k_base, "{c:?}");
+            el.tangent_generic::<TIME_STEP, 1>([&es[1]], 0.7, &mut k_base);
+            assert_eq!(as_lanes(&k), k_base, "{c:?}");
+        }
+    }
+
+    /// Newton's tangent of four elements in lanes equals the four single-element tangents bit
+    /// for bit, added to what the matrices held.
+    #[test]
+    fn tangent_lanes_equal_single_elements() {
+        let l = 0.2;
+        for c in ALL_CURVATURES {
+            let el = Element::new(l, &section(), c, 1.0);
+            let es: Vec<[f64; 24]> =
+                (0..4).map(|k| deformed(l, &[0.3, -0.7, 0.2 * k as f64, 0.9, -0.4 + 0.1 * k as f64], 0.1)).collect();
+            let e: [&[f64]; 4] = std::array::from_fn(|k| &es[k][..]);
+            let start = |l: usize, i: usize, j: usize| if i == j { 1.5 + l as f64 } else { 0.0 };
+            let mut lanes: LaneMatrix<4> =
+                std::array::from_fn(|j| std::array::from_fn(|i| std::array::from_fn(|l| start(l, i, j))));
+            el.add_newton_tangent_upper_lanes(e, 0.7, &mut lanes);
+            for (l, el_e) in es.iter().enumerate() {
+                let mut k = ElementMatrix::from_fn(|i, j| start(l, i, j));
+                el.add_newton_tangent_upper(el_e, 0.7, &mut k);
+                for j in 0..24 {
+                    for i in 0..24 {
+                        assert_eq!(lanes[j][i][l].to_bits(), k[(i, j)].to_bits(), "{c:?} lane {l} ({i}, {j})");
+                    }
+                }
+            }
         }
     }
 

@@ -2,7 +2,7 @@
 //! two presentations to the integrator (index-3 DAE or reduced ODE).
 
 use crate::Energies;
-use crate::elastic_force::{ElementMatrix, mirror_upper_inplace};
+use crate::elastic_force::{ElementMatrix, LaneMatrix, mirror_upper_inplace};
 use crate::element::Element;
 use crate::frame::{fold_angle, section_frame};
 use crate::hinge_spring::{Hessian, HingeSpring, Kinematics};
@@ -831,7 +831,16 @@ impl Model {
         let mut ke = ElementMatrix::zeros();
         let mut e_index = 0;
         for b in &self.bodies {
-            for el in 0..b.n_elements() {
+            let n = b.n_elements();
+            let mut el = 0;
+            // A time step's matrix: elements sharing a kernel four at a time (the lanes give
+            // every element the operations it gets alone).
+            while newton && !at_rest && b.twisted.is_empty() && el + ELEMENT_LANES <= n {
+                self.add_element_matrices::<ELEMENT_LANES>(b, el, e_index, q, (c_m, c_k), &mut ke, k);
+                el += ELEMENT_LANES;
+                e_index += ELEMENT_LANES;
+            }
+            for el in el..n {
                 let first = b.offset + NODE_DOF * el;
                 // c_m M_e on the upper triangle (what the scatter reads; M_e is zero off its diagonal inside a 3×3 block)
                 ke.as_mut_slice().fill(0.0); // a memset (nalgebra's `fill` walks the matrix entry by entry)
@@ -951,6 +960,41 @@ impl Model {
                 k.add_symmetric_indexed(&red.z, block);
             }
             (SolvePath::Ode, None, None) => unreachable!("every element off the contiguous map has a reduction"),
+        }
+    }
+
+    /// `c_m M_e + c_k K_e` (Newton's tangent of a time step, upper triangle) of the `L`
+    /// elements from `el0` of body `b`, computed together, then scattered one after the other
+    /// through `ke` as [`add_iteration_matrix`](Self::add_iteration_matrix) scatters single
+    /// elements.
+    #[allow(clippy::too_many_arguments)] // the body's run of elements, the state, the weights, the targets
+    fn add_element_matrices<const L: usize>(
+        &self,
+        b: &Body,
+        el0: usize,
+        e_index0: usize,
+        q: &[f64],
+        (c_m, c_k): (f64, f64),
+        ke: &mut ElementMatrix,
+        k: &mut MatView<'_>,
+    ) {
+        let first = |l: usize| b.offset + NODE_DOF * (el0 + l);
+        let mut lanes: LaneMatrix<L> = [[[0.0; L]; ELEMENT_DOF]; ELEMENT_DOF];
+        for &(a, bb, m) in b.element.mass_nz.iter().filter(|(a, bb, _)| a <= bb) {
+            for i in 0..3 {
+                lanes[3 * bb + i][3 * a + i] = [c_m * m; L];
+            }
+        }
+        let e: [&[f64]; L] = std::array::from_fn(|l| &q[first(l)..first(l) + ELEMENT_DOF]);
+        b.kernel(el0).add_newton_tangent_upper_lanes(e, c_k, &mut lanes);
+        for l in 0..L {
+            // the upper triangle: the scatter reads no more (the lower one stays zero)
+            for (j, (col, lane_col)) in ke.data.0.iter_mut().zip(&lanes).enumerate() {
+                for (x, y) in col[..=j].iter_mut().zip(lane_col) {
+                    *x = y[l];
+                }
+            }
+            self.scatter_element(first(l), e_index0 + l, ke, k);
         }
     }
 

@@ -39,8 +39,12 @@ pub struct SkylineLu {
     inv_diag: Vec<f64>,
     /// Per-row pivot floors of the factorisation in hand ([`SkylineLu::pivot_floors`]).
     floor: Vec<f64>,
-    /// `|a_ii|` of the matrix being factorised (scratch of [`SkylineLu::pivot_floors`]).
+    /// `|a_ii|` of the matrix being factorised and its reciprocal (0 where `a_ii` is 0): scratch
+    /// of [`SkylineLu::pivot_floors`].
     diag_abs: Vec<f64>,
+    inv_diag_abs: Vec<f64>,
+    /// Width of the column group starting at each column ([`SkylineLu::column_groups`]).
+    group_width: Vec<u8>,
     work: Vec<f64>,
     is_multiplier: Vec<bool>,
     last_coupled: Vec<usize>,
@@ -250,6 +254,7 @@ impl SkylineLu {
         }
         self.lptr[n] = lsize;
         self.uptr[n] = usize_;
+        self.column_groups();
         // Profiles larger than a third of the matrix go to the dense LU; the envelope storage
         // grows to what the profile needs (never n²).
         if lsize > n * n / 6 + n || usize_ > n * n / 6 + 2 * n {
@@ -337,14 +342,17 @@ impl SkylineLu {
             self.floor.resize(n, 0.0);
         }
         self.diag_abs.resize(n, 0.0);
-        for (i, d) in self.diag_abs.iter_mut().enumerate() {
+        self.inv_diag_abs.resize(n, 0.0);
+        for (i, (d, inv)) in self.diag_abs.iter_mut().zip(self.inv_diag_abs.iter_mut()).enumerate() {
             *d = self.uval[self.uptr[i] + (i - self.first[i])].abs();
+            *inv = if *d > 0.0 { 1.0 / *d } else { 0.0 };
         }
         for i in 0..n {
             let (fi, up) = (self.first[i], self.uptr[i]);
             let u = &self.uval[up..up + (i - fi)]; // A[fi..i][i]
             let l = if symmetric { u } else { &self.lval[self.lptr[i]..self.lptr[i] + (i - fi)] }; // A[i][fi..i]
-            self.floor[i] = 1e-13 * self.diag_abs[i].max(largest_elimination_term(l, u, &self.diag_abs[fi..i]));
+            let term = largest_elimination_term(l, u, &self.inv_diag_abs[fi..i]);
+            self.floor[i] = 1e-13 * self.diag_abs[i].max(term);
         }
     }
 
@@ -352,26 +360,45 @@ impl SkylineLu {
     /// rows of `L` above. Consecutive columns, and consecutive rows, with the same profile start
     /// are taken together (columns in fours, else pairs; rows in pairs), so that each loaded value
     /// serves several products (the node-ordered ANCF unknowns come in runs of 12 with a common
-    /// start).
+    /// start). The grouping is [`column_groups`](Self::column_groups), fixed with the profile.
     #[inline(always)]
     fn factorize_symmetric(&mut self) -> bool {
         let n = self.n;
         let mut j = 0;
         while j < n {
-            let f = self.first[j];
-            let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
-            let (ok, width) = match run {
-                4 if self.quad_pairs_rows_like_pairs(j) => (self.symmetric_column_quad(j), 4),
-                4 => (self.symmetric_column_pair(j), 2),
-                2 | 3 => (self.symmetric_column_pair(j), 2),
-                _ => (self.symmetric_column(j), 1),
+            let width = self.group_width[j];
+            let ok = match width {
+                4 => self.symmetric_column_quad(j),
+                2 => self.symmetric_column_pair(j),
+                _ => self.symmetric_column(j),
             };
             if !ok {
                 return false;
             }
-            j += width;
+            j += width as usize;
         }
         true
+    }
+
+    /// The column groups of [`factorize_symmetric`](Self::factorize_symmetric) from the profile:
+    /// `group_width[j]` is 4, 2 or 1 at the first column `j` of each group (runs of four with a
+    /// common start whose rows pair like two pairs, else pairs, else single columns). Computed
+    /// with the profile ([`set_pointers`](Self::set_pointers)), not per factorisation.
+    fn column_groups(&mut self) {
+        let n = self.n;
+        self.group_width.resize(n, 1);
+        let mut j = 0;
+        while j < n {
+            let f = self.first[j];
+            let run = self.first[j..n.min(j + 4)].iter().take_while(|&&x| x == f).count();
+            let width = match run {
+                4 if self.quad_pairs_rows_like_pairs(j) => 4,
+                2..=4 => 2,
+                _ => 1,
+            };
+            self.group_width[j] = width;
+            j += width as usize;
+        }
     }
 
     /// Whether the rows above column `j` pair up (consecutive rows with a common profile
@@ -572,15 +599,16 @@ impl SkylineLu {
     }
 }
 
-/// `max_k |l_k u_k| / d_k` over the `k` with `d_k > 0` (0 if there is none; a NaN term is
-/// skipped as `f64::max` skips it). Four running maxima without branches, so that consecutive
-/// divisions overlap instead of waiting for each other through one maximum (the maximum does not
-/// depend on the order).
+/// `max_k |l_k u_k| inv_k` with `inv_k = 1 / d_k` (0 where `d_k` is 0; a NaN term is skipped
+/// as `f64::max` skips it). The reciprocals are taken once per row, not once per profile entry:
+/// a division per entry cost about an eighth of the factorisation, and the floor only decides
+/// between this LU and the dense one, so its last bit does not matter. Four running maxima
+/// without branches (the maximum does not depend on the order).
 #[inline(always)]
-fn largest_elimination_term(l: &[f64], u: &[f64], d: &[f64]) -> f64 {
-    let term = |l: f64, u: f64, d: f64| if d > 0.0 { (l * u).abs() / d } else { 0.0 };
+fn largest_elimination_term(l: &[f64], u: &[f64], inv_d: &[f64]) -> f64 {
+    let term = |l: f64, u: f64, inv: f64| (l * u).abs() * inv;
     let mut m = [0.0_f64; 4];
-    let (lc, uc, dc) = (l.chunks_exact(4), u.chunks_exact(4), d.chunks_exact(4));
+    let (lc, uc, dc) = (l.chunks_exact(4), u.chunks_exact(4), inv_d.chunks_exact(4));
     let (lr, ur, dr) = (lc.remainder(), uc.remainder(), dc.remainder());
     for ((l, u), d) in lc.zip(uc).zip(dc) {
         for c in 0..4 {
@@ -906,6 +934,8 @@ impl LinearSolver for SkylineLu {
         self.inv_diag = vec![0.0; n];
         self.floor = vec![0.0; n];
         self.diag_abs = vec![0.0; n];
+        self.inv_diag_abs = vec![0.0; n];
+        self.group_width = vec![1; n];
         self.is_multiplier = vec![false; n];
         self.last_coupled = vec![0; n];
         self.contiguous = vec![false; n];

@@ -329,8 +329,12 @@ impl Block {
             zr[lo..].copy_from_slice(&self.f[r * m + lo..(r + 1) * m]);
         }
         if let (true, Some(nb)) = (self.use_nodal, &self.nodal) {
-            for (zr, &(lo, _)) in z.chunks_exact_mut(m).zip(&self.row_range) {
-                nb.right_solve(zr, lo);
+            if self.rows.len() > 64 {
+                for (zr, &(lo, _)) in z.chunks_exact_mut(m).zip(&self.row_range) {
+                    nb.right_solve(zr, lo);
+                }
+            } else {
+                right_solve_grouped(nb, z, m, &self.row_range);
             }
             return;
         }
@@ -346,6 +350,37 @@ impl Block {
                     rest[0] = (rest[0] - dot(&done[a..], &ucol[a - top..])) * inv;
                 }
             }
+        }
+    }
+}
+
+/// `Z = F U⁻¹` on node blocks for up to 64 rows (`z`: rows of `m` unknowns, row `r` zero
+/// before `ranges[r].0`): rows that start in the same node go through
+/// [`NodeBand::right_solve_lanes`] four (or fewer) at a time, each with the arithmetic of its own
+/// [`NodeBand::right_solve`]. The rows of a beam block start in two or three nodes (the frame
+/// velocities' at the first, a joint's at the last), so most go four at a time.
+#[inline(always)]
+fn right_solve_grouped(nb: &NodeBand, z: &mut [f64], m: usize, ranges: &[(usize, usize)]) {
+    let nr = ranges.len();
+    let mut pending: u64 = if nr == 64 { !0 } else { (1 << nr) - 1 };
+    while pending != 0 {
+        let n0 = ranges[pending.trailing_zeros() as usize].0 / crate::node_lu::P;
+        let (mut lanes, mut count) = ([0; 4], 0);
+        let mut bits = pending;
+        while bits != 0 && count < 4 {
+            let r = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if ranges[r].0 / crate::node_lu::P == n0 {
+                lanes[count] = r;
+                count += 1;
+                pending &= !(1 << r);
+            }
+        }
+        match count {
+            4 => nb.right_solve_lanes::<4>(z, m, lanes, n0),
+            3 => nb.right_solve_lanes::<3>(z, m, [lanes[0], lanes[1], lanes[2]], n0),
+            2 => nb.right_solve_lanes::<2>(z, m, [lanes[0], lanes[1]], n0),
+            _ => nb.right_solve_lanes::<1>(z, m, [lanes[0]], n0),
         }
     }
 }

@@ -346,6 +346,57 @@ impl NodeBand {
         }
     }
 
+    /// [`right_solve`](Self::right_solve) on `L` rows of `z` at once (row `rows[l]` at
+    /// `z[rows[l] m..]`, `m` unknowns), all zero before node `n0`. Each row gets exactly the
+    /// operations of `right_solve` from node `n0`, in the same order (every sum from −0.0, as
+    /// `Iterator::sum` starts); the rows run in the lanes of fixed-size arrays, so that the
+    /// products with a block vectorise across rows instead of ending in horizontal sums.
+    #[inline(always)]
+    pub fn right_solve_lanes<const L: usize>(&self, z: &mut [f64], m: usize, rows: [usize; L], n0: usize) {
+        let (nn, kb) = (self.nn, self.kb);
+        let seg = |z: &[f64], i: usize| -> [[f64; L]; P] {
+            std::array::from_fn(|c| std::array::from_fn(|l| z[rows[l] * m + i * P + c]))
+        };
+        for j in n0..nn {
+            let mut zj = seg(z, j);
+            for i in j.saturating_sub(kb).max(n0)..j {
+                let k = self.idx(i, j);
+                if self.nz[k] {
+                    let (u, zi) = (&self.a[k], seg(z, i));
+                    for (c, x) in zj.iter_mut().enumerate() {
+                        let mut acc = [-0.0; L];
+                        for r in 0..P {
+                            for l in 0..L {
+                                acc[l] += zi[r][l] * u[c][r];
+                            }
+                        }
+                        for l in 0..L {
+                            x[l] -= acc[l];
+                        }
+                    }
+                }
+            }
+            let d = &self.a[self.idx(j, j)];
+            for kk in 0..P {
+                let mut s = [-0.0; L];
+                for l in 0..kk {
+                    for ll in 0..L {
+                        s[ll] += zj[l][ll] * d[kk][l];
+                    }
+                }
+                let inv = self.inv_diag[j * P + kk];
+                for ll in 0..L {
+                    zj[kk][ll] = (zj[kk][ll] - s[ll]) * inv;
+                }
+            }
+            for (c, x) in zj.iter().enumerate() {
+                for l in 0..L {
+                    z[rows[l] * m + j * P + c] = x[l];
+                }
+            }
+        }
+    }
+
     /// Overwrite the row vector `z` with `z U⁻¹`; `z` is zero before unknown `start`.
     #[inline(always)]
     pub fn right_solve(&self, z: &mut [f64], start: usize) {
