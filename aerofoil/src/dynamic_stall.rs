@@ -210,19 +210,17 @@ impl DynamicStall {
     }
 
     /// Kirchhoff's static separation point `f_st` and the fully separated lift `cl_fs` at
-    /// incidence `alpha` where the polar's lift is `cl_st`.
+    /// incidence `alpha` where the polar's lift is `cl_st` and its slope `dcl_st`.
     ///
     /// With `r = cl_st/(cl_α(α − α₀))` and `g = √r`: `f = (2g − 1)²` and
     /// `cl_fs = cl_α(α − α₀)(3g − 1)/(4g)` for `1/4 < r ≤ 1` (the decomposition
     /// `cl_st = cl_α(α − α₀) f + cl_fs (1 − f)` without its 0/0 at `f = 1`); `f = 0`,
     /// `cl_fs = cl_st` for `r ≤ 1/4` (fully separated, or lift against the incidence);
-    /// `f = 1`, `cl_fs = cl_α(α − α₀)/2` for `r > 1` and at `α₀`.
-    pub fn separation(&self, alpha: f64, cl_st: f64) -> (f64, f64) {
+    /// `f = 1`, `cl_fs = cl_α(α − α₀)/2` for `r > 1`. Within 1e-6 rad of `α₀`, where `r` is
+    /// 0/0, its limit `r = dcl_st/cl_α`.
+    pub fn separation(&self, alpha: f64, cl_st: f64, dcl_st: f64) -> (f64, f64) {
         let line = self.lift_slope * (alpha - self.alpha0);
-        if line.abs() < 1e-12 {
-            return (1.0, 0.5 * cl_st);
-        }
-        let r = cl_st / line;
+        let r = if (alpha - self.alpha0).abs() < 1e-6 { dcl_st / self.lift_slope } else { cl_st / line };
         if r <= 0.25 {
             return (0.0, cl_st);
         }
@@ -234,7 +232,7 @@ impl DynamicStall {
     fn target(&self, polar: &Polar, lagged_lift: f64, re: f64) -> Result<f64> {
         let alpha_f = self.alpha0 + lagged_lift / self.lift_slope;
         let c = polar.coefficients(alpha_f, re)?;
-        Ok(self.separation(alpha_f, c.cl).0)
+        Ok(self.separation(alpha_f, c.cl, c.dcl).0)
     }
 
     fn effective_alpha(&self, lag: [f64; 2], alpha: f64) -> f64 {
@@ -298,7 +296,7 @@ impl DynamicStall {
         let flow = &state.flow;
         let alpha_e = self.effective_alpha(state.lag, flow.alpha);
         let st = polar.coefficients(alpha_e, flow.re)?;
-        let (f_st, cl_fs) = self.separation(alpha_e, st.cl);
+        let (f_st, cl_fs) = self.separation(alpha_e, st.cl, st.dcl);
         let x4 = state.separation;
         let rate = flow.half_chord_time() * flow.pitch_rate;
         let line = self.lift_slope * (alpha_e - self.alpha0);
@@ -370,7 +368,7 @@ mod tests {
         let line = m.lift_slope() * (a - m.zero_lift_alpha());
         for r in [-0.3, 0.1, 0.25, 0.2500001, 0.4, 0.7, 0.99, 1.0, 1.3] {
             let cl = r * line;
-            let (f, cl_fs) = m.separation(a, cl);
+            let (f, cl_fs) = m.separation(a, cl, 0.0);
             assert!((0.0..=1.0).contains(&f));
             if r <= 1.0 {
                 // The decomposition holds wherever f is not clipped at 1.
