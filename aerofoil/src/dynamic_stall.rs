@@ -1,5 +1,5 @@
 //! Dynamic stall: the four-state Beddoes–Leishman-type model of Hansen, Gaunaa & Madsen
-//! (Risø-R-1354, 2004), driven only by a section's static polar (docs/section_aero.md §9).
+//! (Risø-R-1354, 2004), driven only by a section's static polar (docs/section_aero.md §8).
 //!
 //! With `T_u = c/(2U)` (the time the flow takes over half a chord), `α` the incidence at the
 //! three-quarter chord, `ω` the section's pitch rate and `cl_α`, `α₀` the attached-flow lift line:
@@ -38,7 +38,7 @@ use crate::polar::Polar;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// The model's dimensionless constants (docs/section_aero.md §9.2 gives their sources).
+/// The model's dimensionless constants (docs/section_aero.md §8.2 gives their sources).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DynamicStallConstants {

@@ -1,4 +1,4 @@
-//! The dynamic-stall model (aerofoil/src/dynamic_stall.rs, docs/section_aero.md §9): its steady
+//! The dynamic-stall model (aerofoil/src/dynamic_stall.rs, docs/section_aero.md §8): its steady
 //! limit, its attached-flow (Wagner, Theodorsen) behaviour, and the pitching-aerofoil loops of the
 //! University of Glasgow experiments (cases/reference/dynamic_stall/, provenance in
 //! cases/reference/README.md) with the NACA 23012 polar of NeuralFoil
