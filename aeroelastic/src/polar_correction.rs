@@ -22,6 +22,8 @@ use crate::section_polars::polars_by_body;
 #[derive(Debug, Clone, PartialEq)]
 pub struct StripPolars {
     by_body: Vec<Option<Arc<aerofoil::Polar>>>,
+    /// The dynamic-stall constants of every body (`None`: off), read by the strip march only.
+    dynamic_by_body: Vec<Option<aerofoil::DynamicStallConstants>>,
     rho: f64,
     kinematic_viscosity: f64,
 }
@@ -59,8 +61,17 @@ impl StripPolars {
             }
             return Ok(None);
         }
+        let mut dynamic_by_body = vec![None; problem.bodies.len()];
+        for p in &problem.polars {
+            for &b in &p.bodies {
+                if let Some(slot) = dynamic_by_body.get_mut(b) {
+                    *slot = p.dynamic_stall;
+                }
+            }
+        }
         Ok(Some(Self {
             by_body: polars_by_body(&problem.polars, problem.bodies.len())?,
+            dynamic_by_body,
             rho: aero.rho,
             kinematic_viscosity: aero.kinematic_viscosity,
         }))
@@ -69,6 +80,16 @@ impl StripPolars {
     /// The polar of body `body`, if it has one.
     pub fn polar_of(&self, body: usize) -> Option<&aerofoil::Polar> {
         self.by_body.get(body).and_then(Option::as_deref)
+    }
+
+    /// The dynamic-stall constants of body `body`, if its polar has the model on.
+    pub fn dynamic_stall_of(&self, body: usize) -> Option<&aerofoil::DynamicStallConstants> {
+        self.dynamic_by_body.get(body).and_then(Option::as_ref)
+    }
+
+    /// The air's density, kg/m³.
+    pub fn rho(&self) -> f64 {
+        self.rho
     }
 
     /// The air's kinematic viscosity, m²/s.

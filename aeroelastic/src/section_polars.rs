@@ -24,6 +24,60 @@ pub struct PolarSpec {
     /// What an incidence or Reynolds number outside the table does; default: an error for both.
     #[cfg_attr(feature = "serde", serde(default))]
     pub bounds: PolarBounds,
+    /// The dynamic-stall model of these bodies' strips (docs/section_aero.md §8); absent: off
+    /// (the polar read quasi-steadily). Only the strip-theory march (`aero.model: "strip"`)
+    /// applies it.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    pub dynamic_stall: Option<DynamicStallSpec>,
+}
+
+/// The constants of the dynamic-stall model (`aero.polars[i].dynamic_stall`), dimensionless;
+/// every field defaults to the value of [`aerofoil::DynamicStallConstants::default`] (sources in
+/// docs/section_aero.md §8.2), so `"dynamic_stall": {}` turns the model on with them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct DynamicStallSpec {
+    /// Wagner amplitude of the slow pole `A₁` (default 0.165, Jones).
+    pub a1: f64,
+    /// Slow pole `b₁`, per semichord travelled (default 0.0455, Jones).
+    pub b1: f64,
+    /// Wagner amplitude of the fast pole `A₂` (default 0.335, Jones).
+    pub a2: f64,
+    /// Fast pole `b₂`, per semichord travelled (default 0.3, Jones).
+    pub b2: f64,
+    /// Pressure-lag time constant `T_p`, semichords (default 1.7).
+    pub t_p: f64,
+    /// Separation-point time constant `T_f`, semichords (default 3.0).
+    pub t_f: f64,
+    /// Attached-flow lift slope, 1/rad; absent: the polar's largest secant slope about its
+    /// zero-lift incidence.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub lift_slope: Option<f64>,
+}
+
+impl Default for DynamicStallSpec {
+    fn default() -> Self {
+        let c = aerofoil::DynamicStallConstants::default();
+        Self { a1: c.a1, b1: c.b1, a2: c.a2, b2: c.b2, t_p: c.t_p, t_f: c.t_f, lift_slope: c.lift_slope }
+    }
+}
+
+impl DynamicStallSpec {
+    /// The `aerofoil` crate's constants.
+    pub fn constants(&self) -> aerofoil::DynamicStallConstants {
+        let s = *self;
+        aerofoil::DynamicStallConstants {
+            a1: s.a1,
+            b1: s.b1,
+            a2: s.a2,
+            b2: s.b2,
+            t_p: s.t_p,
+            t_f: s.t_f,
+            lift_slope: s.lift_slope,
+        }
+    }
 }
 
 /// The range rules of a polar (`aero.polars[i].bounds`).
@@ -93,6 +147,8 @@ pub struct BodyPolar {
     pub bodies: Vec<usize>,
     /// The polar, with its range rules set (shared: problems are cloned per sweep point).
     pub polar: Arc<aerofoil::Polar>,
+    /// The dynamic-stall constants of these bodies' strips (`None`: off).
+    pub dynamic_stall: Option<aerofoil::DynamicStallConstants>,
 }
 
 /// The polar of every body (`None`: uncorrected), from the loaded entries `polars` of a problem

@@ -24,7 +24,11 @@
 //! strip correction ([`StripPolars::correct_one`]) with the strip's own lift line: the polar's
 //! `cl(α + τ δ, Re)` replaces it, its profile drag `cd q c w` acts along `u⊥` and its moment
 //! `cm q c² w` about the span, quasi-steadily on the three-quarter-chord incidence
-//! (docs/section_aero.md §7.6).
+//! (docs/section_aero.md §7.6). With `aero.polars[i].dynamic_stall` the strips of those bodies
+//! carry the dynamic-stall model's states ([`aerofoil::DynamicStall`]; docs/section_aero.md §8),
+//! started at their steady state at the first evaluation and advanced from one evaluation to the
+//! next with the strip's incidence, pitch rate, speed and Reynolds number varying linearly over
+//! the interval; its `cl`, `cd`, `cm` replace the static polar's.
 //!
 //! The loads of a step are those of the state at its start (a loosely coupled march, as the
 //! lattice's); their power `Σ F·v + M·ω` is integrated into the aerodynamic work with the
@@ -59,6 +63,9 @@ pub struct StripAero<'a> {
     loads: Vec<SectionLoad>,
     /// Each column's last loads (in the order of `columns`).
     last: Vec<ColumnLoad>,
+    /// Each column's dynamic-stall model and state (in the order of `columns`; `None` before
+    /// its first evaluation and on bodies without the model).
+    stall: Vec<Option<StallSlot>>,
     scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
 }
 
@@ -73,6 +80,30 @@ struct ColumnLoad {
     at: Vector3<f64>,
     /// The incidence the polar was read at, `α + τ δ`, rad (NaN without a polar).
     alpha: f64,
+}
+
+/// A column's dynamic-stall model and its state at time `t`.
+#[derive(Debug, Clone, Copy)]
+struct StallSlot {
+    model: aerofoil::DynamicStall,
+    state: aerofoil::DynamicStallState,
+    /// Time of `state`, s.
+    t: f64,
+}
+
+/// What the dynamic-stall model of a column needs from its quasi-steady evaluation.
+#[derive(Debug, Clone, Copy)]
+struct StallInput {
+    body: usize,
+    flow: aerofoil::SectionFlow,
+    /// The static polar's coefficients already applied.
+    coefficients: aerofoil::Coefficients,
+    /// `q c w`, N.
+    qcw: f64,
+    /// Lift, drag and span directions (global, unit).
+    lift: Vector3<f64>,
+    drag: Vector3<f64>,
+    span: Vector3<f64>,
 }
 
 /// Thin-aerofoil flap effectiveness `dα/dδ` of a trailing-edge flap of chord fraction `e`.
@@ -95,7 +126,8 @@ impl<'a> StripAero<'a> {
         let none =
             ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: Vector3::zeros(), alpha: f64::NAN };
         let last = vec![none; columns.len()];
-        Self { map, aero, polars, columns, kin, loads, last, scratch: (Vec::new(), Vec::new(), Vec::new()) }
+        let stall = vec![None; columns.len()];
+        Self { map, aero, polars, columns, kin, loads, last, stall, scratch: (Vec::new(), Vec::new(), Vec::new()) }
     }
 
     /// The station loads at time `t` and state `(q, v)`, replacing the loads held so far; and the
@@ -122,7 +154,11 @@ impl<'a> StripAero<'a> {
             l.moment = Vector3::zeros();
         }
         for (n, &j) in self.columns.iter().enumerate() {
-            let c = self.column_load(j, t)?;
+            let (mut c, stall) = self.column_load(j, t)?;
+            if let (Some(input), Some(polars)) = (stall, self.polars) {
+                dynamic_stall(&mut self.stall[n], polars, t, &input, &mut c)
+                    .map_err(|e| format!("dynamic stall of strip {j} (body {}): {e}", input.body))?;
+            }
             for i in [j, j + 1] {
                 let half = c.force * 0.5;
                 self.loads[i].force += half;
@@ -135,8 +171,9 @@ impl<'a> StripAero<'a> {
     }
 
     /// The loads of column `j` (stations `j`, `j + 1`) at time `t`, acting at the quarter chord
-    /// at the column's middle.
-    fn column_load(&self, j: usize, t: f64) -> Result<ColumnLoad, String> {
+    /// at the column's middle, quasi-steady; and, when its body's polar has the dynamic-stall
+    /// model, that model's inputs.
+    fn column_load(&self, j: usize, t: f64) -> Result<(ColumnLoad, Option<StallInput>), String> {
         let (a, b) = (&self.kin[j], &self.kin[j + 1]);
         let (ma, mb) = (&self.map[j], &self.map[j + 1]);
         let p = 0.5 * (a.0 + b.0);
@@ -163,15 +200,17 @@ impl<'a> StripAero<'a> {
         };
         let mut out = ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: r1, alpha: f64::NAN };
         if speed2 == 0.0 {
-            return Ok(out);
+            return Ok((out, None));
         }
         let width = (b.0 - a.0).norm();
         let lift = 0.5 * self.aero.rho * speed2 * chord * self.aero.strip_lift_slope * (alpha + flap) * width;
         out.force = u_perp.cross(&x) / speed2.sqrt() * lift;
-        let Some((polars, polar)) = self.polars.and_then(|p| Some((p, p.polar_of(mb.body)?))) else { return Ok(out) };
+        let Some((polars, polar)) = self.polars.and_then(|p| Some((p, p.polar_of(mb.body)?))) else {
+            return Ok((out, None));
+        };
         if width == 0.0 {
             // Two stations at one point: no strip (and no lift above).
-            return Ok(out);
+            return Ok((out, None));
         }
         // The polar replaces the thin-aerofoil lift: the correction inverts the strip's own lift
         // line (slope `a`, no zero-lift incidence), so it reads the polar at `α + τ δ` exactly,
@@ -184,7 +223,29 @@ impl<'a> StripAero<'a> {
         out.force += df;
         out.moment = dm;
         out.alpha = c.alpha;
-        Ok(out)
+        if polars.dynamic_stall_of(mb.body).is_none() {
+            return Ok((out, None));
+        }
+        let speed = speed2.sqrt();
+        let flow = aerofoil::SectionFlow {
+            alpha: c.alpha,
+            // Nose up is about +x (it turns y, towards the leading edge, to z).
+            pitch_rate: omega.dot(&x),
+            speed,
+            chord,
+            re: speed * chord / polars.kinematic_viscosity(),
+        };
+        let drag = u_perp / speed;
+        let stall = StallInput {
+            body: mb.body,
+            flow,
+            coefficients: c.coefficients,
+            qcw: 0.5 * polars.rho() * speed2 * chord * width,
+            lift: drag.cross(&x),
+            drag,
+            span: x,
+        };
+        Ok((out, Some(stall)))
     }
 
     /// The strips at the last evaluation with a section polar (empty without polars): lift per
@@ -211,6 +272,42 @@ impl<'a> StripAero<'a> {
             })
             .collect()
     }
+}
+
+/// Advance the dynamic-stall state of a column in `slot` to time `t` (started at its steady state
+/// at the first call; a call at the time of the state changes its inputs only) and replace the
+/// static coefficients in the column's loads `out` by the model's.
+fn dynamic_stall(
+    slot: &mut Option<StallSlot>,
+    polars: &StripPolars,
+    t: f64,
+    input: &StallInput,
+    out: &mut ColumnLoad,
+) -> Result<(), aerofoil::AerofoilError> {
+    let (Some(polar), Some(constants)) = (polars.polar_of(input.body), polars.dynamic_stall_of(input.body)) else {
+        return Ok(());
+    };
+    let s = match slot {
+        None => {
+            let model = aerofoil::DynamicStall::new(polar, input.flow.re, *constants)?;
+            let state = model.steady_state(polar, &input.flow)?;
+            slot.insert(StallSlot { model, state, t })
+        }
+        Some(s) if t > s.t => {
+            s.state = s.model.step(polar, &s.state, t - s.t, &input.flow)?;
+            s.t = t;
+            s
+        }
+        Some(s) => {
+            s.state = s.model.jump(polar, &s.state, &input.flow)?;
+            s
+        }
+    };
+    let c = s.model.coefficients(polar, &s.state)?;
+    let st = &input.coefficients;
+    out.force += ((c.cl - st.cl) * input.lift + (c.cd - st.cd) * input.drag) * input.qcw;
+    out.moment += (c.cm - st.cm) * input.qcw * input.flow.chord * input.span;
+    Ok(())
 }
 
 /// Integrate `model` with strip aerodynamics `aero` on the stations `map` (see the module docs).

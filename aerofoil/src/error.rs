@@ -148,6 +148,21 @@ pub enum AerofoilError {
         /// The value (its norm for a vector).
         value: f64,
     },
+    /// A dynamic-stall constant, input or time step is impossible (non-finite, out of range).
+    #[error("invalid dynamic-stall input `{field}` = {value:e}")]
+    InvalidDynamicStall {
+        /// The field of [`crate::DynamicStallConstants`] or [`crate::SectionFlow`], or `dt`.
+        field: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// The polar has no zero-lift incidence (its lift does not change sign) at this Reynolds
+    /// number, so the dynamic-stall model has no lift line.
+    #[error("the polar has no zero-lift incidence at Re = {re:.4e}")]
+    NoZeroLift {
+        /// The Reynolds number.
+        re: f64,
+    },
 }
 
 /// Result alias of the crate.

@@ -18,6 +18,9 @@
 //!    F = F_{inv} + \big(cl(\alpha_e, Re) - \tfrac{L}{qS}\big)\,qS\,\hat l + cd\,qS\,\hat d,
 //!    \qquad M = M_{inv} + r_{c/4}\times(F - F_{inv}) + cm\,qS\,c\,\hat x. $$
 //!
+//! * [`DynamicStall`]: a dynamic-stall model (Hansen, Gaunaa & Madsen's four-state form of
+//!   Beddoes–Leishman) driven by a polar, stepped per section and time step.
+//!
 //! The crate knows no lattice and no beam: its inputs are plain numbers and vectors in a strip's
 //! frame (`x̂` span, `ŷ` towards the leading edge, `ẑ` normal; docs/conventions.md §2), so the
 //! time march, statics, stability and gust can all call the same function.
@@ -46,6 +49,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod dynamic_stall;
 mod error;
 mod extrapolation;
 mod monotone_cubic;
@@ -53,6 +57,7 @@ mod polar;
 mod polar_file;
 mod strip;
 
+pub use dynamic_stall::{DynamicCoefficients, DynamicStall, DynamicStallConstants, DynamicStallState, SectionFlow};
 pub use error::{AerofoilError, Result};
 pub use polar::{AlphaOutOfRange, Bounds, Coefficients, OutOfRange, Polar, Table};
 pub use polar_file::{parse_polar, read_polar};

@@ -7,7 +7,8 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use aeroelastic::section_polars::{BodyPolar, ReBound};
+use aeroelastic::aero_settings::AeroModel;
+use aeroelastic::section_polars::{BodyPolar, DynamicStallSpec, ReBound};
 
 use super::Case;
 
@@ -77,9 +78,43 @@ impl Case {
                     }
                 }
             }
-            loaded.push(BodyPolar { bodies: spec.bodies.clone(), polar: Arc::new(polar) });
+            let dynamic_stall = match &spec.dynamic_stall {
+                Some(ds) => Some(dynamic_stall(i, ds, &polar, aero.model)?),
+                None => None,
+            };
+            loaded.push(BodyPolar { bodies: spec.bodies.clone(), polar: Arc::new(polar), dynamic_stall });
         }
         self.polars = loaded;
         Ok(())
     }
+}
+
+/// The constants of `aero.polars[i].dynamic_stall`, checked: each in range, the polar with a
+/// zero-lift incidence (its lift line), and the strip march as the analysis.
+fn dynamic_stall(
+    i: usize,
+    spec: &DynamicStallSpec,
+    polar: &aerofoil::Polar,
+    model: AeroModel,
+) -> Result<aerofoil::DynamicStallConstants, String> {
+    let field = format!("aero.polars[{i}].dynamic_stall");
+    if model != AeroModel::Strip {
+        return Err(format!(
+            "{field}: only the strip-theory march applies the dynamic-stall model; set aero.model to \"strip\" \
+             or remove it (docs/section_aero.md §8)"
+        ));
+    }
+    let constants = spec.constants();
+    let named = |e: aerofoil::AerofoilError| match e {
+        aerofoil::AerofoilError::InvalidDynamicStall { field: f, value } => {
+            format!("{field}.{f}: {value} is out of range (docs/section_aero.md §8.2)")
+        }
+        e => format!("{field}: {e}"),
+    };
+    constants.validate().map_err(named)?;
+    // The lift line at the polar's first table (any Reynolds number for a single table): a polar
+    // whose lift never changes sign has none.
+    let re = polar.re_range().map_or(1.0, |r| r.0);
+    aerofoil::DynamicStall::new(polar, re, constants).map_err(named)?;
+    Ok(constants)
 }

@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod control_surfaces;
 mod divergence_swept;
+mod dynamic_stall;
 mod external;
 mod flight_gust;
 mod fuzz;
