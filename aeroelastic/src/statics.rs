@@ -235,10 +235,13 @@ struct Secant {
     has_step: bool,
     zeros: Vec<f64>,
     residual: Vec<f64>,
+    /// The increment weights `W` of the coordinates (fixed by the model's coordinates).
+    weights: Vec<f64>,
 }
 
 impl Secant {
-    fn new(n: usize, n_coords: usize) -> Self {
+    fn new(n_coords: usize, weights: Vec<f64>) -> Self {
+        let n = weights.len();
         Self {
             q: vec![0.0; n_coords],
             g: vec![0.0; n],
@@ -248,6 +251,7 @@ impl Secant {
             has_step: false,
             zeros: vec![0.0; n],
             residual: vec![0.0; n],
+            weights,
         }
     }
 
@@ -273,16 +277,17 @@ impl Secant {
 
     /// Correct `k` (row-major n × n, used times `scale`) with the load `g` at the end of the
     /// noted step, if that step left the remembered state and is long enough.
-    fn update(&mut self, k: &mut [f64], scale: f64, g: &[f64], weight: impl Fn(usize) -> f64) {
+    fn update(&mut self, k: &mut [f64], scale: f64, g: &[f64]) {
         if !(self.has_g && self.has_step && self.from == self.q) {
             return;
         }
         let n = self.g.len();
-        let size = self.step.iter().enumerate().fold(0.0_f64, |m, (j, s)| m.max((s * weight(j)).abs()));
+        let w = &self.weights;
+        let size = self.step.iter().zip(w).fold(0.0_f64, |m, (s, w)| m.max((s * w).abs()));
         if !(size > SECANT_MIN_STEP && scale.is_finite() && scale > 0.0) {
             return;
         }
-        let denom: f64 = self.step.iter().enumerate().map(|(j, s)| (s * weight(j)).powi(2)).sum();
+        let denom: f64 = self.step.iter().zip(w).map(|(s, w)| (s * w).powi(2)).sum();
         for i in 0..n {
             let ks: f64 = k[i * n..(i + 1) * n].iter().zip(&self.step).map(|(a, s)| a * s).sum();
             self.residual[i] = (g[i] - self.g[i]) / scale - ks;
@@ -292,8 +297,8 @@ impl Secant {
             if c == 0.0 {
                 continue;
             }
-            for (j, (a, s)) in k[i * n..(i + 1) * n].iter_mut().zip(&self.step).enumerate() {
-                *a += c * s * weight(j).powi(2);
+            for ((a, s), w) in k[i * n..(i + 1) * n].iter_mut().zip(&self.step).zip(w) {
+                *a += c * s * w.powi(2);
             }
         }
     }
@@ -369,7 +374,7 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
             valid: false,
             refresh: false,
             n_refresh: 0,
-            secant: Secant::new(n, model.n_coords()),
+            secant: Secant::new(model.n_coords(), (0..n).map(|j| model.increment_weight(j)).collect()),
             dq: vec![0.0; n],
             q_tmp: vec![0.0; model.n_coords()],
             r0: vec![0.0; n],
@@ -490,6 +495,10 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
 
     /// Replace the structural model (same coordinates; e.g. with scaled gravity).
     pub fn set_model(&mut self, model: S) {
+        let tg = self.tangent.get_mut().unwrap_or_else(PoisonError::into_inner);
+        for (j, w) in tg.secant.weights.iter_mut().enumerate() {
+            *w = model.increment_weight(j);
+        }
         *write(&self.model) = model;
         self.begin_solve(false);
     }
@@ -654,11 +663,9 @@ impl<'a, S: Structure> AeroStatic<'a, S> {
         for ((g, a), b) in tg.r1.iter_mut().zip(r).zip(&tg.r0) {
             *g = a - b;
         }
-        let model = read(&self.model);
-        let weight = |j: usize| model.increment_weight(j);
         let scale = self.speed2 / tg.speed2;
         if tg.n_refresh == refreshes {
-            tg.secant.update(&mut tg.k, scale, &tg.r1, weight);
+            tg.secant.update(&mut tg.k, scale, &tg.r1);
         }
         tg.secant.remember(q, &tg.r1);
     }
