@@ -839,6 +839,10 @@ impl<S: Structure> ConstrainedSystem for AeroStatic<'_, S> {
         lock(&self.tangent).secant.note_step(q_from, dq);
     }
 
+    fn adjust_static_step(&self, q: &[f64], dq: &mut [f64]) {
+        read(&self.model).adjust_static_step(q, dq);
+    }
+
     fn n_coords(&self) -> usize {
         read(&self.model).n_coords()
     }

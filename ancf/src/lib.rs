@@ -67,6 +67,7 @@ pub use scene::samples;
 pub mod shape;
 pub mod skyline;
 mod spec;
+mod static_step;
 pub mod statics;
 pub mod strain;
 mod structure;

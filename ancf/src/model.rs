@@ -1191,6 +1191,14 @@ impl ConstrainedSystem for Model {
         true
     }
 
+    /// The slopes turned rather than pushed (docs/ancf.md §9); the ODE path's independent
+    /// coordinates keep the linear step.
+    fn adjust_static_step(&self, q: &[f64], dq: &mut [f64]) {
+        if self.options.path == SolvePath::Dae {
+            self.turn_node_steps(q, dq);
+        }
+    }
+
     fn phi_inplace(&self, _t: f64, q: &[f64], phi: &mut [f64]) {
         if self.options.path == SolvePath::Dae {
             for (p, row) in phi.iter_mut().zip(&self.rows) {
@@ -1249,6 +1257,19 @@ impl ConstrainedSystem for Model {
 }
 
 impl Model {
+    /// `static_step::turn_node_steps` on every body's nodes (full coordinates), the step first
+    /// shortened to turn no node by more than `static_step::MAX_TURN`.
+    pub(crate) fn turn_node_steps(&self, q: &[f64], dq: &mut [f64]) {
+        use crate::static_step::{MAX_TURN, largest_turn};
+        let turn = self.bodies.iter().map(|b| largest_turn(b.offset, b.n_nodes, q, dq)).fold(0.0, f64::max);
+        if turn > MAX_TURN {
+            dq.iter_mut().for_each(|d| *d *= MAX_TURN / turn);
+        }
+        for b in &self.bodies {
+            crate::static_step::turn_node_steps(b.offset, b.n_nodes, q, dq);
+        }
+    }
+
     /// The DAE band blocks `(first, len, half-bandwidth)` with the bodies a flared hinge's spring
     /// couples merged into one block (with everything between them), whose half-bandwidth covers
     /// the spring's couplings.

@@ -90,6 +90,9 @@ impl ConstrainedSystem for FullCoordinates<'_> {
     fn increment_weight(&self, i: usize) -> f64 {
         self.0.full_weight(i)
     }
+    fn adjust_static_step(&self, q: &[f64], dq: &mut [f64]) {
+        self.0.turn_node_steps(q, dq);
+    }
 }
 
 impl Model {

@@ -81,6 +81,15 @@ pub trait ConstrainedSystem {
     /// update). Default: nothing.
     fn note_static_step(&self, _q_from: &[f64], _dq: &[f64]) {}
 
+    /// The static solver's Newton step `dq` from `q`, which the model may replace by another
+    /// with the same first order (so that Newton's convergence is unchanged) that a linearised
+    /// step would make worse: ANCF turns the rotational part of each node's slope increment into
+    /// an exact rotation, where the linear one would stretch the slopes by half the square of the
+    /// angle against their stiff section strains (docs/ancf.md §9). The solver then retracts the
+    /// replaced step and tells [`note_static_step`](Self::note_static_step) that one. Default:
+    /// nothing.
+    fn adjust_static_step(&self, _q: &[f64], _dq: &mut [f64]) {}
+
     /// Holonomic constraint residual Φ(q) (length `n_holonomic`).
     fn phi_inplace(&self, _t: f64, _q: &[f64], _phi: &mut [f64]) {}
     /// `j += Φ_q`, an `n_holonomic × n_dof` view.

@@ -359,6 +359,7 @@ impl StaticSolver {
     ) {
         let n = self.n;
         self.rhs[..n].iter_mut().zip(&self.step[..n]).for_each(|(r, d)| *r = alpha * d);
+        system.adjust_static_step(&self.q_prev, &mut self.rhs[..n]);
         system.retract_inplace(&self.q_prev, &self.rhs[..n], &mut x.q);
         normalise(&mut x.q);
         system.note_static_step(&self.q_prev, &self.rhs[..n]);
