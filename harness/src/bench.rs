@@ -63,7 +63,7 @@ pub struct BenchRow {
 /// resolution); `None` off Linux, where the caller falls back to wall time.
 pub(crate) use aeroelastic::clock::thread_cpu_s;
 
-fn median(v: &mut [f64]) -> f64 {
+pub(crate) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n == 0 {

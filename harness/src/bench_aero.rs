@@ -9,8 +9,9 @@
 //!   observer reads the process's CPU time at every step, and the figure is the mean over the
 //!   last 20 steps (process time, so that the lattice's own threads count).
 //! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
-//!   Healy's static sweep per formulation, each also with the committed NACA 0015 polars on both
-//!   bodies (`cases/polars/`; the summary gives the ratio of their CPU times), the Goland wing's
+//!   Healy's static sweep per formulation (the sweep as the median of 7 runs), each also with the
+//!   committed NACA 0015 polars on both bodies (`cases/polars/`, interleaved with the runs
+//!   without; the summary gives the ratio of their CPU times), the Goland wing's
 //!   21-speed flutter sweep, and Healy's gust sweep (both formulations, run as `harness all` runs
 //!   it).
 
@@ -159,23 +160,59 @@ fn timed(analysis: &str, formulation: &str, work: impl FnOnce() -> Option<String
 /// what is timed here.
 const NACA0015: &str = r#"aero.polars=[{"bodies":[0,1],"file":"polars/naca0015_neuralfoil.csv","bounds":{"alpha":"flat_plate","re":"clamp"}}]"#;
 
+/// Runs of each static sweep, with and without polars interleaved; the figure is the median
+/// (a sweep takes a fifth of a second, where one run's noise is tens of percent).
+const STATIC_REPEATS: usize = 7;
+
+/// The median CPU and wall time of `runs` timed runs, and the first error.
+fn median_row(analysis: &str, formulation: &str, runs: &[AnalysisRow]) -> AnalysisRow {
+    let mut cpu: Vec<f64> = runs.iter().map(|r| r.cpu_s).collect();
+    let mut wall: Vec<f64> = runs.iter().map(|r| r.wall_s).collect();
+    AnalysisRow {
+        analysis: analysis.into(),
+        formulation: formulation.into(),
+        cpu_s: crate::bench::median(&mut cpu),
+        wall_s: crate::bench::median(&mut wall),
+        error: runs.iter().find_map(|r| r.error.clone()),
+    }
+}
+
+/// Healy's static sweep per formulation without and with the polars, [`STATIC_REPEATS`] runs
+/// of each, interleaved, as medians.
+fn static_sweeps(cases: &Path) -> Result<Vec<AnalysisRow>, Error> {
+    let mut out = Vec::new();
+    let plain = spec(cases, "healy_ffwt_flare10_aoa5.json", &[])?;
+    let polars = spec(cases, "healy_ffwt_flare10_aoa5.json", &[NACA0015.to_string()])?;
+    for f in Formulation::ALL {
+        let problems = [plain.case(f).problem(), polars.case(f).problem()];
+        let mut runs: [Vec<AnalysisRow>; 2] = [Vec::new(), Vec::new()];
+        for _ in 0..STATIC_REPEATS {
+            for (p, r) in problems.iter().zip(runs.iter_mut()) {
+                r.push(timed("", "", || {
+                    aeroelastic::statics::run_static(p, f).points.iter().find_map(|x| x.error.clone())
+                }));
+            }
+        }
+        for (suffix, r) in ["", POLARS_SUFFIX].iter().zip(&runs) {
+            out.push(median_row(&format!("Healy static sweep (12 airspeeds){suffix}"), &f.to_string(), r));
+        }
+    }
+    Ok(out)
+}
+
 /// The whole analyses of the module docs.
 fn analyses(cases: &Path) -> Result<Vec<AnalysisRow>, Error> {
     let mut out = Vec::new();
     for (suffix, sets) in [("", vec![]), (POLARS_SUFFIX, vec![NACA0015.to_string()])] {
         let wing = spec(cases, "wing_aoa5.json", &sets)?;
-        let healy = spec(cases, "healy_ffwt_flare10_aoa5.json", &sets)?;
         for f in Formulation::ALL {
             let p = wing.case(f).problem();
             out.push(timed(&format!("{} s run of the paper's wing{suffix}", p.t_end), &f.to_string(), || {
                 aeroelastic::factory::run_formulation(&p, f).error
             }));
-            let p = healy.case(f).problem();
-            out.push(timed(&format!("Healy static sweep (12 airspeeds){suffix}"), &f.to_string(), || {
-                aeroelastic::statics::run_static(&p, f).points.iter().find_map(|x| x.error.clone())
-            }));
         }
     }
+    out.extend(static_sweeps(cases)?);
     let goland = spec(cases, "goland_flutter.json", &[])?;
     for f in Formulation::ALL {
         let p = goland.case(f).problem();
