@@ -43,13 +43,22 @@ fn rotation_minus_identity(w: Vector3<f64>) -> Matrix3<f64> {
     k * alpha + k * k * beta
 }
 
+/// The previous node along the body: its position, its linear and its turned position step, and
+/// its rotation.
+#[derive(Clone, Copy)]
+struct Previous {
+    r: Vector3<f64>,
+    dr: Vector3<f64>,
+    turned_dr: Vector3<f64>,
+    w: Vector3<f64>,
+}
+
 /// Replace the step `dq` of the nodes whose coordinates start at `first + NODE_DOF · n`,
 /// `n < n_nodes` (one body, in order along it), by the turned step of the module documentation.
 /// A node whose slopes are singular or whose step is not finite keeps its linear step and turns
 /// its element by its neighbour's rotation alone.
 pub(crate) fn turn_node_steps(first: usize, n_nodes: usize, q: &[f64], dq: &mut [f64]) {
-    // The previous node: its position, its linear and its turned position step, its rotation.
-    let mut prev: Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>)> = None;
+    let mut prev: Option<Previous> = None;
     for n in 0..n_nodes {
         let i = first + NODE_DOF * n;
         let (Some(qn), Some(dn)) = (q.get(i..i + NODE_DOF), dq.get(i..i + NODE_DOF)) else {
@@ -62,7 +71,7 @@ pub(crate) fn turn_node_steps(first: usize, n_nodes: usize, q: &[f64], dq: &mut 
             dq[i + 3..i + 12].copy_from_slice(turned.as_slice());
         }
         let mut turned_dr = dr;
-        if let Some((r0, dr0, turned_dr0, w0)) = prev {
+        if let Some(Previous { r: r0, dr: dr0, turned_dr: turned_dr0, w: w0 }) = prev {
             let (d, dd) = (r - r0, dr - dr0);
             let we = 0.5 * (w + w0);
             let rest = dd - we.cross(&d);
@@ -73,7 +82,7 @@ pub(crate) fn turn_node_steps(first: usize, n_nodes: usize, q: &[f64], dq: &mut 
             }
         }
         dq[i..i + 3].copy_from_slice(turned_dr.as_slice());
-        prev = Some((r, dr, turned_dr, w));
+        prev = Some(Previous { r, dr, turned_dr, w });
     }
 }
 
