@@ -43,8 +43,9 @@ pub struct StripReport {
     pub cl_slope: Vec<f64>,
     /// Sum of the change of force over the strips, N.
     pub total_delta: Vector3<f64>,
-    /// Sum of the profile drag `cd qS` over the strips, N.
-    pub profile_drag: f64,
+    /// Sum of the profile drag forces `cd qS d̂` over the strips (each along its strip's
+    /// section-plane flow; global), N.
+    pub profile_drag: Vector3<f64>,
 }
 
 impl StripPolars {
@@ -146,7 +147,7 @@ impl StripPolars {
         report.cl_slope.clear();
         report.cl_slope.resize(n, f64::NAN);
         report.total_delta = Vector3::zeros();
-        report.profile_drag = 0.0;
+        report.profile_drag = Vector3::zeros();
         for st in self.placed(stations, map) {
             let g = StripGeometry { frame: st.frame, chord: st.chord, width: st.width };
             let (df, dm, c) = self
@@ -168,7 +169,7 @@ impl StripPolars {
             report.cl[st.j] = c.coefficients.cl;
             report.cl_slope[st.j] = c.coefficients.dcl;
             report.total_delta += df;
-            report.profile_drag += c.profile_drag();
+            report.profile_drag += st.frame * (c.profile_drag() * c.drag_dir);
         }
         Ok(())
     }

@@ -984,6 +984,10 @@ pub struct StaticPoint {
     /// Total drag (along the free stream), N: the lattice's induced drag, plus the profile drag
     /// of the section polars when the case has them.
     pub drag: f64,
+    /// The section polars' profile drag along the free stream, N (0 without polars): each
+    /// strip's `cd qS` along its section-plane flow, projected. `drag − profile_drag` is the
+    /// lattice's induced drag (the static strips': the drag of their lift along the free stream).
+    pub profile_drag: f64,
     /// Hinge moment of each control surface (`aero.control_surfaces`, in order), N·m, trailing
     /// edge down positive: the lattice's loads (docs/uvlm.md §15); empty without surfaces.
     #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Vec::is_empty"))]
@@ -1100,6 +1104,7 @@ fn failed_point(airspeed: f64, msg: String) -> StaticPoint {
         },
         lift: f64::NAN,
         drag: f64::NAN,
+        profile_drag: f64::NAN,
         control_hinge_moments: Vec::new(),
         newton_iterations: 0,
         error: Some(msg),
@@ -1560,7 +1565,9 @@ pub(crate) fn point_at<S: Structure>(
         (total, strips_of(map, &stations, &uv_loads, &report, lift_dir, qdyn))
     };
     let lift = total.dot(&lift_dir);
-    let drag = total.dot(&Vector3::from(v_inf).normalize());
+    let stream = Vector3::from(v_inf).normalize();
+    let drag = total.dot(&stream);
+    let profile_drag = report.profile_drag.dot(&stream);
     StaticPoint {
         airspeed,
         sideslip_deg: sys.sideslip_deg(),
@@ -1569,6 +1576,7 @@ pub(crate) fn point_at<S: Structure>(
         loads,
         lift,
         drag,
+        profile_drag,
         control_hinge_moments,
         newton_iterations: 0,
         error: None,

@@ -221,7 +221,7 @@ impl StripStatics {
             report.alpha[j] = alpha;
             report.cl[j] = cl;
             report.total_delta += force;
-            report.profile_drag += cd * qs;
+            report.profile_drag += cd * qs * d;
         }
         Ok(())
     }

@@ -120,10 +120,10 @@ pub fn to_csv(rows: &[Row], surfaces: &[String]) -> String {
 /// Column header of `static_<f>.csv`.
 pub const STATIC_HEADER: &str = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift,\
 root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag,\
-sideslip_deg";
+sideslip_deg,profile_drag,induced_drag";
 
 /// The header of `static_<f>.csv` with a `<name>_hinge_moment` column per control surface after
-/// `sideslip_deg`.
+/// `induced_drag`.
 pub fn static_header(surfaces: &[String]) -> String {
     let mut h = STATIC_HEADER.to_string();
     for name in surfaces {

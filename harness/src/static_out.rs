@@ -97,7 +97,7 @@ pub fn to_csv(out: &StaticOutput, surfaces: &[String]) -> String {
         let l = &p.loads;
         let _ = write!(
             s,
-            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e},{}",
+            "{},{:.6},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{:.9e},{},{:.9e},{:.9e}",
             p.airspeed,
             p.fold_deg,
             p.tip[0],
@@ -116,7 +116,9 @@ pub fn to_csv(out: &StaticOutput, surfaces: &[String]) -> String {
             p.newton_iterations,
             u8::from(p.error.is_none()),
             p.drag,
-            p.sideslip_deg
+            p.sideslip_deg,
+            p.profile_drag,
+            p.drag - p.profile_drag
         );
         for i in 0..surfaces.len() {
             let _ = write!(s, ",{:.6e}", p.control_hinge_moments.get(i).copied().unwrap_or(f64::NAN));

@@ -201,6 +201,8 @@ pub fn static_columns<'py>(py: Python<'py>, out: &StaticOutput, surfaces: &[Stri
     d.set_item("converged", PyArray1::from_vec(py, ok))?;
     d.set_item("drag", f(|p| p.drag))?;
     d.set_item("sideslip_deg", f(|p| p.sideslip_deg))?;
+    d.set_item("profile_drag", f(|p| p.profile_drag))?;
+    d.set_item("induced_drag", f(|p| p.drag - p.profile_drag))?;
     for (i, name) in surfaces.iter().enumerate() {
         let v: Vec<f64> = p.iter().map(|p| p.control_hinge_moments.get(i).copied().unwrap_or(f64::NAN)).collect();
         d.set_item(format!("{name}_hinge_moment"), PyArray1::from_vec(py, v))?;

@@ -112,8 +112,11 @@ def test_static_sweep_columns():
     case = ROOT / "cases" / "healy_ffwt_flare10_aoa0.json"
     r = flexmb.static(case, "gebf", set={"static.airspeeds": [15, 25]})
     header = "airspeed,fold_deg,tip_x,tip_y,tip_z,root_bending_moment,root_torque,hinge_moment,lift," \
-        "root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag,sideslip_deg"
+        "root_force_x,root_force_y,root_force_z,root_moment_x,root_moment_y,root_moment_z,newton_iterations,converged,drag,sideslip_deg," \
+        "profile_drag,induced_drag"
     assert list(r) == header.split(",")
+    assert np.array_equal(r["profile_drag"], [0.0, 0.0])
+    assert np.allclose(r["induced_drag"], r["drag"], rtol=0, atol=0)
     assert np.array_equal(r["airspeed"], [15.0, 25.0])
     assert r["converged"].all() and np.all(r["lift"] > 0)
 
