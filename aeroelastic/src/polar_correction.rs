@@ -5,8 +5,10 @@
 //! half by the column's two stations, with the rigid-arm transfer of the lattice's own loads.
 //!
 //! A strip between stations `j` and `j + 1` (quarter-chord points `p_j`, `p_{j+1}`):
-//! frame `x̂ = (x_j + x_{j+1})/|…|` (span), `ŷ` the mean chord direction made perpendicular to
-//! `x̂`, `ẑ = x̂ × ŷ`; chord the mean of the two; width `|(p_{j+1} − p_j)·x̂|`; the point
+//! frame `x̂ = (p_{j+1} − p_j)/|…|` (span: the line of the strip's bound vortex; the stations'
+//! own span axes would tilt it by half the angle between two bodies where they meet, since the
+//! station there carries the inner body's frame), `ŷ` the mean chord direction made
+//! perpendicular to `x̂`, `ẑ = x̂ × ŷ`; chord the mean of the two; width `|p_{j+1} − p_j|`; the point
 //! `p = (p_j + p_{j+1})/2`; its flow the air velocity relative to it without the lattice's own
 //! induced velocity (the downwash is in the lattice's lift, hence in the effective incidence).
 
@@ -225,7 +227,7 @@ impl StripPolars {
             let polar = self.by_body.get(body).and_then(Option::as_ref)?;
             let (a, b) = (&stations[j], &stations[j + 1]);
             let (pa, pb) = (a.origin + a.arm(0.25), b.origin + b.arm(0.25));
-            let frame = strip_frame(&a.frame, &b.frame);
+            let frame = strip_frame(pb - pa, &a.frame, &b.frame);
             Some(PlacedStrip {
                 j,
                 i: j - map[j].lifting,
@@ -234,7 +236,7 @@ impl StripPolars {
                 frame,
                 p: 0.5 * (pa + pb),
                 chord: 0.5 * (a.chord + b.chord),
-                width: (pb - pa).dot(&frame.column(0)).abs(),
+                width: (pb - pa).norm(),
             })
         })
     }
@@ -398,10 +400,12 @@ impl LinearCorrection {
     }
 }
 
-/// The strip frame between two station frames (columns span, chord towards the leading edge,
-/// normal), re-orthonormalised.
-fn strip_frame(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix3<f64> {
-    let x = (a.column(0) + b.column(0)).normalize();
+/// The strip frame (columns span, chord towards the leading edge, normal) with its span along
+/// `span` (from the strip's inner quarter-chord point to its outer one) and its chord the mean of
+/// the two station frames' chord directions, made perpendicular to it.
+fn strip_frame(span: Vector3<f64>, a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix3<f64> {
+    // A strip of no width (coincident quarter-chord points) keeps the stations' mean span axis.
+    let x = span.try_normalize(1e-300).unwrap_or_else(|| (a.column(0) + b.column(0)).normalize());
     let y0 = a.column(1) + b.column(1);
     let y = (y0 - x * x.dot(&y0)).normalize();
     let z = x.cross(&y);

@@ -263,6 +263,9 @@ pub struct TrimOutput {
     pub lift: f64,
     /// Drag (along the flow), N, as `lift`.
     pub drag: f64,
+    /// The section polars' part of `drag` (their profile drag along the flow), N; 0 without
+    /// polars.
+    pub profile_drag: f64,
     /// Tip position (body axes), m.
     pub tip: [f64; 3],
     /// Wall time, s.
@@ -302,6 +305,7 @@ fn failed(p: &Problem, f: Formulation, msg: String) -> TrimOutput {
         static_solves: 0,
         lift: f64::NAN,
         drag: f64::NAN,
+        profile_drag: f64::NAN,
         tip: [f64::NAN; 3],
         wall_s: 0.0,
         error: Some(msg),
@@ -613,6 +617,7 @@ fn finish<M: BuildModel>(
         static_solves: held.solves,
         lift: point.lift,
         drag: point.drag,
+        profile_drag: point.profile_drag,
         tip: model.tip(&held.x.q),
         wall_s: 0.0,
         error,

@@ -43,6 +43,7 @@ pub fn to_json(o: &TrimOutput) -> serde_json::Value {
         },
         "lift": o.lift,
         "drag": o.drag,
+        "profile_drag": o.profile_drag,
         "tip": o.tip,
         "iterations": o.iterations,
         "static_solves": o.static_solves,

@@ -70,10 +70,11 @@ fn horten_profile_drag(cd: f64, alpha: f64) -> f64 {
 /// cl = 2πα, cd = 0.01, cm = 0: the trimmed thrust rises by the profile drag. In level flight
 /// with the thrust along the body axis `T cos α = D` (the forward and vertical balances of body
 /// axes), so `ΔT cos α` is the change of drag: the closed-form profile drag of
-/// [`horten_profile_drag`] within 2 % (measured +1.3 %; what it leaves out: the strips' widths
-/// between quarter-chord points, which the taper makes 0.2 % longer than the beam's, the wing's
-/// bending and twist, and the change of induced drag with the lift and elevator). ANCF
-/// and GEBF agree within 0.01° (α, elevator) and 0.5 % (thrust), as without polars.
+/// [`horten_profile_drag`] within 0.5 % (measured −0.18 %: the trim's own profile drag is the
+/// closed form's within 0.2 % (measured −0.08 %; the closed form leaves out the strips' widths
+/// along the tapered quarter-chord line and the wing's bending and twist), and the induced drag
+/// falls by 0.1 % of the profile drag with the lift the thrust takes over). ANCF and GEBF agree
+/// within 0.01° (α, elevator) and 0.5 % (thrust), as without polars.
 #[test]
 fn a_drag_polar_raises_the_trimmed_thrust_by_the_profile_drag() {
     let dir = scratch("flight_drag_trim");
@@ -99,7 +100,15 @@ fn a_drag_polar_raises_the_trimmed_thrust_by_the_profile_drag() {
             a.drag,
             b.drag,
         );
-        assert!(rel(got, want) < 0.02, "{f}: ΔT cos α {got} N vs {want} N");
+        println!(
+            "{f}: profile drag {:.4} N against the closed form's {want:.4} N ({:+.3} %); induced {:.4} -> {:.4} N",
+            b.profile_drag,
+            100.0 * (b.profile_drag - want) / want,
+            a.drag - a.profile_drag,
+            b.drag - b.profile_drag
+        );
+        assert!(rel(got, want) < 5e-3, "{f}: ΔT cos α {got} N vs {want} N");
+        assert!(rel(b.profile_drag, want) < 2e-3, "{f}: profile drag {} N vs {want} N", b.profile_drag);
         // The trim's own drag output holds the profile drag: T cos α = D.
         assert!(rel(b.thrust * alpha.cos(), b.drag) < 1e-3, "{f}: {} vs {}", b.thrust, b.drag);
         outs.push(b);
