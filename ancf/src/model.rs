@@ -1191,7 +1191,7 @@ impl ConstrainedSystem for Model {
         true
     }
 
-    /// The slopes turned rather than pushed (docs/ancf.md §9); the ODE path's independent
+    /// The nodes turned rather than pushed (docs/ancf.md §9); the ODE path's independent
     /// coordinates keep the linear step.
     fn adjust_static_step(&self, q: &[f64], dq: &mut [f64]) {
         if self.options.path == SolvePath::Dae {
