@@ -16,6 +16,9 @@ fn solver(rows: usize, aggregation: WakeAggregation) -> (Uvlm, Vec<SpanStation>)
     let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
     p.parallel = Parallel::Off;
     p.n_wake_rows = rows;
+    // As the harness marches: the far wake frozen within a step, closure legs.
+    p.wake_reuse = WakeReuse::Frozen;
+    p.wake_closure = true;
     p.wake_aggregation = aggregation;
     let mut u = Uvlm::new(lat, p).unwrap();
     for _ in 0..rows + 2 {

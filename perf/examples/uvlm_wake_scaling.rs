@@ -26,6 +26,9 @@ fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
     let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
     p.parallel = Parallel::Off;
     p.n_wake_rows = rows;
+    // As the harness marches: the far wake frozen within a step, closure legs.
+    p.wake_reuse = WakeReuse::Frozen;
+    p.wake_closure = true;
     p.wake_aggregation = agg;
     let mut u = Uvlm::new(lat, p).unwrap();
     for _ in 0..rows + 2 {

@@ -369,12 +369,61 @@ pub(crate) fn build_known_wake(
     part: WakePart,
 ) {
     fil.clear();
-    append_known_wake(fil, te, wake, closure_dir, core, te_core, part);
+    append_known_wake(fil, te, wake, closure_dir, core, te_core, part, None);
     append_images(fil, planes);
+}
+
+/// Names of a wake's segments that stay with them as the wake is convected and new rows are
+/// shed: surface, push number of the segment's downstream node row ([`Wake::n_pushed`]),
+/// spanwise edge or chordwise leg, strip, and image copy. In the order [`append_known_wake`] and
+/// [`append_images`] lay the segments out the keys ascend, so two key lists are compared by
+/// one merge. A persistent treecode of the far wake uses them to find what changed
+/// (wake_tree.rs).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SegmentKeys {
+    pub(crate) keys: Vec<u64>,
+    /// The surface of the segments pushed next (< 64).
+    pub(crate) surface: u64,
+}
+
+/// Largest push number a key holds.
+const KEY_ROW_MAX: u64 = (1 << 35) - 1;
+
+impl SegmentKeys {
+    /// Forget every key.
+    pub(crate) fn clear(&mut self) {
+        self.keys.clear();
+    }
+
+    /// The key of a segment of the current surface at push number `row`, a chordwise leg or a
+    /// spanwise edge, on strip `j`: surface in bits 56–61, `KEY_ROW_MAX − row` in 21–55 (newer
+    /// rows first), the kind in bit 20, the strip in 0–19.
+    fn push(&mut self, row: u64, chordwise: bool, j: usize) {
+        let row = KEY_ROW_MAX - row.min(KEY_ROW_MAX);
+        self.keys.push((self.surface << 56) | (row << 21) | (u64::from(chordwise) << 20) | (j as u64 & 0xf_ffff));
+    }
+
+    /// The keys of the image copies of [`append_images`]: copy `c` of every key, with `c` in
+    /// bits 62–63.
+    pub(crate) fn append_images(&mut self, n_planes: usize) {
+        let n = self.keys.len();
+        for c in 1..crate::images::copy_signs(n_planes).len() as u64 {
+            for i in 0..n {
+                let k = self.keys[i];
+                self.keys.push(k | (c << 62));
+            }
+        }
+    }
+
+    /// Whether the keys name every segment uniquely (fewer than 64 surfaces, 2^20 strips).
+    pub(crate) fn representable(n_surfaces: usize, n_spanwise: usize) -> bool {
+        n_surfaces < 64 && n_spanwise < (1 << 20)
+    }
 }
 
 /// Append one surface's known wake (as [`build_known_wake`], without images) to `fil`, after
 /// what it holds: the wakes of several surfaces go into one set, then the images of all.
+#[allow(clippy::too_many_arguments)] // the wake, its two cores, closure, part and the keys' sink
 pub(crate) fn append_known_wake(
     fil: &mut Filaments,
     te: &[[f64; 3]],
@@ -383,6 +432,7 @@ pub(crate) fn append_known_wake(
     core: &CoreModel,
     te_core: &CoreModel,
     part: WakePart,
+    mut keys: Option<&mut SegmentKeys>,
 ) {
     let len = wake.n_rows();
     let n = wake.n_spanwise();
@@ -435,6 +485,9 @@ pub(crate) fn append_known_wake(
                     let scale = 0.5 * (dist((k0, j), (k1, j)) + dist((k0, j + 1), (k1, j + 1)));
                     let c = if k == 0 { te_core } else { core };
                     fil.push_segment_scaled(node(k, j), node(k, j + 1), s, c, scale);
+                    if let Some(keys) = keys.as_deref_mut() {
+                        keys.push(wake.n_pushed() - k as u64, false, j);
+                    }
                 }
             }
         }
@@ -444,6 +497,9 @@ pub(crate) fn append_known_wake(
                 let s = g(r - 1, j as isize - 1) - g(r - 1, j as isize);
                 if s != 0.0 {
                     fil.push_segment(node(k - 1, j), node(k, j), s, core);
+                    if let Some(keys) = keys.as_deref_mut() {
+                        keys.push(wake.n_pushed() - k as u64, true, j);
+                    }
                 }
             }
         }

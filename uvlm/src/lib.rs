@@ -140,6 +140,7 @@ mod surface;
 pub mod treecode;
 mod wake;
 mod wake_nodes;
+mod wake_tree;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
 pub use error::{Result, UvlmError};

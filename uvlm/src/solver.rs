@@ -1,7 +1,7 @@
 //! The UVLM solver: steady solve and unsteady time steps on one or several lattices (surfaces),
 //! each with its wake, in one influence system.
 
-use crate::aic::{BoundSystem, TrailingEdge, WakePart, append_known_wake};
+use crate::aic::{BoundSystem, SegmentKeys, TrailingEdge, WakePart, append_known_wake};
 use crate::axis_extension::{
     ExtensionLayout, SurfaceLayout, WakeColumns, correct_axis_extensions, correct_wake_columns,
 };
@@ -13,13 +13,13 @@ use crate::images::append_images;
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads, concatenate_loads};
-use crate::params::{Parallel, SteadyWake, UvlmParams, WakeAggregation, WakeConvection, WakeReuse};
+use crate::params::{SteadyWake, UvlmParams, WakeConvection, WakeReuse};
 use crate::scratch::ScratchPool;
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
 use crate::surface::Surface;
-use crate::treecode::{Treecode, block_order};
 use crate::wake::Wake;
+use crate::wake_tree::{WakeTree, keys_representable};
 use std::time::Instant;
 
 /// Which trailing-edge model the current AIC was built for.
@@ -75,6 +75,8 @@ pub struct Uvlm {
     /// Treecodes over `known` and `far` (when the aggregation applies), valid while the flags are.
     known_tree: WakeTree,
     far_tree: WakeTree,
+    /// The names of `far`'s segments, for the persistent tree (wake_tree.rs).
+    far_keys: SegmentKeys,
     lu: DenseLu,
     aic: Vec<f64>,
     rhs: Vec<f64>,
@@ -141,6 +143,7 @@ impl Uvlm {
             u_far_mid: Vec::new(),
             known_tree: WakeTree::new(&params.wake_aggregation),
             far_tree: WakeTree::new(&params.wake_aggregation),
+            far_keys: SegmentKeys::default(),
             lu: DenseLu::new(nr),
             aic: vec![0.0; nr * nr],
             rhs: vec![0.0; nr],
@@ -612,6 +615,7 @@ impl Uvlm {
                 s.gamma_row[j] = self.gamma[ring0 + lat.ring_index(m - 1, j)];
             }
             s.wake.clear();
+            self.far_tree.break_persistence();
             for r in (0..s.wake.capacity()).rev() {
                 let k = (r + 1) as f64 * dt;
                 for j in 0..=n {
@@ -657,6 +661,17 @@ impl Uvlm {
             // The same displacement V∞·dt for every node.
             let v = self.flow.free_stream();
             let d = [v[0] * dt, v[1] * dt, v[2] * dt];
+            // The images move with the wake when `d` lies in every plane.
+            let along = self.params.images.iter().all(|p| {
+                let n = p.unit_normal();
+                (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).abs()
+                    <= 1e-12 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            });
+            if along {
+                self.far_tree.translate(d);
+            } else {
+                self.far_tree.break_persistence();
+            }
             for s in &mut self.surfaces {
                 s.wake.translate(d);
                 for p in &mut s.prev_te {
@@ -667,6 +682,7 @@ impl Uvlm {
             }
             return;
         }
+        self.far_tree.break_persistence();
         self.load_wake_points();
         self.v_wake.resize(self.wpts.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.wpts, t, &mut self.v_wake);
@@ -764,11 +780,18 @@ impl Uvlm {
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
         let frozen = self.params.wake_reuse == WakeReuse::Frozen;
         let part = if frozen { WakePart::Near } else { WakePart::All };
-        build_wakes(&mut self.known, &self.surfaces, closure, &self.params, part);
+        build_wakes(&mut self.known, &self.surfaces, closure, &self.params, part, None);
         self.known_tree.invalidate();
         if frozen && !self.far_ready {
-            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far);
-            self.far_tree.invalidate();
+            // The far wake's segments are named when a tree can be kept across steps.
+            let named = self.params.wake_aggregation.enabled
+                && keys_representable(
+                    self.surfaces.len(),
+                    self.surfaces.iter().map(|s| s.wake.n_spanwise()).max().unwrap_or(0),
+                );
+            let keys = if named { Some(&mut self.far_keys) } else { None };
+            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far, keys);
+            self.far_tree.sync(&self.far, named.then_some(&self.far_keys.keys[..]));
         }
         let t = self.time + dt;
         self.solve_gamma(true, t)?;
@@ -813,90 +836,30 @@ impl Uvlm {
 /// The known wake of every surface into `fil` (surface after surface, each from its own trailing
 /// edge; `part` as in [`WakePart`]), then the images of all. One surface gives exactly
 /// [`crate::aic::build_known_wake`]'s set.
-fn build_wakes(fil: &mut Filaments, surfaces: &[Surface], closure: Option<[f64; 3]>, p: &UvlmParams, part: WakePart) {
+fn build_wakes(
+    fil: &mut Filaments,
+    surfaces: &[Surface],
+    closure: Option<[f64; 3]>,
+    p: &UvlmParams,
+    part: WakePart,
+    mut keys: Option<&mut SegmentKeys>,
+) {
     fil.clear();
-    for s in surfaces {
+    if let Some(k) = keys.as_deref_mut() {
+        k.clear();
+    }
+    for (i, s) in surfaces.iter().enumerate() {
         let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
         let te = &s.lattice.ring_nodes()[m * (n + 1)..];
-        append_known_wake(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part);
+        if let Some(k) = keys.as_deref_mut() {
+            k.surface = i as u64;
+        }
+        append_known_wake(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part, keys.as_deref_mut());
     }
     append_images(fil, &p.images);
-}
-
-/// A wake filament set's induction: direct, or through a treecode built once per set.
-#[derive(Debug)]
-struct WakeTree {
-    settings: WakeAggregation,
-    tree: Treecode,
-    /// Whether `tree` holds the current set.
-    ready: bool,
-    order: Vec<u32>,
-    stack: Vec<(usize, usize)>,
-}
-
-impl WakeTree {
-    fn new(settings: &WakeAggregation) -> Self {
-        let tree =
-            if settings.enabled { Treecode::new(settings.order, settings.leaf_size) } else { Treecode::default() };
-        Self { settings: *settings, tree, ready: false, order: Vec::new(), stack: Vec::new() }
+    if let Some(k) = keys {
+        k.append_images(p.images.len());
     }
-
-    fn invalidate(&mut self) {
-        self.ready = false;
-    }
-
-    fn applies(&self, set: &Filaments) -> bool {
-        self.settings.applies(set.n_segments())
-    }
-
-    /// Add the velocity induced by `set` at `pts` to `out`: through the treecode (to within
-    /// `tol`, m/s) when the aggregation applies to the set, else directly. Returns the pairs
-    /// summed directly.
-    fn add_velocity(
-        &mut self,
-        set: &Filaments,
-        pts: &Points,
-        tol: f64,
-        out: &mut [[f64; 3]],
-        parallel: Parallel,
-        scratch: &mut ScratchPool<NodeBlock>,
-    ) -> u64 {
-        if pts.is_empty() || set.n_filaments() == 0 {
-            return 0;
-        }
-        if !self.applies(set) {
-            if out.iter().all(|u| *u == [0.0; 3]) {
-                return induced_velocity_inplace(&[set], pts, out, parallel, scratch);
-            }
-            let blk = scratch.first();
-            let mut pairs = 0;
-            for b in 0..pts.len().div_ceil(crate::biot_savart::LANES) {
-                pairs += add_block_direct(set, pts, b, out, blk);
-            }
-            return pairs;
-        }
-        if !self.ready {
-            self.tree.build(set);
-            self.ready = true;
-        }
-        block_order(pts, &mut self.order, &mut self.stack);
-        self.tree.add_velocity_inplace(pts, &self.order, tol, out, parallel)
-    }
-}
-
-/// Add the direct induction of `set` at block `b` of `pts` to `out`.
-fn add_block_direct(set: &Filaments, pts: &Points, b: usize, out: &mut [[f64; 3]], blk: &mut NodeBlock) -> u64 {
-    use crate::biot_savart::{LANES, fill_block, load_lanes, velocity_block};
-    let (px, py, pz) = (load_lanes(&pts.x, b), load_lanes(&pts.y, b), load_lanes(&pts.z, b));
-    let mut u = [[0.0; LANES]; 3];
-    fill_block(set, &px, &py, &pz, blk);
-    velocity_block(set, blk, &mut u);
-    for l in 0..LANES.min(pts.len() - b * LANES) {
-        for q in 0..3 {
-            out[b * LANES + l][q] += u[q][l];
-        }
-    }
-    (LANES * set.n_filaments()) as u64
 }
 
 /// `a[i] += b[i]` componentwise.

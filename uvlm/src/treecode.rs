@@ -41,6 +41,9 @@ use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
 
+/// Number of moments at [`MAX_ORDER`]: the multi-indices of degree ≤ 12.
+const MOMENTS_MAX: usize = (MAX_ORDER + 1) * (MAX_ORDER + 2) * (MAX_ORDER + 3) / 6;
+
 /// A multi-index table: every `k` with `|k| ≤ degree`, sorted by degree.
 #[derive(Debug, Clone, Default)]
 struct Indices {
@@ -155,6 +158,11 @@ pub struct Treecode {
     n_leaves: usize,
     /// The set's legs, summed directly.
     legs: Filaments,
+    /// Per source segment: the leaf cluster holding it and its index in that leaf's set.
+    seg_leaf: Vec<u32>,
+    seg_slot: Vec<u32>,
+    /// Per cluster: its parent (`NONE` for the root).
+    parent: Vec<u32>,
     /// Σ |Γ/4π| |B − A| over all segments.
     total_strength: f64,
     /// The traversals' workspace: one entry per threaded chunk of point blocks (the first
@@ -305,6 +313,7 @@ impl Treecode {
             self.split(fil);
         }
         self.fill_leaves(fil);
+        self.index_segments();
         self.compute_moments(fil);
         self.legs.clear();
         for l in 0..fil.n_legs() {
@@ -314,6 +323,79 @@ impl Treecode {
             self.legs.leg_g.push(fil.leg_g[l]);
             self.legs.leg_core2.push(fil.leg_core2[l]);
             self.legs.leg_cut2.push(fil.leg_cut2[l]);
+        }
+    }
+
+    /// Sum the set's legs elsewhere: the tree holds its segments only.
+    pub(crate) fn drop_legs(&mut self) {
+        self.legs.clear();
+    }
+
+    /// The parents of the clusters and, per source segment, its leaf and slot in the leaf.
+    fn index_segments(&mut self) {
+        self.parent.clear();
+        self.parent.resize(self.clusters.len(), NONE);
+        self.seg_leaf.resize(self.perm.len(), NONE);
+        self.seg_slot.resize(self.perm.len(), 0);
+        for (ci, c) in self.clusters.iter().enumerate() {
+            if c.child != NONE {
+                self.parent[c.child as usize] = ci as u32;
+                self.parent[c.child as usize + 1] = ci as u32;
+            } else {
+                for (slot, &s) in self.perm[c.start as usize..c.end as usize].iter().enumerate() {
+                    self.seg_leaf[s as usize] = ci as u32;
+                    self.seg_slot[s as usize] = slot as u32;
+                }
+            }
+        }
+    }
+
+    /// Give source segment `s` of the built set the strength `g` (as stored, with its 1/4π)
+    /// and the core constants `core2`, `cut2`: the leaf's copy takes them, and the moments of
+    /// the leaf and of every cluster above it change by the segment's moments times the change
+    /// of strength (the moments are linear in the strengths). The segment keeps its place and
+    /// the clusters their centres and radii, which still bound every segment (a strength of 0
+    /// removes the segment). The total strength follows, so the error bound holds as at a
+    /// build.
+    pub(crate) fn set_segment(&mut self, s: usize, g: f64, core2: f64, cut2: f64) {
+        let ci = self.seg_leaf[s] as usize;
+        let slot = self.seg_slot[s] as usize;
+        let leaf = &mut self.leaves[self.clusters[ci].leaf as usize];
+        let old = leaf.seg_g[slot];
+        leaf.seg_core2[slot] = core2;
+        leaf.seg_cut2[slot] = cut2;
+        if g == old {
+            return;
+        }
+        leaf.seg_g[slot] = g;
+        let (pa, pb) = (leaf.node(leaf.seg_a[slot] as usize), leaf.node(leaf.seg_b[slot] as usize));
+        let l = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+        let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        self.total_strength = (self.total_strength + (g.abs() - old.abs()) * len).max(0.0);
+        let nm = self.mom_idx.k.len();
+        let mut mono = [0.0; MOMENTS_MAX];
+        let mut c = ci;
+        loop {
+            let centre = self.clusters[c].center;
+            let mom = &mut self.moments[c * nm..(c + 1) * nm];
+            for &(t, w) in &self.gauss {
+                let x = [pa[0] + t * l[0] - centre[0], pa[1] + t * l[1] - centre[1], pa[2] + t * l[2] - centre[2]];
+                let a = [(g - old) * w * l[0], (g - old) * w * l[1], (g - old) * w * l[2]];
+                mono[0] = 1.0;
+                for (k, m) in mom.iter_mut().enumerate() {
+                    if k > 0 {
+                        let (parent, axis) = self.up[k];
+                        mono[k] = mono[parent as usize] * x[axis as usize];
+                    }
+                    for q in 0..3 {
+                        m[q] += a[q] * mono[k];
+                    }
+                }
+            }
+            match self.parent[c] {
+                NONE => break,
+                p => c = p as usize,
+            }
         }
     }
 

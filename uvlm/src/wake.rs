@@ -14,6 +14,8 @@ pub struct Wake {
     len: usize,
     nodes: Vec<[f64; 3]>,
     gamma: Vec<f64>,
+    /// Rows pushed since construction (never reset): row `r` is push number `n_pushed − 1 − r`.
+    n_pushed: u64,
 }
 
 impl Wake {
@@ -26,6 +28,7 @@ impl Wake {
             len: 0,
             nodes: vec![[0.0; 3]; capacity * (n_spanwise + 1)],
             gamma: vec![0.0; capacity * n_spanwise],
+            n_pushed: 0,
         }
     }
 
@@ -40,6 +43,12 @@ impl Wake {
     /// Number of rings per row.
     pub fn n_spanwise(&self) -> usize {
         self.n
+    }
+
+    /// Rows pushed since construction, including those dropped and cleared: row `r` is push
+    /// number `n_pushed() − 1 − r`, a name that stays with the row as newer rows arrive.
+    pub fn n_pushed(&self) -> u64 {
+        self.n_pushed
     }
 
     #[inline]
@@ -74,6 +83,7 @@ impl Wake {
         assert!(nodes.len() == self.n + 1 && gamma.len() == self.n, "wake row length mismatch");
         self.head = (self.head + self.capacity - 1) % self.capacity;
         self.len = (self.len + 1).min(self.capacity);
+        self.n_pushed += 1;
         let p = self.head;
         self.nodes[p * (self.n + 1)..(p + 1) * (self.n + 1)].copy_from_slice(nodes);
         self.gamma[p * self.n..(p + 1) * self.n].copy_from_slice(gamma);
