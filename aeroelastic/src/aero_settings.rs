@@ -85,12 +85,18 @@ pub struct AeroSettings {
     /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub gust: Option<GustSpec>,
-    /// Sum the wake through the UVLM's treecode, within 1e-6 of the free-stream speed at every
-    /// point (docs/uvlm.md §14); default false (every wake filament summed directly: at the
-    /// cases' 40 wake rows the direct sum is faster, at 320 rows the treecode's step is 1.4–1.9×
-    /// faster on the paper's and Healy's wings, docs/outputs.md).
-    #[cfg_attr(feature = "serde", serde(default))]
+    /// Sum long wakes through the UVLM's treecode, within 1e-6 of the free-stream speed at
+    /// every point (docs/uvlm.md §14): a wake of at least `wake_aggregation_min_segments`
+    /// filaments (its images included) goes through the treecode, a shorter one is summed
+    /// directly, bit for bit as with `false`; default true. `false` sums every wake directly.
+    #[cfg_attr(feature = "serde", serde(default = "default_true"))]
     pub wake_aggregation: bool,
+    /// The wake size from which `wake_aggregation` applies, filaments (the far wake's segments
+    /// with their images); default 6000 (`uvlm::WakeAggregation::AUTO_MIN_SEGMENTS`: about 90
+    /// rows of the paper's wing or 67 of Healy's; the treecode breaks even below it,
+    /// docs/uvlm.md §14). 0 aggregates every wake.
+    #[cfg_attr(feature = "serde", serde(default = "default_aggregation_min_segments"))]
+    pub wake_aggregation_min_segments: usize,
     /// Section polars (issue 37, docs/section_aero.md): the lattice's loads on the strips of
     /// these bodies are corrected by the polar (lift, profile drag, moment); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
@@ -190,8 +196,14 @@ impl AeroSettings {
         params.parallel =
             if ACTIVE_RUNS.load(Ordering::SeqCst) == 1 { uvlm::Parallel::Auto } else { uvlm::Parallel::Off };
         params.wake_reuse = if self.coupling.reuse_wake { uvlm::WakeReuse::Frozen } else { uvlm::WakeReuse::Recompute };
-        params.wake_aggregation =
-            if self.wake_aggregation { uvlm::WakeAggregation::treecode() } else { uvlm::WakeAggregation::off() };
+        params.wake_aggregation = if self.wake_aggregation {
+            uvlm::WakeAggregation {
+                min_segments: self.wake_aggregation_min_segments,
+                ..uvlm::WakeAggregation::treecode()
+            }
+        } else {
+            uvlm::WakeAggregation::off()
+        };
         params
     }
 }
@@ -232,6 +244,10 @@ fn default_lift_slope() -> f64 {
 #[cfg(feature = "serde")]
 fn default_cutoff() -> f64 {
     1e-6
+}
+
+fn default_aggregation_min_segments() -> usize {
+    uvlm::WakeAggregation::AUTO_MIN_SEGMENTS
 }
 
 fn default_kinematic_viscosity() -> f64 {

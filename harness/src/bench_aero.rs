@@ -125,6 +125,8 @@ fn step_row(cases: &Path, file: &str, rows: usize, treecode: bool) -> Result<Ste
     let sets = [
         format!("aero.n_wake_rows={rows}"),
         format!("aero.wake_aggregation={treecode}"),
+        // The treecode at every size, to show where it breaks even.
+        "aero.wake_aggregation_min_segments=0".to_string(),
         format!("t_end={}", steps as f64 * dt),
         format!("output_dt={dt}"),
     ];

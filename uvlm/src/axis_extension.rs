@@ -178,6 +178,11 @@ pub(crate) struct WakeColumns<'a> {
     pub(crate) closure: Option<[f64; 3]>,
     pub(crate) core: &'a CoreModel,
     pub(crate) part: WakePart,
+    /// Correct only the filaments whose cut-off cylinder holds the point (where the kernel's
+    /// cut-off zeroes what the regular form keeps); elsewhere outside a filament the two forms
+    /// are the same law and differ by rounding. For a wake summed through the treecode, whose
+    /// far clusters are expansions of the singular law, not the kernel.
+    pub(crate) cutoff_only: bool,
 }
 
 /// The time march's counterpart of [`correct_wake_extensions`] without a pass over the whole
@@ -207,20 +212,28 @@ pub(crate) fn correct_wake_columns(
     };
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
+    if w.cutoff_only {
+        cutoff_columns(sl, p0, w, pts, u, rows.clone());
+    }
     for s in m * n..m * n + m * nc {
         let j = (s - m * n) % nc;
         let i = p0 + s;
         let x = [pts.x[i], pts.y[i], pts.z[i]];
-        let column = rows.clone().filter_map(|k| {
-            let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
-            (gamma != 0.0).then(|| {
-                let (a, b) = (pos(k - 1, j), pos(k, j));
-                let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
-                let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
-                (a, b, (gamma * INV_FOUR_PI, core2, cut2))
-            })
-        });
-        fix_run(column, x, &mut u[i]);
+        if !w.cutoff_only {
+            // The column's nodes row by row: each row's node ends one leg and starts the next.
+            let mut b = pos(rows.start() - 1, j);
+            let column = rows.clone().filter_map(|k| {
+                let a = b;
+                b = pos(k, j);
+                let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
+                (gamma != 0.0).then(|| {
+                    let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
+                    let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
+                    (a, b, (gamma * INV_FOUR_PI, core2, cut2))
+                })
+            });
+            fix_run(column, x, &mut u[i]);
+        }
         if let Some(dir) = w.closure
             && w.part != WakePart::Near
         {
@@ -230,6 +243,55 @@ pub(crate) fn correct_wake_columns(
                 let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
                 let (core2, cut2) = w.core.leg_coefficients(l);
                 fix_leg_at(a, dir, (gamma * INV_FOUR_PI, core2, cut2), x, &mut u[i]);
+            }
+        }
+    }
+}
+
+/// [`correct_wake_columns`] with `cutoff_only`: the streamwise filaments of each column, [`RUN`]
+/// rows at a time (their strengths and cores computed once for the column's points), corrected
+/// at each of the column's load points only where the point lies in the filament's cut-off
+/// cylinder (`|r₁×r₂|² + core2 ≤ cut2`, the kernel's own test).
+fn cutoff_columns(
+    sl: &SurfaceLayout,
+    p0: usize,
+    w: &WakeColumns<'_>,
+    pts: &Points,
+    u: &mut [[f64; 3]],
+    rows: std::ops::RangeInclusive<usize>,
+) {
+    let (m, n, wake) = (sl.m, sl.n, w.wake);
+    let nc = n + 1;
+    let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
+    let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
+    let mut legs = [([0.0; 3], [0.0; 3], (0.0, 0.0, 0.0)); RUN];
+    for j in 0..nc {
+        let mut b = pos(rows.start() - 1, j);
+        let mut k = *rows.start();
+        while k <= *rows.end() {
+            let mut count = 0;
+            while count < RUN && k <= *rows.end() {
+                let a = b;
+                b = pos(k, j);
+                let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
+                if gamma != 0.0 {
+                    let len2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2);
+                    let (core2, cut2) = w.core.coefficients(len2, len2.sqrt());
+                    legs[count] = (a, b, (gamma * INV_FOUR_PI, core2, cut2));
+                    count += 1;
+                }
+                k += 1;
+            }
+            for row in 0..m {
+                let i = p0 + m * n + row * nc + j;
+                let x = [pts.x[i], pts.y[i], pts.z[i]];
+                let inside = legs[..count].iter().filter(|(a, b, (_, core2, cut2))| {
+                    let (r1, r2) = ([x[0] - a[0], x[1] - a[1], x[2] - a[2]], [x[0] - b[0], x[1] - b[1], x[2] - b[2]]);
+                    let c =
+                        [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
+                    c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + core2 <= *cut2
+                });
+                fix_run(inside.copied(), x, &mut u[i]);
             }
         }
     }

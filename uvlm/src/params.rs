@@ -80,14 +80,22 @@ pub struct WakeAggregation {
     /// Bound of the aggregation error of the induced velocity at every point, relative to the
     /// free-stream speed |V∞|. Default 1e-6.
     pub tolerance: f64,
-    /// Order p of the clusters' Cartesian expansions, ≤ 12. Default 4 (the fastest of 3–8 on
-    /// the paper's wing at 40–320 wake rows; the bound holds at any order).
+    /// Order p of the clusters' Cartesian expansions, ≤ 12. Default 5 (the fastest of 4–6 on
+    /// the paper's wing at 160–320 wake rows, docs/uvlm.md §14; the bound holds at any order).
     pub order: usize,
     /// Most segments in a leaf cluster (summed directly when near), ≥ 1. Default 128.
     pub leaf_size: usize,
 }
 
 impl WakeAggregation {
+    /// The wake size from which the harness aggregates (`aero.wake_aggregation`): segments of
+    /// the far wake, images included. The treecode kept across steps (p = 5, leaves of 128,
+    /// 1e-6 |V∞|) breaks even with the direct sum at about 55 rows of the paper's wing (65
+    /// segments a row, 420 points; 3600 segments) and is 20 % faster at Healy's 60 rows (89 a
+    /// row, 576 points; 5300 segments), docs/uvlm.md §14. Set above Healy's 60 rows so that the
+    /// shipped cases keep the direct sum.
+    pub const AUTO_MIN_SEGMENTS: usize = 6000;
+
     /// Aggregation switched off: every wake filament summed directly (the default).
     pub fn off() -> Self {
         Self { enabled: false, ..Self::default() }
@@ -106,7 +114,7 @@ impl WakeAggregation {
 
 impl Default for WakeAggregation {
     fn default() -> Self {
-        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 4, leaf_size: 128 }
+        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 5, leaf_size: 128 }
     }
 }
 

@@ -527,12 +527,14 @@ impl Uvlm {
     /// solve's legs take, so that a steady solution is the march's equilibrium.
     fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool) {
         let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+        // The far wake through the treecode: its clusters are expansions of the singular law.
+        let cutoff_only = far && self.far_tree.applies(&self.far);
         let u = if far { &mut self.u_far_mid } else { &mut self.u_mid };
         let mut p0 = 0;
         for (sl, s) in layout.surfaces.iter().zip(&self.surfaces) {
             let (m, n) = (s.lattice.n_chordwise(), s.lattice.n_spanwise());
             let te = &s.lattice.ring_nodes()[m * (n + 1)..];
-            let w = WakeColumns { te, wake: &s.wake, closure, core: &self.params.wake_core, part };
+            let w = WakeColumns { te, wake: &s.wake, closure, core: &self.params.wake_core, part, cutoff_only };
             correct_wake_columns(sl, p0, &w, &self.mid, u);
             p0 += sl.n_load;
         }

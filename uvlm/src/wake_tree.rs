@@ -29,6 +29,11 @@ use crate::treecode::{Treecode, block_order};
 /// directly, so a longer period trades build time for direct sums.
 pub(crate) const REBUILD_PERIOD: usize = 16;
 
+/// A tree built for one set (not kept across steps) applies from this many times the
+/// aggregation's `min_segments`: on the paper's wing it breaks even at about twice the wake of a
+/// kept tree (docs/uvlm.md §14).
+pub(crate) const REBUILT_FACTOR: usize = 2;
+
 /// A wake filament set's induction: direct, or through a treecode built once per set or kept
 /// across steps.
 #[derive(Debug)]
@@ -187,7 +192,9 @@ impl WakeTree {
         if pts.is_empty() || set.n_filaments() == 0 {
             return 0;
         }
-        if !self.applies(set) {
+        // A tree built for this use alone pays its build: it breaks even at a larger wake.
+        let rebuilt = !(self.ready && self.persist.valid);
+        if !self.applies(set) || (rebuilt && set.n_segments() < REBUILT_FACTOR * self.settings.min_segments) {
             return add_direct(set, pts, out, parallel, scratch);
         }
         if !self.ready {
