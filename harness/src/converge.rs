@@ -28,6 +28,7 @@ use crate::case::{Block, Elements, Formulation, RunSpec};
 use crate::csv::{Curve, read_curve, write_file};
 use crate::metrics::{tip_curve, tip_difference, window_stats};
 use crate::plot::{Dash, Marker, Panel, Series, Style, colors, panels_svg};
+use crate::progress::Progress;
 use crate::run::RunOutput;
 use crate::scene::run_formulation;
 
@@ -235,8 +236,9 @@ fn plan(spec: &RunSpec) -> Plan {
     p
 }
 
-/// Run the three ladders of both formulations (rayon over rungs).
-pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error> {
+/// Run the three ladders of both formulations (rayon over rungs), counting the rungs on
+/// `progress`.
+pub fn converge(spec: &RunSpec, progress: &Progress) -> Result<ConvergeResult, Error> {
     let plan = plan(spec);
     // A converged external reference, if the case names one.
     let case = &spec.ancf;
@@ -244,7 +246,7 @@ pub fn converge(spec: &RunSpec, progress: bool) -> Result<ConvergeResult, Error>
         Some(r) => Some((r.label.clone(), read_curve(&spec.dir.join(&r.file))?)),
         None => None,
     };
-    let bar = if progress { indicatif::ProgressBar::new(plan.len() as u64) } else { indicatif::ProgressBar::hidden() };
+    let bar = progress.counter(plan.len(), &format!("ladders of {}", spec.name));
     // Rungs side by side on the rayon threads, costliest first (one task each, so that the long
     // fine rungs start at once and the short ones fill in). Each rung runs on one thread (its
     // Biot–Savart sums single-threaded: several runs are registered), so the thread's CPU time

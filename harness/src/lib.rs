@@ -12,6 +12,7 @@
 pub mod atomic;
 pub mod bench;
 pub mod bench_aero;
+pub mod console;
 pub mod converge;
 pub mod csv;
 pub mod driver;

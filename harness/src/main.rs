@@ -11,6 +11,7 @@ use clap::{Args, Parser, Subcommand};
 
 use harness::budget::Analysis;
 use harness::case::{CaseFile, Formulation, Override, RunSpec, json_schema};
+use harness::console::Lines;
 use harness::driver::{
     any_interrupted, claim_outputs, discover, expand_all, finish_case, limit_steps, run_all, run_into, variant_name,
     write_index,
@@ -363,31 +364,52 @@ enum Cmd {
     Schema,
 }
 
+/// Repeats of each timed run of the benchmark in `harness all`.
+const BENCH_REPEATS: usize = 7;
+
 /// Run the benchmark on `runs` and write `dir` (`<out>/bench/`); the targets apply to the cases without
 /// aerodynamics (the issues' figures are for the paper's pendulums).
 fn run_bench(runs: &[RunSpec], repeats: usize, dir: &Path) -> Result<Vec<bench::BenchRow>> {
     let t = std::time::Instant::now();
     let rows = bench::run(runs, repeats, true);
-    let pendulums: Vec<&str> = runs.iter().filter(|r| r.ancf.aero.is_none()).map(|r| r.name.as_str()).collect();
-    bench::write(dir, &rows, |c| pendulums.contains(&c))?;
-    println!("bench: {} configurations x {repeats} runs in {:.1} s", rows.len(), t.elapsed().as_secs_f64());
+    write_bench(runs, repeats, &rows, dir, t)?;
     Ok(rows)
 }
 
-/// Run the energy study on the c = 1 pendulums among `runs`, write `dir` (`<out>/energy/`) and print the
-/// drifts; returns whether every run reached its end (true when there is nothing to study).
-fn run_energy(runs: &[RunSpec], dir: &Path) -> Result<bool> {
+/// Write the benchmark's `rows` of `runs` (begun at `t`) to `dir` and print its time.
+fn write_bench(
+    runs: &[RunSpec],
+    repeats: usize,
+    rows: &[bench::BenchRow],
+    dir: &Path,
+    t: std::time::Instant,
+) -> Result<()> {
+    let pendulums: Vec<&str> = runs.iter().filter(|r| r.ancf.aero.is_none()).map(|r| r.name.as_str()).collect();
+    bench::write(dir, rows, |c| pendulums.contains(&c))?;
+    println!("bench: {} configurations x {repeats} runs in {:.1} s", rows.len(), t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// Run the energy study on the c = 1 pendulums among `runs` (none when there are none); the
+/// runs and the wall time, s.
+fn energy_study(runs: &[RunSpec]) -> (Vec<energy::EnergyRun>, f64) {
     let t = std::time::Instant::now();
     let specs = energy::select(runs);
-    if specs.is_empty() {
-        println!("energy study: no c = 1 pendulum (no aerodynamics) among the cases; nothing written");
+    let study = if specs.is_empty() { Vec::new() } else { energy::run(&specs) };
+    (study, t.elapsed().as_secs_f64())
+}
+
+/// Write the energy study (`secs` s of wall time) to `dir` (`<out>/energy/`) and keep the drifts
+/// in `lines`; returns whether every run reached its end (true when there was nothing to study).
+fn energy_report(study: &[energy::EnergyRun], secs: f64, dir: &Path, lines: &mut Lines) -> Result<bool> {
+    if study.is_empty() {
+        lines.out("energy study: no c = 1 pendulum (no aerodynamics) among the cases; nothing written");
         return Ok(true);
     }
-    let study = energy::run(&specs);
-    energy::write(dir, &study)?;
-    for r in &study {
+    energy::write(dir, study)?;
+    for r in study {
         let m = &r.metrics;
-        println!(
+        lines.out(format!(
             "energy {} {} {}: {}",
             r.case,
             r.formulation,
@@ -399,9 +421,9 @@ fn run_energy(runs: &[RunSpec], dir: &Path) -> Result<bool> {
                 ),
                 |e| format!("FAILED: {e}")
             )
-        );
+        ));
     }
-    println!("energy study: {} runs in {:.1} s", study.len(), t.elapsed().as_secs_f64());
+    lines.out(format!("energy study: {} runs in {secs:.1} s", study.len()));
     Ok(study.iter().all(|r| r.metrics.error.is_none()))
 }
 
@@ -430,30 +452,35 @@ fn run_stability_case(spec: &RunSpec, fs: &[Formulation]) -> Vec<harness::stabil
     fs.par_iter().map(|&f| harness::stability::run_stability(&spec.case(f).problem(), f)).collect()
 }
 
-/// Print a stability sweep's results; true when a point failed.
-fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) -> bool {
+/// Keep a stability sweep's results in `lines`; true when a point failed.
+fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput], lines: &mut Lines) -> bool {
     let mut failed = false;
     for o in outs {
         if let Some(e) = &o.error {
-            eprintln!("stability {name} {}: {e}", o.formulation);
+            lines.err(format!("stability {name} {}: {e}", o.formulation));
             failed = true;
             continue;
         }
         let bad = o.points.iter().filter(|p| p.error.is_some()).count();
         let unconverged = harness::stability_out::unconverged_roots(o);
         if unconverged > 0 {
-            eprintln!(
+            lines.err(format!(
                 "stability {name} {}: WARNING: {unconverged} root(s) did not converge; the flutter and divergence \
                  speeds may be wrong (stability_{}.json: \"roots_converged\": false)",
                 o.formulation, o.formulation
-            );
+            ));
         }
         for p in o.points.iter().filter(|p| p.error.is_some()) {
-            eprintln!("stability {name} {} at {} m/s: {}", o.formulation, p.airspeed, p.error.as_deref().unwrap_or(""));
+            lines.err(format!(
+                "stability {name} {} at {} m/s: {}",
+                o.formulation,
+                p.airspeed,
+                p.error.as_deref().unwrap_or("")
+            ));
         }
         failed |= bad > 0;
         let f = |x: Option<f64>| x.map_or_else(|| "none".to_string(), |v| format!("{v:.3}"));
-        println!(
+        lines.out(format!(
             "stability {name} {}: flutter {} m/s at {} rad/s, divergence {} m/s; {} points ({} failed, {} unconverged roots), basis {} of {} free motions, {} + {} rings, build {:.3} s, roots {:.3} s, {} D(s) evaluations",
             o.formulation,
             f(o.flutter_speed),
@@ -469,32 +496,42 @@ fn report_stability(name: &str, outs: &[harness::stability::StabilityOutput]) ->
             o.build_s,
             o.solve_s,
             o.n_evaluations
-        );
+        ));
     }
     failed
 }
 
-/// The gust sweep of one run specification with the formulations `fs`, written to
-/// `<out>/<case>/` and printed; true when a run of the sweep failed.
-fn gust_case(spec: &RunSpec, fs: &[Formulation], out: &Path, file: &str) -> Result<bool> {
-    let mut failed = false;
+/// The gust sweep of one run specification (of case file `file`) with the formulations `fs`.
+fn gust_sweep(spec: &RunSpec, fs: &[Formulation], file: &str) -> Result<harness::gust_out::GustSummary> {
     let sweep = spec.gust_sweep(fs).map_err(|msg| harness::Error::Case { file: file.to_string(), msg })?;
-    let summary = harness::gust_out::summarise(sweep);
+    Ok(harness::gust_out::summarise(sweep))
+}
+
+/// Write a gust sweep of `spec` to `<out>/<case>/` and keep its lines; true when a run of the
+/// sweep failed.
+fn gust_report(
+    spec: &RunSpec,
+    fs: &[Formulation],
+    summary: &harness::gust_out::GustSummary,
+    out: &Path,
+    lines: &mut Lines,
+) -> Result<bool> {
+    let mut failed = false;
     let dir = out.join(&spec.name);
-    harness::gust_out::write(&dir, &summary)?;
+    harness::gust_out::write(&dir, summary)?;
     for r in &summary.runs {
         match &r.error {
             Some(e) => {
                 failed = true;
-                eprintln!(
+                lines.err(format!(
                     "gust {} {} {} H = {} m: FAILED: {e}",
                     spec.name,
                     r.formulation,
                     r.hinge.label(),
                     r.gradient_m
-                );
+                ));
             }
-            None => println!(
+            None => lines.out(format!(
                 "gust {} {} {:<6} H = {:>8.3} m ({:.3} Hz, {:.3} m/s): peak dM_root {:>11.5} N m at {:.2} s, peak dfold {:>8.3} deg, {:.2} s CPU",
                 spec.name,
                 r.formulation,
@@ -506,25 +543,28 @@ fn gust_case(spec: &RunSpec, fs: &[Formulation], out: &Path, file: &str) -> Resu
                 r.peak_delta_root_bending_moment.1,
                 r.peak_delta_fold_deg.0,
                 r.cpu_s
-            ),
+            )),
         }
     }
     for a in &summary.alleviation {
-        println!(
+        lines.out(format!(
             "  {} {} H = {:.3} m: alleviation {:.1} %",
             a.formulation,
             a.hinge.label(),
             a.gradient_m,
             a.root_bending_moment_percent
-        );
+        ));
     }
     let pair = match (summary.max_peak_rbm_difference_percent, summary.max_peak_fold_difference_deg) {
         (Some(m), Some(f)) => format!("ANCF-GEBF peak dM_root within {m:.3} %, peak fold within {f:.3} deg"),
         _ if fs.len() == 2 => "ANCF-GEBF: no pair of runs both formulations finished".into(),
         _ => "one formulation".into(),
     };
-    println!("gust {}: {pair}; {} run(s) failed; sweep {:.1} s wall", spec.name, summary.n_failed, summary.wall_s);
-    println!("wrote {}", dir.display());
+    lines.out(format!(
+        "gust {}: {pair}; {} run(s) failed; sweep {:.1} s wall",
+        spec.name, summary.n_failed, summary.wall_s
+    ));
+    lines.out(format!("wrote {}", dir.display()));
     Ok(failed)
 }
 
@@ -571,13 +611,14 @@ fn stress_units(base: &RunSpec, axes: &stress::Axes, extras: &[(String, RunSpec)
 }
 
 /// Run this shard's cells and extra runs of the stress study (all of them without a plan),
-/// adding their units to `done`.
+/// adding their units to `done`, with their progress on `progress`.
 fn run_stress(
     base: &RunSpec,
     axes: &stress::Axes,
     extras: &[(String, RunSpec)],
     plan: Option<&Plan>,
     done: &mut Vec<String>,
+    progress: &Progress,
 ) -> (Vec<stress::Cell>, Vec<stress::Extra>) {
     let jobs: Vec<stress::Job> =
         stress::jobs(axes).into_iter().filter(|j| runs_here(plan, &stress::job_id(j))).collect();
@@ -585,7 +626,7 @@ fn run_stress(
         extras.iter().filter(|(l, _)| runs_here(plan, &harness::merge::extra_unit(l))).cloned().collect();
     // The extra runs are long (a 20 s run whose recovery with step control takes minutes): they
     // start at once beside the matrix, whose short cells fill the other threads meanwhile.
-    let (ex, cells) = rayon::join(|| stress::run_extras(&mine), || stress::run_jobs(base, &jobs, true));
+    let (ex, cells) = rayon::join(|| stress::run_extras(&mine, progress), || stress::run_jobs(base, &jobs, progress));
     done.extend(jobs.iter().map(stress::job_id));
     done.extend(mine.iter().map(|(l, _)| harness::merge::extra_unit(l)));
     (cells, ex)
@@ -600,12 +641,13 @@ fn run_static_case(spec: &RunSpec, fs: &[Formulation]) -> harness::static_out::S
     summary
 }
 
-/// Print a sweep's outcome; true when a point (or a point of the model held at the experiment) failed.
-fn report_static(s: &harness::static_out::StaticSummary) -> bool {
+/// Keep a sweep's outcome in `lines`; true when a point (or a point of the model held at the
+/// experiment) failed.
+fn report_static(s: &harness::static_out::StaticSummary, lines: &mut Lines) -> bool {
     let structural = s.runs.iter().flat_map(|r| &r.points).any(|p| p.load_factor.is_some());
     for r in &s.runs {
         let ok = r.points.iter().filter(|p| p.error.is_none()).count();
-        println!(
+        lines.out(format!(
             "static {} {}: {ok} of {} {} in {:.3} s ({} steady solves, {} aerodynamic tangents, {} unknowns)",
             s.name,
             r.formulation,
@@ -615,16 +657,16 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             r.n_aero_solves,
             r.n_tangents,
             r.n_dof
-        );
+        ));
         for p in &r.points {
             if let Some(lf) = p.load_factor {
                 // A structural static case: tip positions at the load factors.
                 match &p.error {
-                    Some(e) => eprintln!("  load factor {lf}: FAILED: {e}"),
-                    None => println!(
+                    Some(e) => lines.err(format!("  load factor {lf}: FAILED: {e}")),
+                    None => lines.out(format!(
                         "  load factor {lf:>6}  tip ({:.4}, {:.4}, {:.4})  ({} Newton)",
                         p.tip[0], p.tip[1], p.tip[2], p.newton_iterations
-                    ),
+                    )),
                 }
                 continue;
             }
@@ -633,8 +675,8 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
                 harness::static_out::Abscissa::Sideslip => format!("{:>5} deg sideslip", p.sideslip_deg),
             };
             match &p.error {
-                Some(e) => eprintln!("  {at}: FAILED: {e}"),
-                None => println!(
+                Some(e) => lines.err(format!("  {at}: FAILED: {e}")),
+                None => lines.out(format!(
                     "  {at}  fold {:>8.3} deg  RBM {:>9.5} N m  torque {:>9.5} N m  hinge {:>9.2e} N m  lift {:>8.4} N  ({} Newton)",
                     p.fold_deg,
                     p.loads.root_bending_moment,
@@ -642,7 +684,7 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
                     p.loads.hinge_moment,
                     p.lift,
                     p.newton_iterations
-                ),
+                )),
             }
         }
     }
@@ -651,12 +693,12 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
         for (f, rms) in &r.rms_deg {
             match rms {
                 Some(rms) => {
-                    println!("static {} {f}: RMS error against {} = {rms:.2} deg (over {band})", s.name, r.label)
+                    lines.out(format!("static {} {f}: RMS error against {} = {rms:.2} deg (over {band})", s.name, r.label))
                 }
-                None => println!(
+                None => lines.out(format!(
                     "static {} {f}: no RMS error against {}: no equilibrium at its points in {band} ({f} failed, see below)",
                     s.name, r.label
-                ),
+                )),
             }
         }
     }
@@ -664,11 +706,11 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
     for h in &s.held {
         held_failed |= h.error.is_some();
         match &h.error {
-            Some(e) => eprintln!(
+            Some(e) => lines.err(format!(
                 "static {} {}: held at {} deg at {} m/s: FAILED: {e}",
                 s.name, h.formulation, h.coast_deg, h.airspeed
-            ),
-            None => println!(
+            )),
+            None => lines.out(format!(
                 "static {} {}: held at the measured {:.2} deg at {} m/s: hinge moment {:+.5} N m ({:+.3e} m^3 x q), equivalent pitch {:+.2} deg",
                 s.name,
                 h.formulation,
@@ -677,11 +719,11 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
                 h.hinge_moment,
                 h.per_dynamic_pressure,
                 h.equivalent_pitch_deg
-            ),
+            )),
         }
     }
     for c in &s.history {
-        println!(
+        lines.out(format!(
             "static {} {}: time history mean over {:.0}-{:.0} s: tip z {:.4} m, fold {:.3} deg; static {:.4} m ({:+.2} %), {:.3} deg ({:+.3} deg)",
             s.name,
             c.formulation,
@@ -693,15 +735,15 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             100.0 * c.tip_z_relative_difference,
             c.static_fold_deg,
             c.fold_difference_deg
-        );
+        ));
         match &c.run_wake_error {
-            Some(e) => println!(
+            Some(e) => lines.out(format!(
                 "static {} {}: static with the run's wake ({}) failed: {e}",
                 s.name,
                 c.formulation,
                 harness::static_out::wake_label(&c.run_wake)
-            ),
-            None => println!(
+            )),
+            None => lines.out(format!(
                 "static {} {}: static with the run's wake ({}): {:.4} m ({:+.2} %), {:.3} deg ({:+.3} deg)",
                 s.name,
                 c.formulation,
@@ -710,7 +752,7 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
                 100.0 * c.run_wake_tip_z_relative_difference,
                 c.run_wake_static_fold_deg,
                 c.run_wake_fold_difference_deg
-            ),
+            )),
         }
     }
     if let (true, [a, g]) = (structural, s.runs.as_slice()) {
@@ -721,20 +763,21 @@ fn report_static(s: &harness::static_out::StaticSummary) -> bool {
             .filter(|(pa, pg)| pa.error.is_none() && pg.error.is_none())
             .map(|(pa, pg)| (0..3).map(|i| (pa.tip[i] - pg.tip[i]).powi(2)).sum::<f64>().sqrt())
             .fold(0.0, f64::max);
-        println!("static {}: ANCF-GEBF max tip distance {d:.4e} m", s.name);
+        lines.out(format!("static {}: ANCF-GEBF max tip distance {d:.4e} m", s.name));
     } else if s.runs.len() == 2 {
         match (s.max_fold_difference_deg, s.max_rbm_relative_difference) {
-            (Some(d), Some(r)) => println!(
+            (Some(d), Some(r)) => lines.out(format!(
                 "static {}: ANCF-GEBF max fold difference {d:.4} deg, max root bending moment difference {:.3} % \
                  (over the points both solved)",
                 s.name,
                 100.0 * r
-            ),
-            _ => println!("static {}: ANCF-GEBF: no comparison, no airspeed has an equilibrium in both", s.name),
+            )),
+            _ => lines
+                .out(format!("static {}: ANCF-GEBF: no comparison, no airspeed has an equilibrium in both", s.name)),
         }
     }
     for f in &s.failures {
-        eprintln!("static {}: FAILED: {}", s.name, f.text());
+        lines.err(format!("static {}: FAILED: {}", s.name, f.text()));
     }
     s.n_failed > 0 || held_failed || s.runs.iter().any(|r| r.error.is_some())
 }
@@ -868,8 +911,10 @@ fn cmd_static(a: &AnalysisArgs) -> Result<ExitCode> {
         let summary = run_static_case(spec, &fs);
         let dir = out.join(&spec.name);
         harness::static_out::write(&dir, &summary)?;
-        let failed = report_static(&summary);
-        println!("wrote {}", dir.display());
+        let mut lines = Lines::new();
+        let failed = report_static(&summary, &mut lines);
+        lines.out(format!("wrote {}", dir.display()));
+        lines.print(&Progress::Off);
         Ok(failed)
     })
 }
@@ -881,12 +926,14 @@ fn cmd_healy_readings(a: &ReadingsArgs) -> Result<ExitCode> {
         eprintln!("error: --formulation: give one formulation (ancf or gebf)");
         return Ok(ExitCode::from(2));
     };
-    let failed = healy_readings(&a.cases.cases, &a.out.out, f)?;
-    Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+    let mut lines = Lines::new();
+    let failed = healy_readings(&a.cases.cases, &a.out.out, f, &mut lines);
+    lines.print(&Progress::Off);
+    Ok(if failed? { ExitCode::FAILURE } else { ExitCode::SUCCESS })
 }
 
-/// Compute and write the Healy readings; print the table; true when a point failed.
-fn healy_readings(cases: &Path, out: &Path, f: Formulation) -> Result<bool> {
+/// Compute and write the Healy readings; keep the table in `lines`; true when a point failed.
+fn healy_readings(cases: &Path, out: &Path, f: Formulation, lines: &mut Lines) -> Result<bool> {
     use harness::healy_readings as hr;
     let t = std::time::Instant::now();
     let results = hr::run(cases, f)?;
@@ -895,13 +942,17 @@ fn healy_readings(cases: &Path, out: &Path, f: Formulation) -> Result<bool> {
     let mut failed = false;
     for r in &results {
         let rms: Vec<String> = r.curves.iter().map(|c| c.rms_deg.map_or("-".into(), |x| format!("{x:.2}"))).collect();
-        println!("healy reading {}: RMS {} deg", r.reading.label(), rms.join(" / "));
+        lines.out(format!("healy reading {}: RMS {} deg", r.reading.label(), rms.join(" / ")));
         for e in r.curves.iter().flat_map(|c| &c.failures).chain(&r.level_failures) {
             failed = true;
-            println!("  FAILED: {e}");
+            lines.out(format!("  FAILED: {e}"));
         }
     }
-    println!("healy readings: {:.1} s; wrote {}", t.elapsed().as_secs_f64(), out.join("healy_readings.csv").display());
+    lines.out(format!(
+        "healy readings: {:.1} s; wrote {}",
+        t.elapsed().as_secs_f64(),
+        out.join("healy_readings.csv").display()
+    ));
     Ok(failed)
 }
 
@@ -916,8 +967,10 @@ fn cmd_stability(a: &AnalysisArgs) -> Result<ExitCode> {
         let outs = run_stability_case(spec, &fs);
         let dir = out.join(&spec.name);
         harness::stability_out::write_with_history(&dir, &spec.name, &outs, None)?;
-        let failed = report_stability(&spec.name, &outs);
-        println!("wrote {}", dir.display());
+        let mut lines = Lines::new();
+        let failed = report_stability(&spec.name, &outs, &mut lines);
+        lines.out(format!("wrote {}", dir.display()));
+        lines.print(&Progress::Off);
         Ok(failed)
     })
 }
@@ -929,7 +982,13 @@ fn cmd_gust(a: &AnalysisArgs) -> Result<ExitCode> {
     let (runs, plan) = analysis_runs(a, Analysis::Gust, |r| r.ancf.gust.is_some(), missing)?;
     let fs = a.formulation.formulations();
     let file = a.case.display().to_string();
-    analysis_loop(Analysis::Gust, &fs, &runs, plan.as_ref(), &a.out.out, |spec| gust_case(spec, &fs, &a.out.out, &file))
+    analysis_loop(Analysis::Gust, &fs, &runs, plan.as_ref(), &a.out.out, |spec| {
+        let summary = gust_sweep(spec, &fs, &file)?;
+        let mut lines = Lines::new();
+        let failed = gust_report(spec, &fs, &summary, &a.out.out, &mut lines);
+        lines.print(&Progress::Off);
+        failed
+    })
 }
 
 /// `harness trim`: every run of the case file trimmed; exit 2 without a `trim` block or on a bad
@@ -948,8 +1007,10 @@ fn cmd_trim(a: &TrimArgs) -> Result<ExitCode> {
         let outs = harness::trim_out::run(spec, &fs).map_err(|msg| harness::Error::Case { file: name.clone(), msg })?;
         let dir = a.out.out.join(&spec.name);
         harness::trim_out::write(&dir, &spec.name, &outs)?;
-        failed |= harness::trim_out::report(&spec.name, &outs);
-        println!("wrote {}", dir.display());
+        let mut lines = Lines::new();
+        failed |= harness::trim_out::report(&spec.name, &outs, &mut lines);
+        lines.out(format!("wrote {}", dir.display()));
+        lines.print(&Progress::Off);
     }
     Ok(if failed { ExitCode::FAILURE } else { ExitCode::SUCCESS })
 }
@@ -1054,10 +1115,57 @@ impl AllPlan {
 /// `harness all`: the cases, then (unless `--quick` or interrupted) the studies, the analyses and
 /// the reports; exit 2 when a case file was bad, 1 when a run, a gate or an analysis failed, 130
 /// when interrupted.
+///
+/// The phases go side by side in four lanes, threads that hand their runs to the one rayon pool,
+/// so that both cores stay busy to the end (one lane's idle tail is filled with another's runs):
+/// the cases, then their analyses' comparisons with the runs and the analyses' files
+/// ([`all_cases`]); the static, stability and trim sweeps ([`all_sweeps`]); the stress matrix
+/// and the energy study ([`all_studies`]); Healy's readings and the gust sweeps ([`all_gusts`]).
+/// The phases whose figures are times meant to characterise speed run after them, alone
+/// ([`all_timed`]). Each phase prints its lines whole when it ends.
 fn cmd_all(a: &AllArgs) -> Result<ExitCode> {
-    let (cases, out, set) = (&a.cases.cases, &a.out.out, &a.set.set);
-    let files = discover(cases)?;
+    let out = &a.out.out;
     let progress = Progress::new(true);
+    let (p, errors) = all_plan(a, &progress)?;
+    // Every run keeps one thread while the phases go side by side (the UVLM threads a run only
+    // while it is the one run registered): the pool's threads are the only ones computing.
+    let _one_thread_each = harness::aero::register_runs(2);
+    let (cases, studies, gusts) = std::thread::scope(|s| {
+        let studies = s.spawn(|| all_studies(a, &p, &progress));
+        let gusts = s.spawn(|| all_gusts(a, &p, &progress));
+        let sweeps = s.spawn(|| all_sweeps(&p, &progress));
+        let cases = all_cases(a, &p, &progress, sweeps);
+        (cases, joined(studies), joined(gusts))
+    });
+    let (cases, studies, gusts) = (cases?, studies?, gusts?);
+    let interrupted = cases.interrupted || harness::signal::interrupted();
+    let (ladders, bench) = if a.quick || interrupted { Default::default() } else { all_timed(a, &p, &progress)? };
+    // The manifest's units: the cases, the ladders, the stress matrix, the energy study, the benchmark.
+    let done: Vec<String> = [cases.done, ladders, studies, bench].concat();
+    let failures = cases.failures.and(gusts);
+    match &p.plan {
+        Some(plan) => {
+            progress.phase("shard: the exact runs and the manifest for `harness merge`");
+            for (spec, r) in p.runs.iter().zip(&cases.results) {
+                harness::merge::save_case(&plan.data_dir(out), spec, r)?;
+            }
+            let stress_dir = variant_name("stress", &a.set.set, &Formulation::ALL);
+            let args = serde_json::json!({ "report": true, "stress_dir": stress_dir, "axes": p.axes });
+            plan.write_manifest(out, args, &done)?;
+        }
+        None => {
+            progress.phase("reports: index.html, summary.md");
+            write_index(out, &cases.results).context("writing reports")?;
+        }
+    }
+    all_verdict(out, &cases.results, cases.wall, &failures, &errors, interrupted)
+}
+
+/// Read the case files and plan `harness all` (this shard's runs among all); the files that did
+/// not load are printed and returned.
+fn all_plan(a: &AllArgs, progress: &Progress) -> Result<(AllPlan, Vec<harness::Error>)> {
+    let (cases, set) = (&a.cases.cases, &a.set.set);
+    let files = discover(cases)?;
     progress.phase(&format!("reading {} case files in {}", files.len(), cases.display()));
     let (runs, errors) = expand_all(&files, set);
     for e in &errors {
@@ -1076,58 +1184,86 @@ fn cmd_all(a: &AllArgs) -> Result<ExitCode> {
         all_units(&all_runs, a.quick, stress_base.as_ref(), &axes, &extras)
     })?;
     let runs: Vec<_> = all_runs.iter().filter(|r| runs_here(plan.as_ref(), &run_unit(&r.name))).cloned().collect();
-    let p = AllPlan { all_runs, runs, stress_base, axes, extras, plan };
-    let mut done: Vec<String> = Vec::new();
+    Ok((AllPlan { all_runs, runs, stress_base, axes, extras, plan }, errors))
+}
+
+/// The value a lane's thread returned; a panic there goes on here.
+fn joined<T>(lane: std::thread::ScopedJoinHandle<'_, T>) -> T {
+    lane.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+}
+
+/// Whether a signal stopped `harness all`: a phase not yet begun is skipped.
+fn stopping() -> bool {
+    harness::signal::interrupted()
+}
+
+/// Whether a signal came while `phase` ran (its time loops stopped early): then it writes
+/// nothing, and says so.
+fn cut_short(progress: &Progress, phase: &str) -> bool {
+    let cut = harness::signal::interrupted();
+    if cut {
+        progress.phase(&format!("{phase}: interrupted, nothing written"));
+    }
+    cut
+}
+
+/// What the cases' lane of `harness all` hands back.
+struct CasesOutcome {
+    results: Vec<harness::report::CaseResult>,
+    /// Wall time of the case runs, s.
+    wall: f64,
+    /// Whether a signal stopped the case runs.
+    interrupted: bool,
+    /// The units finished (for a shard's manifest).
+    done: Vec<String>,
+    failures: AnalysisFailures,
+}
+
+/// The cases' lane of `harness all`: this shard's case runs, then (unless a signal stopped them)
+/// the files of their static, stability and trim sweeps (`sweeps`, computed meanwhile), compared
+/// with the runs.
+fn all_cases<'p>(
+    a: &AllArgs,
+    p: &'p AllPlan,
+    progress: &Progress,
+    sweeps: std::thread::ScopedJoinHandle<'_, Sweeps<'p>>,
+) -> Result<CasesOutcome> {
+    let out = &a.out.out;
     let t0 = std::time::Instant::now();
     progress.phase(&format!("cases: {} runs x 2 formulations", p.runs.len()));
     // Each run also records its 3-D view for the report (and writes VTK where the case asks).
-    let (results, interrupted) = run_and_write(&p.runs, &Formulation::ALL, out, &progress, &|spec, f| {
+    let (results, interrupted) = run_and_write(&p.runs, &Formulation::ALL, out, progress, &|spec, f| {
         harness::view3d::report_observer(out, spec, f)
     })?;
     let wall = t0.elapsed().as_secs_f64();
-    if !interrupted {
-        done.extend(p.runs.iter().map(|r| run_unit(&r.name)));
+    if interrupted {
+        let failures = AnalysisFailures::default();
+        return Ok(CasesOutcome { results, wall, interrupted, done: Vec::new(), failures });
     }
-    if !a.quick && !interrupted {
-        all_studies(a, &p, &progress, &mut done)?;
-    }
-    let failures = if interrupted { AnalysisFailures::default() } else { all_analyses(a, &p, &results, &progress)? };
-    match &p.plan {
-        Some(plan) => {
-            progress.phase("shard: the exact runs and the manifest for `harness merge`");
-            for (spec, r) in p.runs.iter().zip(&results) {
-                harness::merge::save_case(&plan.data_dir(out), spec, r)?;
-            }
-            let stress_dir = variant_name("stress", set, &Formulation::ALL);
-            let args = serde_json::json!({ "report": true, "stress_dir": stress_dir, "axes": p.axes });
-            plan.write_manifest(out, args, &done)?;
-        }
-        None => {
-            progress.phase("reports: index.html, summary.md");
-            write_index(out, &results).context("writing reports")?;
-        }
-    }
-    all_verdict(out, &results, wall, &failures, &errors, interrupted)
+    progress.phase(&format!("cases: done in {wall:.1} s"));
+    let done = p.runs.iter().map(|r| run_unit(&r.name)).collect();
+    let failures = all_analyses(a, &results, joined(sweeps), progress)?;
+    Ok(CasesOutcome { results, wall, interrupted, done, failures })
 }
 
-/// The phases of `harness all` after the case runs (not with --quick): the refinement ladders,
-/// the stress matrix, the energy study and the benchmark, each where this shard runs it.
-fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress, done: &mut Vec<String>) -> Result<()> {
+/// The studies' lane of `harness all` (not with --quick): the stress matrix, then the energy
+/// study, each where this shard runs it; the units finished.
+fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<Vec<String>> {
+    let mut done = Vec::new();
+    if a.quick {
+        return Ok(done);
+    }
     let (out, set) = (&a.out.out, &a.set.set);
     // Studies of a run with overrides go to folders that say so too.
     let study = |name: &str| out.join(variant_name(name, set, &Formulation::ALL));
-    for spec in p.all_runs.iter().filter(|r| r.ancf.converge && p.here(&format!("converge:{}", r.name))) {
-        progress.phase(&format!("refinement ladders of {}", spec.name));
-        let t = std::time::Instant::now();
-        let r = converge::converge(spec, true)?;
-        converge::write(&study("converge").join(&spec.name), &r)?;
-        println!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-        done.push(format!("converge:{}", spec.name));
-    }
-    if let Some(spec) = &p.stress_base {
+    if let Some(spec) = p.stress_base.as_ref().filter(|_| !stopping()) {
         progress.phase("stress matrix (c x beta x dt x rho_inf, both formulations), then its two long runs");
         let t = std::time::Instant::now();
-        let (cells, ex) = run_stress(spec, &p.axes, &p.extras, p.plan.as_ref(), done);
+        let mut units = Vec::new();
+        let (cells, ex) = run_stress(spec, &p.axes, &p.extras, p.plan.as_ref(), &mut units, progress);
+        if cut_short(progress, "stress matrix") {
+            return Ok(done);
+        }
         match &p.plan {
             Some(plan) => harness::merge::save_stress(&plan.data_dir(out), &cells, &ex)?,
             None => {
@@ -1135,24 +1271,106 @@ fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress, done: &mut Vec<Str
                 stress::write_extras(&study("stress"), &ex)?;
             }
         }
+        let mut lines = Lines::new();
         for f in Formulation::ALL {
             let (ok, rec, n) = stress::survival(&cells, f);
-            println!("stress {f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control");
+            lines
+                .out(format!("stress {f}: {ok} of {n} cells reach t_end at fixed steps, {rec} more with step control"));
         }
-        println!("stress matrix: {:.1} s", t.elapsed().as_secs_f64());
+        lines.out(format!("stress matrix: {:.1} s", t.elapsed().as_secs_f64()));
+        lines.print(progress);
+        done.extend(units);
     }
-    if p.here("energy") {
+    if p.here("energy") && !stopping() {
         progress.phase("energy study (rho_inf = 1, both forms, dt and dt/2)");
-        run_energy(&p.all_runs, &study("energy"))?;
+        let (runs, secs) = energy_study(&p.all_runs);
+        if cut_short(progress, "energy study") {
+            return Ok(done);
+        }
+        let mut lines = Lines::new();
+        energy_report(&runs, secs, &study("energy"), &mut lines)?;
+        lines.print(progress);
         done.push("energy".into());
     }
-    if p.here("bench") {
-        progress.phase("speed benchmark (serial repeated runs)");
-        let pendulums: Vec<_> = p.all_runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
-        run_bench(&pendulums, 7, &study("bench"))?;
-        done.push("bench".into());
+    Ok(done)
+}
+
+/// The lane of `harness all` with Healy's readings (where the three cases are) and the gust
+/// sweeps, several minutes of CPU: not with --quick, and not on a shard (on a cluster the gust
+/// sweeps are their own array, `harness gust --shard`).
+fn all_gusts(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<AnalysisFailures> {
+    let mut n = AnalysisFailures::default();
+    if a.quick || p.plan.is_some() {
+        return Ok(n);
     }
-    Ok(())
+    let (cases, out) = (&a.cases.cases, &a.out.out);
+    let healy_here = harness::healy_readings::CASES.iter().all(|c| cases.join(format!("{c}.json")).is_file());
+    if healy_here && !stopping() {
+        progress.phase("the readings of Healy's experiment");
+        let mut lines = Lines::new();
+        n.static_failed += usize::from(healy_readings(cases, out, Formulation::Gebf, &mut lines)?);
+        lines.print(progress);
+    }
+    for spec in p.runs.iter().filter(|r| r.ancf.gust.is_some()) {
+        if stopping() {
+            break;
+        }
+        progress.phase(&format!("gust sweep of {}", spec.name));
+        let t = std::time::Instant::now();
+        let file = spec.dir.join(format!("{}.json", spec.name)).display().to_string();
+        let summary = gust_sweep(spec, &Formulation::ALL, &file)?;
+        if cut_short(progress, &format!("gust sweep of {}", spec.name)) {
+            break;
+        }
+        let mut lines = Lines::new();
+        n.gust_failed += usize::from(gust_report(spec, &Formulation::ALL, &summary, out, &mut lines)?);
+        lines.out(format!("gust {}: {:.1} s", spec.name, t.elapsed().as_secs_f64()));
+        lines.print(progress);
+    }
+    Ok(n)
+}
+
+/// The studies of `harness all` whose figures are times meant to characterise speed, after every
+/// other phase (not with --quick nor after a signal), each where this shard runs it; the units
+/// finished, the ladders' and the benchmark's.
+///
+/// They run alone: the cost of a ladder's rung is its thread CPU time in the work-precision plot,
+/// and the rungs go two at a time as `harness converge` runs them, so that each shares the
+/// machine's memory and caches with another rung only, not with whatever runs of other phases
+/// happen to go beside it; the benchmark is the median thread CPU time of serial runs, with the
+/// other core idle.
+fn all_timed(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<(Vec<String>, Vec<String>)> {
+    let (out, set) = (&a.out.out, &a.set.set);
+    let study = |name: &str| out.join(variant_name(name, set, &Formulation::ALL));
+    let mut ladders = Vec::new();
+    for spec in p.all_runs.iter().filter(|r| r.ancf.converge && p.here(&format!("converge:{}", r.name))) {
+        if stopping() {
+            break;
+        }
+        progress.phase(&format!("refinement ladders of {}", spec.name));
+        let t = std::time::Instant::now();
+        let r = converge::converge(spec, progress)?;
+        if cut_short(progress, &format!("refinement ladders of {}", spec.name)) {
+            break;
+        }
+        converge::write(&study("converge").join(&spec.name), &r)?;
+        let mut lines = Lines::new();
+        lines.out(format!("converge {}: {:.1} s", spec.name, t.elapsed().as_secs_f64()));
+        lines.print(progress);
+        ladders.push(format!("converge:{}", spec.name));
+    }
+    let mut bench = Vec::new();
+    if p.here("bench") && !stopping() {
+        progress.phase("speed benchmark (serial repeated runs)");
+        let t = std::time::Instant::now();
+        let pendulums: Vec<_> = p.all_runs.iter().filter(|r| r.ancf.aero.is_none()).cloned().collect();
+        let rows = bench::run(&pendulums, BENCH_REPEATS, true);
+        if !cut_short(progress, "speed benchmark") {
+            write_bench(&pendulums, BENCH_REPEATS, &rows, &study("bench"), t)?;
+            bench.push("bench".into());
+        }
+    }
+    Ok((ladders, bench))
 }
 
 /// How many sweeps of each analysis failed in `harness all`.
@@ -1164,63 +1382,110 @@ struct AnalysisFailures {
     gust_failed: usize,
 }
 
-/// The analyses of `harness all` on this shard's runs: the static and stability sweeps (beside
-/// the runs' histories), and without --quick or a shard the gust sweeps.
+impl AnalysisFailures {
+    /// The failures of both.
+    fn and(self, o: Self) -> Self {
+        Self {
+            static_failed: self.static_failed + o.static_failed,
+            stability_failed: self.stability_failed + o.stability_failed,
+            trim_failed: self.trim_failed + o.trim_failed,
+            gust_failed: self.gust_failed + o.gust_failed,
+        }
+    }
+}
+
+/// The static, stability and trim sweeps of this shard's runs, each with both formulations and
+/// its wall time, s (the sweeps of a kind side by side; a run's sweep not begun when a signal came
+/// is left out).
+struct Sweeps<'p> {
+    statics: PerRun<'p, harness::static_out::StaticSummary>,
+    stabilities: PerRun<'p, Vec<harness::stability::StabilityOutput>>,
+    trims: PerRun<'p, Result<Vec<aeroelastic::trim::TrimOutput>, String>>,
+}
+
+/// Runs, each with a result and its wall time, s.
+type PerRun<'p, T> = Vec<(&'p RunSpec, T, f64)>;
+
+/// The sweeps' lane of `harness all`: the static, stability and trim sweeps of this shard's runs,
+/// which need nothing of the runs until they are compared with them ([`all_analyses`]).
+fn all_sweeps<'p>(p: &'p AllPlan, progress: &Progress) -> Sweeps<'p> {
+    use rayon::prelude::*;
+    /// `work` on every run with `has` (unless a signal came before it began), side by side, timed.
+    fn each<'p, T: Send>(
+        runs: &'p [RunSpec],
+        has: impl Fn(&RunSpec) -> bool,
+        work: impl Fn(&RunSpec) -> T + Sync,
+    ) -> PerRun<'p, T> {
+        let specs: Vec<&RunSpec> = runs.iter().filter(|r| has(r)).collect();
+        let timed = |spec: &&'p RunSpec| {
+            let t = std::time::Instant::now();
+            (!stopping()).then(|| (*spec, work(spec), t.elapsed().as_secs_f64()))
+        };
+        specs.par_iter().filter_map(timed).collect()
+    }
+    let count = |has: fn(&RunSpec) -> bool| p.runs.iter().filter(|r| has(r)).count();
+    let has_static: fn(&RunSpec) -> bool = |r| r.ancf.statics.is_some();
+    let has_stability: fn(&RunSpec) -> bool = |r| r.ancf.stability.is_some();
+    let has_trim: fn(&RunSpec) -> bool = |r| r.ancf.trim.is_some();
+    progress.phase(&format!(
+        "sweeps: static of {} runs, stability of {}, trim of {}",
+        count(has_static),
+        count(has_stability),
+        count(has_trim)
+    ));
+    let fs = &Formulation::ALL;
+    // The costliest kind first: its long sweeps start while there is other work to go beside them.
+    let stabilities = each(&p.runs, has_stability, |spec| run_stability_case(spec, fs));
+    let statics = each(&p.runs, has_static, |spec| run_static_case(spec, fs));
+    let trims = each(&p.runs, has_trim, |spec| harness::trim_out::run(spec, fs));
+    Sweeps { statics, stabilities, trims }
+}
+
+/// The files of the sweeps of this shard's runs in `harness all` and their lines, after the runs:
+/// the static sweeps compared with the runs' time histories (side by side), the stability sweeps
+/// beside them, and the trims; in the runs' order.
 fn all_analyses(
     a: &AllArgs,
-    p: &AllPlan,
     results: &[harness::report::CaseResult],
+    sweeps: Sweeps<'_>,
     progress: &Progress,
 ) -> Result<AnalysisFailures> {
+    use rayon::prelude::*;
     let out = &a.out.out;
     let mut n = AnalysisFailures::default();
-    for spec in p.runs.iter().filter(|r| r.ancf.statics.is_some()) {
-        progress.phase(&format!("static sweep of {}", spec.name));
-        let t = std::time::Instant::now();
-        let mut summary = run_static_case(spec, &Formulation::ALL);
-        if let Some(r) = results.iter().find(|r| r.name == spec.name) {
-            harness::static_out::compare_with_history(&mut summary, spec, &r.runs);
-        }
-        harness::static_out::write(&out.join(&spec.name), &summary)?;
-        n.static_failed += usize::from(report_static(&summary));
-        println!("static {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-    }
-    // The readings of Healy's experiment (about a minute of CPU), where the three cases are.
-    let cases = &a.cases.cases;
-    let healy_here = harness::healy_readings::CASES.iter().all(|c| cases.join(format!("{c}.json")).is_file());
-    if !a.quick && p.plan.is_none() && healy_here {
-        progress.phase("the readings of Healy's experiment");
-        n.static_failed += usize::from(healy_readings(cases, out, Formulation::Gebf)?);
-    }
-    for spec in p.runs.iter().filter(|r| r.ancf.stability.is_some()) {
-        progress.phase(&format!("stability sweep of {}", spec.name));
-        let t = std::time::Instant::now();
-        let outs = run_stability_case(spec, &Formulation::ALL);
-        let history = results.iter().find(|r| r.name == spec.name).map(|r| r.metrics.clone());
-        harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, &outs, history.as_ref())?;
-        n.stability_failed += usize::from(report_stability(&spec.name, &outs));
-        println!("stability {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-    }
-    for spec in p.runs.iter().filter(|r| r.ancf.trim.is_some()) {
-        progress.phase(&format!("trim of {}", spec.name));
-        let t = std::time::Instant::now();
-        let outs = harness::trim_out::run(spec, &Formulation::ALL)
-            .map_err(|msg| harness::Error::Case { file: spec.name.clone(), msg })?;
-        harness::trim_out::write(&out.join(&spec.name), &spec.name, &outs)?;
-        n.trim_failed += usize::from(harness::trim_out::report(&spec.name, &outs));
-        println!("trim {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
-    }
-    // The gust sweeps (several minutes of CPU): not with --quick, and on a cluster as their own
-    // array (`harness gust --shard`).
-    if !a.quick && p.plan.is_none() {
-        for spec in p.runs.iter().filter(|r| r.ancf.gust.is_some()) {
-            progress.phase(&format!("gust sweep of {}", spec.name));
+    let history = |spec: &RunSpec| results.iter().find(|r| r.name == spec.name);
+    if !sweeps.statics.is_empty() {
+        progress.phase("static sweeps: against the runs' time histories");
+        let mut statics = sweeps.statics;
+        statics.par_iter_mut().for_each(|(spec, summary, secs)| {
             let t = std::time::Instant::now();
-            let file = spec.dir.join(format!("{}.json", spec.name)).display().to_string();
-            n.gust_failed += usize::from(gust_case(spec, &Formulation::ALL, out, &file)?);
-            println!("gust {}: {:.1} s", spec.name, t.elapsed().as_secs_f64());
+            if let Some(r) = history(spec) {
+                harness::static_out::compare_with_history(summary, spec, &r.runs);
+            }
+            *secs += t.elapsed().as_secs_f64();
+        });
+        let mut lines = Lines::new();
+        for (spec, summary, secs) in &statics {
+            harness::static_out::write(&out.join(&spec.name), summary)?;
+            n.static_failed += usize::from(report_static(summary, &mut lines));
+            lines.out(format!("static {}: {secs:.1} s", spec.name));
         }
+        lines.print(progress);
     }
+    let mut lines = Lines::new();
+    for (spec, outs, secs) in &sweeps.stabilities {
+        let metrics = history(spec).map(|r| r.metrics.clone());
+        harness::stability_out::write_with_history(&out.join(&spec.name), &spec.name, outs, metrics.as_ref())?;
+        n.stability_failed += usize::from(report_stability(&spec.name, outs, &mut lines));
+        lines.out(format!("stability {}: {secs:.1} s", spec.name));
+    }
+    for (spec, outs, secs) in sweeps.trims {
+        let outs = outs.map_err(|msg| harness::Error::Case { file: spec.name.clone(), msg })?;
+        harness::trim_out::write(&out.join(&spec.name), &spec.name, &outs)?;
+        n.trim_failed += usize::from(harness::trim_out::report(&spec.name, &outs, &mut lines));
+        lines.out(format!("trim {}: {secs:.1} s", spec.name));
+    }
+    lines.print(progress);
     Ok(n)
 }
 
@@ -1350,8 +1615,9 @@ fn cmd_converge(a: &StudyArgs) -> Result<ExitCode> {
             .collect()
     })?;
     let mut done = Vec::new();
+    let progress = Progress::new(true);
     for spec in runs.iter().filter(|r| runs_here(plan.as_ref(), &format!("converge:{}", r.name))) {
-        let r = converge::converge(spec, true)?;
+        let r = converge::converge(spec, &progress)?;
         let dir = out.join("converge").join(&spec.name);
         converge::write(&dir, &r)?;
         for o in &r.orders {
@@ -1410,7 +1676,7 @@ fn cmd_stress(a: &StressArgs) -> Result<ExitCode> {
     let plan = harness::shard::plan("stress", a.shard.shard, || stress_units(base, &axes, &extras))?;
     let t0 = std::time::Instant::now();
     let mut done = Vec::new();
-    let (cells, ex) = run_stress(base, &axes, &extras, plan.as_ref(), &mut done);
+    let (cells, ex) = run_stress(base, &axes, &extras, plan.as_ref(), &mut done, &Progress::new(true));
     let dir = out.join("stress");
     for f in Formulation::ALL {
         let (ok, rec, n) = stress::survival(&cells, f);
@@ -1447,8 +1713,11 @@ fn cmd_energy(a: &EnergyArgs) -> Result<ExitCode> {
     for e in &errors {
         eprintln!("error: {e}");
     }
-    let ok = run_energy(&runs, &a.out.out.join("energy"))?;
-    Ok(exit_code(&errors, ok))
+    let (study, secs) = energy_study(&runs);
+    let mut lines = Lines::new();
+    let ok = energy_report(&study, secs, &a.out.out.join("energy"), &mut lines);
+    lines.print(&Progress::Off);
+    Ok(exit_code(&errors, ok?))
 }
 
 /// The case files of `harness gate` and `harness bench` (explicit, else discovered), expanded;

@@ -60,6 +60,22 @@ impl Progress {
         }
     }
 
+    /// A bar counting `len` items of work (ladder rungs, stress cells) labelled `label`, among
+    /// the runs' bars; hidden unless there are bars.
+    pub fn counter(&self, len: usize, label: &str) -> ProgressBar {
+        match self {
+            Progress::Bars(m) => {
+                let b = m.add(ProgressBar::new(len as u64));
+                if let Ok(style) = ProgressStyle::with_template("{bar:30} {msg}: {pos} of {len}") {
+                    b.set_style(style);
+                }
+                b.set_message(label.to_string());
+                b
+            }
+            _ => ProgressBar::hidden(),
+        }
+    }
+
     /// Announce a phase of a command (`harness all`: cases, ladders, stress, energy, bench, reports).
     pub fn phase(&self, text: &str) {
         match self {
@@ -67,6 +83,14 @@ impl Progress {
                 let _ = m.println(format!("== {text}"));
             }
             _ => eprintln!("== {text}"),
+        }
+    }
+
+    /// Run `f` (which prints) with the bars hidden, and draw them again after it.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        match self {
+            Progress::Bars(m) => m.suspend(f),
+            _ => f(),
         }
     }
 }

@@ -16,6 +16,7 @@ use crate::Error;
 use crate::case::{Case, Formulation, Joint, RunSpec};
 use crate::csv::write_file;
 use crate::metrics::FormulationMetrics;
+use crate::progress::Progress;
 use crate::scene::run_formulation;
 
 /// The axes of the matrix.
@@ -130,14 +131,15 @@ pub fn job_cost(base: &RunSpec, &(f, c, b, d, r): &Job) -> f64 {
     crate::budget::estimate(&cell_case(base.case(f), c, b, d, r), f, None).seconds
 }
 
-/// Run the matrix on `base` (rayon over cells).
-pub fn run(base: &RunSpec, axes: &Axes, progress: bool) -> Vec<Cell> {
+/// Run the matrix on `base` (rayon over cells), counting the cells on `progress`.
+pub fn run(base: &RunSpec, axes: &Axes, progress: &Progress) -> Vec<Cell> {
     run_jobs(base, &jobs(axes), progress)
 }
 
-/// Run the given cells of the matrix on `base` (rayon over cells), in their order.
-pub fn run_jobs(base: &RunSpec, jobs: &[Job], progress: bool) -> Vec<Cell> {
-    let bar = if progress { indicatif::ProgressBar::new(jobs.len() as u64) } else { indicatif::ProgressBar::hidden() };
+/// Run the given cells of the matrix on `base` (rayon over cells), in their order, counting
+/// them on `progress`.
+pub fn run_jobs(base: &RunSpec, jobs: &[Job], progress: &Progress) -> Vec<Cell> {
+    let bar = progress.counter(jobs.len(), "stress cells");
     let cells = jobs
         .par_iter()
         .map(|&(f, c, b, d, r)| {
@@ -332,10 +334,8 @@ impl crate::run::Observer for Progressed {
 }
 
 /// Run extra cases (label, case spec) with both formulations in parallel, each rerun with step
-/// control if it fails, with per-run progress.
-pub fn run_extras(extras: &[(String, RunSpec)]) -> Vec<Extra> {
-    let progress = crate::progress::Progress::new(true);
-    let progress = &progress;
+/// control if it fails, with per-run progress on `progress`.
+pub fn run_extras(extras: &[(String, RunSpec)], progress: &Progress) -> Vec<Extra> {
     let jobs: Vec<(usize, Formulation)> =
         (0..extras.len()).flat_map(|i| Formulation::ALL.into_iter().map(move |f| (i, f))).collect();
     jobs.par_iter()

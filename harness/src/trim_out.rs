@@ -110,13 +110,13 @@ pub fn sections_html(out: &Path) -> String {
     crate::report::fragments(out, SECTION_FILE)
 }
 
-/// One line per formulation; true when a trim failed.
-pub fn report(name: &str, outs: &[TrimOutput]) -> bool {
+/// One line per formulation, kept in `lines`; true when a trim failed.
+pub fn report(name: &str, outs: &[TrimOutput], lines: &mut crate::console::Lines) -> bool {
     let mut failed = false;
     for o in outs {
         let controls: Vec<String> = o.controls.iter().map(|(n, d)| format!("{n} {d:+.4} deg")).collect();
         match &o.error {
-            None => println!(
+            None => lines.out(format!(
                 "trim {name} {}: alpha {:.4} deg, elevator {:+.4} deg ({}), thrust {:.4} N at {:.2} m/s; net load \
                  {:.2e} N forward, {:.2e} N up, {:.2e} N m pitch; {} iterations, {} static solves, {:.2} s",
                 o.formulation,
@@ -131,10 +131,10 @@ pub fn report(name: &str, outs: &[TrimOutput]) -> bool {
                 o.iterations,
                 o.static_solves,
                 o.wall_s
-            ),
+            )),
             Some(e) => {
                 failed = true;
-                eprintln!("trim {name} {}: FAILED: {e}", o.formulation);
+                lines.err(format!("trim {name} {}: FAILED: {e}", o.formulation));
             }
         }
     }
