@@ -2,7 +2,8 @@
 //! (40 to 320 rows), direct and through the treecode at 1e-6 |V∞| (orders 4, 5, 6), and the
 //! direct kernel's throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
 //! shared machine, where the wall time of `cargo bench -p perf --bench uvlm_wake_scaling` / `--bench
-//! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full.
+//! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full;
+//! the last line is the 8×-wake ratio at p = 5 (interleaved medians of seven runs of 64 steps).
 //! Run: `cargo run --release -p perf --example uvlm_wake_scaling`.
 use uvlm::samples::FlaredWing;
 use uvlm::*;
@@ -19,14 +20,15 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
+/// The paper's wing marched until its wake of `rows` rows is full, as the harness marches: the
+/// far wake frozen within a step, closure legs.
+fn solver(rows: usize, agg: WakeAggregation) -> (Uvlm, Vec<SpanStation>) {
     let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
     let st = wing.stations(10f64.to_radians());
     let lat = Lattice::from_stations(wing.spec(), &st).unwrap();
     let mut p = UvlmParams::new(0.0889, [0.0, -25.0, 0.0]);
     p.parallel = Parallel::Off;
     p.n_wake_rows = rows;
-    // As the harness marches: the far wake frozen within a step, closure legs.
     p.wake_reuse = WakeReuse::Frozen;
     p.wake_closure = true;
     p.wake_aggregation = agg;
@@ -35,18 +37,41 @@ fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
         u.update_stations(&st, None).unwrap();
         u.step(0.01).unwrap();
     }
-    // The thread's CPU clock ticks coarsely on some kernels: time 20 steps at once, 3 times.
-    let times = (0..3)
-        .map(|_| {
-            let t0 = cpu_ns();
-            for _ in 0..20 {
-                u.update_stations(&st, None).unwrap();
-                std::hint::black_box(u.step(0.01).unwrap().total_force());
-            }
-            (cpu_ns() - t0) as f64 * 1e-6 / 20.0
-        })
-        .collect();
-    median(times)
+    (u, st)
+}
+
+/// Thread CPU time per step over `n` steps at once (the clock ticks coarsely on some kernels), ms.
+fn steps_ms(u: &mut Uvlm, st: &[SpanStation], n: usize) -> f64 {
+    let t0 = cpu_ns();
+    for _ in 0..n {
+        u.update_stations(st, None).unwrap();
+        std::hint::black_box(u.step(0.01).unwrap().total_force());
+    }
+    (cpu_ns() - t0) as f64 * 1e-6 / n as f64
+}
+
+fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
+    let (mut u, st) = solver(rows, agg);
+    median((0..3).map(|_| steps_ms(&mut u, &st, 20)).collect())
+}
+
+/// The performance issue's "a wake 8× longer costs at most 2.5× per step": the treecode's step
+/// at 320 rows over the faster of the direct and the treecode's at 40 rows, interleaved, medians
+/// of seven runs of 64 steps.
+fn ratio(order: usize) {
+    let tree = WakeAggregation { order, min_segments: 0, ..WakeAggregation::treecode() };
+    let mut runs = [solver(40, WakeAggregation::off()), solver(40, tree), solver(320, tree)];
+    let mut times = [vec![], vec![], vec![]];
+    for _ in 0..7 {
+        for ((u, st), t) in runs.iter_mut().zip(&mut times) {
+            t.push(steps_ms(u, st, 64));
+        }
+    }
+    let [d40, t40, t320] = times.map(median);
+    println!(
+        "p = {order}: 40 rows direct {d40:.3} / treecode {t40:.3} ms, 320 rows treecode {t320:.3} ms: {:.2}x",
+        t320 / d40.min(t40)
+    );
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -127,4 +152,5 @@ fn main() {
         let t6 = step_ms(rows, tree(6));
         println!("{rows:4}  {d:9.3}  {t4:8.3}  {t5:8.3}  {t6:8.3}");
     }
+    ratio(5);
 }

@@ -19,7 +19,7 @@ use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
 use crate::surface::Surface;
 use crate::wake::Wake;
-use crate::wake_tree::{WakeTree, keys_representable};
+use crate::wake_tree::WakeTree;
 use std::time::Instant;
 
 /// Which trailing-edge model the current AIC was built for.
@@ -787,7 +787,7 @@ impl Uvlm {
         if frozen && !self.far_ready {
             // The far wake's segments are named when a tree can be kept across steps.
             let named = self.params.wake_aggregation.enabled
-                && keys_representable(
+                && SegmentKeys::representable(
                     self.surfaces.len(),
                     self.surfaces.iter().map(|s| s.wake.n_spanwise()).max().unwrap_or(0),
                 );

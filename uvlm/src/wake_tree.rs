@@ -13,12 +13,11 @@
 //!   changes strength: the tree takes the new strengths (0 for a segment that left) through
 //!   [`Treecode::set_segment`], which updates the moments exactly and keeps the error bound.
 //!
-//! Segments are matched through their [`SegmentKeys`] (surface, push number of the row, kind,
+//! Segments are matched through their [`SegmentKeys`](crate::aic::SegmentKeys) (surface, push number of the row, kind,
 //! strip, image copy), which ascend in the set's order, so one merge of the two key lists finds
 //! what changed. The tree is rebuilt every [`REBUILD_PERIOD`] steps, when the wake did not move
 //! rigidly ([`WakeTree::break_persistence`]), and when most of the set is new.
 
-use crate::aic::SegmentKeys;
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, load_lanes, velocity_block};
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::params::{Parallel, WakeAggregation};
@@ -277,15 +276,10 @@ fn copy_legs(set: &Filaments, out: &mut Filaments) {
     }
 }
 
-/// Whether the keys of a wake of these dimensions name its segments uniquely.
-pub(crate) fn keys_representable(n_surfaces: usize, n_spanwise: usize) -> bool {
-    SegmentKeys::representable(n_surfaces, n_spanwise)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::aic::{WakePart, append_known_wake};
+    use crate::aic::{SegmentKeys, WakePart, append_known_wake};
     use crate::biot_savart::CoreModel;
     use crate::images::{ImagePlane, append_images};
     use crate::induce::induced_velocity;
