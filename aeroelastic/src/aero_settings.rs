@@ -85,18 +85,24 @@ pub struct AeroSettings {
     /// A gust or turbulence field convected with the free stream (docs/gust.md); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     pub gust: Option<GustSpec>,
-    /// Sum long wakes through the UVLM's treecode, within 1e-6 of the free-stream speed at
-    /// every point (docs/uvlm.md §14): a wake of at least `wake_aggregation_min_segments`
-    /// filaments (its images included) goes through the treecode, a shorter one is summed
-    /// directly, bit for bit as with `false`; default true. `false` sums every wake directly.
+    /// Sum the far wake to within 1e-6 of the free-stream speed at every point instead of
+    /// exactly (docs/uvlm.md §14): a wake of at least `wake_aggregation_min_segments` filaments
+    /// (its images included) goes through the UVLM's treecode, a shorter one is summed directly
+    /// in mixed precision (`wake_mixed_precision`); default true. `false` sums every wake
+    /// directly in f64.
     #[cfg_attr(feature = "serde", serde(default = "default_true"))]
     pub wake_aggregation: bool,
     /// The wake size from which `wake_aggregation` applies, filaments (the far wake's segments
-    /// with their images); default 6000 (`uvlm::WakeAggregation::AUTO_MIN_SEGMENTS`: about 90
-    /// rows of the paper's wing or 67 of Healy's; the treecode breaks even below it,
-    /// docs/uvlm.md §14). 0 aggregates every wake.
+    /// with their images); default 8000 (`uvlm::WakeAggregation::AUTO_MIN_SEGMENTS`: about 120
+    /// rows of the paper's wing or 90 of Healy's, where the treecode breaks even with the
+    /// mixed-precision direct sum, docs/uvlm.md §14). 0 aggregates every wake.
     #[cfg_attr(feature = "serde", serde(default = "default_aggregation_min_segments"))]
     pub wake_aggregation_min_segments: usize,
+    /// With `wake_aggregation`: sum the far wake (rows one and on) in mixed precision where the
+    /// treecode does not apply (positions and sums in f64, the kernel in f32; within 1e-6 of the
+    /// free-stream speed, docs/uvlm.md §14); default true. `false` sums it in f64.
+    #[cfg_attr(feature = "serde", serde(default = "default_true"))]
+    pub wake_mixed_precision: bool,
     /// Section polars (issue 37, docs/section_aero.md): the lattice's loads on the strips of
     /// these bodies are corrected by the polar (lift, profile drag, moment); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
@@ -199,6 +205,7 @@ impl AeroSettings {
         params.wake_aggregation = if self.wake_aggregation {
             uvlm::WakeAggregation {
                 min_segments: self.wake_aggregation_min_segments,
+                mixed_precision: self.wake_mixed_precision,
                 ..uvlm::WakeAggregation::treecode()
             }
         } else {

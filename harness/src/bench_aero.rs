@@ -4,9 +4,10 @@
 //!
 //! * **The step against the wake's length.** The coupled time step of the paper's wing
 //!   (`wing_aoa5.json`) and of Healy's wing (`healy_ffwt_flare10_aoa5.json`), GEBF, with the
-//!   wake cut to 20, 40, 80, 160 and 320 rows, summed directly and through the treecode
-//!   (`aero.wake_aggregation`). A run marches until its wake is full and 20 steps more; an
-//!   observer reads the process's CPU time at every step, and the figure is the mean over the
+//!   wake cut to 20, 40, 80, 160 and 320 rows, summed directly in f64, directly in mixed
+//!   precision and through the treecode (`aero.wake_aggregation`,
+//!   `aero.wake_aggregation_min_segments`). A run marches until its wake is full and 20 steps
+//!   more; an observer reads the process's CPU time at every step, and the figure is the mean over the
 //!   last 20 steps (process time, so that the lattice's own threads count).
 //! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
 //!   Healy's static sweep per formulation (the sweep as the median of 7 runs), each also with the
@@ -35,6 +36,43 @@ const TIMED_STEPS: usize = 20;
 /// The ending of the name of an analysis run with section polars.
 const POLARS_SUFFIX: &str = ", NACA 0015 polars";
 
+/// How the far wake is summed in a timed step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Summation {
+    /// Directly, in f64 (`aero.wake_aggregation=false`).
+    Direct,
+    /// Directly, in mixed precision (the treecode never applies).
+    Mixed,
+    /// Through the treecode at every size (its near leaves in mixed precision).
+    Treecode,
+}
+
+impl Summation {
+    /// All three, in the table's order.
+    pub const ALL: [Summation; 3] = [Summation::Direct, Summation::Mixed, Summation::Treecode];
+
+    /// The name in the tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Summation::Direct => "direct",
+            Summation::Mixed => "mixed",
+            Summation::Treecode => "treecode",
+        }
+    }
+
+    /// The case overrides that select it.
+    fn overrides(self) -> [String; 2] {
+        let (on, min) = match self {
+            Summation::Direct => (false, 0),
+            Summation::Mixed => (true, usize::MAX),
+            // The treecode at every size, to show where it breaks even.
+            Summation::Treecode => (true, 0),
+        };
+        [format!("aero.wake_aggregation={on}"), format!("aero.wake_aggregation_min_segments={min}")]
+    }
+}
+
 /// One timed step.
 #[derive(Debug, Clone, Serialize)]
 pub struct StepRow {
@@ -42,8 +80,8 @@ pub struct StepRow {
     pub case: String,
     /// Wake rows.
     pub rows: usize,
-    /// The wake summed through the treecode.
-    pub treecode: bool,
+    /// How the far wake was summed.
+    pub summation: Summation,
     /// Mean process CPU time of a step with the wake full, ms.
     pub cpu_ms: f64,
     /// Why the run stopped early, if it did.
@@ -118,15 +156,15 @@ fn spec(cases: &Path, file: &str, sets: &[String]) -> Result<RunSpec, Error> {
 }
 
 /// The mean CPU time of a GEBF step of `file` with a wake of `rows` rows, full.
-fn step_row(cases: &Path, file: &str, rows: usize, treecode: bool) -> Result<StepRow, Error> {
+fn step_row(cases: &Path, file: &str, rows: usize, summation: Summation) -> Result<StepRow, Error> {
     let probe = spec(cases, file, &[])?;
     let dt = probe.case(Formulation::ALL[1]).block(Formulation::ALL[1]).dt;
     let steps = rows + 2 + TIMED_STEPS;
+    let [on, min] = summation.overrides();
     let sets = [
         format!("aero.n_wake_rows={rows}"),
-        format!("aero.wake_aggregation={treecode}"),
-        // The treecode at every size, to show where it breaks even.
-        "aero.wake_aggregation_min_segments=0".to_string(),
+        on,
+        min,
         format!("t_end={}", steps as f64 * dt),
         format!("output_dt={dt}"),
     ];
@@ -140,7 +178,7 @@ fn step_row(cases: &Path, file: &str, rows: usize, treecode: bool) -> Result<Ste
     let n = cpu.0.len();
     let cpu_ms =
         if n > TIMED_STEPS { 1e3 * (cpu.0[n - 1] - cpu.0[n - 1 - TIMED_STEPS]) / TIMED_STEPS as f64 } else { f64::NAN };
-    Ok(StepRow { case: run.name.clone(), rows, treecode, cpu_ms, error: out.error })
+    Ok(StepRow { case: run.name.clone(), rows, summation, cpu_ms, error: out.error })
 }
 
 /// Time `work` once: process CPU and wall seconds and its error.
@@ -236,10 +274,10 @@ pub fn run(cases: &Path, progress: bool) -> Result<AeroBench, Error> {
     let mut steps = Vec::new();
     for file in ["wing_aoa5.json", "healy_ffwt_flare10_aoa5.json"] {
         for rows in WAKE_ROWS {
-            for treecode in [false, true] {
-                let r = step_row(cases, file, rows, treecode)?;
+            for summation in Summation::ALL {
+                let r = step_row(cases, file, rows, summation)?;
                 if progress {
-                    let how = if treecode { "treecode" } else { "direct" };
+                    let how = summation.name();
                     println!("bench --aero {:<26} {rows:>4} rows {how:<8}: {:8.2} ms CPU per step", r.case, r.cpu_ms);
                 }
                 steps.push(r);
@@ -259,12 +297,12 @@ pub fn run(cases: &Path, progress: bool) -> Result<AeroBench, Error> {
 }
 
 /// The ratio of the step's cost at the longest wake to that at 1/8 of it, per case and summation.
-pub fn scaling(b: &AeroBench) -> Vec<(String, bool, f64)> {
+pub fn scaling(b: &AeroBench) -> Vec<(String, Summation, f64)> {
     let mut out = Vec::new();
     for r in b.steps.iter().filter(|r| r.rows == WAKE_ROWS[4]) {
-        let short = b.steps.iter().find(|s| s.case == r.case && s.treecode == r.treecode && s.rows == WAKE_ROWS[1]);
+        let short = b.steps.iter().find(|s| s.case == r.case && s.summation == r.summation && s.rows == WAKE_ROWS[1]);
         if let Some(s) = short {
-            out.push((r.case.clone(), r.treecode, r.cpu_ms / s.cpu_ms));
+            out.push((r.case.clone(), r.summation, r.cpu_ms / s.cpu_ms));
         }
     }
     out
@@ -294,31 +332,31 @@ pub fn markdown(b: &AeroBench) -> String {
     s.push_str(&"---|".repeat(WAKE_ROWS.len() + 1));
     s.push('\n');
     let ratios = scaling(b);
-    let mut seen: Vec<(String, bool)> = Vec::new();
+    let mut seen: Vec<(String, Summation)> = Vec::new();
     for r in &b.steps {
-        if seen.contains(&(r.case.clone(), r.treecode)) {
+        if seen.contains(&(r.case.clone(), r.summation)) {
             continue;
         }
-        seen.push((r.case.clone(), r.treecode));
-        let _ = write!(s, "| {} | {} |", r.case, if r.treecode { "treecode" } else { "direct" });
+        seen.push((r.case.clone(), r.summation));
+        let _ = write!(s, "| {} | {} |", r.case, r.summation.name());
         for rows in WAKE_ROWS {
-            let x = b.steps.iter().find(|x| x.case == r.case && x.treecode == r.treecode && x.rows == rows);
+            let x = b.steps.iter().find(|x| x.case == r.case && x.summation == r.summation && x.rows == rows);
             let _ = write!(s, " {:.2} |", x.map_or(f64::NAN, |x| x.cpu_ms));
         }
-        let ratio = ratios.iter().find(|x| x.0 == r.case && x.1 == r.treecode).map_or(f64::NAN, |x| x.2);
+        let ratio = ratios.iter().find(|x| x.0 == r.case && x.1 == r.summation).map_or(f64::NAN, |x| x.2);
         let _ = writeln!(s, " {ratio:.2}× |");
     }
     // The figure: the treecode at 320 rows over the faster summation at 40 rows.
     s.push_str("\nA wake 8× longer, the treecode's 320-row step over the faster 40-row step:");
-    for case in seen.iter().filter(|x| x.1).map(|x| &x.0) {
-        let at = |rows: usize, tree: Option<bool>| {
+    for case in seen.iter().filter(|x| x.1 == Summation::Treecode).map(|x| &x.0) {
+        let at = |rows: usize, how: Option<Summation>| {
             b.steps
                 .iter()
-                .filter(|x| &x.case == case && x.rows == rows && tree.is_none_or(|t| x.treecode == t))
+                .filter(|x| &x.case == case && x.rows == rows && how.is_none_or(|h| x.summation == h))
                 .map(|x| x.cpu_ms)
                 .fold(f64::INFINITY, f64::min)
         };
-        let _ = write!(s, " {case} {:.2}×;", at(320, Some(true)) / at(40, None));
+        let _ = write!(s, " {case} {:.2}×;", at(320, Some(Summation::Treecode)) / at(40, None));
     }
     s.push_str("\n\nWhole analyses:\n\n| analysis | formulation | CPU s | wall s | error |\n|---|---|---|---|---|\n");
     for a in &b.analyses {
@@ -343,9 +381,9 @@ pub fn markdown(b: &AeroBench) -> String {
 /// Write `aero.csv`, `aero.md`, `aero.json` and `aero_wake.svg` into `dir`.
 pub fn write(dir: &Path, b: &AeroBench) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
-    let mut csv = String::from("case,rows,treecode,cpu_ms_per_step\n");
+    let mut csv = String::from("case,rows,summation,cpu_ms_per_step\n");
     for r in &b.steps {
-        let _ = writeln!(csv, "{},{},{},{:.4}", r.case, r.rows, r.treecode, r.cpu_ms);
+        let _ = writeln!(csv, "{},{},{},{:.4}", r.case, r.rows, r.summation.name(), r.cpu_ms);
     }
     write_file(&dir.join("aero.csv"), &csv)?;
     write_file(&dir.join("aero.md"), &markdown(b))?;
@@ -381,21 +419,21 @@ fn svg(path: &Path, b: &AeroBench) -> Result<(), Box<dyn std::error::Error>> {
         .draw()?;
     let palette = colors::PALETTE;
     let mut k = 0;
-    let mut seen: Vec<(String, bool)> = Vec::new();
+    let mut seen: Vec<(String, Summation)> = Vec::new();
     for r in &ok {
-        if seen.contains(&(r.case.clone(), r.treecode)) {
+        if seen.contains(&(r.case.clone(), r.summation)) {
             continue;
         }
-        seen.push((r.case.clone(), r.treecode));
+        seen.push((r.case.clone(), r.summation));
         let pts: Vec<(f64, f64)> = ok
             .iter()
-            .filter(|x| x.case == r.case && x.treecode == r.treecode)
+            .filter(|x| x.case == r.case && x.summation == r.summation)
             .map(|x| (x.rows as f64, x.cpu_ms))
             .collect();
         let c = palette[k % palette.len()];
         k += 1;
-        let label = format!("{} ({})", r.case, if r.treecode { "treecode" } else { "direct" });
-        let style = if r.treecode { c.stroke_width(2) } else { c.stroke_width(1) };
+        let label = format!("{} ({})", r.case, r.summation.name());
+        let style = if r.summation == Summation::Treecode { c.stroke_width(2) } else { c.stroke_width(1) };
         chart
             .draw_series(LineSeries::new(pts.clone(), style))?
             .label(label)
@@ -419,17 +457,18 @@ mod tests {
     /// The table's ratio is the 320-row step over the 40-row one, and every file is written.
     #[test]
     fn the_table_reports_the_eightfold_wake_and_the_files_are_written() {
-        let step = |case: &str, rows: usize, treecode: bool, cpu_ms: f64| StepRow {
+        let step = |case: &str, rows: usize, summation: Summation, cpu_ms: f64| StepRow {
             case: case.into(),
             rows,
-            treecode,
+            summation,
             cpu_ms,
             error: None,
         };
         let mut steps = Vec::new();
         for (k, rows) in WAKE_ROWS.iter().enumerate() {
-            steps.push(step("wing", *rows, false, 1.0 + k as f64));
-            steps.push(step("wing", *rows, true, 2.0 * (1.0 + k as f64).sqrt()));
+            steps.push(step("wing", *rows, Summation::Direct, 1.0 + k as f64));
+            steps.push(step("wing", *rows, Summation::Mixed, 1.5 + k as f64));
+            steps.push(step("wing", *rows, Summation::Treecode, 2.0 * (1.0 + k as f64).sqrt()));
         }
         let row = |analysis: &str, formulation: &str, cpu_s: f64| AnalysisRow {
             analysis: analysis.into(),
@@ -446,10 +485,11 @@ mod tests {
         let b = AeroBench { steps, analyses };
         assert_eq!(polar_cost(&b), vec![("a run".to_string(), "ancf".to_string(), 1.25)]);
         let ratios = scaling(&b);
-        assert_eq!(ratios.len(), 2);
+        assert_eq!(ratios.len(), 3);
         assert!((ratios[0].2 - 5.0 / 2.0).abs() < 1e-12, "{ratios:?}");
         let md = markdown(&b);
         assert!(md.contains("| wing | direct | 1.00 | 2.00 | 3.00 | 4.00 | 5.00 | 2.50× |"), "{md}");
+        assert!(md.contains("| wing | mixed | 1.50 | 2.50 | 3.50 | 4.50 | 5.50 | 2.20× |"), "{md}");
         assert!(md.contains("| a run | ancf | 1.250 |"), "{md}");
         // 2√5 at 320 rows through the treecode over the direct 2.00 at 40 rows (below its 2√2).
         assert!(md.contains("wing 2.24×;"), "{md}");

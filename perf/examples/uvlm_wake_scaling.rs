@@ -1,6 +1,6 @@
 //! CPU time of the calling thread per UVLM step of the paper's wing against the wake's length
-//! (40 to 320 rows), direct and through the treecode at 1e-6 |V∞| (orders 4, 5, 6), and the
-//! direct kernel's throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
+//! (40 to 320 rows), direct (f64, and mixed precision) and through the treecode at 1e-6 |V∞|
+//! (orders 4, 5, 6), and the direct kernels' throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
 //! shared machine, where the wall time of `cargo bench -p perf --bench uvlm_wake_scaling` / `--bench
 //! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full;
 //! the last line is the 8×-wake ratio at p = 5 (interleaved medians of seven runs of 64 steps).
@@ -60,18 +60,23 @@ fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
 /// of seven runs of 64 steps.
 fn ratio(order: usize) {
     let tree = WakeAggregation { order, min_segments: 0, ..WakeAggregation::treecode() };
-    let mut runs = [solver(40, WakeAggregation::off()), solver(40, tree), solver(320, tree)];
-    let mut times = [vec![], vec![], vec![]];
+    let mut runs = [solver(40, WakeAggregation::off()), solver(40, mixed()), solver(40, tree), solver(320, tree)];
+    let mut times = [vec![], vec![], vec![], vec![]];
     for _ in 0..7 {
         for ((u, st), t) in runs.iter_mut().zip(&mut times) {
             t.push(steps_ms(u, st, 64));
         }
     }
-    let [d40, t40, t320] = times.map(median);
+    let [d40, m40, t40, t320] = times.map(median);
     println!(
-        "p = {order}: 40 rows direct {d40:.3} / treecode {t40:.3} ms, 320 rows treecode {t320:.3} ms: {:.2}x",
-        t320 / d40.min(t40)
+        "p = {order}: 40 rows direct {d40:.3} / mixed {m40:.3} / treecode {t40:.3} ms, 320 rows treecode {t320:.3} ms: {:.2}x",
+        t320 / d40.min(m40).min(t40)
     );
+}
+
+/// The far wake summed directly in mixed precision (the treecode never applies).
+fn mixed() -> WakeAggregation {
+    WakeAggregation { min_segments: usize::MAX, ..WakeAggregation::treecode() }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -123,6 +128,18 @@ fn kernel() {
             .collect(),
     );
     println!("direct kernel: {:.3e} point-segment pairs/s per core", rate);
+    let rate32 = median(
+        (0..5)
+            .map(|_| {
+                let t0 = cpu_ns();
+                for _ in 0..20 {
+                    std::hint::black_box(induced_velocity_mixed(&fil, &pts));
+                }
+                20.0 * pairs / ((cpu_ns() - t0) as f64 * 1e-9)
+            })
+            .collect(),
+    );
+    println!("mixed-precision kernel: {:.3e} point-segment pairs/s per core", rate32);
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
         let n = 20_000_000;
@@ -138,19 +155,21 @@ fn kernel() {
         );
         println!("FMA roofline (AVX-512): {:.3e} flop/s per core", flops);
         println!("pairs per roofline flop: {:.4} (a pair is ~30 flops and one division)", rate / flops);
+        println!("mixed: pairs per f32 roofline flop (twice the f64 lanes): {:.4}", rate32 / (2.0 * flops));
     }
 }
 
 fn main() {
     kernel();
-    println!("rows  direct_ms  tree4_ms  tree5_ms  tree6_ms   (CPU time per step, median of 3 × 20 steps)");
+    println!("rows  direct_ms  mixed_ms  tree4_ms  tree5_ms  tree6_ms   (CPU time per step, median of 3 × 20 steps)");
     let tree = |order| WakeAggregation { order, ..WakeAggregation::treecode() };
     for rows in [40usize, 80, 160, 320] {
         let d = step_ms(rows, WakeAggregation::off());
+        let m = step_ms(rows, mixed());
         let t4 = step_ms(rows, tree(4));
         let t5 = step_ms(rows, tree(5));
         let t6 = step_ms(rows, tree(6));
-        println!("{rows:4}  {d:9.3}  {t4:8.3}  {t5:8.3}  {t6:8.3}");
+        println!("{rows:4}  {d:9.3}  {m:8.3}  {t4:8.3}  {t5:8.3}  {t6:8.3}");
     }
     ratio(5);
 }

@@ -66,10 +66,11 @@ pub enum WakeReuse {
     Frozen,
 }
 
-/// Far-field aggregation of the wake's induction: a treecode over the wake's segments with an
-/// error bound (docs/uvlm.md §14). Below `min_segments` wake segments, and when disabled (the
-/// default: on the paper's wing it beats the direct sum only from about 160 wake rows,
-/// docs/uvlm.md §14), every wake filament is summed directly, bit for bit as without the option.
+/// The far wake's induction to a stated accuracy instead of exactly (docs/uvlm.md §14): from
+/// `min_segments` wake segments on, a treecode over the wake's segments with an error bound;
+/// below it (and in the treecode's near leaves), the direct sum in mixed precision when
+/// `mixed_precision` (mixed.rs). Disabled (the crate's default), every wake filament is summed
+/// directly in f64, bit for bit as without the option.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WakeAggregation {
@@ -85,16 +86,20 @@ pub struct WakeAggregation {
     pub order: usize,
     /// Most segments in a leaf cluster (summed directly when near), ≥ 1. Default 128.
     pub leaf_size: usize,
+    /// Sum the far wake (rows one and on) directly in mixed precision where the treecode does
+    /// not apply: positions in f64, the kernel in f32, sums in f64 (mixed.rs, docs/uvlm.md
+    /// §14). Default true; only when `enabled`.
+    pub mixed_precision: bool,
 }
 
 impl WakeAggregation {
     /// The wake size from which the harness aggregates (`aero.wake_aggregation`): segments of
     /// the far wake, images included. The treecode kept across steps (p = 5, leaves of 128,
-    /// 1e-6 |V∞|) breaks even with the direct sum at about 55 rows of the paper's wing (65
-    /// segments a row, 420 points; 3600 segments) and is 20 % faster at Healy's 60 rows (89 a
-    /// row, 576 points; 5300 segments), docs/uvlm.md §14. Set above Healy's 60 rows so that the
-    /// shipped cases keep the direct sum.
-    pub const AUTO_MIN_SEGMENTS: usize = 6000;
+    /// 1e-6 |V∞|, near leaves in mixed precision) breaks even with the mixed-precision direct
+    /// sum at about 120 rows of the paper's wing (65 segments a row, 420 points; 7800
+    /// segments), docs/uvlm.md §14. The shipped cases' wakes (2600 and 5300 segments) are
+    /// summed directly.
+    pub const AUTO_MIN_SEGMENTS: usize = 8000;
 
     /// Aggregation switched off: every wake filament summed directly (the default).
     pub fn off() -> Self {
@@ -114,7 +119,7 @@ impl WakeAggregation {
 
 impl Default for WakeAggregation {
     fn default() -> Self {
-        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 5, leaf_size: 128 }
+        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 5, leaf_size: 128, mixed_precision: true }
     }
 }
 

@@ -142,7 +142,7 @@ impl Uvlm {
             u_far_col: vec![[0.0; 3]; nr],
             u_far_mid: Vec::new(),
             known_tree: WakeTree::new(&params.wake_aggregation),
-            far_tree: WakeTree::new(&params.wake_aggregation),
+            far_tree: WakeTree::far(&params.wake_aggregation),
             far_keys: SegmentKeys::default(),
             lu: DenseLu::new(nr),
             aic: vec![0.0; nr * nr],
@@ -527,8 +527,9 @@ impl Uvlm {
     /// solve's legs take, so that a steady solution is the march's equilibrium.
     fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool) {
         let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
-        // The far wake through the treecode: its clusters are expansions of the singular law.
-        let cutoff_only = far && self.far_tree.applies(&self.far);
+        // The far wake through the treecode (its clusters are expansions of the singular law) or
+        // the mixed-precision kernel (regular forms outside the filaments).
+        let cutoff_only = far && !self.far_tree.kernel_exact(&self.far);
         let u = if far { &mut self.u_far_mid } else { &mut self.u_mid };
         let mut p0 = 0;
         for (sl, s) in layout.surfaces.iter().zip(&self.surfaces) {

@@ -35,6 +35,7 @@
 
 use crate::biot_savart::{Filaments, Isa, LANES, NodeBlock, fill_block, isa, velocity_block};
 use crate::induce::{Points, use_threads};
+use crate::mixed::{Block32, Filaments32, add_lanes};
 use crate::params::Parallel;
 use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 
@@ -150,6 +151,9 @@ pub struct Treecode {
     /// Each leaf's segments as a set of its own (each node of the leaf once) for the block
     /// kernels.
     leaves: Vec<Filaments>,
+    /// Sum the near leaves in mixed precision (mixed.rs), with these f32 constants per leaf.
+    mixed: bool,
+    leaves32: Vec<Filaments32>,
     /// Per node of the source set: the last leaf fill that copied it (`stamp_gen`), and its
     /// index in that leaf.
     node_stamp: Vec<u64>,
@@ -197,6 +201,7 @@ struct Scratch {
     taylor: Vec<[f64; LANES]>,
     stats: TreeStats,
     blk: NodeBlock,
+    blk32: Block32<LANES>,
 }
 
 impl Treecode {
@@ -275,6 +280,12 @@ impl Treecode {
         }
     }
 
+    /// Sum the near leaves in mixed precision (f32 kernel, f64 positions and sums; mixed.rs)
+    /// from the next [`Treecode::build`] on.
+    pub(crate) fn set_mixed(&mut self, mixed: bool) {
+        self.mixed = mixed;
+    }
+
     /// Expansion order p.
     pub fn order(&self) -> usize {
         self.order
@@ -313,6 +324,12 @@ impl Treecode {
             self.split(fil);
         }
         self.fill_leaves(fil);
+        if self.mixed {
+            self.leaves32.resize_with(self.n_leaves, Filaments32::default);
+            for (c, leaf) in self.leaves32.iter_mut().zip(&self.leaves[..self.n_leaves]) {
+                c.load(leaf);
+            }
+        }
         self.index_segments();
         self.compute_moments(fil);
         self.legs.clear();
@@ -364,6 +381,9 @@ impl Treecode {
         let old = leaf.seg_g[slot];
         leaf.seg_core2[slot] = core2;
         leaf.seg_cut2[slot] = cut2;
+        if self.mixed {
+            self.leaves32[self.clusters[ci].leaf as usize].set_segment(slot, g, core2, cut2);
+        }
         if g == old {
             return;
         }
@@ -715,8 +735,12 @@ impl Treecode {
                 sc.stats.n_expansions += LANES as u64;
             } else if c.leaf != NONE {
                 let leaf = &self.leaves[c.leaf as usize];
-                fill_block(leaf, px, py, pz, &mut sc.blk);
-                velocity_block(leaf, &sc.blk, u);
+                if self.mixed {
+                    add_lanes(leaf, &self.leaves32[c.leaf as usize], &[*px, *py, *pz], &mut sc.blk32, u);
+                } else {
+                    fill_block(leaf, px, py, pz, &mut sc.blk);
+                    velocity_block(leaf, &sc.blk, u);
+                }
                 let n = (LANES * leaf.n_segments()) as u64;
                 pairs += n;
                 sc.stats.n_direct_pairs += n;

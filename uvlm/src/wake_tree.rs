@@ -20,6 +20,7 @@
 
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, load_lanes, velocity_block};
 use crate::induce::{Points, induced_velocity_inplace};
+use crate::mixed::{MixedScratch, add_velocity_mixed};
 use crate::params::{Parallel, WakeAggregation};
 use crate::scratch::ScratchPool;
 use crate::treecode::{Treecode, block_order};
@@ -44,6 +45,8 @@ pub(crate) struct WakeTree {
     order: Vec<u32>,
     stack: Vec<(usize, usize)>,
     persist: Persist,
+    /// The workspace of the mixed-precision direct sum, when this tree's set may use it.
+    mixed: Option<MixedScratch>,
 }
 
 /// The state of a tree kept across steps.
@@ -67,9 +70,21 @@ struct Persist {
 }
 
 impl WakeTree {
+    /// A tree whose set is summed with the f64 kernel where the treecode does not apply.
     pub(crate) fn new(settings: &WakeAggregation) -> Self {
-        let tree =
+        Self::with_mixed(settings, false)
+    }
+
+    /// A tree for the far wake: where the treecode does not apply, its set is summed in mixed
+    /// precision when the settings ask for it (mixed.rs).
+    pub(crate) fn far(settings: &WakeAggregation) -> Self {
+        Self::with_mixed(settings, settings.enabled && settings.mixed_precision)
+    }
+
+    fn with_mixed(settings: &WakeAggregation, mixed: bool) -> Self {
+        let mut tree =
             if settings.enabled { Treecode::new(settings.order, settings.leaf_size) } else { Treecode::default() };
+        tree.set_mixed(mixed);
         Self {
             settings: *settings,
             tree,
@@ -77,6 +92,7 @@ impl WakeTree {
             order: Vec::new(),
             stack: Vec::new(),
             persist: Persist::default(),
+            mixed: mixed.then(MixedScratch::default),
         }
     }
 
@@ -102,6 +118,12 @@ impl WakeTree {
 
     pub(crate) fn applies(&self, set: &Filaments) -> bool {
         self.settings.applies(set.n_segments())
+    }
+
+    /// Whether `set`'s induction comes from the crate's f64 kernel throughout (not from a
+    /// treecode's expansions, nor from the mixed-precision kernel's regular forms).
+    pub(crate) fn kernel_exact(&self, set: &Filaments) -> bool {
+        self.mixed.is_none() && !self.applies(set)
     }
 
     /// Make the tree hold `set`, whose segments are named by `keys` (or `None` when they cannot
@@ -193,8 +215,13 @@ impl WakeTree {
         }
         // A tree built for this use alone pays its build: it breaks even at a larger wake.
         let rebuilt = !(self.ready && self.persist.valid);
-        if !self.applies(set) || (rebuilt && set.n_segments() < REBUILT_FACTOR * self.settings.min_segments) {
-            return add_direct(set, pts, out, parallel, scratch);
+        if !self.applies(set)
+            || (rebuilt && set.n_segments() < REBUILT_FACTOR.saturating_mul(self.settings.min_segments))
+        {
+            return match &mut self.mixed {
+                Some(m) => add_velocity_mixed(set, pts, out, parallel, m),
+                None => add_direct(set, pts, out, parallel, scratch),
+            };
         }
         if !self.ready {
             self.tree.build(set);
@@ -212,7 +239,11 @@ impl WakeTree {
         }
         block_order(&p.shifted, &mut self.order, &mut self.stack);
         let pairs = self.tree.add_velocity_inplace(&p.shifted, &self.order, tol, out, parallel);
-        pairs + add_direct(&p.direct, pts, out, parallel, scratch)
+        pairs
+            + match &mut self.mixed {
+                Some(m) => add_velocity_mixed(&p.direct, pts, out, parallel, m),
+                None => add_direct(&p.direct, pts, out, parallel, scratch),
+            }
     }
 }
 
