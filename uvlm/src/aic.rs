@@ -482,8 +482,12 @@ pub(crate) fn append_known_wake(
                 let s = g(r, j as isize) - up;
                 if s != 0.0 {
                     let (k0, k1) = if k < len { (k, k + 1) } else { (k - 1, k) };
-                    let scale = 0.5 * (dist((k0, j), (k1, j)) + dist((k0, j + 1), (k1, j + 1)));
                     let c = if k == 0 { te_core } else { core };
+                    let scale = if c.uses_scale() {
+                        0.5 * (dist((k0, j), (k1, j)) + dist((k0, j + 1), (k1, j + 1)))
+                    } else {
+                        0.0
+                    };
                     fil.push_segment_scaled(node(k, j), node(k, j + 1), s, c, scale);
                     if let Some(keys) = keys.as_deref_mut() {
                         keys.push(wake.n_pushed() - k as u64, false, j);

@@ -69,6 +69,13 @@ impl CoreModel {
         }
     }
 
+    /// Whether [`CoreModel::coefficients`] reads its `scale` argument (only the Scully core sized
+    /// from the panel): callers skip computing it otherwise.
+    #[inline]
+    pub fn uses_scale(&self) -> bool {
+        matches!(self, CoreModel::Scully { .. })
+    }
+
     /// Per-segment kernel constants `(core2, cut2)` for a segment of squared length `len2` whose
     /// local panel length is `scale`: the term added to |r₁×r₂|² and the threshold below which
     /// the induction is zeroed.
@@ -234,8 +241,12 @@ impl Filaments {
     /// Append the segment `a → b` of circulation `gamma` with the given core, sized (for
     /// [`CoreModel::Scully`]) from the segment's own length.
     pub fn push_segment(&mut self, a: u32, b: u32, gamma: f64, core: &CoreModel) {
-        let (pa, pb) = (self.node(a as usize), self.node(b as usize));
-        let len = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt();
+        let len = if core.uses_scale() {
+            let (pa, pb) = (self.node(a as usize), self.node(b as usize));
+            ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt()
+        } else {
+            0.0
+        };
         self.push_segment_scaled(a, b, gamma, core, len);
     }
 
