@@ -71,29 +71,35 @@ pub fn run_into(
         (0..runs.len()).flat_map(|i| formulations.iter().map(move |&f| (i, f))).collect();
     // A single run may thread its aerodynamics; several share the threads one each.
     let _runs = crate::aero::register_runs(jobs.len());
-    let outputs: Vec<_> = jobs
-        .par_iter()
-        .map(|&(i, f)| {
-            let case = runs[i].case(f);
-            let csv = match dirs
-                .map(|d| {
-                    CsvStream::create(&d[i].join(format!("{f}.csv")), casefile::csv::surface_names(case.aero.as_ref()))
-                })
-                .transpose()
-            {
-                Ok(c) => c,
-                Err(e) => return (i, RunOutput::failed(f, e.to_string())),
-            };
-            let dt = case.block(f).dt;
-            let mut obs = Streamed {
-                csv,
-                progress: progress.run(&runs[i].name, f, case.t_end, dt),
-                inner: observer(&runs[i], f),
-            };
-            let out = run_formulation_observed(case, f, &mut obs);
-            (i, out)
-        })
-        .collect();
+    // On a pool thread: a lone run's parallel loops then split their work with the thread that
+    // marches, instead of each loop being handed to the pool from outside and waited on.
+    let outputs: Vec<_> = rayon::scope(|_| {
+        jobs.par_iter()
+            .map(|&(i, f)| {
+                let case = runs[i].case(f);
+                let csv = match dirs
+                    .map(|d| {
+                        CsvStream::create(
+                            &d[i].join(format!("{f}.csv")),
+                            casefile::csv::surface_names(case.aero.as_ref()),
+                        )
+                    })
+                    .transpose()
+                {
+                    Ok(c) => c,
+                    Err(e) => return (i, RunOutput::failed(f, e.to_string())),
+                };
+                let dt = case.block(f).dt;
+                let mut obs = Streamed {
+                    csv,
+                    progress: progress.run(&runs[i].name, f, case.t_end, dt),
+                    inner: observer(&runs[i], f),
+                };
+                let out = run_formulation_observed(case, f, &mut obs);
+                (i, out)
+            })
+            .collect()
+    });
     let mut per: Vec<Vec<_>> = vec![Vec::new(); runs.len()];
     for (i, o) in outputs {
         per[i].push(o);

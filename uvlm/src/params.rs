@@ -124,7 +124,7 @@ impl Default for WakeAggregation {
 }
 
 /// Work per thread below which [`Parallel::Auto`] stays sequential (point–filament pairs).
-pub const PARALLEL_MIN_PAIRS: usize = 100_000;
+pub const PARALLEL_MIN_PAIRS: usize = 25_000;
 
 /// Parameters of the UVLM solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
