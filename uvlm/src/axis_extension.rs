@@ -23,7 +23,9 @@
 
 use crate::aic::WakePart;
 use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI, Isa, isa};
-use crate::induce::Points;
+use crate::induce::{Points, use_threads};
+use crate::params::Parallel;
+use rayon::prelude::*;
 use crate::wake::Wake;
 
 /// A segment pair seen from a load point (`u = Γ/4π · k · r₁×r₂`): `r₁×r₂`, `r₁·r₂`, the block
@@ -94,6 +96,14 @@ pub(crate) struct ExtensionLayout {
     pub(crate) n_copies: usize,
 }
 
+impl ExtensionLayout {
+    /// The segment pairs [`correct_axis_extensions`] evaluates (a bound on them: every point
+    /// takes the longer of its row and its column).
+    fn n_axis_pairs(&self) -> usize {
+        self.surfaces.iter().map(|sl| sl.n_load * (sl.n.max(sl.m + 1))).sum::<usize>() * self.n_copies
+    }
+}
+
 /// The crate kernel's factor of a leg pair, with the block kernels' arithmetic.
 #[inline]
 fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
@@ -113,34 +123,62 @@ fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
 /// trailing leg — by the regular form of [`pair_factors`] and [`leg_factor`] where the point
 /// lies outside the segment (module doc). Other filaments are never collinear with a load point
 /// of a ring lattice by construction, and keep the block kernels' value.
-pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
-    let mut p = 0;
+pub(crate) fn correct_axis_extensions(
+    fil: &Filaments,
+    layout: &ExtensionLayout,
+    pts: &Points,
+    u: &mut [[f64; 3]],
+    parallel: Parallel,
+) {
+    if use_threads(parallel, AXIS_PAIR_COST * layout.n_axis_pairs()) {
+        u.par_chunks_mut(AXIS_CHUNK)
+            .enumerate()
+            .for_each(|(c, out)| correct_axis_points(fil, layout, pts, c * AXIS_CHUNK, out));
+    } else {
+        correct_axis_points(fil, layout, pts, 0, u);
+    }
+}
+
+/// Load points per task of a threaded [`correct_axis_extensions`].
+const AXIS_CHUNK: usize = 48;
+
+/// The cost of a regular-form pair of [`correct_axis_extensions`] in block-kernel pairs (its two
+/// square roots and two divisions against the kernel's share of a node's), for
+/// [`use_threads`].
+const AXIS_PAIR_COST: usize = 4;
+
+/// [`correct_axis_extensions`] at the load points `first..first + out.len()`, into `out`.
+fn correct_axis_points(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, first: usize, out: &mut [[f64; 3]]) {
+    let mut ch = RunChunk::new();
+    let mut base = 0;
     for sl in &layout.surfaces {
         let (m, n) = (sl.m, sl.n);
         let nc = n + 1;
-        for s in 0..sl.n_load {
+        let (lo, hi) = (first.max(base), (first + out.len()).min(base + sl.n_load));
+        for p in lo..hi {
+            let s = p - base;
             let x = [pts.x[p], pts.y[p], pts.z[p]];
-            let o = &mut u[p];
-            p += 1;
+            let o = &mut out[p - first];
             for c in 0..layout.n_copies {
                 let seg = |b: usize| c * layout.n_base_seg + b;
                 if s < m * n || s >= m * n + m * nc {
                     // A spanwise point: the segments of its row.
                     let i = if s < m * n { s / n } else { m };
                     let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
-                    fix_run((first..first + n).map(|b| filament(fil, seg(b))), x, o);
+                    fix_run(&mut ch, (first..first + n).map(|b| filament(fil, seg(b))), x, o);
                 } else {
                     // A chordwise point: the segments of its column and its trailing leg.
                     let j = (s - m * n) % nc;
                     let column = (0..m).map(|i| sl.seg0 + m * n + i * nc + j);
                     let finite = sl.finite.then_some(sl.seg0 + sl.n_lattice_seg + j);
-                    fix_run(column.chain(finite).map(|b| filament(fil, seg(b))), x, o);
+                    fix_run(&mut ch, column.chain(finite).map(|b| filament(fil, seg(b))), x, o);
                     if !sl.finite && layout.n_base_leg > 0 {
                         fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
                     }
                 }
             }
         }
+        base += sl.n_load;
     }
 }
 
@@ -151,6 +189,7 @@ pub(crate) fn correct_axis_extensions(fil: &Filaments, layout: &ExtensionLayout,
 /// wake and its unit rings then take the terms the steady solve's trailing legs (or finite wake)
 /// take (docs/uvlm.md §3). A filament off the point's axis changes by rounding only.
 pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout, pts: &Points, u: &mut [[f64; 3]]) {
+    let mut ch = RunChunk::new();
     let mut p = 0;
     for sl in &layout.surfaces {
         let (m, n) = (sl.m, sl.n);
@@ -161,7 +200,7 @@ pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout
                 continue;
             }
             let x = [pts.x[i], pts.y[i], pts.z[i]];
-            fix_run((0..wake.n_segments()).map(|f| filament(wake, f)), x, &mut u[i]);
+            fix_run(&mut ch, (0..wake.n_segments()).map(|f| filament(wake, f)), x, &mut u[i]);
             for l in 0..wake.n_legs() {
                 fix_leg(wake, l, x, &mut u[i]);
             }
@@ -211,6 +250,7 @@ pub(crate) fn correct_wake_columns(
         WakePart::Far => 2..=len,
     };
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
+    let mut ch = RunChunk::new();
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
     if w.cutoff_only {
         cutoff_columns(sl, p0, w, pts, u, rows.clone());
@@ -232,7 +272,7 @@ pub(crate) fn correct_wake_columns(
                     (a, b, (gamma * INV_FOUR_PI, core2, cut2))
                 })
             });
-            fix_run(column, x, &mut u[i]);
+            fix_run(&mut ch, column, x, &mut u[i]);
         }
         if let Some(dir) = w.closure
             && w.part != WakePart::Near
@@ -261,6 +301,7 @@ fn cutoff_columns(
     rows: std::ops::RangeInclusive<usize>,
 ) {
     let (m, n, wake) = (sl.m, sl.n, w.wake);
+    let mut ch = RunChunk::new();
     let nc = n + 1;
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
@@ -291,7 +332,7 @@ fn cutoff_columns(
                         [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
                     c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + core2 <= *cut2
                 });
-                fix_run(inside.copied(), x, &mut u[i]);
+                fix_run(&mut ch, inside.copied(), x, &mut u[i]);
             }
         }
     }
@@ -315,6 +356,24 @@ struct RunChunk {
     new: [f64; RUN],
 }
 
+impl RunChunk {
+    /// A chunk of zeros, reused point after point (lanes past a run's length keep the previous
+    /// run's finite values, which [`flush_run`] does not read).
+    fn new() -> Self {
+        Self {
+            r1: [[0.0; RUN]; 3],
+            r2: [[0.0; RUN]; 3],
+            g: [0.0; RUN],
+            core2: [0.0; RUN],
+            cut2: [0.0; RUN],
+            dot: [0.0; RUN],
+            c: [[0.0; RUN]; 3],
+            old: [0.0; RUN],
+            new: [0.0; RUN],
+        }
+    }
+}
+
 /// A segment `a → b` with `(Γ/4π, core2, cut2)`.
 type Segment = ([f64; 3], [f64; 3], (f64, f64, f64));
 
@@ -332,18 +391,7 @@ fn filament(fil: &Filaments, f: usize) -> Segment {
 /// where `x` lies outside it, in their order, a chunk of [`RUN`] at a time through the vectorised
 /// [`run_factors`] (Rust does not fuse multiplications and additions, so each lane rounds as the
 /// scalar [`pair_factors`] does).
-fn fix_run(segs: impl Iterator<Item = Segment>, x: [f64; 3], o: &mut [f64; 3]) {
-    let mut ch = RunChunk {
-        r1: [[0.0; RUN]; 3],
-        r2: [[0.0; RUN]; 3],
-        g: [0.0; RUN],
-        core2: [0.0; RUN],
-        cut2: [0.0; RUN],
-        dot: [0.0; RUN],
-        c: [[0.0; RUN]; 3],
-        old: [0.0; RUN],
-        new: [0.0; RUN],
-    };
+fn fix_run(ch: &mut RunChunk, segs: impl Iterator<Item = Segment>, x: [f64; 3], o: &mut [f64; 3]) {
     let mut k = 0;
     for (a, b, (g, core2, cut2)) in segs {
         for q in 0..3 {
@@ -353,12 +401,12 @@ fn fix_run(segs: impl Iterator<Item = Segment>, x: [f64; 3], o: &mut [f64; 3]) {
         (ch.g[k], ch.core2[k], ch.cut2[k]) = (g, core2, cut2);
         k += 1;
         if k == RUN {
-            flush_run(&mut ch, k, o);
+            flush_run(ch, k, o);
             k = 0;
         }
     }
     if k > 0 {
-        flush_run(&mut ch, k, o);
+        flush_run(ch, k, o);
     }
 }
 

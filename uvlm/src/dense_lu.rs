@@ -5,7 +5,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::{PartialPivLuParams, lu_in_place, lu_in_place_scratch};
 use faer::linalg::lu::partial_pivoting::solve::{solve_in_place, solve_in_place_scratch};
 use faer::perm::PermRef;
-use faer::{Mat, MatMut, Par, Spec};
+use faer::{Mat, MatMut, MatRef, Par, Spec};
 
 /// Factorisation of an `n × n` matrix given row-major.
 pub(crate) struct DenseLu {
@@ -36,11 +36,7 @@ impl DenseLu {
     pub(crate) fn factorize_row_major(&mut self, a: &[f64]) -> Result<(), usize> {
         let n = self.n;
         assert_eq!(a.len(), n * n, "factorize: dimension mismatch");
-        for i in 0..n {
-            for j in 0..n {
-                self.lu[(i, j)] = a[i * n + j];
-            }
-        }
+        self.lu.copy_from(MatRef::from_row_major_slice(a, n, n));
         let stack = MemStack::new(&mut self.buf);
         lu_in_place(self.lu.as_mut(), &mut self.perm, &mut self.perm_inv, Par::Seq, stack, Default::default());
         let scale = (0..n).map(|i| self.lu[(i, i)].abs()).fold(0.0_f64, f64::max);

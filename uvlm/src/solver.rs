@@ -473,7 +473,7 @@ impl Uvlm {
         // The bound filaments' regular induction on their axis extensions (docs/uvlm.md §3).
         let mut layout = std::mem::take(&mut self.ext_layout);
         self.load_layout(&mut layout);
-        correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid);
+        correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid, self.params.parallel);
         let frozen = self.params.wake_reuse == WakeReuse::Frozen;
         if with_known_wake {
             // The known wake's streamwise filaments on the same footing (as the steady legs).
