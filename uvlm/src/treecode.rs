@@ -42,8 +42,6 @@ use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
 
-/// Number of moments at [`MAX_ORDER`]: the multi-indices of degree ≤ 12.
-const MOMENTS_MAX: usize = (MAX_ORDER + 1) * (MAX_ORDER + 2) * (MAX_ORDER + 3) / 6;
 
 /// A multi-index table: every `k` with `|k| ≤ degree`, sorted by degree.
 #[derive(Debug, Clone, Default)]
@@ -136,6 +134,8 @@ pub struct Treecode {
     up: Vec<(u32, u8)>,
     /// The leaf moments' samples and lane accumulators.
     samples: MomentSamples,
+    /// The workspace of [`Treecode::set_segments`].
+    edits: Edits,
     /// Gauss–Legendre points on [0, 1] and weights (summing to 1).
     gauss: Vec<(f64, f64)>,
     /// The shift of moments to a parent's centre: `(j, k − j, C(k, j))` for every `j ≤ k`,
@@ -189,6 +189,43 @@ struct MomentSamples {
     xz: Vec<f64>,
     mono: Vec<[f64; LANES]>,
     acc: Vec<[[f64; LANES]; 3]>,
+}
+
+impl MomentSamples {
+    /// Pad the samples to whole blocks with zero weights and add their moments (monomials of
+    /// the positions times the weights, table `up`) to `mom`.
+    fn accumulate(&mut self, up: &[(u32, u8)], mom: &mut [[f64; 3]]) {
+        let n = self.ax.len().div_ceil(LANES) * LANES;
+        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.xx, &mut self.xy, &mut self.xz] {
+            v.resize(n, 0.0);
+        }
+        for a in self.acc.iter_mut() {
+            *a = [[0.0; LANES]; 3];
+        }
+        self.mono[0] = [1.0; LANES];
+        match isa() {
+            Isa::Generic => moments_generic(up, self),
+            // SAFETY: the features were detected at run time.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { moments_avx2(up, self) },
+            // SAFETY: the features were detected at run time.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { moments_avx512(up, self) },
+        }
+        for (mm, acc) in mom.iter_mut().zip(&self.acc) {
+            for q in 0..3 {
+                mm[q] += acc[q].iter().sum::<f64>();
+            }
+        }
+    }
+}
+
+/// The changes of [`Treecode::set_segments`]: per changed segment its first node, its vector and
+/// its change of strength; (cluster, change) for the segment's leaf and every cluster above.
+#[derive(Debug, Clone, Default)]
+struct Edits {
+    deltas: Vec<([f64; 3], [f64; 3], f64)>,
+    touched: Vec<(u32, u32)>,
 }
 
 /// The velocities at one block's points and the point–filament pairs summed directly.
@@ -367,55 +404,74 @@ impl Treecode {
         }
     }
 
-    /// Give source segment `s` of the built set the strength `g` (as stored, with its 1/4π)
-    /// and the core constants `core2`, `cut2`: the leaf's copy takes them, and the moments of
-    /// the leaf and of every cluster above it change by the segment's moments times the change
-    /// of strength (the moments are linear in the strengths). The segment keeps its place and
-    /// the clusters their centres and radii, which still bound every segment (a strength of 0
-    /// removes the segment). The total strength follows, so the error bound holds as at a
-    /// build.
-    pub(crate) fn set_segment(&mut self, s: usize, g: f64, core2: f64, cut2: f64) {
-        let ci = self.seg_leaf[s] as usize;
-        let slot = self.seg_slot[s] as usize;
-        let leaf = &mut self.leaves[self.clusters[ci].leaf as usize];
-        let old = leaf.seg_g[slot];
-        leaf.seg_core2[slot] = core2;
-        leaf.seg_cut2[slot] = cut2;
-        if self.mixed {
-            self.leaves32[self.clusters[ci].leaf as usize].set_segment(slot, g, core2, cut2);
-        }
-        if g == old {
-            return;
-        }
-        leaf.seg_g[slot] = g;
-        let (pa, pb) = (leaf.node(leaf.seg_a[slot] as usize), leaf.node(leaf.seg_b[slot] as usize));
-        let l = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-        let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-        self.total_strength = (self.total_strength + (g.abs() - old.abs()) * len).max(0.0);
-        let nm = self.mom_idx.k.len();
-        let mut mono = [0.0; MOMENTS_MAX];
-        let mut c = ci;
-        loop {
-            let centre = self.clusters[c].center;
-            let mom = &mut self.moments[c * nm..(c + 1) * nm];
-            for &(t, w) in &self.gauss {
-                let x = [pa[0] + t * l[0] - centre[0], pa[1] + t * l[1] - centre[1], pa[2] + t * l[2] - centre[2]];
-                let a = [(g - old) * w * l[0], (g - old) * w * l[1], (g - old) * w * l[2]];
-                mono[0] = 1.0;
-                for (k, m) in mom.iter_mut().enumerate() {
-                    if k > 0 {
-                        let (parent, axis) = self.up[k];
-                        mono[k] = mono[parent as usize] * x[axis as usize];
-                    }
-                    for q in 0..3 {
-                        m[q] += a[q] * mono[k];
-                    }
+    /// Give source segments of the built set new strengths (as stored, with their 1/4π) and
+    /// core constants, `(segment, g, core2, cut2)` each: the leaves' copies take them, and the
+    /// moments of each leaf and of every cluster above it change by the segments' moments times
+    /// their change of strength (the moments are linear in the strengths). The segments keep
+    /// their places and the clusters their centres and radii, which still bound every segment
+    /// (a strength of 0 removes a segment). The total strength follows, so the error bound holds
+    /// as at a build.
+    ///
+    /// Each touched cluster sums the (segment, Gauss point) samples of its changed segments
+    /// through the leaf moments' vectorised kernel, once for all of them.
+    pub(crate) fn set_segments(&mut self, changes: &[(u32, f64, f64, f64)]) {
+        let edits = &mut self.edits;
+        edits.deltas.clear();
+        edits.touched.clear();
+        for &(s, g, core2, cut2) in changes {
+            let s = s as usize;
+            let ci = self.seg_leaf[s] as usize;
+            let slot = self.seg_slot[s] as usize;
+            let leaf = &mut self.leaves[self.clusters[ci].leaf as usize];
+            let old = leaf.seg_g[slot];
+            leaf.seg_core2[slot] = core2;
+            leaf.seg_cut2[slot] = cut2;
+            if self.mixed {
+                self.leaves32[self.clusters[ci].leaf as usize].set_segment(slot, g, core2, cut2);
+            }
+            if g == old {
+                continue;
+            }
+            leaf.seg_g[slot] = g;
+            let (pa, pb) = (leaf.node(leaf.seg_a[slot] as usize), leaf.node(leaf.seg_b[slot] as usize));
+            let l = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+            let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+            self.total_strength = (self.total_strength + (g.abs() - old.abs()) * len).max(0.0);
+            let d = edits.deltas.len() as u32;
+            edits.deltas.push((pa, l, g - old));
+            let mut c = ci;
+            loop {
+                edits.touched.push((c as u32, d));
+                match self.parent[c] {
+                    NONE => break,
+                    p => c = p as usize,
                 }
             }
-            match self.parent[c] {
-                NONE => break,
-                p => c = p as usize,
+        }
+        edits.touched.sort_unstable();
+        let nm = self.mom_idx.k.len();
+        let sm = &mut self.samples;
+        sm.mono.resize(nm, [0.0; LANES]);
+        sm.acc.resize(nm, [[0.0; LANES]; 3]);
+        for group in edits.touched.chunk_by(|a, b| a.0 == b.0) {
+            let ci = group[0].0 as usize;
+            let centre = self.clusters[ci].center;
+            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
+                v.clear();
             }
+            for &(_, d) in group {
+                let (pa, l, dg) = edits.deltas[d as usize];
+                for &(t, w) in &self.gauss {
+                    sm.ax.push(dg * w * l[0]);
+                    sm.ay.push(dg * w * l[1]);
+                    sm.az.push(dg * w * l[2]);
+                    sm.xx.push(pa[0] + t * l[0] - centre[0]);
+                    sm.xy.push(pa[1] + t * l[1] - centre[1]);
+                    sm.xz.push(pa[2] + t * l[2] - centre[2]);
+                }
+            }
+            let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
+            sm.accumulate(&self.up, mom);
         }
     }
 
@@ -544,30 +600,9 @@ impl Treecode {
                     sm.xz.push(pa[2] + t * l[2] - c.center[2]);
                 }
             }
-            // Pad to whole blocks with zero weights.
-            let n = sm.ax.len().div_ceil(LANES) * LANES;
-            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
-                v.resize(n, 0.0);
-            }
-            for a in sm.acc.iter_mut() {
-                *a = [[0.0; LANES]; 3];
-            }
-            sm.mono[0] = [1.0; LANES];
-            match isa() {
-                Isa::Generic => moments_generic(&self.up, sm),
-                // SAFETY: the features were detected at run time.
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => unsafe { moments_avx2(&self.up, sm) },
-                // SAFETY: the features were detected at run time.
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => unsafe { moments_avx512(&self.up, sm) },
-            }
             let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
-            for (mm, acc) in mom.iter_mut().zip(&sm.acc) {
-                for q in 0..3 {
-                    mm[q] = acc[q].iter().sum();
-                }
-            }
+            mom.fill([0.0; 3]);
+            sm.accumulate(&self.up, mom);
         }
         // M_k(parent) = Σ_children Σ_{j ≤ k} C(k, j) δ^{k − j} M_j(child), both children in one
         // sweep of the table, each k summed in registers (the table is grouped by k).

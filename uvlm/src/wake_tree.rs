@@ -11,7 +11,7 @@
 //!   the rows nearest the lattice, which a tree sums directly anyway);
 //! - the oldest rows leave it when the ring buffer is full, and the last row's spanwise edge
 //!   changes strength: the tree takes the new strengths (0 for a segment that left) through
-//!   [`Treecode::set_segment`], which updates the moments exactly and keeps the error bound.
+//!   [`Treecode::set_segments`], which updates the moments exactly and keeps the error bound.
 //!
 //! Segments are matched through their [`SegmentKeys`](crate::aic::SegmentKeys) (surface, push number of the row, kind,
 //! strip, image copy), which ascend in the set's order, so one merge of the two key lists finds
@@ -67,6 +67,8 @@ struct Persist {
     direct: Filaments,
     /// The points moved by `−shift`.
     shifted: Points,
+    /// The held segments whose strength or core changed: `(segment, g, core2, cut2)`.
+    changes: Vec<(u32, f64, f64, f64)>,
 }
 
 impl WakeTree {
@@ -159,6 +161,7 @@ impl WakeTree {
     fn update(&mut self, set: &Filaments, keys: &[u64]) -> bool {
         let p = &mut self.persist;
         p.direct.clear();
+        p.changes.clear();
         let (mut i, mut s) = (0, 0);
         let mut n_new = 0;
         loop {
@@ -172,14 +175,14 @@ impl WakeTree {
                     let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs());
                     let held = p.held[i];
                     if now[0] != held[0] || !same(now[1], held[1]) || !same(now[2], held[2]) {
-                        self.tree.set_segment(i, now[0], now[1], now[2]);
+                        p.changes.push((i as u32, now[0], now[1], now[2]));
                         p.held[i] = now;
                     }
                     (i, s) = (i + 1, s + 1);
                 }
                 (Some(a), b) if b.is_none_or(|b| a < b) => {
                     if p.held[i] != [0.0; 3] {
-                        self.tree.set_segment(i, 0.0, 0.0, 0.0);
+                        p.changes.push((i as u32, 0.0, 0.0, 0.0));
                         p.held[i] = [0.0; 3];
                     }
                     i += 1;
@@ -194,6 +197,7 @@ impl WakeTree {
         if 2 * n_new > keys.len() {
             return false;
         }
+        self.tree.set_segments(&p.changes);
         copy_legs(set, &mut p.direct);
         true
     }
