@@ -25,8 +25,8 @@ use crate::aic::WakePart;
 use crate::biot_savart::{CoreModel, Filaments, INV_FOUR_PI, Isa, isa};
 use crate::induce::{Points, use_threads};
 use crate::params::Parallel;
-use rayon::prelude::*;
 use crate::wake::Wake;
+use rayon::prelude::*;
 
 /// A segment pair seen from a load point (`u = Γ/4π · k · r₁×r₂`): `r₁×r₂`, `r₁·r₂`, the block
 /// kernels' factor `k` (their arithmetic, so that the term they added is removed exactly) and the

@@ -42,7 +42,6 @@ use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
 
-
 /// A multi-index table: every `k` with `|k| ≤ degree`, sorted by degree.
 #[derive(Debug, Clone, Default)]
 struct Indices {
