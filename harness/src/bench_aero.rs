@@ -6,9 +6,11 @@
 //!   (`wing_aoa5.json`) and of Healy's wing (`healy_ffwt_flare10_aoa5.json`), GEBF, with the
 //!   wake cut to 20, 40, 80, 160 and 320 rows, summed directly in f64, directly in mixed
 //!   precision and through the treecode (`aero.wake_aggregation`,
-//!   `aero.wake_aggregation_min_segments`). A run marches until its wake is full and 20 steps
-//!   more; an observer reads the process's CPU time at every step, and the figure is the mean over the
-//!   last 20 steps (process time, so that the lattice's own threads count).
+//!   `aero.wake_aggregation_min_segments`). A run marches until its wake is full and 32 steps
+//!   more; an observer reads the process's CPU time at every step, and a run's figure is the mean
+//!   over the last 32 steps (process time, so that the lattice's own threads count). Every
+//!   configuration runs three times, interleaved with the others, and the table gives the
+//!   median.
 //! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
 //!   Healy's static sweep per formulation (the sweep as the median of 7 runs), each also with the
 //!   committed NACA 0015 polars on both bodies (`cases/polars/`, interleaved with the runs
@@ -31,8 +33,12 @@ use aeroelastic::run::{Observer, Row, Snapshot};
 
 /// The wake lengths the step is timed at, rows.
 pub const WAKE_ROWS: [usize; 5] = [20, 40, 80, 160, 320];
-/// Steps timed once the wake is full.
-const TIMED_STEPS: usize = 20;
+/// Steps timed once the wake is full: two rebuild periods of a kept tree, so that every window
+/// holds the same number of rebuilds.
+const TIMED_STEPS: usize = 32;
+/// Timed runs of each step configuration, interleaved (every configuration once, then again);
+/// the figure is their median.
+const STEP_REPEATS: usize = 3;
 /// The ending of the name of an analysis run with section polars.
 const POLARS_SUFFIX: &str = ", NACA 0015 polars";
 
@@ -271,18 +277,26 @@ fn analyses(cases: &Path) -> Result<Vec<AnalysisRow>, Error> {
 
 /// Run both parts; with `progress`, print each figure as it comes.
 pub fn run(cases: &Path, progress: bool) -> Result<AeroBench, Error> {
-    let mut steps = Vec::new();
-    for file in ["wing_aoa5.json", "healy_ffwt_flare10_aoa5.json"] {
-        for rows in WAKE_ROWS {
-            for summation in Summation::ALL {
-                let r = step_row(cases, file, rows, summation)?;
-                if progress {
-                    let how = summation.name();
-                    println!("bench --aero {:<26} {rows:>4} rows {how:<8}: {:8.2} ms CPU per step", r.case, r.cpu_ms);
-                }
-                steps.push(r);
-            }
+    let configs: Vec<(&str, usize, Summation)> = ["wing_aoa5.json", "healy_ffwt_flare10_aoa5.json"]
+        .into_iter()
+        .flat_map(|f| WAKE_ROWS.into_iter().flat_map(move |r| Summation::ALL.map(|s| (f, r, s))))
+        .collect();
+    let mut runs: Vec<Vec<StepRow>> = vec![Vec::new(); configs.len()];
+    for _ in 0..STEP_REPEATS {
+        for (k, &(file, rows, summation)) in configs.iter().enumerate() {
+            runs[k].push(step_row(cases, file, rows, summation)?);
         }
+    }
+    let mut steps = Vec::new();
+    for mut reps in runs {
+        let mut cpu: Vec<f64> = reps.iter().map(|r| r.cpu_ms).collect();
+        let mut r = reps.swap_remove(0);
+        r.cpu_ms = crate::bench::median(&mut cpu);
+        if progress {
+            let how = r.summation.name();
+            println!("bench --aero {:<26} {:>4} rows {how:<8}: {:8.2} ms CPU per step", r.case, r.rows, r.cpu_ms);
+        }
+        steps.push(r);
     }
     let analyses = analyses(cases)?;
     if progress {
