@@ -290,8 +290,11 @@ pub fn run(cases: &Path, progress: bool) -> Result<AeroBench, Error> {
     let mut steps = Vec::new();
     for mut reps in runs {
         let mut cpu: Vec<f64> = reps.iter().map(|r| r.cpu_ms).collect();
+        // A repeat that failed is reported even when the others make a median.
+        let error = reps.iter().find_map(|r| r.error.clone());
         let mut r = reps.swap_remove(0);
         r.cpu_ms = crate::bench::median(&mut cpu);
+        r.error = error;
         if progress {
             let how = r.summation.name();
             println!("bench --aero {:<26} {:>4} rows {how:<8}: {:8.2} ms CPU per step", r.case, r.rows, r.cpu_ms);

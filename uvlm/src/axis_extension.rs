@@ -147,18 +147,18 @@ const AXIS_CHUNK: usize = 48;
 /// [`use_threads`].
 const AXIS_PAIR_COST: usize = 4;
 
-/// [`correct_axis_extensions`] at the load points `first..first + out.len()`, into `out`.
-fn correct_axis_points(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, first: usize, out: &mut [[f64; 3]]) {
+/// [`correct_axis_extensions`] at the load points `p0..p0 + out.len()`, into `out`.
+fn correct_axis_points(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, p0: usize, out: &mut [[f64; 3]]) {
     let mut ch = RunChunk::new();
     let mut base = 0;
     for sl in &layout.surfaces {
         let (m, n) = (sl.m, sl.n);
         let nc = n + 1;
-        let (lo, hi) = (first.max(base), (first + out.len()).min(base + sl.n_load));
+        let (lo, hi) = (p0.max(base), (p0 + out.len()).min(base + sl.n_load));
         for p in lo..hi {
             let s = p - base;
             let x = [pts.x[p], pts.y[p], pts.z[p]];
-            let o = &mut out[p - first];
+            let o = &mut out[p - p0];
             for c in 0..layout.n_copies {
                 let seg = |b: usize| c * layout.n_base_seg + b;
                 if s < m * n || s >= m * n + m * nc {
@@ -250,11 +250,11 @@ pub(crate) fn correct_wake_columns(
         WakePart::Far => 2..=len,
     };
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
-    let mut ch = RunChunk::new();
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
     if w.cutoff_only {
         cutoff_columns(sl, p0, w, pts, u, rows.clone());
     }
+    let mut ch = RunChunk::new();
     for s in m * n..m * n + m * nc {
         let j = (s - m * n) % nc;
         let i = p0 + s;
@@ -301,8 +301,8 @@ fn cutoff_columns(
     rows: std::ops::RangeInclusive<usize>,
 ) {
     let (m, n, wake) = (sl.m, sl.n, w.wake);
-    let mut ch = RunChunk::new();
     let nc = n + 1;
+    let mut ch = RunChunk::new();
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
     let mut legs = [([0.0; 3], [0.0; 3], (0.0, 0.0, 0.0)); RUN];

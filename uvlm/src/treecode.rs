@@ -191,6 +191,27 @@ struct MomentSamples {
 }
 
 impl MomentSamples {
+    /// No samples.
+    fn clear(&mut self) {
+        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.xx, &mut self.xy, &mut self.xz] {
+            v.clear();
+        }
+    }
+
+    /// The Gauss samples of the segment from `pa` along `l` with strength `g`: weights
+    /// `g w l`, positions relative to `centre`.
+    fn push_segment(&mut self, gauss: &[(f64, f64)], pa: [f64; 3], l: [f64; 3], g: f64, centre: [f64; 3]) {
+        for &(t, w) in gauss {
+            let gw = g * w;
+            self.ax.push(gw * l[0]);
+            self.ay.push(gw * l[1]);
+            self.az.push(gw * l[2]);
+            self.xx.push(pa[0] + t * l[0] - centre[0]);
+            self.xy.push(pa[1] + t * l[1] - centre[1]);
+            self.xz.push(pa[2] + t * l[2] - centre[2]);
+        }
+    }
+
     /// Pad the samples to whole blocks with zero weights and add their moments (monomials of
     /// the positions times the weights, table `up`) to `mom`.
     fn accumulate(&mut self, up: &[(u32, u8)], mom: &mut [[f64; 3]]) {
@@ -455,19 +476,10 @@ impl Treecode {
         for group in edits.touched.chunk_by(|a, b| a.0 == b.0) {
             let ci = group[0].0 as usize;
             let centre = self.clusters[ci].center;
-            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
-                v.clear();
-            }
+            sm.clear();
             for &(_, d) in group {
                 let (pa, l, dg) = edits.deltas[d as usize];
-                for &(t, w) in &self.gauss {
-                    sm.ax.push(dg * w * l[0]);
-                    sm.ay.push(dg * w * l[1]);
-                    sm.az.push(dg * w * l[2]);
-                    sm.xx.push(pa[0] + t * l[0] - centre[0]);
-                    sm.xy.push(pa[1] + t * l[1] - centre[1]);
-                    sm.xz.push(pa[2] + t * l[2] - centre[2]);
-                }
+                sm.push_segment(&self.gauss, pa, l, dg, centre);
             }
             let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
             sm.accumulate(&self.up, mom);
@@ -581,23 +593,13 @@ impl Treecode {
                 continue;
             }
             // The samples: weights Γ w (B − A) and positions relative to the centre.
-            for v in [&mut sm.ax, &mut sm.ay, &mut sm.az, &mut sm.xx, &mut sm.xy, &mut sm.xz] {
-                v.clear();
-            }
+            sm.clear();
             for &s in &self.perm[c.start as usize..c.end as usize] {
                 let s = s as usize;
                 let (a, b) = fil.segment_nodes(s);
                 let (pa, pb) = (fil.node(a as usize), fil.node(b as usize));
                 let l = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-                for &(t, w) in &self.gauss {
-                    let gw = fil.seg_g[s] * w;
-                    sm.ax.push(gw * l[0]);
-                    sm.ay.push(gw * l[1]);
-                    sm.az.push(gw * l[2]);
-                    sm.xx.push(pa[0] + t * l[0] - c.center[0]);
-                    sm.xy.push(pa[1] + t * l[1] - c.center[1]);
-                    sm.xz.push(pa[2] + t * l[2] - c.center[2]);
-                }
+                sm.push_segment(&self.gauss, pa, l, fil.seg_g[s], c.center);
             }
             let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
             mom.fill([0.0; 3]);
