@@ -865,6 +865,10 @@ impl<'a> MarchAero<'a> {
     ) -> Result<genalpha::StepStats, String> {
         let dt = self.dt;
         let t1 = s.t + dt;
+        // (A hinge event on ANCF's ODE path changes the number of coordinates.)
+        self.dq.resize(s.v.len(), 0.0);
+        self.vp.resize(s.v.len(), 0.0);
+        self.qp.resize(s.q.len(), 0.0);
         // 1. Predict the structure at t_{n+1} and move the lattice there.
         for i in 0..self.dq.len() {
             self.dq[i] = dt * s.v[i] + 0.5 * dt * dt * s.v_dot[i];

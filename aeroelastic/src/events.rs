@@ -271,21 +271,23 @@ impl<'a, S: Structure> Events<'a, S> {
         }
         let lock = matches!(e.action, HingeAction::Lock).then_some(fold);
         let mut new = (self.rebuild)(e.joint, lock)?;
-        if new.n_coords() != s.q.len() || new.n_dof() != s.v.len() {
-            return Err(format!(
-                "the new model has {} coordinates and {} velocities, not {} and {}",
-                new.n_coords(),
-                new.n_dof(),
-                s.q.len(),
-                s.v.len()
-            ));
-        }
+        let (q, v) = new.carry_state(model, &s.q, &s.v)?;
+        // Carried into other coordinates (ANCF's ODE path), the velocities are projected onto the
+        // new model's admissible ones: the kinetic energy that removed is an impact's (a lock's,
+        // and a release's small one where a weld's state does not meet the hinge's equations).
+        let mut energy_loss = if q.len() != s.q.len() || v.len() != s.v.len() {
+            (model.energies(&s.q, &s.v).kinetic - new.energies(&q, &v).kinetic).max(0.0)
+        } else {
+            0.0
+        };
+        (s.q, s.v) = (q, v);
+        s.v_dot.resize(s.v.len(), 0.0);
+        s.a.resize(s.v.len(), 0.0);
         new.set_section_loads(loads).map_err(|err| err.to_string())?;
-        let mut energy_loss = 0.0;
         if lock.is_some() {
             let hit = genalpha::analysis::impact(&new, s.t, &s.q, &s.v).map_err(|err| err.to_string())?;
             s.v.copy_from_slice(&hit.velocities);
-            energy_loss = hit.energy_loss;
+            energy_loss += hit.energy_loss;
         }
         let fresh = new.initial_state();
         s.lambda = fresh.lambda;

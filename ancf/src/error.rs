@@ -110,6 +110,15 @@ pub enum Error {
         /// Number of bodies.
         expected: usize,
     },
+    /// A state carried from a model that does not share this one's full coordinates (or a
+    /// state that does not fit the model it came from).
+    #[error("carried state: the previous model has {got} full coordinates, this one {expected}")]
+    CarriedState {
+        /// Full coordinates of the previous model.
+        got: usize,
+        /// Full coordinates of this one.
+        expected: usize,
+    },
     /// A singular matrix in the static solver or the modal analysis.
     #[error("singular matrix (zero pivot in row {pivot})")]
     SingularMatrix {

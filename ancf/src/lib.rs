@@ -49,6 +49,7 @@
 //! Units SI; global frame as in docs/conventions.md §1.
 #![warn(missing_docs)]
 
+mod carry;
 pub mod elastic_force;
 pub mod element;
 mod error;

@@ -541,6 +541,22 @@ impl Model {
         out
     }
 
+    /// `out = M v` for full velocities `v` (the constant mass of the elements and point
+    /// masses), `out` overwritten.
+    pub(crate) fn mass_times_full(&self, v: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for b in &self.bodies {
+            for k in 0..b.n_elements() {
+                let range = b.offset + NODE_DOF * k..b.offset + NODE_DOF * k + ELEMENT_DOF;
+                b.element.add_mass_times(1.0, &v[range.clone()], &mut out[range]);
+            }
+        }
+        for p in &self.point_inertia {
+            let range = p.first..p.first + ELEMENT_DOF;
+            p.add_mass_times(1.0, &v[range.clone()], &mut out[range]);
+        }
+    }
+
     /// Power dissipated by the hinge dampers `Σ c θ̇²`, W (≥ 0), at coordinates `q` and
     /// velocities `v` of the model's form. Its time integral is the work the dampers took out
     /// of `T + U + V + spring energy`.

@@ -15,6 +15,9 @@ impl Structure for Model {
     fn initial_state(&self) -> State {
         Model::initial_state(self)
     }
+    fn carry_state(&self, old: &Self, q: &[f64], v: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String> {
+        Model::carry_state(self, old, q, v).map_err(|e| e.to_string())
+    }
     fn tip(&self, q: &[f64]) -> [f64; 3] {
         self.tip_position(q).into()
     }

@@ -211,18 +211,11 @@ impl Case {
 
     /// Every joint names existing bodies, flare angles lie in [−90°, 90°], and `fold_joint` is
     /// a flared hinge.
-    /// Each event on a flared hinge by name, at a time within the run or on one condition, on
-    /// ANCF's DAE path (whose coordinates do not depend on the joints); the timed events of a
-    /// hinge without triggered ones lock a free hinge or release a locked one, in time order
-    /// (a triggered event's order is known only in the run, which refuses a lock of a locked
-    /// hinge naming the event and the time).
+    /// Each event on a flared hinge by name, at a time within the run or on one condition; the
+    /// timed events of a hinge without triggered ones lock a free hinge or release a locked one,
+    /// in time order (a triggered event's order is known only in the run, which refuses a lock
+    /// of a locked hinge naming the event and the time).
     fn check_events(&self) -> Result<(), String> {
-        if !self.events.is_empty() && self.ancf.path == aeroelastic::problem::AncfPath::Ode {
-            return Err(
-                "events: hinge events need ancf.path \"dae\" (the ODE path's coordinates change with the joints)"
-                    .into(),
-            );
-        }
         let hinge = |field: String, name: &str| match self.joints.iter().position(|j| j.name() == Some(name)) {
             Some(j) if matches!(self.joints[j], Joint::FlaredHinge { .. }) => Ok(j),
             Some(_) => Err(format!("{field}: `{name}` is not a flared hinge")),

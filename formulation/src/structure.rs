@@ -161,6 +161,30 @@ pub trait Structure: ConstrainedSystem {
     /// formulation that carries a quantity across steps, such as GEBF's momentum projection,
     /// takes it from here. Called after the initial accelerations. Default: nothing.
     fn start_march(&mut self, _t: f64, _q: &[f64], _v: &[f64]) {}
+    /// The state `(q, v)` of `old` — this formulation's model of the same bodies before a joint
+    /// changed state (a hinge event) — in this model's coordinates and velocities. Where the
+    /// two do not share their layout, the velocities come out admissible for this model, closest
+    /// to `v` in kinetic energy (ANCF's ODE path). Default: `(q, v)` unchanged, refused when
+    /// the sizes differ.
+    ///
+    /// # Errors
+    /// A message when the state cannot be carried over.
+    fn carry_state(&self, old: &Self, q: &[f64], v: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String>
+    where
+        Self: Sized,
+    {
+        let _ = old;
+        if self.n_coords() != q.len() || self.n_dof() != v.len() {
+            return Err(format!(
+                "the new model has {} coordinates and {} velocities, not {} and {}",
+                self.n_coords(),
+                self.n_dof(),
+                q.len(),
+                v.len()
+            ));
+        }
+        Ok((q.to_vec(), v.to_vec()))
+    }
     /// Bring stored coordinates back to their canonical branch without changing the
     /// configuration, after every Newton update of a static solve (GEBF: rotation vectors past
     /// π and the joints' position projection). Default: nothing.

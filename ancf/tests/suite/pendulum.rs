@@ -2,7 +2,7 @@
 //! `cases/reference/` (Exudyn geometrically exact beam, converged; see its README).
 use crate::common;
 
-use ancf::{Options, SolvePath};
+use ancf::{Model, Options, SolvePath, samples};
 use common::*;
 
 /// c = 1, β = 45°, 10 elements per body, dt = 0.0005, rho_inf = 0.8 (the reference's settings):
@@ -99,4 +99,79 @@ fn beta45_diagonal_ladder_converges_to_the_reference() {
     println!("c=1 beta=45 diagonal ladder: max tip errors {:?} mm", errors.iter().map(|e| e * 1e3).collect::<Vec<_>>());
     assert!(errors.windows(2).all(|w| w[1] < w[0]), "the error must shrink at every rung: {errors:?}");
     assert!(errors[3] < 3.5e-3, "40 el/body, dt 0.25 ms: {} m", errors[3]);
+}
+
+/// A hinge locked and released on the ODE path, whose independent coordinates change with the
+/// joints: `Model::carry_state` passes the state through the full coordinates. Taken 0.2 s into
+/// the free pendulum: carried to the ODE path and back to full coordinates it is unchanged (1e-12 m,
+/// 1e-9 of the largest rate); locked at its fold, its velocities are
+/// those of the DAE path's impact (`genalpha::analysis::impact`, the M-orthogonal projection
+/// onto the new null space) and the kinetic energy it loses is the impact's; released again,
+/// the kinetic energy it loses is the M-norm of its velocity jump (a projection).
+#[test]
+fn ode_path_carries_the_state_through_a_lock_and_a_release() {
+    use ancf::JointSpec;
+    use genalpha::ConstrainedSystem;
+    let (bodies, joints, g) = samples::double_pendulum(1.0, 45.0, 5);
+    let ode = Options { path: SolvePath::Ode, ..Default::default() };
+    let mut model = Model::new(&bodies, &joints, g, Options::default()).expect("valid scene");
+    let mut ga = model.integrator(params(0.8, 0.002)).expect("valid parameters");
+    let mut s = model.initial_state();
+    ga.initialize(&model, &mut s).expect("consistent start");
+    for _ in 0..100 {
+        ga.step(&mut model, &mut s).expect("step");
+    }
+    let fold = model.fold_angle(&s.q, 1).expect("flared hinge");
+    let mut locked_joints = joints.clone();
+    locked_joints[1] = JointSpec::LockedHinge { parent: 0, child: 1, beta: 45f64.to_radians(), fold };
+    let free_ode = Model::new(&bodies, &joints, g, ode).expect("valid scene");
+    let locked_ode = Model::new(&bodies, &locked_joints, g, ode).expect("valid scene");
+    let locked_dae = Model::new(&bodies, &locked_joints, g, Options::default()).expect("valid scene");
+    assert!(free_ode.n_dof() > locked_ode.n_dof(), "a lock removes independent coordinates");
+    let gap = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let full = |m: &Model, q: &[f64], v: &[f64]| {
+        let mut vf = vec![0.0; m.n_full_coords()];
+        m.full_velocities_inplace(v, &mut vf);
+        (m.full_coordinates(q), vf)
+    };
+
+    // (The DAE path's velocities meet the hinge's velocity equations to its Newton tolerance:
+    // the projection removes that residue, 4e-12 m/s.)
+    let scale = s.v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let (zq, zv) = free_ode.carry_state(&model, &s.q, &s.v).expect("carried");
+    let (qf, vf) = full(&free_ode, &zq, &zv);
+    println!("DAE → ODE: {:e} m, {:e} of {scale:e} m/s", gap(&qf, &s.q), gap(&vf, &s.v));
+    assert!(gap(&qf, &s.q) < 1e-12 && gap(&vf, &s.v) < 1e-9 * scale);
+
+    let (lq, lv) = locked_ode.carry_state(&free_ode, &zq, &zv).expect("locked");
+    let hit = genalpha::analysis::impact(&locked_dae, s.t, &s.q, &s.v).expect("impact");
+    let (lqf, lvf) = full(&locked_ode, &lq, &lv);
+    println!("lock at {fold:.4} rad: velocity gap to the DAE impact {:e} of {scale:e} m/s", gap(&lvf, &hit.velocities));
+    // The weld's linear equations at the measured fold hold on the deformed hinge sections only
+    // to their strain: the restriction moves the configuration onto them, by the locked model's
+    // residual of the free state (the DAE path's first Newton step after the lock does the same).
+    let before = locked_dae.constraint_residual(&s.q);
+    println!("lock: configuration moved {:e} m; weld residual {before:e}", gap(&lqf, &s.q));
+    assert!(gap(&lqf, &s.q) < 2.0 * before);
+    assert!(gap(&lvf, &hit.velocities) < 1e-9 * scale, "velocities differ from the impact's");
+    let loss = free_ode.energies(&zq, &zv).kinetic - locked_ode.energies(&lq, &lv).kinetic;
+    println!("kinetic energy lost {loss:e} J, impact {:e} J", hit.energy_loss);
+    assert!(hit.energy_loss > 0.0 && (loss - hit.energy_loss).abs() < 1e-6 * hit.energy_loss);
+
+    let (rq, rv) = free_ode.carry_state(&locked_ode, &lq, &lv).expect("released");
+    // The weld leaves the centreline slopes free and the free hinge's axis equation reads them,
+    // so the welded state meets the hinge's equations only to the sections' strain too: the
+    // release moves it back by as much as the lock moved it, and its velocities lose the part
+    // that the hinge's equations forbid — an impact on the hinge sections' slope rates, whose
+    // loss is again the M-norm of the jump (the DAE path takes it in its first step).
+    let (rqf, rvf) = full(&free_ode, &rq, &rv);
+    let loss = locked_ode.energies(&lq, &lv).kinetic - free_ode.energies(&rq, &rv).kinetic;
+    let jump: Vec<f64> = lvf.iter().zip(&rvf).map(|(a, b)| a - b).collect();
+    let norm = model.energies(&lqf, &jump).kinetic;
+    println!(
+        "release: configuration moved {:e} m; kinetic energy lost {loss:e} J, ½|Δv|²_M {norm:e} J",
+        gap(&rqf, &lqf)
+    );
+    assert!(gap(&rqf, &lqf) < 2.0 * before);
+    assert!(loss >= 0.0 && (loss - norm).abs() < 1e-6 * norm + 1e-14);
 }

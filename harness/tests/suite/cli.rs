@@ -394,14 +394,6 @@ fn bad_hinge_events_exit_2_naming_the_field() {
             "events[0].action",
         ),
         (
-            "ode",
-            |v| {
-                v["events"] = json!([{"time": 0.5, "joint": "fold", "action": "lock"}]);
-                v["ancf"]["path"] = json!("ode");
-            },
-            "events: hinge events need ancf.path",
-        ),
-        (
             "both",
             |v| v["events"] = json!([{"time": 0.5, "when": {"fold_deg_above": 10}, "joint": "fold", "action": "lock"}]),
             "events[0]: give either",
