@@ -22,7 +22,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::polar_correction::{StripPolars, StripReport};
 use crate::problem::{Joint, Problem};
 
-pub use crate::aero_settings::{AeroSettings, Coupling, MirrorPlane, RunsGuard, register_runs};
+pub use crate::aero_settings::{AeroSettings, Coupling, LoadPredictor, MirrorPlane, RunsGuard, register_runs};
 use formulation::Structure;
 
 pub use formulation::SectionLoad;
@@ -506,6 +506,7 @@ pub fn march_aero<S: Structure>(
                 dissipation.restart(model, &s);
                 // The stations' velocities after the event (a lock changes them).
                 c.move_to(model, &s.q, &s.v, s.t);
+                c.restart_loads();
             }
             Ok(None) => {}
             Err(e) => return fail(out, format!("step {k}: {e}")),
@@ -530,6 +531,8 @@ pub fn march_aero<S: Structure>(
     out.events = events.records.clone();
     out.wall_s = wall.elapsed().as_secs_f64();
     out.aero_wall_s = c.uv.stats().wall_time;
+    out.aero_solves = c.n_solves;
+    out.aero_steps = c.n_steps;
     out.strips = c.strips();
     let checkpoint =
         stopped.map(|step| MarchCheckpoint { state: s, step, uv: c.uv, loads: c.loads, lift: c.lift, hinge: c.hinge });
@@ -627,6 +630,13 @@ struct MarchAero<'a> {
     polars: Option<&'a StripPolars>,
     /// The polars' correction of the last solve.
     report: StripReport,
+    /// The loads of the step before the last ([`LoadPredictor::Extrapolate`]), valid when
+    /// `known_loads` ≥ 1 (0 after a (re)start of the march).
+    loads_previous: Vec<SectionLoad>,
+    known_loads: usize,
+    /// Aerodynamic solves and time steps of the march.
+    n_solves: usize,
+    n_steps: usize,
 }
 
 /// Buffers of the lumping of the lattice's nodal loads to the stations: the stations' origins,
@@ -759,6 +769,10 @@ impl<'a> MarchAero<'a> {
             hinge,
             polars,
             report: StripReport::default(),
+            loads_previous: Vec::new(),
+            known_loads: 0,
+            n_solves: 0,
+            n_steps: 0,
         })
     }
 
@@ -793,6 +807,7 @@ impl<'a> MarchAero<'a> {
     /// loads into `loads` (`into_new`: `new_loads`), corrected by the section polars; the lift of
     /// the solve.
     fn solve(&mut self, into_new: bool, t: f64) -> Result<f64, String> {
+        self.n_solves += 1;
         crate::lifting::move_lattices(&mut self.uv, &self.ranges, &self.stations, Some(&self.vel))
             .map_err(|e| e.to_string())?;
         self.uv.solve_step().map_err(|e| e.to_string())?;
@@ -840,6 +855,29 @@ impl<'a> MarchAero<'a> {
         crate::statics::strips_of(self.map, &self.stations, self.uv.loads(), &self.report, lift_dir, qdyn)
     }
 
+    /// [`LoadPredictor::Extrapolate`]: the applied loads `L_n` become `2 L_n − L_{n−1}` (kept as
+    /// they are on the first step after a (re)start, which knows no `L_{n−1}`), and `L_n` is kept
+    /// as the next step's previous loads.
+    fn extrapolate_loads(&mut self) {
+        if self.known_loads >= 1 {
+            for (l, p) in self.loads.iter_mut().zip(&mut self.loads_previous) {
+                let (f, m) = (l.force, l.moment);
+                l.force = 2.0 * f - p.force;
+                l.moment = 2.0 * m - p.moment;
+                p.force = f;
+                p.moment = m;
+            }
+        } else {
+            self.loads_previous.clone_from(&self.loads);
+            self.known_loads = 1;
+        }
+    }
+
+    /// Forget the loads of earlier steps (after a hinge event, whose jump they do not predict).
+    fn restart_loads(&mut self) {
+        self.known_loads = 0;
+    }
+
     /// Relax the applied loads towards the sub-iteration's; whether the relative change was
     /// within the coupling's tolerance.
     fn relax(&mut self) -> bool {
@@ -869,29 +907,36 @@ impl<'a> MarchAero<'a> {
         self.dq.resize(s.v.len(), 0.0);
         self.vp.resize(s.v.len(), 0.0);
         self.qp.resize(s.q.len(), 0.0);
-        // 1. Predict the structure at t_{n+1} and move the lattice there.
-        for i in 0..self.dq.len() {
-            self.dq[i] = dt * s.v[i] + 0.5 * dt * dt * s.v_dot[i];
-            self.vp[i] = s.v[i] + dt * s.v_dot[i];
-        }
-        model.retract_inplace(&s.q, &self.dq, &mut self.qp);
         self.vel_n.clear();
         self.vel_n.extend_from_slice(&self.vel);
-        stations_at(
-            model,
-            &self.qp,
-            &self.vp,
-            self.map,
-            self.aero,
-            Some(t1),
-            &mut self.scratch,
-            &mut self.stations,
-            &mut self.vel,
-        );
-        // 2. Wake and aerodynamic solve at the predicted lattice.
         let aero_err = |e: String| format!("step {k} (t = {t1:.4} s): aerodynamics: {e}");
-        self.uv.advance_wake(dt).map_err(|e| aero_err(e.to_string()))?;
-        self.lift = self.solve(false, t1).map_err(aero_err)?;
+        let coupling = &self.aero.coupling;
+        if coupling.max_sub_iterations > 0 && coupling.predictor == LoadPredictor::Extrapolate {
+            // 1–2. Convect and shed the wake; the last two steps' loads extrapolated to t_{n+1}.
+            self.uv.advance_wake(dt).map_err(|e| aero_err(e.to_string()))?;
+            self.extrapolate_loads();
+        } else {
+            // 1. Predict the structure at t_{n+1} and move the lattice there.
+            for i in 0..self.dq.len() {
+                self.dq[i] = dt * s.v[i] + 0.5 * dt * dt * s.v_dot[i];
+                self.vp[i] = s.v[i] + dt * s.v_dot[i];
+            }
+            model.retract_inplace(&s.q, &self.dq, &mut self.qp);
+            stations_at(
+                model,
+                &self.qp,
+                &self.vp,
+                self.map,
+                self.aero,
+                Some(t1),
+                &mut self.scratch,
+                &mut self.stations,
+                &mut self.vel,
+            );
+            // 2. Wake and aerodynamic solve at the predicted lattice.
+            self.uv.advance_wake(dt).map_err(|e| aero_err(e.to_string()))?;
+            self.lift = self.solve(false, t1).map_err(aero_err)?;
+        }
         // 3. Structural step with these loads.
         let s_n: genalpha::State = s.clone();
         model.set_section_loads(&self.loads).map_err(|e| format!("step {k} (t = {t1:.4} s): {e}"))?;
@@ -910,6 +955,7 @@ impl<'a> MarchAero<'a> {
             st = ga.step(model, s).map_err(|e| format!("step {k} (sub-iteration): {e}"))?;
         }
         self.uv.commit_step().map_err(|e| format!("step {k}: aerodynamics: {e}"))?;
+        self.n_steps += 1;
         debug_assert!(
             (self.uv.time() - s.t).abs() <= 1e-9 * s.t.abs().max(1.0),
             "the UVLM's clock follows the structure's"

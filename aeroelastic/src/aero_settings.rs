@@ -314,12 +314,36 @@ pub struct Coupling {
     /// trailing-edge filaments and the bound rings follow the structure's motion; docs/uvlm.md
     /// §9); default true. False recomputes the whole wake at every sub-iteration.
     pub reuse_wake: bool,
+    /// The loads of a strongly coupled step's first structural solve (docs/coupling.md §4).
+    pub predictor: LoadPredictor,
 }
 
 impl Default for Coupling {
     fn default() -> Self {
-        Self { max_sub_iterations: 0, tolerance: 1e-4, relaxation: 1.0, reuse_wake: true }
+        Self {
+            max_sub_iterations: 0,
+            tolerance: 1e-4,
+            relaxation: 1.0,
+            reuse_wake: true,
+            predictor: LoadPredictor::default(),
+        }
     }
+}
+
+/// Where the first structural solve of a strongly coupled step (`max_sub_iterations` ≥ 1) takes
+/// its loads from. Both end on the same test, the sub-iterations' relative load change within
+/// `tolerance`; a loosely coupled step always solves at the predicted structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum LoadPredictor {
+    /// The loads of the last two steps extrapolated linearly to the new time: no aerodynamic
+    /// solve before the structure's first step, one fewer per step.
+    #[default]
+    Extrapolate,
+    /// An aerodynamic solve at the structure predicted from its state at the step's start.
+    Solve,
 }
 
 impl AeroSettings {

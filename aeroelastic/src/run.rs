@@ -211,6 +211,12 @@ pub struct RunOutput {
     pub error: Option<String>,
     /// Wall time spent in the aerodynamics, s (0 without).
     pub aero_wall_s: f64,
+    /// Aerodynamic solves of the time march (0 without aerodynamics): one per step loosely
+    /// coupled, one per sub-iteration (and the predictor's, docs/coupling.md §4) strongly.
+    pub aero_solves: usize,
+    /// Time steps marched with the aerodynamics (the structure's steps, `stats.n_steps`, also
+    /// count the sub-iterations' repeats).
+    pub aero_steps: usize,
     /// The hinge events that acted, in order.
     pub events: Vec<crate::events::EventRecord>,
     /// The lattice's strips at the last solve with the section polars' correction (lift per span
@@ -230,6 +236,8 @@ impl RunOutput {
             n_dof: 0,
             error: Some(error),
             aero_wall_s: 0.0,
+            aero_solves: 0,
+            aero_steps: 0,
             events: Vec::new(),
             strips: Vec::new(),
         }
@@ -390,6 +398,8 @@ pub fn simulate_with_events<S: Structure>(
         n_dof: model.n_dof(),
         error: None,
         aero_wall_s: 0.0,
+        aero_solves: 0,
+        aero_steps: 0,
         events: Vec::new(),
         strips: Vec::new(),
     };

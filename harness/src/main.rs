@@ -1574,12 +1574,17 @@ fn print_run(out: &Path, r: &harness::report::CaseResult) -> bool {
                 eprintln!("{} {}: FAILED: {e}", r.name, run.formulation);
             }
             None => println!(
-                "{} {}: {} steps in {:.1} ms, {:.2} Newton/step, energy drift {:.2e}, max constraint {:.1e} -> {}",
+                "{} {}: {} steps in {:.1} ms, {:.2} Newton/step{}, energy drift {:.2e}, max constraint {:.1e} -> {}",
                 r.name,
                 run.formulation,
                 m.n_steps,
                 1e3 * m.wall_s,
                 m.newton_per_step,
+                if m.aero_solves_per_step > 0.0 {
+                    format!(", {:.2} aero solves/step", m.aero_solves_per_step)
+                } else {
+                    String::new()
+                },
                 m.energy_drift,
                 m.max_constraint_residual,
                 dir.join(format!("{}.csv", run.formulation)).display()

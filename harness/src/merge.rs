@@ -109,6 +109,10 @@ struct RunRecord {
     n_dof: usize,
     error: Option<String>,
     aero_wall_s: u64,
+    #[serde(default)]
+    aero_solves: usize,
+    #[serde(default)]
+    aero_steps: usize,
 }
 
 impl RunRecord {
@@ -129,6 +133,8 @@ impl RunRecord {
             n_dof: r.n_dof,
             error: r.error.clone(),
             aero_wall_s: r.aero_wall_s.to_bits(),
+            aero_solves: r.aero_solves,
+            aero_steps: r.aero_steps,
         }
     }
 
@@ -150,6 +156,8 @@ impl RunRecord {
             n_dof: self.n_dof,
             error: self.error.clone(),
             aero_wall_s: f64::from_bits(self.aero_wall_s),
+            aero_solves: self.aero_solves,
+            aero_steps: self.aero_steps,
             // The shards' exact results do not carry the hinge events' records (their effect is
             // in the rows; each shard's own folder has its events CSV).
             events: Vec::new(),
@@ -199,6 +207,8 @@ struct MetricsRecord {
     /// Each oscillation's window start and end, frequency, growth rate, damping ratio, amplitude.
     oscillations: Vec<[u64; 6]>,
     oscillation_signal: String,
+    #[serde(default)]
+    aero_solves_per_step: u64,
 }
 
 impl MetricsRecord {
@@ -225,6 +235,7 @@ impl MetricsRecord {
                 })
                 .collect(),
             oscillation_signal: m.oscillation_signal.to_string(),
+            aero_solves_per_step: m.aero_solves_per_step.to_bits(),
         }
     }
 
@@ -246,6 +257,7 @@ impl MetricsRecord {
             max_constraint_residual: f(6),
             error: self.error.clone(),
             aero_wall_s,
+            aero_solves_per_step: f64::from_bits(self.aero_solves_per_step),
             oscillations: self
                 .oscillations
                 .iter()

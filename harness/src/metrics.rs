@@ -104,6 +104,8 @@ pub struct FormulationMetrics {
     pub error: Option<String>,
     /// Wall time in the aerodynamics, s.
     pub aero_wall_s: f64,
+    /// Aerodynamic solves per time step of the march (0 without aerodynamics).
+    pub aero_solves_per_step: f64,
     /// Dominant oscillation of the fold angle (the tip's vertical position without a fold
     /// hinge) in four equal windows of the run, by the matrix pencil method
     /// ([`crate::pencil`]): frequency and growth rate to compare with the stability analysis.
@@ -141,6 +143,7 @@ impl FormulationMetrics {
             max_constraint_residual: run.rows.iter().map(|r| r.constraint_residual).fold(0.0, f64::max),
             error: run.error.clone(),
             aero_wall_s: run.aero_wall_s,
+            aero_solves_per_step: run.aero_solves as f64 / run.aero_steps.max(1) as f64,
             oscillations: Vec::new(),
             oscillation_signal: "",
             roll: RollResponse::of(&run.rows),
