@@ -14,7 +14,9 @@
 //! 3. apply them and solve the structural step;
 //! 4. strong coupling (optional): move the lattice to the new structure, re-solve the same UVLM
 //!    step, relax the loads and redo the structural step from `n` until the relative load change
-//!    is below the tolerance;
+//!    is below the tolerance. Strongly coupled, steps 1–2 are by default only the wake's
+//!    convection, and step 3 takes the last two steps' loads extrapolated to `t_{n+1}`
+//!    ([`LoadPredictor`]; docs/coupling.md §4);
 //! 5. commit the UVLM step and add the aerodynamic work `∫ Σ (F·v + M·ω) dt` (trapezoidal).
 
 use nalgebra::{Matrix3, Vector3};
