@@ -10,7 +10,8 @@
 //!   more; an observer reads the process's CPU time at every step, and a run's figure is the mean
 //!   over the last 32 steps (process time, so that the lattice's own threads count). Every
 //!   configuration runs three times, interleaved with the others, and the table gives the
-//!   median.
+//!   median, then each case's aerodynamic solves per time step (more than one with the
+//!   coupling's sub-iterations).
 //! * **Whole analyses**, each once, process CPU and wall time: a 20 s run of the paper's wing and
 //!   Healy's static sweep per formulation (the sweep as the median of 7 runs), each also with the
 //!   committed NACA 0015 polars on both bodies (`cases/polars/`, interleaved with the runs
@@ -90,6 +91,9 @@ pub struct StepRow {
     pub summation: Summation,
     /// Mean process CPU time of a step with the wake full, ms.
     pub cpu_ms: f64,
+    /// Aerodynamic solves per time step over the run (with the coupling's sub-iterations,
+    /// docs/coupling.md §4).
+    pub aero_solves_per_step: f64,
     /// Why the run stopped early, if it did.
     pub error: Option<String>,
 }
@@ -184,7 +188,8 @@ fn step_row(cases: &Path, file: &str, rows: usize, summation: Summation) -> Resu
     let n = cpu.0.len();
     let cpu_ms =
         if n > TIMED_STEPS { 1e3 * (cpu.0[n - 1] - cpu.0[n - 1 - TIMED_STEPS]) / TIMED_STEPS as f64 } else { f64::NAN };
-    Ok(StepRow { case: run.name.clone(), rows, summation, cpu_ms, error: out.error })
+    let aero_solves_per_step = out.aero_solves as f64 / out.aero_steps.max(1) as f64;
+    Ok(StepRow { case: run.name.clone(), rows, summation, cpu_ms, aero_solves_per_step, error: out.error })
 }
 
 /// Time `work` once: process CPU and wall seconds and its error.
@@ -375,6 +380,12 @@ pub fn markdown(b: &AeroBench) -> String {
         };
         let _ = write!(s, " {case} {:.2}×;", at(320, Some(Summation::Treecode)) / at(40, None));
     }
+    // What a step is: one aerodynamic solve loosely coupled, more with sub-iterations.
+    s.push_str("\n\nAerodynamic solves per time step (mean over the case's runs):");
+    for case in seen.iter().filter(|x| x.1 == Summation::Treecode).map(|x| &x.0) {
+        let per: Vec<f64> = b.steps.iter().filter(|x| &x.case == case).map(|x| x.aero_solves_per_step).collect();
+        let _ = write!(s, " {case} {:.2};", per.iter().sum::<f64>() / per.len().max(1) as f64);
+    }
     s.push_str("\n\nWhole analyses:\n\n| analysis | formulation | CPU s | wall s | error |\n|---|---|---|---|---|\n");
     for a in &b.analyses {
         let _ = writeln!(
@@ -398,9 +409,10 @@ pub fn markdown(b: &AeroBench) -> String {
 /// Write `aero.csv`, `aero.md`, `aero.json` and `aero_wake.svg` into `dir`.
 pub fn write(dir: &Path, b: &AeroBench) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
-    let mut csv = String::from("case,rows,summation,cpu_ms_per_step\n");
+    let mut csv = String::from("case,rows,summation,cpu_ms_per_step,aero_solves_per_step\n");
     for r in &b.steps {
-        let _ = writeln!(csv, "{},{},{},{:.4}", r.case, r.rows, r.summation.name(), r.cpu_ms);
+        let _ =
+            writeln!(csv, "{},{},{},{:.4},{:.3}", r.case, r.rows, r.summation.name(), r.cpu_ms, r.aero_solves_per_step);
     }
     write_file(&dir.join("aero.csv"), &csv)?;
     write_file(&dir.join("aero.md"), &markdown(b))?;
@@ -479,6 +491,7 @@ mod tests {
             rows,
             summation,
             cpu_ms,
+            aero_solves_per_step: if rows == 40 { 2.0 } else { 1.0 },
             error: None,
         };
         let mut steps = Vec::new();
@@ -510,6 +523,8 @@ mod tests {
         assert!(md.contains("| a run | ancf | 1.250 |"), "{md}");
         // 2√5 at 320 rows through the treecode over the direct 2.00 at 40 rows (below its 2√2).
         assert!(md.contains("wing 2.24×;"), "{md}");
+        // Over the 15 runs: three at 40 rows with 2 solves a step, twelve with 1.
+        assert!(md.contains("solves per time step (mean over the case's runs): wing 1.20;"), "{md}");
         let dir = std::env::temp_dir().join(format!("flexmb-bench-aero-{}", std::process::id()));
         write(&dir, &b).unwrap();
         for f in ["aero.csv", "aero.md", "aero.json", "aero_wake.svg"] {
