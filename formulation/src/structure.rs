@@ -169,11 +169,10 @@ pub trait Structure: ConstrainedSystem {
     ///
     /// # Errors
     /// A message when the state cannot be carried over.
-    fn carry_state(&self, old: &Self, q: &[f64], v: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String>
+    fn carry_state(&self, _old: &Self, q: &[f64], v: &[f64]) -> Result<(Vec<f64>, Vec<f64>), String>
     where
         Self: Sized,
     {
-        let _ = old;
         if self.n_coords() != q.len() || self.n_dof() != v.len() {
             return Err(format!(
                 "the new model has {} coordinates and {} velocities, not {} and {}",
