@@ -633,9 +633,9 @@ struct MarchAero<'a> {
     /// The polars' correction of the last solve.
     report: StripReport,
     /// The loads of the step before the last ([`LoadPredictor::Extrapolate`]), valid when
-    /// `known_loads` ≥ 1 (0 after a (re)start of the march).
+    /// `has_previous_loads` (false after a (re)start of the march).
     loads_previous: Vec<SectionLoad>,
-    known_loads: usize,
+    has_previous_loads: bool,
     /// Aerodynamic solves and time steps of the march.
     n_solves: usize,
     n_steps: usize,
@@ -772,7 +772,7 @@ impl<'a> MarchAero<'a> {
             polars,
             report: StripReport::default(),
             loads_previous: Vec::new(),
-            known_loads: 0,
+            has_previous_loads: false,
             n_solves: 0,
             n_steps: 0,
         })
@@ -861,7 +861,7 @@ impl<'a> MarchAero<'a> {
     /// they are on the first step after a (re)start, which knows no `L_{n−1}`), and `L_n` is kept
     /// as the next step's previous loads.
     fn extrapolate_loads(&mut self) {
-        if self.known_loads >= 1 {
+        if self.has_previous_loads {
             for (l, p) in self.loads.iter_mut().zip(&mut self.loads_previous) {
                 let (f, m) = (l.force, l.moment);
                 l.force = 2.0 * f - p.force;
@@ -871,13 +871,13 @@ impl<'a> MarchAero<'a> {
             }
         } else {
             self.loads_previous.clone_from(&self.loads);
-            self.known_loads = 1;
+            self.has_previous_loads = true;
         }
     }
 
     /// Forget the loads of earlier steps (after a hinge event, whose jump they do not predict).
     fn restart_loads(&mut self) {
-        self.known_loads = 0;
+        self.has_previous_loads = false;
     }
 
     /// Relax the applied loads towards the sub-iteration's; whether the relative change was
