@@ -5,35 +5,81 @@
 //! screenshot shows the drawing (pixels in the formulations' colours that a screenshot of the
 //! same page without its script does not have).
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 use super::external::{chromium, copy_tree, root, temp_dir, venv_python};
 
 const TEST: &str = "report_loads_and_draws_in_headless_chromium";
 
-/// Run Chromium headless on `url` with `extra` flags and a profile under `dir`.
+/// How long one Chromium run may take before it counts as hung. A run takes 1–3 s here; a
+/// headless Chromium now and then stalls with no CPU use and never exits.
+const CHROME_DEADLINE: Duration = Duration::from_secs(90);
+/// Runs after a hang before the test gives up.
+const CHROME_TRIES: usize = 3;
+
+/// Run Chromium headless on `url` with `extra` flags and a fresh profile under `dir`. A run that
+/// passes [`CHROME_DEADLINE`] is killed with its whole process group and started again, up to
+/// [`CHROME_TRIES`] times; a hang on every try fails the test, naming the url.
 fn chrome(exe: &Path, dir: &Path, url: &str, extra: &[&str]) -> Output {
-    let profile = dir.join("profile");
-    Command::new(exe)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--enable-logging=stderr",
-            "--v=0",
-            "--virtual-time-budget=8000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .arg(url)
-        .output()
-        .expect("chromium starts")
+    for attempt in 0..CHROME_TRIES {
+        let run = dir.join(format!("chrome-{attempt}"));
+        let _ = std::fs::remove_dir_all(&run);
+        std::fs::create_dir_all(&run).unwrap();
+        // Files, not pipes: a killed browser's children cannot keep a reader waiting.
+        let (out_path, err_path) = (run.join("stdout"), run.join("stderr"));
+        let mut child = Command::new(exe)
+            .args([
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                "--enable-logging=stderr",
+                "--v=0",
+                "--virtual-time-budget=8000",
+            ])
+            .arg(format!("--user-data-dir={}", run.join("profile").display()))
+            .args(extra)
+            .arg(url)
+            .stdin(Stdio::null())
+            .stdout(std::fs::File::create(&out_path).unwrap())
+            .stderr(std::fs::File::create(&err_path).unwrap())
+            .process_group(0)
+            .spawn()
+            .expect("chromium starts");
+        let start = Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break Some(status);
+            }
+            if start.elapsed() > CHROME_DEADLINE {
+                break None;
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        };
+        match status {
+            Some(status) => {
+                return Output {
+                    status,
+                    stdout: std::fs::read(&out_path).unwrap(),
+                    stderr: std::fs::read(&err_path).unwrap(),
+                };
+            }
+            None => {
+                // The group holds the browser and every renderer and helper it started.
+                let _ = Command::new("kill").args(["-KILL", &format!("-{}", child.id())]).status();
+                let _ = child.wait();
+                eprintln!("chromium hung for {CHROME_DEADLINE:?} on {url} (try {}); killed", attempt + 1);
+            }
+        }
+    }
+    panic!("chromium hung on all {CHROME_TRIES} tries on {url}");
 }
 
 /// Every relative `href="…"` and `src="…"` of `html`.
