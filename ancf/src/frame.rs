@@ -15,7 +15,45 @@ pub fn section_frame(r_y: &Vector3<f64>, r_z: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// The rotation factor of the polar decomposition `F = R U` (the rotation closest to `F`).
+///
+/// For `det F > 0` (every section frame: `det [n, r_y, r_z] = |r_y × r_z|`) by Higham's Newton
+/// iteration `X ← (ζX + (ζX)⁻ᵀ/ζ)/2` with the determinant scaling `ζ = |det X|^(−1/3)`, which
+/// converges quadratically to the polar factor (Higham, *Functions of Matrices*, SIAM 2008,
+/// §8.6): a section's slopes are orthonormal to their strain, so three or four iterations of
+/// a 3 × 3 inverse reach rounding, against a general SVD that cost a fifth of the paper's wing
+/// run. Otherwise (a reflection or a singular `F`) from the SVD, as the closest proper rotation.
 pub fn polar_rotation(f: &Matrix3<f64>) -> Matrix3<f64> {
+    let mut x = *f;
+    let mut det = x.determinant();
+    for _ in 0..POLAR_MAX_ITERATIONS {
+        if !(det > 0.0 && det.is_finite()) {
+            return polar_rotation_svd(f);
+        }
+        let zeta = det.cbrt().recip();
+        // (ζX)⁻ᵀ from the cofactors: (X⁻¹)ᵀ = cof(X)/det X.
+        let (c0, c1, c2) = (x.column(0), x.column(1), x.column(2));
+        let cof = Matrix3::from_columns(&[c1.cross(&c2), c2.cross(&c0), c0.cross(&c1)]);
+        let next = (x * zeta + cof * (1.0 / (det * zeta))) * 0.5;
+        let change = (next - x).amax();
+        x = next;
+        if change <= POLAR_TOLERANCE {
+            return x;
+        }
+        det = x.determinant();
+    }
+    polar_rotation_svd(f)
+}
+
+/// Iterations of [`polar_rotation`]'s Newton iteration before it falls back to the SVD (a
+/// well-conditioned `F` takes 3–5; scaling bounds the count by about 9 for condition 1e16).
+const POLAR_MAX_ITERATIONS: usize = 20;
+
+/// Largest entry change of a Newton iterate at which [`polar_rotation`] stops: quadratic
+/// convergence leaves the next change at about its square, below rounding.
+const POLAR_TOLERANCE: f64 = 1e-12;
+
+/// The closest proper rotation to `f` from its SVD (a reflection flips the last singular vector).
+fn polar_rotation_svd(f: &Matrix3<f64>) -> Matrix3<f64> {
     let svd = f.svd(true, true);
     let (u, vt) = match (svd.u, svd.v_t) {
         (Some(u), Some(vt)) => (u, vt),
@@ -72,6 +110,32 @@ mod tests {
         let rot = Rotation3::from_scaled_axis(Vector3::new(0.3, -1.1, 0.4)).into_inner();
         let f = section_frame(&(rot * Vector3::y()), &(rot * Vector3::z()));
         assert_relative_eq!(f, rot, epsilon = 1e-14);
+    }
+
+    #[test]
+    fn newton_polar_factor_equals_the_svd_one() {
+        // Near rotations (a section's slopes) and strongly distorted matrices with det > 0.
+        let mut seed = 12345u64;
+        let mut rand = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for k in 0..400 {
+            let rot = Rotation3::from_scaled_axis(Vector3::new(6.0 * rand(), 6.0 * rand(), 6.0 * rand()));
+            let size = if k % 2 == 0 { 1e-3 } else { 1.0 };
+            let u = Matrix3::from_fn(|i, j| f64::from(u8::from(i == j)) + size * rand());
+            let f = rot.into_inner() * u;
+            if f.determinant() <= 1e-3 {
+                continue;
+            }
+            let (newton, svd) = (polar_rotation(&f), polar_rotation_svd(&f));
+            assert_relative_eq!(newton, svd, epsilon = 1e-13);
+            assert_relative_eq!(newton.transpose() * newton, Matrix3::identity(), epsilon = 1e-14);
+        }
+        // A reflection takes the SVD's closest proper rotation.
+        let m = Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, -0.5));
+        assert_relative_eq!(polar_rotation(&m), polar_rotation_svd(&m), epsilon = 1e-15);
+        assert!(polar_rotation(&m).determinant() > 0.0);
     }
 
     #[test]
