@@ -277,21 +277,56 @@ fn reference_frames(case: &Problem) -> Vec<Matrix3<f64>> {
         .collect()
 }
 
+/// Reused buffers of the stations' poses and velocities: the probe states `q ⊕ ±ε v` and the
+/// poses at `q` and at both probes.
+#[derive(Debug, Clone, Default)]
+pub struct StationScratch {
+    dq: Vec<f64>,
+    qp: Vec<f64>,
+    qm: Vec<f64>,
+    at: Vec<(usize, f64)>,
+    poses: [Vec<(Vector3<f64>, Matrix3<f64>)>; 3],
+}
+
+/// A section's pose and velocity: point, frame, linear and angular velocity.
+pub type SectionKinematics = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
+
 /// Pose and velocity of a section by central differences along the retraction.
 pub fn section_state<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
     v: &[f64],
     st: &StationMap,
-    scratch: &mut (Vec<f64>, Vec<f64>, Vec<f64>),
-) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
-    let (p, r) = model.section_pose(q, st.body, st.s);
+    scratch: &mut StationScratch,
+) -> SectionKinematics {
+    let mut out = None;
+    station_states(model, q, v, std::slice::from_ref(st), scratch, |_, k| out = Some(k));
+    out.unwrap_or_else(|| unreachable!("one station in, one out"))
+}
+
+/// [`section_state`] of every station of `map`, handed to `each` with its index: the probe
+/// states `q ⊕ ±ε v` depend on the state only, so one pair serves every station (a retraction
+/// costs the whole structure), and the poses go through [`Structure::section_poses`].
+pub fn station_states<S: Structure + ?Sized>(
+    model: &S,
+    q: &[f64],
+    v: &[f64],
+    map: &[StationMap],
+    scratch: &mut StationScratch,
+    mut each: impl FnMut(usize, SectionKinematics),
+) {
     let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    if vmax == 0.0 {
-        return (p, r, Vector3::zeros(), Vector3::zeros());
-    }
-    let eps = 1e-6 / vmax.max(1.0);
-    let (dq, qp, qm) = scratch;
+    let eps = (vmax != 0.0).then(|| 1e-6 / vmax.max(1.0));
+    let StationScratch { dq, qp, qm, at, poses } = scratch;
+    at.clear();
+    at.extend(map.iter().map(|st| (st.body, st.s)));
+    model.section_poses(q, at, &mut poses[0]);
+    let Some(eps) = eps else {
+        for (i, &(p, r)) in poses[0].iter().enumerate() {
+            each(i, (p, r, Vector3::zeros(), Vector3::zeros()));
+        }
+        return;
+    };
     dq.clear();
     dq.extend(v.iter().map(|x| eps * x));
     qp.resize(q.len(), 0.0);
@@ -299,12 +334,15 @@ pub fn section_state<S: Structure + ?Sized>(
     model.retract_inplace(q, dq, qp);
     dq.iter_mut().for_each(|x| *x = -*x);
     model.retract_inplace(q, dq, qm);
-    let (pp, rp) = model.section_pose(qp, st.body, st.s);
-    let (pm, rm) = model.section_pose(qm, st.body, st.s);
-    let vel = (pp - pm) / (2.0 * eps);
-    let w = (rp - rm) * r.transpose() / (2.0 * eps);
-    let omega = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
-    (p, r, vel, omega)
+    let [p0, pp, pm] = poses;
+    model.section_poses(qp, at, pp);
+    model.section_poses(qm, at, pm);
+    for (i, ((&(p, r), &(pp, rp)), &(pm, rm))) in p0.iter().zip(pp.iter()).zip(pm.iter()).enumerate() {
+        let vel = (pp - pm) / (2.0 * eps);
+        let w = (rp - rm) * r.transpose() / (2.0 * eps);
+        let omega = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]) * 0.5;
+        each(i, (p, r, vel, omega));
+    }
 }
 
 /// Build the lattice stations (and their velocities) of the current structural state, with the
@@ -318,14 +356,14 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
     map: &[StationMap],
     aero: &AeroSettings,
     t: Option<f64>,
-    scratch: &mut (Vec<f64>, Vec<f64>, Vec<f64>),
+    scratch: &mut StationScratch,
     stations: &mut Vec<uvlm::SpanStation>,
     velocities: &mut Vec<uvlm::StationVelocity>,
 ) {
     stations.clear();
     velocities.clear();
-    for st in map {
-        let (p, r, vel, omega) = section_state(model, q, v, st, scratch);
+    station_states(model, q, v, map, scratch, |i, (p, r, vel, omega)| {
+        let st = &map[i];
         stations.push(uvlm::SpanStation {
             origin: p,
             frame: r,
@@ -335,7 +373,7 @@ pub(crate) fn stations_at<S: Structure + ?Sized>(
             flap: st.control.map(|i| aero.control_surfaces[i].flap_at(t)),
         });
         velocities.push(uvlm::StationVelocity { linear: vel, angular: omega });
-    }
+    });
 }
 
 /// Aerodynamic power Σ F·v + M·ω of station loads with station velocities, W.
@@ -594,7 +632,7 @@ fn march_start<'a, S: Structure>(
 
 /// The stations placed on a structure: the scratch of [`stations_at`], the stations and their
 /// velocities.
-type Placed = ((Vec<f64>, Vec<f64>, Vec<f64>), Vec<uvlm::SpanStation>, Vec<uvlm::StationVelocity>);
+type Placed = (StationScratch, Vec<uvlm::SpanStation>, Vec<uvlm::StationVelocity>);
 
 /// The span direction of the lift (the global X axis).
 const SPAN_DIR: [f64; 3] = [1.0, 0.0, 0.0];
@@ -607,7 +645,7 @@ struct MarchAero<'a> {
     map: &'a [StationMap],
     aero: &'a AeroSettings,
     dt: f64,
-    scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+    scratch: StationScratch,
     stations: Vec<uvlm::SpanStation>,
     vel: Vec<uvlm::StationVelocity>,
     vel_n: Vec<uvlm::StationVelocity>,
@@ -692,7 +730,7 @@ impl<'a> MarchAero<'a> {
         at_equilibrium: bool,
         polars: Option<&'a StripPolars>,
     ) -> Result<Self, String> {
-        let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+        let mut scratch = StationScratch::default();
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
         stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
         let mut params = aero.uvlm_params(aero.free_stream());
@@ -725,7 +763,7 @@ impl<'a> MarchAero<'a> {
         polars: Option<&'a StripPolars>,
         ck: MarchCheckpoint,
     ) -> Result<Self, String> {
-        let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+        let mut scratch = StationScratch::default();
         let (mut stations, mut vel) = (Vec::new(), Vec::new());
         stations_at(model, &s.q, &s.v, map, aero, Some(s.t), &mut scratch, &mut stations, &mut vel);
         if ck.loads.len() != map.len() {

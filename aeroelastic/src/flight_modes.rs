@@ -122,7 +122,7 @@ impl StationMotion {
         (map, aero, p): (&[StationMap], &AeroSettings, &Problem),
     ) -> Self {
         let zeros = vec![0.0; model.n_dof()];
-        let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+        let mut scratch = crate::aero::StationScratch::default();
         let (mut st0, mut vel) = (Vec::new(), Vec::new());
         stations_at(model, q, &zeros, map, aero, None, &mut scratch, &mut st0, &mut vel);
         let span = p.span().max(1e-3);

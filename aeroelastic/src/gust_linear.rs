@@ -120,7 +120,7 @@ fn run<S: Structure>(
 
     // The linear UVLM on the equilibrium's lattice and the gust's input to it.
     let zeros = vec![0.0; model.n_dof()];
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let mut scratch = crate::aero::StationScratch::default();
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(&model, &q, &zeros, &map, aero, None, &mut scratch, &mut stations, &mut vel);
     let mut uv = crate::lifting::new_uvlm(&map, aero, &stations, aero.uvlm_params(v_inf))

@@ -34,7 +34,7 @@ use nalgebra::{Complex, DMatrix, DVector, Vector3};
 
 use formulation::Structure;
 
-use crate::aero::{AeroSettings, SectionLoad, StationMap, station_map, stations_at};
+use crate::aero::{AeroSettings, SectionLoad, StationMap, StationScratch, station_map, stations_at};
 use crate::factory::{BuildModel, ForModel, dispatch};
 use crate::polar_correction::StripPolars;
 use crate::problem::{Formulation, Problem};
@@ -640,7 +640,7 @@ pub(crate) fn steady_station_loads<S: Structure>(
     polars: Option<&StripPolars>,
 ) -> Result<Option<Vec<SectionLoad>>, String> {
     let zeros = vec![0.0; model.n_dof()];
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let mut scratch = crate::aero::StationScratch::default();
     let (mut stations, mut vel) = (Vec::new(), Vec::new());
     stations_at(model, q, &zeros, map, aero, None, &mut scratch, &mut stations, &mut vel);
     let mut params = aero.uvlm_params(aero.free_stream());
@@ -693,9 +693,6 @@ pub(crate) fn lump(
         .map(|(m, (f, mo))| SectionLoad { body: m.body, s: m.s, force: Vector3::from(*f), moment: Vector3::from(*mo) })
         .collect()
 }
-
-/// Reused buffers of [`stations_at`].
-type StationScratch = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Zero station loads at the stations of `map`.
 pub(crate) fn zero_loads(map: &[StationMap]) -> Vec<SectionLoad> {

@@ -41,7 +41,7 @@ use nalgebra::{Matrix3, Vector3};
 use formulation::{SectionLoad, Structure};
 use genalpha::State;
 
-use crate::aero::{AeroSettings, StationMap, section_state};
+use crate::aero::{AeroSettings, StationMap, station_states};
 use crate::polar_correction::{StripGeometry, StripPolars};
 use crate::problem::Formulation;
 use crate::run::{Dissipation, Observer, RunOutput, RunSettings, SnapshotFeed, row};
@@ -66,7 +66,7 @@ pub struct StripAero<'a> {
     /// Each column's dynamic-stall model and state (in the order of `columns`; `None` before
     /// its first evaluation and on bodies without the model).
     stall: Vec<Option<StallSlot>>,
-    scratch: (Vec<f64>, Vec<f64>, Vec<f64>),
+    scratch: crate::aero::StationScratch,
 }
 
 /// One column's loads at a state.
@@ -127,7 +127,7 @@ impl<'a> StripAero<'a> {
             ColumnLoad { force: Vector3::zeros(), moment: Vector3::zeros(), at: Vector3::zeros(), alpha: f64::NAN };
         let last = vec![none; columns.len()];
         let stall = vec![None; columns.len()];
-        Self { map, aero, polars, columns, kin, loads, last, stall, scratch: (Vec::new(), Vec::new(), Vec::new()) }
+        Self { map, aero, polars, columns, kin, loads, last, stall, scratch: crate::aero::StationScratch::default() }
     }
 
     /// The station loads at time `t` and state `(q, v)`, replacing the loads held so far; and the
@@ -142,9 +142,8 @@ impl<'a> StripAero<'a> {
         q: &[f64],
         v: &[f64],
     ) -> Result<(&[SectionLoad], f64, f64), String> {
-        for (k, m) in self.kin.iter_mut().zip(self.map) {
-            *k = section_state(model, q, v, m, &mut self.scratch);
-        }
+        let kin = &mut self.kin;
+        station_states(model, q, v, self.map, &mut self.scratch, |i, k| kin[i] = k);
         let power_of = |loads: &[SectionLoad], kin: &[Kinematics]| -> f64 {
             loads.iter().zip(kin).map(|(l, k)| l.force.dot(&k.2) + l.moment.dot(&k.3)).sum()
         };

@@ -145,6 +145,13 @@ pub trait Structure: ConstrainedSystem {
     /// Axis point (m) and section frame (columns x, y, z, orthonormal) of `body` at arclength
     /// `s`. For a station outside the model: a NaN point and the identity.
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>);
+    /// [`section_pose`](Self::section_pose) of each `(body, s)` of `at`, in order, into `out`
+    /// (cleared first). Default: one call each; a formulation whose pose interpolates shared
+    /// element quantities computes them once per element for consecutive stations on it.
+    fn section_poses(&self, q: &[f64], at: &[(usize, f64)], out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>) {
+        out.clear();
+        out.extend(at.iter().map(|&(body, s)| self.section_pose(q, body, s)));
+    }
     /// Replace all external section loads by `loads`, which [`check_section_loads`] has
     /// accepted; an error here ([`LoadError::Model`]) is the model's own refusal of a value
     /// that passed the check. Called through [`set_section_loads`](Self::set_section_loads).

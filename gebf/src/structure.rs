@@ -30,6 +30,36 @@ impl Model {
     }
 }
 
+/// What a section pose interpolates on one element: the three node positions, the middle
+/// node's frame and the end nodes' rotation vectors relative to it.
+struct ElementPose {
+    positions: [Vector3<f64>; 3],
+    middle: Matrix3<f64>,
+    ends: [Vector3<f64>; 2],
+}
+
+impl ElementPose {
+    fn new(model: &Model, q: &[f64], body: usize, nodes: [usize; 3]) -> Self {
+        let pos = |k| model.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
+        let frm = |k| model.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+        let log = |r: &Matrix3<f64>| crate::crv::from_rotation_matrix(r);
+        let middle = frm(nodes[1]);
+        Self {
+            positions: [pos(nodes[0]), pos(nodes[1]), pos(nodes[2])],
+            middle,
+            ends: [log(&(middle.transpose() * frm(nodes[0]))), log(&(middle.transpose() * frm(nodes[2])))],
+        }
+    }
+
+    /// The pose at the quadratic shape-function weights `w`.
+    fn at(&self, w: [f64; 3]) -> (Vector3<f64>, Matrix3<f64>) {
+        let [p0, p1, p2] = &self.positions;
+        let p = p0 * w[0] + p1 * w[1] + p2 * w[2];
+        let phi = self.ends[0] * w[0] + self.ends[1] * w[2];
+        (p, self.middle * nalgebra::Rotation3::new(phi).into_inner())
+    }
+}
+
 impl Structure for Model {
     /// genalpha's default solver, which switches to the bordered node-block LU from GEBF's
     /// declared block-banded structure.
@@ -99,17 +129,27 @@ impl Structure for Model {
     /// angle: an `acos` of the trace returns NaN when rounding pushes it past 3 for the tiny
     /// relative rotations of a stiff wing.
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
-        let Some((nodes, w)) = self.section_element(body, s) else {
-            return (Vector3::from_element(f64::NAN), Matrix3::identity());
-        };
-        let pos = |k| self.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
-        let frm = |k| self.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
-        let log = |r: &Matrix3<f64>| crate::crv::from_rotation_matrix(r);
-        let p = pos(nodes[0]) * w[0] + pos(nodes[1]) * w[1] + pos(nodes[2]) * w[2];
-        let r1 = frm(nodes[1]);
-        let phi = log(&(r1.transpose() * frm(nodes[0]))) * w[0] + log(&(r1.transpose() * frm(nodes[2]))) * w[2];
-        let r = r1 * nalgebra::Rotation3::new(phi).into_inner();
-        (p, r)
+        match self.section_element(body, s) {
+            Some((nodes, w)) => ElementPose::new(self, q, body, nodes).at(w),
+            None => (Vector3::from_element(f64::NAN), Matrix3::identity()),
+        }
+    }
+    /// The element's node positions, middle frame and end rotation vectors are computed once
+    /// for the consecutive stations on it (bit for bit [`section_pose`](Self::section_pose)).
+    fn section_poses(&self, q: &[f64], at: &[(usize, f64)], out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>) {
+        out.clear();
+        let mut current: Option<(usize, usize, ElementPose)> = None;
+        for &(body, s) in at {
+            let Some((nodes, w)) = self.section_element(body, s) else {
+                out.push((Vector3::from_element(f64::NAN), Matrix3::identity()));
+                continue;
+            };
+            let pose = match &current {
+                Some((b, n0, pose)) if *b == body && *n0 == nodes[0] => pose,
+                _ => &current.insert((body, nodes[0], ElementPose::new(self, q, body, nodes))).2,
+            };
+            out.push(pose.at(w));
+        }
     }
     /// Consistent nodal loads: the quadratic weights distribute each station's force and moment.
     fn apply_section_loads(&mut self, loads: &[SectionLoad]) -> Result<(), LoadError> {

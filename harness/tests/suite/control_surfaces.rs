@@ -40,7 +40,7 @@ fn hinge_moment_on_the_lattice(spec: &RunSpec, p: &StaticPoint) -> f64 {
     let q = &p.state.as_ref().unwrap().0;
     let map = harness::aero::station_map(&problem, &aero).unwrap();
     let zeros = vec![0.0; q.len()];
-    let mut scratch = (Vec::new(), Vec::new(), Vec::new());
+    let mut scratch = harness::aero::StationScratch::default();
     let stations: Vec<uvlm::SpanStation> = map
         .iter()
         .map(|m| {
