@@ -183,24 +183,21 @@ impl LoadModel {
         scratch: &mut LoadScratch,
     ) -> (Vector3<f64>, Vector3<f64>) {
         let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
-        for l in aero.iter().filter(|l| cut.bodies.contains(&l.body)) {
-            let (p, _) = model.section_pose(q_of(scratch), l.body, l.s);
+        scratch.ensure_aero_points(model, aero);
+        for (l, p) in aero.iter().zip(&scratch.aero_points).filter(|(l, _)| cut.bodies.contains(&l.body)) {
             f += l.force;
             m += (p - about).cross(&l.force) + l.moment;
         }
         for &b in &cut.bodies {
             let Some(bm) = self.bodies.get(b) else { continue };
             let h = bm.length / bm.n_elements as f64;
-            for e in 0..bm.n_elements {
-                for (xi, w) in GAUSS3 {
-                    let s = h * (e as f64 + xi);
-                    let k = scratch.kinematics(model, b, s);
-                    let cg = k.offset_point(Vector3::new(0.0, bm.cg[0], bm.cg[1]));
-                    let df = bm.mass * (self.gravity - cg.1) * (w * h);
-                    f += df;
-                    m += (cg.0 - about).cross(&df);
-                    m += k.rotary_moment(Vector3::from(bm.rho_i)) * (w * h);
-                }
+            scratch.ensure_gauss(model, b, bm);
+            for (k, (_, w)) in scratch.gauss[b].iter().zip(GAUSS3.iter().cycle()) {
+                let cg = k.offset_point(Vector3::new(0.0, bm.cg[0], bm.cg[1]));
+                let df = bm.mass * (self.gravity - cg.1) * (w * h);
+                f += df;
+                m += (cg.0 - about).cross(&df);
+                m += k.rotary_moment(Vector3::from(bm.rho_i)) * (w * h);
             }
             for pm in &bm.points {
                 let k = scratch.kinematics(model, b, pm.at);
@@ -214,11 +211,8 @@ impl LoadModel {
     }
 }
 
-fn q_of(s: &LoadScratch) -> &[f64] {
-    &s.q[0]
-}
-
 /// Pose, velocity and acceleration of a section.
+#[derive(Debug, Clone)]
 struct Kinematics {
     p: Vector3<f64>,
     r: Matrix3<f64>,
@@ -245,13 +239,21 @@ impl Kinematics {
     }
 }
 
-/// Reused buffers of [`LoadModel::evaluate`]: the states `q`, `q(±ε)` and `q(±2ε)`.
+/// Reused buffers of [`LoadModel::evaluate`]: the states `q`, `q(±ε)` and `q(±2ε)`, and what
+/// one evaluation computes once for both cuts (the hinge's free body lies inside the root's):
+/// the aerodynamic stations' points and each body's kinematics at its Gauss points.
 #[derive(Debug, Clone, Default)]
 pub struct LoadScratch {
     q: [Vec<f64>; 5],
     dq: Vec<f64>,
     eps: f64,
     moving: bool,
+    at: Vec<(usize, f64)>,
+    poses: [Vec<(Vector3<f64>, Matrix3<f64>)>; 5],
+    aero_points: Vec<Vector3<f64>>,
+    aero_ready: bool,
+    /// Per body, the kinematics at its Gauss points in (element, point) order; empty until used.
+    gauss: Vec<Vec<Kinematics>>,
 }
 
 /// Multiples of ε of the states `q[1..]` of [`LoadScratch`].
@@ -262,6 +264,8 @@ impl LoadScratch {
         self.q[0].clear();
         self.q[0].extend_from_slice(q);
         self.moving = false;
+        self.aero_ready = false;
+        self.gauss.iter_mut().for_each(Vec::clear);
         let Some((v, a)) = motion else { return };
         let vmax = v.iter().chain(a).fold(0.0_f64, |m, x| m.max(x.abs()));
         if vmax == 0.0 {
@@ -285,7 +289,18 @@ impl LoadScratch {
     }
 
     fn kinematics<S: Structure + ?Sized>(&self, model: &S, body: usize, s: f64) -> Kinematics {
-        let (p, r) = model.section_pose(&self.q[0], body, s);
+        let n = if self.moving { 5 } else { 1 };
+        let mut poses = [(Vector3::zeros(), Matrix3::zeros()); 5];
+        for (pose, q) in poses.iter_mut().zip(&self.q).take(n) {
+            *pose = model.section_pose(q, body, s);
+        }
+        self.from_poses(&poses)
+    }
+
+    /// The section's kinematics from its poses at the states `q`, `q(±ε)`, `q(±2ε)` (only the
+    /// first when at rest).
+    fn from_poses(&self, poses: &[(Vector3<f64>, Matrix3<f64>); 5]) -> Kinematics {
+        let (p, r) = poses[0];
         if !self.moving {
             return Kinematics {
                 p,
@@ -296,8 +311,7 @@ impl LoadScratch {
                 alpha: Vector3::zeros(),
             };
         }
-        let pose = |k: usize| model.section_pose(&self.q[k], body, s);
-        let ((p1, r1), (m1, rm1), (p2, r2), (m2, rm2)) = (pose(1), pose(2), pose(3), pose(4));
+        let [_, (p1, r1), (m1, rm1), (p2, r2), (m2, rm2)] = *poses;
         let e = self.eps;
         // Five-point central differences: second and first derivatives, O(ε⁴).
         let acc = (16.0 * (p1 + m1) - (p2 + m2) - 30.0 * p) / (12.0 * e * e);
@@ -306,6 +320,46 @@ impl LoadScratch {
         let omega = axial(&w);
         let alpha = axial(&(r_dd * r.transpose()));
         Kinematics { p, r, acc, r_dd, omega, alpha }
+    }
+
+    /// The points of the aerodynamic station loads `aero` at `q`, once per evaluation.
+    fn ensure_aero_points<S: Structure + ?Sized>(&mut self, model: &S, aero: &[SectionLoad]) {
+        if self.aero_ready {
+            return;
+        }
+        self.at.clear();
+        self.at.extend(aero.iter().map(|l| (l.body, l.s)));
+        model.section_poses(&self.q[0], &self.at, &mut self.poses[0]);
+        self.aero_points.clear();
+        self.aero_points.extend(self.poses[0].iter().map(|(p, _)| *p));
+        self.aero_ready = true;
+    }
+
+    /// Body `b`'s kinematics at its Gauss points, once per evaluation (the poses of every
+    /// state through [`Structure::section_poses`]).
+    fn ensure_gauss<S: Structure + ?Sized>(&mut self, model: &S, b: usize, bm: &BodyMass) {
+        if self.gauss.len() <= b {
+            self.gauss.resize_with(b + 1, Vec::new);
+        }
+        if !self.gauss[b].is_empty() {
+            return;
+        }
+        let h = bm.length / bm.n_elements as f64;
+        self.at.clear();
+        self.at.extend((0..bm.n_elements).flat_map(|e| GAUSS3.map(|(xi, _)| (b, h * (e as f64 + xi)))));
+        let n = if self.moving { 5 } else { 1 };
+        for k in 0..n {
+            model.section_poses(&self.q[k], &self.at, &mut self.poses[k]);
+        }
+        let mut gauss = std::mem::take(&mut self.gauss[b]);
+        for i in 0..self.at.len() {
+            let mut poses = [(Vector3::zeros(), Matrix3::zeros()); 5];
+            for (pose, k) in poses.iter_mut().zip(0..n) {
+                *pose = self.poses[k][i];
+            }
+            gauss.push(self.from_poses(&poses));
+        }
+        self.gauss[b] = gauss;
     }
 }
 

@@ -17,7 +17,7 @@ pub fn section_frame(r_y: &Vector3<f64>, r_z: &Vector3<f64>) -> Matrix3<f64> {
 /// The rotation factor of the polar decomposition `F = R U` (the rotation closest to `F`).
 ///
 /// For `det F > 0` (every section frame: `det [n, r_y, r_z] = |r_y × r_z|`) by Higham's Newton
-/// iteration `X ← (ζX + (ζX)⁻ᵀ/ζ)/2` with the determinant scaling `ζ = |det X|^(−1/3)`, which
+/// iteration `X ← (ζX + (ζX)⁻ᵀ/ζ)/2` with the determinant scaling `ζ = |det X|^(−1/3)` (1 once `det X` is within 1e-2 of 1), which
 /// converges quadratically to the polar factor (Higham, *Functions of Matrices*, SIAM 2008,
 /// §8.6): a section's slopes are orthonormal to their strain, so three or four iterations of
 /// a 3 × 3 inverse reach rounding, against a general SVD that cost a fifth of the paper's wing
@@ -29,7 +29,10 @@ pub fn polar_rotation(f: &Matrix3<f64>) -> Matrix3<f64> {
         if !(det > 0.0 && det.is_finite()) {
             return polar_rotation_svd(f);
         }
-        let zeta = det.cbrt().recip();
+        // Scaling pays only far from orthogonality (Higham §8.9 switches it off once the
+        // iteration settles); near it, ζ is 1 to within |det X − 1| and the cube root costs more
+        // than the iteration.
+        let zeta = if (det - 1.0).abs() < 1e-2 { 1.0 } else { det.cbrt().recip() };
         // (ζX)⁻ᵀ from the cofactors: (X⁻¹)ᵀ = cof(X)/det X.
         let (c0, c1, c2) = (x.column(0), x.column(1), x.column(2));
         let cof = Matrix3::from_columns(&[c1.cross(&c2), c2.cross(&c0), c0.cross(&c1)]);

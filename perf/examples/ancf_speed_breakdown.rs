@@ -47,6 +47,12 @@ fn main() {
             if let Some(x) = env("RTOL") {
                 params.newton.rtol = x.parse().expect("a number");
             }
+            if env("PRED").as_deref() == Some("ext") {
+                params.newton.predictor = genalpha::Predictor::ExtrapolatedAcceleration;
+            }
+            if let Some(x) = env("MAXC") {
+                params.newton.max_contraction = x.parse().expect("a number");
+            }
             if let Some(x) = env("ATOL") {
                 params.newton.atol = x.parse().expect("a number");
             }
