@@ -294,12 +294,12 @@ impl LoadScratch {
         for (pose, q) in poses.iter_mut().zip(&self.q).take(n) {
             *pose = model.section_pose(q, body, s);
         }
-        self.from_poses(&poses)
+        self.differentiate(&poses)
     }
 
     /// The section's kinematics from its poses at the states `q`, `q(±ε)`, `q(±2ε)` (only the
     /// first when at rest).
-    fn from_poses(&self, poses: &[(Vector3<f64>, Matrix3<f64>); 5]) -> Kinematics {
+    fn differentiate(&self, poses: &[(Vector3<f64>, Matrix3<f64>); 5]) -> Kinematics {
         let (p, r) = poses[0];
         if !self.moving {
             return Kinematics {
@@ -357,7 +357,7 @@ impl LoadScratch {
             for (pose, k) in poses.iter_mut().zip(0..n) {
                 *pose = self.poses[k][i];
             }
-            gauss.push(self.from_poses(&poses));
+            gauss.push(self.differentiate(&poses));
         }
         self.gauss[b] = gauss;
     }
