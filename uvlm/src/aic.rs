@@ -305,8 +305,11 @@ impl BoundSystem {
             let (nx, ny, nz) = (load_lanes(&nrm.x, b), load_lanes(&nrm.y, b), load_lanes(&nrm.z, b));
             fill_block(&self.fil, &px, &py, &pz, blk);
             influence_block(&self.fil, blk, &nx, &ny, &nz);
-            rows.fill(0.0);
-            let n_rows = rows.len() / n;
+            // Summed per ring in the filaments' order, then transposed into the rows: the
+            // same additions as summing into the rows directly.
+            let rings = &mut blk.rings;
+            rings.clear();
+            rings.resize(n, [0.0; LANES]);
             for f in 0..nf {
                 let (b, _) = self.base_of(f);
                 let v = &blk.infl[f];
@@ -314,9 +317,15 @@ impl BoundSystem {
                     if r == NONE {
                         continue;
                     }
-                    for (l, vl) in v.iter().enumerate().take(n_rows) {
-                        rows[l * n + r as usize] += s * vl;
+                    let acc = &mut rings[r as usize];
+                    for (a, vl) in acc.iter_mut().zip(v) {
+                        *a += s * vl;
                     }
+                }
+            }
+            for (l, row) in rows.chunks_mut(n).enumerate() {
+                for (x, ring) in row.iter_mut().zip(rings.iter()) {
+                    *x = ring[l];
                 }
             }
         };

@@ -331,6 +331,9 @@ pub(crate) struct NodeBlock {
     r: Vec<[[f64; LANES]; 4]>,
     /// Per-filament normal influences of one block (only for influence matrices).
     pub(crate) infl: Vec<[f64; LANES]>,
+    /// Per-ring sums of a block's lanes (only for influence matrices): ring-major, so that a
+    /// filament's lanes go to one cache line instead of one per lane.
+    pub(crate) rings: Vec<[f64; LANES]>,
 }
 
 /// Kernel bodies, compiled once per instruction set by [`multiversion`].

@@ -5,7 +5,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::{PartialPivLuParams, lu_in_place, lu_in_place_scratch};
 use faer::linalg::lu::partial_pivoting::solve::{solve_in_place, solve_in_place_scratch};
 use faer::perm::PermRef;
-use faer::{Mat, MatMut, MatRef, Par, Spec};
+use faer::{Mat, MatMut, Par, Spec};
 
 /// Factorisation of an `n × n` matrix given row-major.
 pub(crate) struct DenseLu {
@@ -36,7 +36,7 @@ impl DenseLu {
     pub(crate) fn factorize_row_major(&mut self, a: &[f64]) -> Result<(), usize> {
         let n = self.n;
         assert_eq!(a.len(), n * n, "factorize: dimension mismatch");
-        self.lu.copy_from(MatRef::from_row_major_slice(a, n, n));
+        transpose_into(a, n, &mut self.lu);
         let stack = MemStack::new(&mut self.buf);
         lu_in_place(self.lu.as_mut(), &mut self.perm, &mut self.perm_inv, Par::Seq, stack, Default::default());
         let scale = (0..n).map(|i| self.lu[(i, i)].abs()).fold(0.0_f64, f64::max);
@@ -58,6 +58,27 @@ impl DenseLu {
         solve_in_place(self.lu.as_ref(), self.lu.as_ref(), perm, rhs, Par::Seq, stack);
     }
 }
+
+/// Copy the row-major `n × n` matrix `a` into the column-major `m` in tiles of [`TILE`] × [`TILE`]
+/// (each tile's rows and columns stay in the first-level cache; faer's general strided copy
+/// took a third of the factorisation at the lattice's sizes).
+fn transpose_into(a: &[f64], n: usize, m: &mut Mat<f64>) {
+    for j0 in (0..n).step_by(TILE) {
+        let j1 = (j0 + TILE).min(n);
+        for i0 in (0..n).step_by(TILE) {
+            let i1 = (i0 + TILE).min(n);
+            for j in j0..j1 {
+                let col = &mut m.col_as_slice_mut(j)[i0..i1];
+                for (x, i) in col.iter_mut().zip(i0..i1) {
+                    *x = a[i * n + j];
+                }
+            }
+        }
+    }
+}
+
+/// Tile size of [`transpose_into`].
+const TILE: usize = 8;
 
 #[cfg(test)]
 mod tests {
