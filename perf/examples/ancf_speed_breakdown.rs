@@ -5,7 +5,8 @@
 //!
 //! Environment: `SOLVER=banded` uses genalpha's `DenseLu` with the declared band structure
 //! instead of `SkylineLu`; `RTOL`, `ATOL` override the Newton increment tolerances;
-//! `NOEST=1` switches the convergence estimate off; `FULL=1` refactorises at every Newton iteration; `OUT=dir` writes every step's tip as
+//! `NOEST=1` switches the convergence estimate off; `MAXC` sets the contraction rate above which a
+//! reused factorisation is refreshed; `PRED=ext` extrapolates the acceleration in the predictor; `FULL=1` refactorises at every Newton iteration; `OUT=dir` writes every step's tip as
 //! `dir/<case>.csv`; `REF=dir` compares the tip with such files and prints the largest
 //! distance relative to the largest tip excursion from its start.
 use ancf::{Model, Options, SolvePath, samples};
