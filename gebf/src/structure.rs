@@ -5,6 +5,7 @@ use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, Stru
 use genalpha::{DenseLu, GenAlpha, IntegratorParams, State};
 use nalgebra::{Matrix3, Vector3};
 
+use crate::crv::rotation_matrix;
 use crate::{Model, NodalLoad};
 
 impl Model {
@@ -31,23 +32,61 @@ impl Model {
 }
 
 /// What a section pose interpolates on one element: the three node positions, the middle
-/// node's frame and the end nodes' rotation vectors relative to it.
+/// node's frame and the end nodes' rotation vectors relative to it (and the last node's frame,
+/// which the next element of the body starts from).
 struct ElementPose {
     positions: [Vector3<f64>; 3],
     middle: Matrix3<f64>,
     ends: [Vector3<f64>; 2],
+    last: Matrix3<f64>,
+}
+
+/// A node's position and frame, [`Model::node_position`] and [`Model::node_frame`] bit for bit,
+/// with the body's frame rotation matrix computed once for its nodes.
+struct NodePoses<'a> {
+    model: &'a Model,
+    q: &'a [f64],
+    body: usize,
+    frame: Option<(Vector3<f64>, crate::quaternion::Quaternion, Matrix3<f64>)>,
+}
+
+impl<'a> NodePoses<'a> {
+    fn new(model: &'a Model, q: &'a [f64], body: usize) -> Self {
+        let frame = model.bodies.get(body).map(|b| {
+            let (r, chi) = b.frame_state(q);
+            (r, chi, chi.to_rotation_matrix())
+        });
+        Self { model, q, body, frame }
+    }
+
+    fn position(&self, k: usize) -> Vector3<f64> {
+        match (&self.frame, self.model.bodies.get(self.body)) {
+            (Some((r, chi, _)), Some(b)) if k < b.n_nodes() => r + chi.rotate(&b.node_state(self.q, k).0),
+            _ => Vector3::from_element(f64::NAN),
+        }
+    }
+
+    fn frame(&self, k: usize) -> Matrix3<f64> {
+        match (&self.frame, self.model.bodies.get(self.body)) {
+            (Some((_, _, c)), Some(b)) if k < b.n_nodes() => c * rotation_matrix(&b.node_state(self.q, k).1),
+            _ => Matrix3::from_element(f64::NAN),
+        }
+    }
 }
 
 impl ElementPose {
-    fn new(model: &Model, q: &[f64], body: usize, nodes: [usize; 3]) -> Self {
-        let pos = |k| model.node_position(q, body, k).unwrap_or_else(|_| Vector3::from_element(f64::NAN));
-        let frm = |k| model.node_frame(q, body, k).unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+    /// The element of `nodes` on the body of `nodes_at`; `start`: its first node's position and
+    /// frame when the previous element (ending there) has them.
+    fn new(nodes_at: &NodePoses<'_>, nodes: [usize; 3], start: Option<(Vector3<f64>, Matrix3<f64>)>) -> Self {
         let log = |r: &Matrix3<f64>| crate::crv::from_rotation_matrix(r);
-        let middle = frm(nodes[1]);
+        let (p0, f0) = start.unwrap_or_else(|| (nodes_at.position(nodes[0]), nodes_at.frame(nodes[0])));
+        let middle = nodes_at.frame(nodes[1]);
+        let last = nodes_at.frame(nodes[2]);
         Self {
-            positions: [pos(nodes[0]), pos(nodes[1]), pos(nodes[2])],
+            positions: [p0, nodes_at.position(nodes[1]), nodes_at.position(nodes[2])],
             middle,
-            ends: [log(&(middle.transpose() * frm(nodes[0]))), log(&(middle.transpose() * frm(nodes[2])))],
+            ends: [log(&(middle.transpose() * f0)), log(&(middle.transpose() * last))],
+            last,
         }
     }
 
@@ -130,23 +169,37 @@ impl Structure for Model {
     /// relative rotations of a stiff wing.
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
         match self.section_element(body, s) {
-            Some((nodes, w)) => ElementPose::new(self, q, body, nodes).at(w),
+            Some((nodes, w)) => ElementPose::new(&NodePoses::new(self, q, body), nodes, None).at(w),
             None => (Vector3::from_element(f64::NAN), Matrix3::identity()),
         }
     }
     /// The element's node positions, middle frame and end rotation vectors are computed once
-    /// for the consecutive stations on it (bit for bit [`section_pose`](Self::section_pose)).
+    /// for the consecutive stations on it, its first node's from the element before it on the
+    /// body, and the body's frame rotation once per run of stations on the body (bit for bit
+    /// [`section_pose`](Self::section_pose)).
     fn section_poses(&self, q: &[f64], at: &[(usize, f64)], out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>) {
         out.clear();
-        let mut current: Option<(usize, usize, ElementPose)> = None;
+        let mut nodes_at: Option<NodePoses<'_>> = None;
+        let mut current: Option<(usize, [usize; 3], ElementPose)> = None;
         for &(body, s) in at {
             let Some((nodes, w)) = self.section_element(body, s) else {
                 out.push((Vector3::from_element(f64::NAN), Matrix3::identity()));
                 continue;
             };
+            if nodes_at.as_ref().is_none_or(|n| n.body != body) {
+                nodes_at = Some(NodePoses::new(self, q, body));
+            }
+            let poses = nodes_at.as_ref().unwrap_or_else(|| unreachable!("set just above"));
             let pose = match &current {
-                Some((b, n0, pose)) if *b == body && *n0 == nodes[0] => pose,
-                _ => &current.insert((body, nodes[0], ElementPose::new(self, q, body, nodes))).2,
+                Some((b, n, pose)) if *b == body && *n == nodes => pose,
+                _ => {
+                    // The previous element on the body ends where this one starts.
+                    let start = match &current {
+                        Some((b, n, pose)) if *b == body && n[2] == nodes[0] => Some((pose.positions[2], pose.last)),
+                        _ => None,
+                    };
+                    &current.insert((body, nodes, ElementPose::new(poses, nodes, start))).2
+                }
             };
             out.push(pose.at(w));
         }
