@@ -282,16 +282,37 @@ impl BoundSystem {
         let n = col.len();
         assert_eq!(aic.len(), n * n, "assemble_aic: dimension");
         let pairs = n.div_ceil(LANES) * LANES * self.n_filaments();
-        self.fill_aic(col, nrm, aic, use_threads(parallel, pairs), scratch);
+        self.fill_aic(col, nrm, aic, AicLayout::RowMajor, use_threads(parallel, pairs), scratch);
         pairs as u64
     }
 
-    /// The AIC's blocks of [`LANES`] rows, on rayon when `threaded`.
+    /// [`assemble_aic`](Self::assemble_aic) in the block-ring layout the solver factorises
+    /// from: for each block `b` of [`LANES`] collocation rows and each ring `r`, the block's
+    /// lanes at `aic[(b n + r) LANES ..][..LANES]` (rows past `n` in the last block hold the
+    /// last point's values). `aic` holds `⌈n / LANES⌉ n LANES` entries. The same values as the
+    /// row-major matrix, without transposing a block's ring sums into rows.
+    pub(crate) fn assemble_aic_blocks(
+        &self,
+        col: &Points,
+        nrm: &Points,
+        aic: &mut [f64],
+        parallel: Parallel,
+        scratch: &mut ScratchPool<NodeBlock>,
+    ) -> u64 {
+        let n = col.len();
+        assert_eq!(aic.len(), n.div_ceil(LANES) * n * LANES, "assemble_aic_blocks: dimension");
+        let pairs = n.div_ceil(LANES) * LANES * self.n_filaments();
+        self.fill_aic(col, nrm, aic, AicLayout::BlockRings, use_threads(parallel, pairs), scratch);
+        pairs as u64
+    }
+
+    /// The AIC's blocks of [`LANES`] rows in `layout`, on rayon when `threaded`.
     fn fill_aic(
         &self,
         col: &Points,
         nrm: &Points,
         aic: &mut [f64],
+        layout: AicLayout,
         threaded: bool,
         scratch: &mut ScratchPool<NodeBlock>,
     ) {
@@ -300,48 +321,72 @@ impl BoundSystem {
             return;
         }
         let nf = self.n_filaments();
-        let work = |b: usize, rows: &mut [f64], blk: &mut NodeBlock| {
+        let work = |b: usize, out: &mut [f64], blk: &mut NodeBlock| {
             let (px, py, pz) = (load_lanes(&col.x, b), load_lanes(&col.y, b), load_lanes(&col.z, b));
             let (nx, ny, nz) = (load_lanes(&nrm.x, b), load_lanes(&nrm.y, b), load_lanes(&nrm.z, b));
             fill_block(&self.fil, &px, &py, &pz, blk);
             influence_block(&self.fil, blk, &nx, &ny, &nz);
-            // Summed per ring in the filaments' order, then transposed into the rows: the
-            // same additions as summing into the rows directly.
-            let rings = &mut blk.rings;
-            rings.clear();
-            rings.resize(n, [0.0; LANES]);
-            for f in 0..nf {
-                let (b, _) = self.base_of(f);
-                let v = &blk.infl[f];
-                for &(r, s) in self.incidences(b) {
-                    if r == NONE {
-                        continue;
-                    }
-                    let acc = &mut rings[r as usize];
-                    for (a, vl) in acc.iter_mut().zip(v) {
-                        *a += s * vl;
+            // Summed per ring in the filaments' order (ring-major, one cache line per
+            // filament): the same additions as summing into the rows directly.
+            let NodeBlock { infl, rings, .. } = blk;
+            let sum_rings = |rings: &mut [[f64; LANES]]| {
+                rings.fill([0.0; LANES]);
+                for (f, v) in infl.iter().enumerate().take(nf) {
+                    let (b, _) = self.base_of(f);
+                    for &(r, s) in self.incidences(b) {
+                        if r == NONE {
+                            continue;
+                        }
+                        let acc = &mut rings[r as usize];
+                        for (a, vl) in acc.iter_mut().zip(v) {
+                            *a += s * vl;
+                        }
                     }
                 }
-            }
-            for (l, row) in rows.chunks_mut(n).enumerate() {
-                for (x, ring) in row.iter_mut().zip(rings.iter()) {
-                    *x = ring[l];
+            };
+            match layout {
+                AicLayout::BlockRings => sum_rings(as_lanes(out)),
+                AicLayout::RowMajor => {
+                    rings.resize(n, [0.0; LANES]);
+                    sum_rings(&mut rings[..n]);
+                    for (l, row) in out.chunks_mut(n).enumerate() {
+                        for (x, ring) in row.iter_mut().zip(rings.iter()) {
+                            *x = ring[l];
+                        }
+                    }
                 }
             }
         };
+        let block_len = LANES * n;
         if threaded {
-            scratch.for_each_chunk(aic, LANES * n, DIRECT_CHUNKS_PER_THREAD, |first, chunk, blk| {
-                for (i, rows) in chunk.chunks_mut(LANES * n).enumerate() {
-                    work(first + i, rows, blk);
+            scratch.for_each_chunk(aic, block_len, DIRECT_CHUNKS_PER_THREAD, |first, chunk, blk| {
+                for (i, out) in chunk.chunks_mut(block_len).enumerate() {
+                    work(first + i, out, blk);
                 }
             });
         } else {
             let blk = scratch.first();
-            for (b, rows) in aic.chunks_mut(LANES * n).enumerate() {
-                work(b, rows, blk);
+            for (b, out) in aic.chunks_mut(block_len).enumerate() {
+                work(b, out, blk);
             }
         }
     }
+}
+
+/// How [`BoundSystem::fill_aic`] lays the influence matrix out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum AicLayout {
+    /// `aic[i n + j]`.
+    RowMajor,
+    /// [`BoundSystem::assemble_aic_blocks`]'s.
+    BlockRings,
+}
+
+/// `v` (a multiple of [`LANES`] long) as lanes.
+fn as_lanes(v: &mut [f64]) -> &mut [[f64; LANES]] {
+    let (lanes, rest) = v.as_chunks_mut::<LANES>();
+    debug_assert!(rest.is_empty(), "a whole number of blocks");
+    lanes
 }
 
 /// Which filaments of the known wake [`build_known_wake`] builds.
@@ -597,7 +642,7 @@ mod tests {
     #[test]
     fn threaded_aic_equals_serial() {
         let lat =
-            Lattice::from_stations(LatticeSpec::new(6), &rectangular_wing(0.0, 4.0, 1.0, 12, SpanSpacing::Uniform))
+            Lattice::from_stations(LatticeSpec::new(6), &rectangular_wing(0.0, 4.0, 1.0, 11, SpanSpacing::Uniform))
                 .unwrap();
         let mut bs = BoundSystem::default();
         let planes = [ImagePlane::through_origin([0.0, 1.0, 0.0])];
@@ -610,14 +655,38 @@ mod tests {
         let n = col.len();
         let mut scratch = ScratchPool::default();
         let mut serial = vec![0.0; n * n];
-        bs.fill_aic(&col, &nrm, &mut serial, false, &mut scratch);
+        bs.fill_aic(&col, &nrm, &mut serial, AicLayout::RowMajor, false, &mut scratch);
+        let n_blocked = n.div_ceil(LANES) * n * LANES;
+        let mut blocked = vec![0.0; n_blocked];
+        bs.fill_aic(&col, &nrm, &mut blocked, AicLayout::BlockRings, false, &mut scratch);
         for threads in [2, 3] {
-            let mut threaded = vec![f64::NAN; n * n];
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| bs.fill_aic(&col, &nrm, &mut threaded, true, &mut scratch));
+            let mut threaded = vec![f64::NAN; n * n];
+            pool.install(|| bs.fill_aic(&col, &nrm, &mut threaded, AicLayout::RowMajor, true, &mut scratch));
             assert_eq!(serial, threaded, "{threads} threads");
             assert!(scratch.entries().len() > 1, "{threads} threads: not chunked");
+            let mut threaded = vec![f64::NAN; n_blocked];
+            pool.install(|| bs.fill_aic(&col, &nrm, &mut threaded, AicLayout::BlockRings, true, &mut scratch));
+            assert_eq!(blocked, threaded, "{threads} threads, blocks of rings");
         }
+        // The block layout holds the row-major matrix's values (n is not a multiple of LANES
+        // here, so the last block's padding rows are exercised too).
+        assert_ne!(n % LANES, 0);
+        for i in 0..n {
+            for j in 0..n {
+                let (b, l) = (i / LANES, i % LANES);
+                assert_eq!(blocked[(b * n + j) * LANES + l].to_bits(), serial[i * n + j].to_bits(), "({i}, {j})");
+            }
+        }
+        // And factorises to the same LU.
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let (mut lu_rows, mut lu_blocks) = (crate::dense_lu::DenseLu::new(n), crate::dense_lu::DenseLu::new(n));
+        lu_rows.factorize_row_major(&serial).unwrap();
+        lu_blocks.factorize_block_rings(&blocked, LANES).unwrap();
+        let (mut x_rows, mut x_blocks) = (rhs.clone(), rhs);
+        lu_rows.solve_in_place(&mut x_rows);
+        lu_blocks.solve_in_place(&mut x_blocks);
+        assert_eq!(x_rows, x_blocks);
     }
 
     /// Rows of equal circulation leave no spanwise filament inside the wake (they are skipped).

@@ -37,6 +37,12 @@ impl DenseLu {
         let n = self.n;
         assert_eq!(a.len(), n * n, "factorize: dimension mismatch");
         transpose_into(a, n, &mut self.lu);
+        self.factorize_in_place()
+    }
+
+    /// LU of `self.lu` in place, with the pivot check.
+    fn factorize_in_place(&mut self) -> Result<(), usize> {
+        let n = self.n;
         let stack = MemStack::new(&mut self.buf);
         lu_in_place(self.lu.as_mut(), &mut self.perm, &mut self.perm_inv, Par::Seq, stack, Default::default());
         let scale = (0..n).map(|i| self.lu[(i, i)].abs()).fold(0.0_f64, f64::max);
@@ -47,6 +53,22 @@ impl DenseLu {
             }
         }
         Ok(())
+    }
+
+    /// Factorise the matrix given in [`crate::aic::BoundSystem::assemble_aic_blocks`]'s
+    /// layout (blocks of `lanes` rows, each ring's lanes contiguous): each column gathers one
+    /// contiguous run per block. Returns the first (numerically) zero pivot row on failure.
+    pub(crate) fn factorize_block_rings(&mut self, a: &[f64], lanes: usize) -> Result<(), usize> {
+        let n = self.n;
+        assert_eq!(a.len(), n.div_ceil(lanes) * n * lanes, "factorize: dimension mismatch");
+        for j in 0..n {
+            let col = self.lu.col_as_slice_mut(j);
+            for (b, rows) in col.chunks_mut(lanes).enumerate() {
+                let at = (b * n + j) * lanes;
+                rows.copy_from_slice(&a[at..at + rows.len()]);
+            }
+        }
+        self.factorize_in_place()
     }
 
     /// Overwrite `b` with `A⁻¹ b`.

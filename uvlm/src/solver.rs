@@ -145,7 +145,7 @@ impl Uvlm {
             far_tree: WakeTree::far(&params.wake_aggregation),
             far_keys: SegmentKeys::default(),
             lu: DenseLu::new(nr),
-            aic: vec![0.0; nr * nr],
+            aic: vec![0.0; nr.div_ceil(crate::biot_savart::LANES) * nr * crate::biot_savart::LANES],
             rhs: vec![0.0; nr],
             aic_mode: None,
             col: Points::default(),
@@ -355,10 +355,12 @@ impl Uvlm {
         self.bound_mode = Some(mode);
         self.load_collocation();
         self.stats.n_pair_evaluations +=
-            self.bound.assemble_aic(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blocks);
+            self.bound.assemble_aic_blocks(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blocks);
         self.stats.n_aic_builds += 1;
         self.aic_mode = None;
-        self.lu.factorize_row_major(&self.aic).map_err(|pivot| UvlmError::SingularAic { pivot })?;
+        self.lu
+            .factorize_block_rings(&self.aic, crate::biot_savart::LANES)
+            .map_err(|pivot| UvlmError::SingularAic { pivot })?;
         self.stats.n_factorizations += 1;
         self.aic_mode = Some(mode);
         for s in &mut self.surfaces {
