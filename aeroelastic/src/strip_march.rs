@@ -41,13 +41,10 @@ use nalgebra::{Matrix3, Vector3};
 use formulation::{SectionLoad, Structure};
 use genalpha::State;
 
-use crate::aero::{AeroSettings, StationMap, station_states};
+use crate::aero::{AeroSettings, SectionKinematics as Kinematics, StationMap, station_states};
 use crate::polar_correction::{StripGeometry, StripPolars};
 use crate::problem::Formulation;
 use crate::run::{Dissipation, Observer, RunOutput, RunSettings, SnapshotFeed, row};
-
-/// A station's pose and motion: axis point, section frame, velocity, angular velocity.
-type Kinematics = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
 
 /// The lift of every strip (the column between two neighbouring stations of a surface) at a
 /// state, lumped to the two stations.

@@ -42,33 +42,34 @@ struct ElementPose {
 }
 
 /// A node's position and frame, [`Model::node_position`] and [`Model::node_frame`] bit for bit,
-/// with the body's frame rotation matrix computed once for its nodes.
+/// with the body's frame rotation matrix computed once for its nodes (NaN for a node or body
+/// the model does not have).
 struct NodePoses<'a> {
-    model: &'a Model,
     q: &'a [f64],
     body: usize,
-    frame: Option<(Vector3<f64>, crate::quaternion::Quaternion, Matrix3<f64>)>,
+    /// The body, its frame position and orientation, and that orientation's matrix.
+    frame: Option<(&'a crate::body::Body, Vector3<f64>, crate::quaternion::Quaternion, Matrix3<f64>)>,
 }
 
 impl<'a> NodePoses<'a> {
     fn new(model: &'a Model, q: &'a [f64], body: usize) -> Self {
         let frame = model.bodies.get(body).map(|b| {
             let (r, chi) = b.frame_state(q);
-            (r, chi, chi.to_rotation_matrix())
+            (b, r, chi, chi.to_rotation_matrix())
         });
-        Self { model, q, body, frame }
+        Self { q, body, frame }
     }
 
     fn position(&self, k: usize) -> Vector3<f64> {
-        match (&self.frame, self.model.bodies.get(self.body)) {
-            (Some((r, chi, _)), Some(b)) if k < b.n_nodes() => r + chi.rotate(&b.node_state(self.q, k).0),
+        match &self.frame {
+            Some((b, r, chi, _)) if k < b.n_nodes() => r + chi.rotate(&b.node_state(self.q, k).0),
             _ => Vector3::from_element(f64::NAN),
         }
     }
 
     fn frame(&self, k: usize) -> Matrix3<f64> {
-        match (&self.frame, self.model.bodies.get(self.body)) {
-            (Some((_, _, c)), Some(b)) if k < b.n_nodes() => c * rotation_matrix(&b.node_state(self.q, k).1),
+        match &self.frame {
+            Some((b, _, _, c)) if k < b.n_nodes() => c * rotation_matrix(&b.node_state(self.q, k).1),
             _ => Matrix3::from_element(f64::NAN),
         }
     }
@@ -186,10 +187,10 @@ impl Structure for Model {
                 out.push((Vector3::from_element(f64::NAN), Matrix3::identity()));
                 continue;
             };
-            if nodes_at.as_ref().is_none_or(|n| n.body != body) {
-                nodes_at = Some(NodePoses::new(self, q, body));
-            }
-            let poses = nodes_at.as_ref().unwrap_or_else(|| unreachable!("set just above"));
+            let poses = match &mut nodes_at {
+                Some(n) if n.body == body => n,
+                slot => slot.insert(NodePoses::new(self, q, body)),
+            };
             let pose = match &current {
                 Some((b, n, pose)) if *b == body && *n == nodes => pose,
                 _ => {
@@ -198,7 +199,7 @@ impl Structure for Model {
                         Some((b, n, pose)) if *b == body && n[2] == nodes[0] => Some((pose.positions[2], pose.last)),
                         _ => None,
                     };
-                    &current.insert((body, nodes, ElementPose::new(poses, nodes, start))).2
+                    &current.insert((body, nodes, ElementPose::new(&*poses, nodes, start))).2
                 }
             };
             out.push(pose.at(w));

@@ -268,41 +268,23 @@ impl BoundSystem {
         }
     }
 
-    /// Assemble the row-major `n_rings × n_rings` AIC at the collocation points `col` with
-    /// normals `nrm` (SoA). Returns the number of point–filament pairs evaluated. `scratch` is
-    /// the caller's workspace (one entry per threaded chunk of row blocks).
+    /// Assemble the `n_rings × n_rings` AIC at the collocation points `col` with normals `nrm`
+    /// (SoA) into `aic`, laid out as `layout` says ([`AicLayout::len`] entries). Returns the
+    /// number of point–filament pairs evaluated. `scratch` is the caller's workspace (one entry
+    /// per threaded chunk of row blocks).
     pub(crate) fn assemble_aic(
         &self,
         col: &Points,
         nrm: &Points,
         aic: &mut [f64],
+        layout: AicLayout,
         parallel: Parallel,
         scratch: &mut ScratchPool<NodeBlock>,
     ) -> u64 {
         let n = col.len();
-        assert_eq!(aic.len(), n * n, "assemble_aic: dimension");
+        assert_eq!(aic.len(), layout.len(n), "assemble_aic: dimension");
         let pairs = n.div_ceil(LANES) * LANES * self.n_filaments();
-        self.fill_aic(col, nrm, aic, AicLayout::RowMajor, use_threads(parallel, pairs), scratch);
-        pairs as u64
-    }
-
-    /// [`assemble_aic`](Self::assemble_aic) in the block-ring layout the solver factorises
-    /// from: for each block `b` of [`LANES`] collocation rows and each ring `r`, the block's
-    /// lanes at `aic[(b n + r) LANES ..][..LANES]` (rows past `n` in the last block hold the
-    /// last point's values). `aic` holds `⌈n / LANES⌉ n LANES` entries. The same values as the
-    /// row-major matrix, without transposing a block's ring sums into rows.
-    pub(crate) fn assemble_aic_blocks(
-        &self,
-        col: &Points,
-        nrm: &Points,
-        aic: &mut [f64],
-        parallel: Parallel,
-        scratch: &mut ScratchPool<NodeBlock>,
-    ) -> u64 {
-        let n = col.len();
-        assert_eq!(aic.len(), n.div_ceil(LANES) * n * LANES, "assemble_aic_blocks: dimension");
-        let pairs = n.div_ceil(LANES) * LANES * self.n_filaments();
-        self.fill_aic(col, nrm, aic, AicLayout::BlockRings, use_threads(parallel, pairs), scratch);
+        self.fill_aic(col, nrm, aic, layout, use_threads(parallel, pairs), scratch);
         pairs as u64
     }
 
@@ -373,13 +355,26 @@ impl BoundSystem {
     }
 }
 
-/// How [`BoundSystem::fill_aic`] lays the influence matrix out.
+/// How [`BoundSystem::assemble_aic`] lays the influence matrix out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum AicLayout {
+pub(crate) enum AicLayout {
     /// `aic[i n + j]`.
     RowMajor,
-    /// [`BoundSystem::assemble_aic_blocks`]'s.
+    /// The layout the solver factorises from: for each block `b` of [`LANES`] collocation rows
+    /// and each ring `r`, the block's lanes at `aic[(b n + r) LANES ..][..LANES]` (rows past `n`
+    /// in the last block hold the last point's values). The same values as the row-major
+    /// matrix, without transposing a block's ring sums into rows.
     BlockRings,
+}
+
+impl AicLayout {
+    /// Entries of an `n × n` matrix in this layout.
+    pub(crate) fn len(self, n: usize) -> usize {
+        match self {
+            AicLayout::RowMajor => n * n,
+            AicLayout::BlockRings => n.div_ceil(LANES) * n * LANES,
+        }
+    }
 }
 
 /// `v` (a multiple of [`LANES`] long) as lanes.
@@ -631,7 +626,7 @@ mod tests {
             nrm.push(*n);
         }
         let mut aic = vec![0.0; 16];
-        bs.assemble_aic(&col, &nrm, &mut aic, Parallel::Off, &mut ScratchPool::default());
+        bs.assemble_aic(&col, &nrm, &mut aic, AicLayout::RowMajor, Parallel::Off, &mut ScratchPool::default());
         for r in 0..4 {
             assert!(aic[r * 4 + r] < 0.0);
         }
@@ -656,7 +651,7 @@ mod tests {
         let mut scratch = ScratchPool::default();
         let mut serial = vec![0.0; n * n];
         bs.fill_aic(&col, &nrm, &mut serial, AicLayout::RowMajor, false, &mut scratch);
-        let n_blocked = n.div_ceil(LANES) * n * LANES;
+        let n_blocked = AicLayout::BlockRings.len(n);
         let mut blocked = vec![0.0; n_blocked];
         bs.fill_aic(&col, &nrm, &mut blocked, AicLayout::BlockRings, false, &mut scratch);
         for threads in [2, 3] {

@@ -55,7 +55,7 @@ impl DenseLu {
         Ok(())
     }
 
-    /// Factorise the matrix given in [`crate::aic::BoundSystem::assemble_aic_blocks`]'s
+    /// Factorise the matrix given in [`crate::aic::AicLayout::BlockRings`]
     /// layout (blocks of `lanes` rows, each ring's lanes contiguous): each column gathers one
     /// contiguous run per block. Returns the first (numerically) zero pivot row on failure.
     pub(crate) fn factorize_block_rings(&mut self, a: &[f64], lanes: usize) -> Result<(), usize> {

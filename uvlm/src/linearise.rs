@@ -233,7 +233,14 @@ fn influence_matrix(lats: &[Lattice], nrm: &[[f64; 3]], fz: &mut Frozen, p: &Uvl
     // Unit strengths (the AIC reads the filaments' strengths).
     let mut unit_bs = BoundSystem::default();
     unit_bs.build_surfaces(lats.iter(), crate::aic::TrailingEdge::Unsteady, &p.bound_core, &p.images);
-    unit_bs.assemble_aic(&fz.col, &nrm_pts, &mut aic_rm, crate::Parallel::Off, &mut fz.blocks);
+    unit_bs.assemble_aic(
+        &fz.col,
+        &nrm_pts,
+        &mut aic_rm,
+        crate::aic::AicLayout::RowMajor,
+        crate::Parallel::Off,
+        &mut fz.blocks,
+    );
     DMatrix::from_row_slice(nr, nr, &aic_rm)
 }
 

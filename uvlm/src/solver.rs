@@ -1,7 +1,7 @@
 //! The UVLM solver: steady solve and unsteady time steps on one or several lattices (surfaces),
 //! each with its wake, in one influence system.
 
-use crate::aic::{BoundSystem, SegmentKeys, TrailingEdge, WakePart, append_known_wake};
+use crate::aic::{AicLayout, BoundSystem, SegmentKeys, TrailingEdge, WakePart, append_known_wake};
 use crate::axis_extension::{
     ExtensionLayout, SurfaceLayout, WakeColumns, correct_axis_extensions, correct_wake_columns,
 };
@@ -145,7 +145,7 @@ impl Uvlm {
             far_tree: WakeTree::far(&params.wake_aggregation),
             far_keys: SegmentKeys::default(),
             lu: DenseLu::new(nr),
-            aic: vec![0.0; nr.div_ceil(crate::biot_savart::LANES) * nr * crate::biot_savart::LANES],
+            aic: vec![0.0; AicLayout::BlockRings.len(nr)],
             rhs: vec![0.0; nr],
             aic_mode: None,
             col: Points::default(),
@@ -354,8 +354,14 @@ impl Uvlm {
         );
         self.bound_mode = Some(mode);
         self.load_collocation();
-        self.stats.n_pair_evaluations +=
-            self.bound.assemble_aic_blocks(&self.col, &self.nrm, &mut self.aic, self.params.parallel, &mut self.blocks);
+        self.stats.n_pair_evaluations += self.bound.assemble_aic(
+            &self.col,
+            &self.nrm,
+            &mut self.aic,
+            AicLayout::BlockRings,
+            self.params.parallel,
+            &mut self.blocks,
+        );
         self.stats.n_aic_builds += 1;
         self.aic_mode = None;
         self.lu
