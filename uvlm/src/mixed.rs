@@ -110,19 +110,23 @@ impl<const N: usize> Default for Block32<N> {
 }
 
 /// One point–segment pair in f32: `r₁×r₂` and the factor `k` (without Γ/4π), the regular form
-/// beyond the segment's ends.
+/// beyond the segment's ends. Products summed with fused multiply-adds (one rounding fewer each;
+/// `mul_add` is exact on every target, in hardware or in software, so results do not depend on
+/// the instruction set), and `|r₁||r₂||r₁×r₂|²` shared by both forms' denominators: the kernel
+/// is bound by the multiplier pipes (docs/uvlm.md §9).
 #[inline(always)]
 fn pair32(r1: [f32; 3], n1: f32, r2: [f32; 3], n2: f32, core2: f32, cut2: f32) -> ([f32; 3], f32) {
-    let cx = r1[1] * r2[2] - r1[2] * r2[1];
-    let cy = r1[2] * r2[0] - r1[0] * r2[2];
-    let cz = r1[0] * r2[1] - r1[1] * r2[0];
-    let c2 = cx * cx + cy * cy + cz * cz;
+    let cx = r1[1].mul_add(r2[2], -(r1[2] * r2[1]));
+    let cy = r1[2].mul_add(r2[0], -(r1[0] * r2[2]));
+    let cz = r1[0].mul_add(r2[1], -(r1[1] * r2[0]));
+    let c2 = cz.mul_add(cz, cy.mul_add(cy, cx * cx));
     let h2 = c2 + core2;
     let n12 = n1 * n2;
-    let dot = r1[0] * r2[0] + r1[1] * r2[1] + r1[2] * r2[2];
+    let dot = r1[2].mul_add(r2[2], r1[1].mul_add(r2[1], r1[0] * r2[0]));
     let beyond = dot > 0.0;
     let a = if beyond { c2 } else { n12 - dot };
-    let b = if beyond { n12 * (n12 + dot) * h2 } else { n12 * h2 };
+    let t = n12 * h2;
+    let b = if beyond { t * (n12 + dot) } else { t };
     let ok = h2 > cut2 && n12 > 0.0;
     let k = if ok { (n1 + n2) * a / b } else { 0.0 };
     ([cx, cy, cz], k)
@@ -197,9 +201,9 @@ macro_rules! velocity32 {
                             cut2,
                         );
                         let gk = g * k;
-                        ux[l] += gk * cr[0];
-                        uy[l] += gk * cr[1];
-                        uz[l] += gk * cr[2];
+                        ux[l] = gk.mul_add(cr[0], ux[l]);
+                        uy[l] = gk.mul_add(cr[1], uy[l]);
+                        uz[l] = gk.mul_add(cr[2], uz[l]);
                     }
                 }
                 for l in 0..N {

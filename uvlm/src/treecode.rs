@@ -129,6 +129,7 @@ pub struct Treecode {
     grad: Vec<([u32; 3], [f64; 3])>,
     /// Per Taylor coefficient: (2n − 1)/n and (n − 1)/n.
     rec: Vec<(f64, f64)>,
+
     /// Per moment m ≠ 0: the position of m − e_i and i, for the first i with m_i > 0.
     up: Vec<(u32, u8)>,
     /// The leaf moments' samples and lane accumulators.
@@ -147,6 +148,9 @@ pub struct Treecode {
     clusters: Vec<Cluster>,
     /// `clusters.len() × n_moments` vector moments.
     moments: Vec<[f64; 3]>,
+    /// `clusters.len() × n_taylor` coefficients `B_k` of the Taylor coefficients in the
+    /// expansion, `u = Σ_k a_k B_k` ([`curl_coefficients`]), derived from the moments.
+    curl: Vec<[f64; 3]>,
     /// Each leaf's segments as a set of its own (each node of the leaf once) for the block
     /// kernels.
     leaves: Vec<Filaments>,
@@ -483,6 +487,8 @@ impl Treecode {
             }
             let mom = &mut self.moments[ci * nm..(ci + 1) * nm];
             sm.accumulate(&self.up, mom);
+            let nt = self.taylor_idx.k.len();
+            curl_coefficients(&self.grad, mom, &mut self.curl[ci * nt..(ci + 1) * nt]);
         }
     }
 
@@ -643,6 +649,12 @@ impl Treecode {
                 }
             }
         }
+        let nt = self.taylor_idx.k.len();
+        self.curl.clear();
+        self.curl.resize(self.clusters.len() * nt, [0.0; 3]);
+        for (mom, curl) in self.moments.chunks_exact(nm).zip(self.curl.chunks_exact_mut(nt)) {
+            curl_coefficients(&self.grad, mom, curl);
+        }
     }
 
     /// Velocity induced by the set at every point of `pts`, added to `out`, to within `tol`
@@ -755,18 +767,18 @@ impl Treecode {
                 s <= budget * d2min
             };
             if accept {
-                let nm = self.mom_idx.k.len();
+                let nt = self.taylor_idx.k.len();
                 let (ci, c) = (ci as usize, c.center);
-                let mom = &self.moments[ci * nm..(ci + 1) * nm];
-                let (idx, rec, grad, a) = (&self.taylor_idx, &self.rec[..], &self.grad[..], &mut sc.taylor[..]);
+                let curl = &self.curl[ci * nt..(ci + 1) * nt];
+                let (idx, rec, a) = (&self.taylor_idx, &self.rec[..], &mut sc.taylor[..]);
                 match isa() {
-                    Isa::Generic => expansion_generic(idx, rec, grad, mom, c, px, py, pz, a, u),
+                    Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
                     // SAFETY: the features were detected at run time.
                     #[cfg(target_arch = "x86_64")]
-                    Isa::Avx2 => unsafe { expansion_avx2(idx, rec, grad, mom, c, px, py, pz, a, u) },
+                    Isa::Avx2 => unsafe { expansion_avx2(idx, rec, curl, c, px, py, pz, a, u) },
                     // SAFETY: the features were detected at run time.
                     #[cfg(target_arch = "x86_64")]
-                    Isa::Avx512 => unsafe { expansion_avx512(idx, rec, grad, mom, c, px, py, pz, a, u) },
+                    Isa::Avx512 => unsafe { expansion_avx512(idx, rec, curl, c, px, py, pz, a, u) },
                 }
                 sc.stats.n_expansions += LANES as u64;
             } else if c.leaf != NONE {
@@ -819,8 +831,7 @@ macro_rules! expansion_variants {
         fn $name(
             idx: &Indices,
             rec: &[(f64, f64)],
-            grad: &[([u32; 3], [f64; 3])],
-            mom: &[[f64; 3]],
+            curl: &[[f64; 3]],
             c: [f64; 3],
             px: &[f64; LANES],
             py: &[f64; LANES],
@@ -828,20 +839,19 @@ macro_rules! expansion_variants {
             a: &mut [[f64; LANES]],
             u: &mut [[f64; LANES]; 3],
         ) {
-            expansion_lanes(idx, rec, grad, mom, c, px, py, pz, a, u);
+            expansion_lanes(idx, rec, curl, c, px, py, pz, a, u);
         }
     )*};
 }
 expansion_variants!(expansion_generic; expansion_avx2, "avx2,fma"; expansion_avx512, "avx512f,avx2,fma");
 
 /// Taylor coefficients at the block's points and the sum over the moments, lane by lane.
-#[allow(clippy::too_many_arguments)] // tables, moments, centre, points, scratch and output
+#[allow(clippy::too_many_arguments)] // tables, coefficients, centre, points, scratch and output
 #[inline(always)]
 fn expansion_lanes(
     idx: &Indices,
     rec: &[(f64, f64)],
-    grad: &[([u32; 3], [f64; 3])],
-    mom: &[[f64; 3]],
+    curl: &[[f64; 3]],
     c: [f64; 3],
     px: &[f64; LANES],
     py: &[f64; LANES],
@@ -883,14 +893,38 @@ fn expansion_lanes(
             out[l] = (c1 * acc1[l] - c2 * acc2[l]) * inv_r2[l];
         }
     }
-    for (m, (pos, fac)) in mom.iter().zip(grad) {
-        let (gx, gy, gz) = (&a[pos[0] as usize], &a[pos[1] as usize], &a[pos[2] as usize]);
+    // a_0 (|k| = 0) has no coefficient: the velocity is a gradient's curl. Summed in registers,
+    // then added to `u`.
+    let mut acc = [[0.0; LANES]; 3];
+    for (b, ak) in curl.iter().zip(&a[..curl.len()]).skip(1) {
         for l in 0..LANES {
-            let g = [fac[0] * gx[l], fac[1] * gy[l], fac[2] * gz[l]];
-            u[0][l] += m[1] * g[2] - m[2] * g[1];
-            u[1][l] += m[2] * g[0] - m[0] * g[2];
-            u[2][l] += m[0] * g[1] - m[1] * g[0];
+            acc[0][l] += ak[l] * b[0];
+            acc[1][l] += ak[l] * b[1];
+            acc[2][l] += ak[l] * b[2];
         }
+    }
+    for (uq, aq) in u.iter_mut().zip(&acc) {
+        for l in 0..LANES {
+            uq[l] += aq[l];
+        }
+    }
+}
+
+/// The coefficients `B_k` (one per Taylor coefficient `a_k`) of the expansion
+/// `u = Σ_m M_m × g_m`, `g_{m,i} = (m_i + 1) a_{m+e_i}`, regrouped by Taylor coefficient:
+/// `u = Σ_k a_k B_k`, with `B_{m+e_i} += (m_i + 1) (M_m × e_i)` for every moment `m` and axis
+/// `i`. The evaluation then costs three products per coefficient instead of nine per moment.
+fn curl_coefficients(grad: &[([u32; 3], [f64; 3])], mom: &[[f64; 3]], curl: &mut [[f64; 3]]) {
+    curl.fill([0.0; 3]);
+    for (m, (pos, fac)) in mom.iter().zip(grad) {
+        let (px, py, pz) = (pos[0] as usize, pos[1] as usize, pos[2] as usize);
+        // M × e_x = (0, M_z, −M_y), M × e_y = (−M_z, 0, M_x), M × e_z = (M_y, −M_x, 0).
+        curl[px][1] += fac[0] * m[2];
+        curl[px][2] -= fac[0] * m[1];
+        curl[py][0] -= fac[1] * m[2];
+        curl[py][2] += fac[1] * m[0];
+        curl[pz][0] += fac[2] * m[1];
+        curl[pz][1] -= fac[2] * m[0];
     }
 }
 
