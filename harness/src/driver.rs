@@ -191,13 +191,14 @@ pub fn claim_outputs(out: &Path, runs: &[RunSpec]) -> Result<(Vec<DirLock>, Vec<
     Ok((locks, dirs))
 }
 
-/// Whether any run of the results was stopped by a signal.
+/// Whether any run of the results was stopped by a signal. A signal that arrives after every
+/// run finished stops nothing: the summaries say `"complete"`, and so must the exit code (the
+/// runs' own errors say whether a signal cut one, including one it kept from starting).
 pub fn any_interrupted(results: &[CaseResult]) -> bool {
-    crate::signal::interrupted()
-        || results
-            .iter()
-            .flat_map(|r| &r.runs)
-            .any(|r| r.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)))
+    results
+        .iter()
+        .flat_map(|r| &r.runs)
+        .any(|r| r.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)))
 }
 
 /// Write a case's files ([`write_case`]: CSV, `summary.json`, plots, each atomically) and put the
