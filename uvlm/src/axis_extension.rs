@@ -123,19 +123,23 @@ fn kernel_leg(r: [f64; 3], d: [f64; 3], core2: f64, cut2: f64) -> f64 {
 /// trailing leg — by the regular form of [`pair_factors`] and [`leg_factor`] where the point
 /// lies outside the segment (module doc). Other filaments are never collinear with a load point
 /// of a ring lattice by construction, and keep the block kernels' value.
+///
+/// With `cutoff_only` (`u` summed by the mixed-precision kernel, which takes the regular form
+/// outside the filaments itself: mixed.rs) only the filaments whose cut-off cylinder holds the
+/// point are corrected, where the kernel's cut-off zeroed what the regular form keeps.
 pub(crate) fn correct_axis_extensions(
     fil: &Filaments,
     layout: &ExtensionLayout,
     pts: &Points,
     u: &mut [[f64; 3]],
     parallel: Parallel,
+    cutoff_only: bool,
 ) {
+    let points = |p0: usize, out: &mut [[f64; 3]]| correct_axis_points(fil, layout, pts, p0, out, cutoff_only);
     if use_threads(parallel, AXIS_PAIR_COST * layout.n_axis_pairs()) {
-        u.par_chunks_mut(AXIS_CHUNK)
-            .enumerate()
-            .for_each(|(c, out)| correct_axis_points(fil, layout, pts, c * AXIS_CHUNK, out));
+        u.par_chunks_mut(AXIS_CHUNK).enumerate().for_each(|(c, out)| points(c * AXIS_CHUNK, out));
     } else {
-        correct_axis_points(fil, layout, pts, 0, u);
+        points(0, u);
     }
 }
 
@@ -148,8 +152,16 @@ const AXIS_CHUNK: usize = 48;
 const AXIS_PAIR_COST: usize = 4;
 
 /// [`correct_axis_extensions`] at the load points `p0..p0 + out.len()`, into `out`.
-fn correct_axis_points(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, p0: usize, out: &mut [[f64; 3]]) {
+fn correct_axis_points(
+    fil: &Filaments,
+    layout: &ExtensionLayout,
+    pts: &Points,
+    p0: usize,
+    out: &mut [[f64; 3]],
+    cutoff_only: bool,
+) {
     let mut ch = RunChunk::new();
+    ch.cutoff_only = cutoff_only;
     let mut base = 0;
     for sl in &layout.surfaces {
         let (m, n) = (sl.m, sl.n);
@@ -173,7 +185,7 @@ fn correct_axis_points(fil: &Filaments, layout: &ExtensionLayout, pts: &Points, 
                     let finite = sl.finite.then_some(sl.seg0 + sl.n_lattice_seg + j);
                     fix_run(&mut ch, column.chain(finite).map(|b| filament(fil, seg(b))), x, o);
                     if !sl.finite && layout.n_base_leg > 0 {
-                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o);
+                        fix_leg(fil, c * layout.n_base_leg + sl.leg0 + j, x, o, cutoff_only);
                     }
                 }
             }
@@ -202,7 +214,7 @@ pub(crate) fn correct_wake_extensions(wake: &Filaments, layout: &ExtensionLayout
             let x = [pts.x[i], pts.y[i], pts.z[i]];
             fix_run(&mut ch, (0..wake.n_segments()).map(|f| filament(wake, f)), x, &mut u[i]);
             for l in 0..wake.n_legs() {
-                fix_leg(wake, l, x, &mut u[i]);
+                fix_leg(wake, l, x, &mut u[i], false);
             }
         }
     }
@@ -326,16 +338,21 @@ fn cutoff_columns(
             for row in 0..m {
                 let i = p0 + m * n + row * nc + j;
                 let x = [pts.x[i], pts.y[i], pts.z[i]];
-                let inside = legs[..count].iter().filter(|(a, b, (_, core2, cut2))| {
-                    let (r1, r2) = ([x[0] - a[0], x[1] - a[1], x[2] - a[2]], [x[0] - b[0], x[1] - b[1], x[2] - b[2]]);
-                    let c =
-                        [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
-                    c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + core2 <= *cut2
-                });
+                let inside =
+                    legs[..count].iter().filter(|(a, b, (_, core2, cut2))| in_cutoff(x, *a, *b, *core2, *cut2));
                 fix_run(&mut ch, inside.copied(), x, &mut u[i]);
             }
         }
     }
+}
+
+/// Whether `x` lies in the cut-off cylinder of the segment `a → b` (the kernel's test,
+/// `|r₁×r₂|² + core2 ≤ cut2`), where the kernel zeroes its term.
+#[inline]
+fn in_cutoff(x: [f64; 3], a: [f64; 3], b: [f64; 3], core2: f64, cut2: f64) -> bool {
+    let (r1, r2) = ([x[0] - a[0], x[1] - a[1], x[2] - a[2]], [x[0] - b[0], x[1] - b[1], x[2] - b[2]]);
+    let c = [r1[1] * r2[2] - r1[2] * r2[1], r1[2] * r2[0] - r1[0] * r2[2], r1[0] * r2[1] - r1[1] * r2[0]];
+    c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + core2 <= cut2
 }
 
 /// Segments per chunk of [`fix_run`].
@@ -354,6 +371,9 @@ struct RunChunk {
     c: [[f64; RUN]; 3],
     old: [f64; RUN],
     new: [f64; RUN],
+    /// Correct only the lanes whose point the kernel's cut-off held (`old` zero): where the
+    /// mixed-precision kernel, which takes the regular form elsewhere, summed the filaments.
+    cutoff_only: bool,
 }
 
 impl RunChunk {
@@ -370,6 +390,7 @@ impl RunChunk {
             c: [[0.0; RUN]; 3],
             old: [0.0; RUN],
             new: [0.0; RUN],
+            cutoff_only: false,
         }
     }
 }
@@ -423,7 +444,7 @@ fn flush_run(ch: &mut RunChunk, k: usize, o: &mut [f64; 3]) {
         Isa::Avx512 => unsafe { run_factors_avx512(ch) },
     }
     for j in 0..k {
-        if ch.dot[j] <= 0.0 {
+        if ch.dot[j] <= 0.0 || (ch.cutoff_only && ch.old[j] != 0.0) {
             continue;
         }
         for q in 0..3 {
@@ -456,10 +477,16 @@ run_factors!(target_feature(enable = "avx2,fma"); run_factors_avx2);
 run_factors!(target_feature(enable = "avx512f,avx2,fma"); run_factors_avx512);
 
 /// Replace leg `l`'s block-kernel term at `x` in `o` by the regular form when `x` lies upstream
-/// of its start.
-fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3]) {
+/// of its start (with `cutoff_only`, only where the kernel's cut-off zeroed the term: see
+/// [`RunChunk::cutoff_only`]).
+fn fix_leg(fil: &Filaments, l: usize, x: [f64; 3], o: &mut [f64; 3], cutoff_only: bool) {
     let a = fil.node(fil.leg_a[l] as usize);
-    fix_leg_at(a, fil.leg_d[l], (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]), x, o);
+    let (g, core2, cut2) = (fil.leg_g[l], fil.leg_core2[l], fil.leg_cut2[l]);
+    let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+    if cutoff_only && kernel_leg(r, fil.leg_d[l], core2, cut2) != 0.0 {
+        return;
+    }
+    fix_leg_at(a, fil.leg_d[l], (g, core2, cut2), x, o);
 }
 
 /// [`fix_leg`] of the leg from `a` along `d` with `(Γ/4π, core2, cut2)`.

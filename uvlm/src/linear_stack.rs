@@ -185,7 +185,7 @@ impl Frozen {
     /// The bound filaments' regular terms on their axis extensions at the midpoints, as the
     /// solver's loads take them (docs/uvlm.md §3).
     pub(crate) fn correct_bound_at_midpoints(&mut self) {
-        correct_axis_extensions(&self.bs.fil, &self.ext, &self.mid, &mut self.u_mid, crate::Parallel::Off);
+        correct_axis_extensions(&self.bs.fil, &self.ext, &self.mid, &mut self.u_mid, crate::Parallel::Off, false);
     }
 
     /// The wake filaments `wake`'s regular terms at the chordwise midpoints, as the solver's

@@ -13,6 +13,7 @@ use crate::images::append_images;
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads, concatenate_loads};
+use crate::mixed::{MixedScratch, add_velocity_mixed};
 use crate::params::{SteadyWake, UvlmParams, WakeConvection, WakeReuse};
 use crate::scratch::ScratchPool;
 use crate::station::{SpanStation, StationVelocity};
@@ -97,6 +98,9 @@ pub struct Uvlm {
     v_wake: Vec<[f64; 3]>,
     /// The Biot–Savart loops' workspace (one entry per threaded chunk).
     blocks: ScratchPool<NodeBlock>,
+    /// The mixed-precision loops' workspace for the load points of a time step
+    /// ([`Uvlm::mixed_loads`]).
+    mixed_mid: MixedScratch,
     /// The loads of all surfaces together (filled with several surfaces only; one surface's
     /// loads are its own).
     loads: Loads,
@@ -154,6 +158,7 @@ impl Uvlm {
             wpts: Points::default(),
             u_col: vec![[0.0; 3]; nr],
             u_mid: Vec::new(),
+            mixed_mid: MixedScratch::default(),
             ext_layout: ExtensionLayout::default(),
             u_wake: Vec::new(),
             v_col: vec![[0.0; 3]; nr],
@@ -313,6 +318,15 @@ impl Uvlm {
         }
     }
 
+    /// Whether a time step's load points take the bound rings and the near wake in mixed
+    /// precision (docs/uvlm.md §14): with the aggregation and its mixed precision on and the far
+    /// wake frozen within the step. The influence matrix and the steady solve's loads (whose
+    /// difference quotients the static analyses take) stay in f64.
+    fn mixed_loads(&self) -> bool {
+        let agg = &self.params.wake_aggregation;
+        agg.enabled && agg.mixed_precision && self.params.wake_reuse == WakeReuse::Frozen
+    }
+
     /// Absolute tolerance of the wake aggregation, m/s: its relative tolerance × |V∞|.
     fn aggregation_tolerance(&self) -> f64 {
         let v = self.flow.free_stream();
@@ -443,7 +457,13 @@ impl Uvlm {
         }
         self.u_mid.resize(self.mid.len(), [0.0; 3]);
         let tol = self.aggregation_tolerance();
-        let pairs = if with_known_wake && self.known_tree.applies(&self.known) {
+        let mixed = with_known_wake && unsteady && self.mixed_loads();
+        let pairs = if mixed {
+            self.u_mid.fill([0.0; 3]);
+            let (parallel, scratch) = (self.params.parallel, &mut self.mixed_mid);
+            add_velocity_mixed(&self.bound.fil, &self.mid, &mut self.u_mid, parallel, scratch)
+                + add_velocity_mixed(&self.known, &self.mid, &mut self.u_mid, parallel, scratch)
+        } else if with_known_wake && self.known_tree.applies(&self.known) {
             let bound = induced_velocity_inplace(
                 &[&self.bound.fil],
                 &self.mid,
@@ -478,15 +498,16 @@ impl Uvlm {
             )
         };
         self.stats.n_pair_evaluations += pairs;
-        // The bound filaments' regular induction on their axis extensions (docs/uvlm.md §3).
+        // The bound filaments' regular induction on their axis extensions (docs/uvlm.md §3):
+        // where the mixed kernel summed them, only inside their cut-off cylinders.
         let mut layout = std::mem::take(&mut self.ext_layout);
         self.load_layout(&mut layout);
-        correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid, self.params.parallel);
+        correct_axis_extensions(&self.bound.fil, &layout, &self.mid, &mut self.u_mid, self.params.parallel, mixed);
         let frozen = self.params.wake_reuse == WakeReuse::Frozen;
         if with_known_wake {
             // The known wake's streamwise filaments on the same footing (as the steady legs).
             let part = if frozen { WakePart::Near } else { WakePart::All };
-            self.correct_wake_at_midpoints(&layout, part, false);
+            self.correct_wake_at_midpoints(&layout, part, false, mixed);
         }
         if with_known_wake && frozen {
             if !self.far_ready {
@@ -500,7 +521,8 @@ impl Uvlm {
                     self.params.parallel,
                     &mut self.blocks,
                 );
-                self.correct_wake_at_midpoints(&layout, WakePart::Far, true);
+                let cutoff_only = !self.far_tree.kernel_exact(&self.far);
+                self.correct_wake_at_midpoints(&layout, WakePart::Far, true, cutoff_only);
             }
             add_to(&mut self.u_mid, &self.u_far_mid);
         }
@@ -532,12 +554,11 @@ impl Uvlm {
     /// The regular form of the known wake's part `part` (its streamwise filaments, column by
     /// column) at the chordwise load points, in `u_far_mid` (`far`) or `u_mid`
     /// (axis_extension.rs, docs/uvlm.md §3): the time march's wake rows take the terms the steady
-    /// solve's legs take, so that a steady solution is the march's equilibrium.
-    fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool) {
+    /// solve's legs take, so that a steady solution is the march's equilibrium. `cutoff_only`
+    /// where the part went through the treecode (its clusters are expansions of the singular
+    /// law) or the mixed-precision kernel (regular forms outside the filaments).
+    fn correct_wake_at_midpoints(&mut self, layout: &ExtensionLayout, part: WakePart, far: bool, cutoff_only: bool) {
         let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
-        // The far wake through the treecode (its clusters are expansions of the singular law) or
-        // the mixed-precision kernel (regular forms outside the filaments).
-        let cutoff_only = far && !self.far_tree.kernel_exact(&self.far);
         let u = if far { &mut self.u_far_mid } else { &mut self.u_mid };
         let mut p0 = 0;
         for (sl, s) in layout.surfaces.iter().zip(&self.surfaces) {
