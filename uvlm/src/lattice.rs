@@ -331,16 +331,27 @@ impl Lattice {
                 }
                 let nh = [nrm[0] / (2.0 * area), nrm[1] / (2.0 * area), nrm[2] / (2.0 * area)];
                 let corners = [a, b, c, d];
-                let mut min_angle = f64::INFINITY;
-                for k in 0..4 {
+                let corner = |k: usize| {
                     let p = corners[k];
                     let q = sub(corners[(k + 3) % 4], p);
                     let r = sub(corners[(k + 1) % 4], p);
-                    let s = dot(cross(q, r), nh);
-                    let co = dot(q, r);
-                    let ang = if norm(q) * norm(r) > 0.0 { s.atan2(co) } else { 0.0 };
-                    min_angle = min_angle.min(ang);
-                }
+                    (dot(cross(q, r), nh), dot(q, r), norm(q) * norm(r) > 0.0)
+                };
+                // The corner angles (atan2) only where a corner is not clearly wider than the limit.
+                let clear = (0..4).all(|k| {
+                    let (s, co, sized) = corner(k);
+                    sized && clearly_wider(s, co, limit)
+                });
+                let min_angle = if clear {
+                    limit
+                } else {
+                    (0..4)
+                        .map(|k| {
+                            let (s, co, sized) = corner(k);
+                            if sized { s.atan2(co) } else { 0.0 }
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                };
                 if min_angle < limit {
                     return Err(UvlmError::SkewedPanel {
                         row: i,
@@ -521,11 +532,45 @@ fn vec_none() -> [f64; 3] {
     [0.0; 3]
 }
 
+/// Whether the corner angle `atan2(s, co)` is wider than `limit` (0 < limit ≤ π/2) by more than
+/// rounding, without the arctangent: the angle lies in (0, π) when `s > 0`, where it exceeds
+/// `limit` when `co ≤ 0` or `co sin(limit) < s cos(limit)`. A margin of 1e-9 leaves the
+/// borderline corners (and `s ≤ 0`) to the arctangent, so the test never decides otherwise
+/// than it would.
+fn clearly_wider(s: f64, co: f64, limit: f64) -> bool {
+    if !(limit > 0.0 && limit <= std::f64::consts::FRAC_PI_2) || s <= 0.0 {
+        return false;
+    }
+    co <= 0.0 || co * limit.sin() * (1.0 + 1e-9) < s * limit.cos()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use nalgebra::{Matrix3, Vector3};
+
+    /// The corner test without the arctangent never passes a corner the arctangent puts below
+    /// the limit, and passes the clear ones: corners all round the circle, limits 0.5° to 89.9°,
+    /// including angles within 1e-7 rad of the limit.
+    #[test]
+    fn clearly_wider_agrees_with_the_arctangent() {
+        let mut passed = 0;
+        for li in 0..60 {
+            let limit = (0.5 + 89.4 * li as f64 / 59.0).to_radians();
+            for k in 0..2000 {
+                let theta = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * (k as f64 + 0.37) / 2000.0;
+                for (t, mag) in [(theta, 1.0), (limit + 1e-7, 3.0), (limit - 1e-7, 0.2), (limit, 7.0)] {
+                    let (s, co) = (mag * t.sin(), mag * t.cos());
+                    if clearly_wider(s, co, limit) {
+                        assert!(s.atan2(co) >= limit, "limit {limit}, angle {}", s.atan2(co));
+                        passed += 1;
+                    }
+                }
+            }
+        }
+        assert!(passed > 60 * 1000, "{passed} clear corners");
+    }
 
     /// Stations of a flat rectangular wing along +Y with the flow along +X (x_s = Y, y_s = −X).
     fn rect(n: usize, span: f64, chord: f64) -> Vec<SpanStation> {
