@@ -316,6 +316,7 @@ impl Lattice {
             return Err(UvlmError::NonFiniteNode { row: k / nc, column: k % nc });
         }
         let limit = self.spec.min_corner_angle_deg.to_radians();
+        let wider = CornerTest::new(limit);
         let mut prev_normal = vec_none();
         for i in 0..m {
             for j in 0..n {
@@ -340,7 +341,7 @@ impl Lattice {
                 // The corner angles (atan2) only where a corner is not clearly wider than the limit.
                 let clear = (0..4).all(|k| {
                     let (s, co, sized) = corner(k);
-                    sized && clearly_wider(s, co, limit)
+                    sized && wider.clearly(s, co)
                 });
                 let min_angle = if clear {
                     limit
@@ -532,16 +533,25 @@ fn vec_none() -> [f64; 3] {
     [0.0; 3]
 }
 
-/// Whether the corner angle `atan2(s, co)` is wider than `limit` (0 < limit ≤ π/2) by more than
+/// Whether a corner angle `atan2(s, co)` is wider than `limit` (0 < limit ≤ π/2) by more than
 /// rounding, without the arctangent: the angle lies in (0, π) when `s > 0`, where it exceeds
 /// `limit` when `co ≤ 0` or `co sin(limit) < s cos(limit)`. A margin of 1e-9 leaves the
 /// borderline corners (and `s ≤ 0`) to the arctangent, so the test never decides otherwise
-/// than it would.
-fn clearly_wider(s: f64, co: f64, limit: f64) -> bool {
-    if !(limit > 0.0 && limit <= std::f64::consts::FRAC_PI_2) || s <= 0.0 {
-        return false;
+/// than it would. The limit's sine (with the margin) and cosine, once per lattice check; `None`
+/// for a limit outside (0, π/2], which every corner leaves to the arctangent.
+struct CornerTest(Option<(f64, f64)>);
+
+impl CornerTest {
+    fn new(limit: f64) -> Self {
+        Self((limit > 0.0 && limit <= std::f64::consts::FRAC_PI_2).then(|| (limit.sin() * (1.0 + 1e-9), limit.cos())))
     }
-    co <= 0.0 || co * limit.sin() * (1.0 + 1e-9) < s * limit.cos()
+
+    fn clearly(&self, s: f64, co: f64) -> bool {
+        match self.0 {
+            Some((sin, cos)) if s > 0.0 => co <= 0.0 || co * sin < s * cos,
+            _ => false,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -554,15 +564,16 @@ mod tests {
     /// the limit, and passes the clear ones: corners all round the circle, limits 0.5° to 89.9°,
     /// including angles within 1e-7 rad of the limit.
     #[test]
-    fn clearly_wider_agrees_with_the_arctangent() {
+    fn the_corner_test_agrees_with_the_arctangent() {
         let mut passed = 0;
         for li in 0..60 {
             let limit = (0.5 + 89.4 * li as f64 / 59.0).to_radians();
+            let wider = CornerTest::new(limit);
             for k in 0..2000 {
                 let theta = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * (k as f64 + 0.37) / 2000.0;
                 for (t, mag) in [(theta, 1.0), (limit + 1e-7, 3.0), (limit - 1e-7, 0.2), (limit, 7.0)] {
                     let (s, co) = (mag * t.sin(), mag * t.cos());
-                    if clearly_wider(s, co, limit) {
+                    if wider.clearly(s, co) {
                         assert!(s.atan2(co) >= limit, "limit {limit}, angle {}", s.atan2(co));
                         passed += 1;
                     }
