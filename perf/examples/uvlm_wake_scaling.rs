@@ -4,7 +4,8 @@
 //! shared machine, where the wall time of `cargo bench -p perf --bench uvlm_wake_scaling` / `--bench
 //! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full;
 //! the last line is the 8×-wake ratio at p = 5 (interleaved medians of seven runs of 64 steps).
-//! Run: `cargo run --release -p perf --example uvlm_wake_scaling`.
+//! Run: `cargo run --release -p perf --example uvlm_wake_scaling [-- kernel]` (with `kernel`, the
+//! throughputs only).
 use uvlm::samples::FlaredWing;
 use uvlm::*;
 
@@ -94,6 +95,59 @@ fn fma_avx512(n: usize) -> f64 {
     x.iter().map(|v| _mm512_reduce_add_pd(*v)).sum()
 }
 
+/// [`fma_avx512`] on AVX2: twelve independent chains of four-lane f64 fused multiply-adds.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn fma_avx2(n: usize) -> f64 {
+    use std::arch::x86_64::*;
+    let a = _mm256_set1_pd(0.999_999);
+    let b = _mm256_set1_pd(1e-7);
+    let mut x = [_mm256_set1_pd(1.0); 12];
+    for _ in 0..n {
+        for v in &mut x {
+            *v = _mm256_fmadd_pd(*v, a, b);
+        }
+    }
+    let mut lanes = [0.0; 4];
+    x.iter().fold(0.0, |s, v| {
+        _mm256_storeu_pd(lanes.as_mut_ptr(), *v);
+        s + lanes.iter().sum::<f64>()
+    })
+}
+
+/// The machine's FMA roofline, f64 flop/s per core, and the instruction set it was measured
+/// with (the widest the kernels use here).
+fn roofline() -> Option<(f64, &'static str)> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let n = 20_000_000;
+        let fma = std::is_x86_feature_detected!("fma");
+        let (lanes, isa): (usize, &str) = if fma && std::is_x86_feature_detected!("avx512f") {
+            (8, "AVX-512")
+        } else if fma && std::is_x86_feature_detected!("avx2") {
+            (4, "AVX2")
+        } else {
+            return None;
+        };
+        let flops = median(
+            (0..9)
+                .map(|_| {
+                    let t0 = cpu_ns();
+                    // SAFETY: the features were detected above.
+                    let s = unsafe {
+                        if lanes == 8 { fma_avx512(std::hint::black_box(n)) } else { fma_avx2(std::hint::black_box(n)) }
+                    };
+                    std::hint::black_box(s);
+                    (n * 12 * lanes * 2) as f64 / ((cpu_ns() - t0) as f64 * 1e-9)
+                })
+                .collect(),
+        );
+        Some((flops, isa))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    None
+}
+
 fn kernel() {
     let mut fil = Filaments::default();
     let core = CoreModel::CutOff { radius: 1e-6 };
@@ -140,20 +194,8 @@ fn kernel() {
             .collect(),
     );
     println!("mixed-precision kernel: {:.3e} point-segment pairs/s per core", rate32);
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
-        let n = 20_000_000;
-        let flops = median(
-            (0..9)
-                .map(|_| {
-                    let t0 = cpu_ns();
-                    // SAFETY: features detected above.
-                    std::hint::black_box(unsafe { fma_avx512(std::hint::black_box(n)) });
-                    (n * 12 * 8 * 2) as f64 / ((cpu_ns() - t0) as f64 * 1e-9)
-                })
-                .collect(),
-        );
-        println!("FMA roofline (AVX-512): {:.3e} flop/s per core", flops);
+    if let Some((flops, isa)) = roofline() {
+        println!("FMA roofline ({isa}): {:.3e} flop/s per core", flops);
         println!("pairs per roofline flop: {:.4} (a pair is ~30 flops and one division)", rate / flops);
         println!("mixed: pairs per f32 roofline flop (twice the f64 lanes): {:.4}", rate32 / (2.0 * flops));
     }
@@ -161,6 +203,9 @@ fn kernel() {
 
 fn main() {
     kernel();
+    if std::env::args().nth(1).as_deref() == Some("kernel") {
+        return;
+    }
     println!("rows  direct_ms  mixed_ms  tree4_ms  tree5_ms  tree6_ms   (CPU time per step, median of 3 × 20 steps)");
     let tree = |order| WakeAggregation { order, ..WakeAggregation::treecode() };
     for rows in [40usize, 80, 160, 320] {

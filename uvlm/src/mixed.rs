@@ -173,65 +173,82 @@ macro_rules! fill32 {
     };
 }
 
-/// The kernel body, compiled once per instruction set.
+/// The lanes `h..h + W` of a node's row.
+#[inline(always)]
+fn sub_lanes<const N: usize, const W: usize>(row: &[f32; N], h: usize) -> &[f32; W] {
+    row[h..h + W].first_chunk::<W>().expect("a sub-block lies within the block")
+}
+
+/// The kernel body, compiled once per instruction set. The `N` lanes go through the filaments
+/// `W` at a time: one register of f32 per quantity (with AVX2's sixteen registers, two per
+/// quantity spilled the partial sums to the stack at every filament). Each lane's arithmetic
+/// and order of summation do not depend on `W`.
 macro_rules! velocity32 {
     ($($attr:meta)?; $vel:ident) => {
         $(#[$attr])?
-        fn $vel<const N: usize>(fil: &Filaments, c: &Filaments32, blk: &Block32<N>, u: &mut [[f64; N]; 3]) {
+        fn $vel<const N: usize, const W: usize>(
+            fil: &Filaments,
+            c: &Filaments32,
+            blk: &Block32<N>,
+            u: &mut [[f64; N]; 3],
+        ) {
+            const { assert!(W > 0 && N.is_multiple_of(W)) };
             let ns = fil.n_segments();
             let (sa, sb) = (&fil.seg_a[..ns], &fil.seg_b[..ns]);
             let (sg, sc, st) = (&c.seg_g[..ns], &c.seg_core2[..ns], &c.seg_cut2[..ns]);
-            let mut s0 = 0;
-            while s0 < ns {
-                let s1 = (s0 + FLUSH).min(ns);
-                let mut ux = [0.0f32; N];
-                let mut uy = [0.0f32; N];
-                let mut uz = [0.0f32; N];
-                for s in s0..s1 {
-                    let r1 = &blk.r[sa[s] as usize];
-                    let r2 = &blk.r[sb[s] as usize];
-                    let (g, core2, cut2) = (sg[s], sc[s], st[s]);
-                    for l in 0..N {
-                        let (cr, k) = pair32(
-                            [r1[0][l], r1[1][l], r1[2][l]],
-                            r1[3][l],
-                            [r2[0][l], r2[1][l], r2[2][l]],
-                            r2[3][l],
-                            core2,
-                            cut2,
-                        );
+            for h in (0..N).step_by(W) {
+                let mut s0 = 0;
+                while s0 < ns {
+                    let s1 = (s0 + FLUSH).min(ns);
+                    let mut ux = [0.0f32; W];
+                    let mut uy = [0.0f32; W];
+                    let mut uz = [0.0f32; W];
+                    for s in s0..s1 {
+                        let r1 = blk.r[sa[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                        let r2 = blk.r[sb[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                        let (g, core2, cut2) = (sg[s], sc[s], st[s]);
+                        for l in 0..W {
+                            let (cr, k) = pair32(
+                                [r1[0][l], r1[1][l], r1[2][l]],
+                                r1[3][l],
+                                [r2[0][l], r2[1][l], r2[2][l]],
+                                r2[3][l],
+                                core2,
+                                cut2,
+                            );
+                            let gk = g * k;
+                            ux[l] = gk.mul_add(cr[0], ux[l]);
+                            uy[l] = gk.mul_add(cr[1], uy[l]);
+                            uz[l] = gk.mul_add(cr[2], uz[l]);
+                        }
+                    }
+                    for l in 0..W {
+                        u[0][h + l] += ux[l] as f64;
+                        u[1][h + l] += uy[l] as f64;
+                        u[2][h + l] += uz[l] as f64;
+                    }
+                    s0 = s1;
+                }
+                let nl = fil.n_legs();
+                let mut ux = [0.0f32; W];
+                let mut uy = [0.0f32; W];
+                let mut uz = [0.0f32; W];
+                for j in 0..nl {
+                    let r = blk.r[fil.leg_a[j] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                    let (d, g, core2, cut2) = (c.leg_d[j], c.leg_g[j], c.leg_core2[j], c.leg_cut2[j]);
+                    for l in 0..W {
+                        let (cr, k) = leg32([r[0][l], r[1][l], r[2][l]], r[3][l], d, core2, cut2);
                         let gk = g * k;
-                        ux[l] = gk.mul_add(cr[0], ux[l]);
-                        uy[l] = gk.mul_add(cr[1], uy[l]);
-                        uz[l] = gk.mul_add(cr[2], uz[l]);
+                        ux[l] += gk * cr[0];
+                        uy[l] += gk * cr[1];
+                        uz[l] += gk * cr[2];
                     }
                 }
-                for l in 0..N {
-                    u[0][l] += ux[l] as f64;
-                    u[1][l] += uy[l] as f64;
-                    u[2][l] += uz[l] as f64;
+                for l in 0..W {
+                    u[0][h + l] += ux[l] as f64;
+                    u[1][h + l] += uy[l] as f64;
+                    u[2][h + l] += uz[l] as f64;
                 }
-                s0 = s1;
-            }
-            let nl = fil.n_legs();
-            let mut ux = [0.0f32; N];
-            let mut uy = [0.0f32; N];
-            let mut uz = [0.0f32; N];
-            for j in 0..nl {
-                let r = &blk.r[fil.leg_a[j] as usize];
-                let (d, g, core2, cut2) = (c.leg_d[j], c.leg_g[j], c.leg_core2[j], c.leg_cut2[j]);
-                for l in 0..N {
-                    let (cr, k) = leg32([r[0][l], r[1][l], r[2][l]], r[3][l], d, core2, cut2);
-                    let gk = g * k;
-                    ux[l] += gk * cr[0];
-                    uy[l] += gk * cr[1];
-                    uz[l] += gk * cr[2];
-                }
-            }
-            for l in 0..N {
-                u[0][l] += ux[l] as f64;
-                u[1][l] += uy[l] as f64;
-                u[2][l] += uz[l] as f64;
             }
         }
     };
@@ -240,14 +257,15 @@ macro_rules! velocity32 {
 fill32!(; fill_generic);
 velocity32!(; velocity_generic);
 #[cfg(target_arch = "x86_64")]
-fill32!(target_feature(enable = "avx2,fma"); fill_avx2);
-#[cfg(target_arch = "x86_64")]
 velocity32!(target_feature(enable = "avx2,fma"); velocity_avx2);
 #[cfg(target_arch = "x86_64")]
 velocity32!(target_feature(enable = "avx512f,avx2,fma"); velocity_avx512);
 
-/// The node fill written with intrinsics: auto-vectorisation of the portable version runs
-/// across nodes with gathers and scatters (measured slower than the kernel itself).
+/// The node fill written with intrinsics, here and in [`fill_avx2`]: auto-vectorisation of the
+/// portable version runs across nodes with gathers and scatters, or on AVX2 with four-lane
+/// shuffles (measured slower than the kernel itself). The same operations in the same order as
+/// [`fill_generic`]: the difference in f64 rounded to f32, then `(x² + y²) + z²` without fused
+/// products, so the lanes are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
 fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block32<N>) {
@@ -280,6 +298,48 @@ fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Blo
     }
 }
 
+/// [`fill_avx512`] on AVX2: eight lanes per pass, each from two four-lane f64 differences.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block32<N>) {
+    use std::arch::x86_64::*;
+    const { assert!(N.is_multiple_of(8)) };
+    let n = c.x.len();
+    if blk.r.len() < n {
+        blk.r.resize(n, [[0.0; N]; 4]);
+    }
+    // SAFETY: unaligned loads of 4 f64 at offsets h, h + 4 (h + 8 ≤ N) of [f64; N] arrays, and
+    // stores of 8 f32 at offset h of [f32; N] arrays.
+    unsafe {
+        for h in (0..N).step_by(8) {
+            let lo = [
+                _mm256_loadu_pd(p[0].as_ptr().add(h)),
+                _mm256_loadu_pd(p[1].as_ptr().add(h)),
+                _mm256_loadu_pd(p[2].as_ptr().add(h)),
+            ];
+            let hi = [
+                _mm256_loadu_pd(p[0].as_ptr().add(h + 4)),
+                _mm256_loadu_pd(p[1].as_ptr().add(h + 4)),
+                _mm256_loadu_pd(p[2].as_ptr().add(h + 4)),
+            ];
+            let diff = |q: usize, x: f64| {
+                let x = _mm256_set1_pd(x);
+                _mm256_set_m128(_mm256_cvtpd_ps(_mm256_sub_pd(hi[q], x)), _mm256_cvtpd_ps(_mm256_sub_pd(lo[q], x)))
+            };
+            let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
+            for (((r, &x), &y), &z) in blk.r[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
+                let (dx, dy, dz) = (diff(0, x), diff(1, y), diff(2, z));
+                let n2 =
+                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+                _mm256_storeu_ps(r[0].as_mut_ptr().add(h), dx);
+                _mm256_storeu_ps(r[1].as_mut_ptr().add(h), dy);
+                _mm256_storeu_ps(r[2].as_mut_ptr().add(h), dz);
+                _mm256_storeu_ps(r[3].as_mut_ptr().add(h), _mm256_sqrt_ps(n2));
+            }
+        }
+    }
+}
+
 /// The lanes of block `b` of `v` (the last point repeated past the end).
 fn lanes(v: &[f64], b: usize) -> [f64; LANES32] {
     let mut out = [0.0; LANES32];
@@ -299,25 +359,38 @@ pub(crate) fn add_lanes<const N: usize>(
     blk: &mut Block32<N>,
     u: &mut [[f64; N]; 3],
 ) {
+    add_lanes_on(isa(), fil, c, p, blk, u);
+}
+
+/// [`add_lanes`] with the kernel of `isa`, which the caller has checked the CPU supports.
+#[inline]
+fn add_lanes_on<const N: usize>(
+    isa: Isa,
+    fil: &Filaments,
+    c: &Filaments32,
+    p: &[[f64; N]; 3],
+    blk: &mut Block32<N>,
+    u: &mut [[f64; N]; 3],
+) {
     let mut v = [[0.0; N]; 3];
     // The points over ℓ, as the nodes.
     let p = &p.map(|q| q.map(|x| x * c.inv_len));
-    match isa() {
+    match isa {
         Isa::Generic => {
             fill_generic(c, p, blk);
-            velocity_generic(fil, c, blk, &mut v);
+            velocity_generic::<N, N>(fil, c, blk, &mut v);
         }
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe {
             fill_avx2(c, p, blk);
-            velocity_avx2(fil, c, blk, &mut v);
+            velocity_avx2::<N, 8>(fil, c, blk, &mut v);
         },
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
             fill_avx512(c, p, blk);
-            velocity_avx512(fil, c, blk, &mut v);
+            velocity_avx512::<N, N>(fil, c, blk, &mut v);
         },
     }
     // (P − X)/ℓ gives the velocity times ℓ.
@@ -501,6 +574,62 @@ mod tests {
             })
         });
         assert_eq!(threaded, u);
+    }
+
+    /// Every kernel this CPU runs gives the portable kernel's lanes bit for bit, for blocks of
+    /// both widths (the direct sum's and the treecode's leaves'), with points near the
+    /// filaments' axes and cut-off cylinders: the f32 results do not depend on the instruction
+    /// set.
+    #[test]
+    fn instruction_sets_agree_bit_for_bit() {
+        let mut seed = 5u64;
+        let mut rng = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let core = CoreModel::CutOff { radius: 1e-3 };
+        let mut fil = Filaments::default();
+        let mut nodes = Vec::new();
+        for _ in 0..40 {
+            nodes.push(fil.push_node([3.0 * rng(), 2.0 * rng(), 0.5 * rng()]));
+        }
+        for k in 0..700 {
+            let (a, b) = (nodes[k % 40], nodes[(7 * k + 3) % 40]);
+            if a != b {
+                fil.push_segment(a, b, 2.0 * rng() - 1.0, &core);
+            }
+        }
+        fil.push_leg(nodes[0], [1.0, 0.0, 0.0], 0.4, &core, 1.0);
+        fil.push_leg(nodes[1], [0.0, 0.6, 0.8], -0.3, &core, 1.0);
+        let mut c = Filaments32::default();
+        c.load(&fil);
+        let mut isas = vec![Isa::Generic];
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            isas.push(Isa::Avx2);
+            if std::is_x86_feature_detected!("avx512f") {
+                isas.push(Isa::Avx512);
+            }
+        }
+        // Points on a node, on a segment's axis beyond its end, inside a cut-off, and anywhere.
+        let (p0, p1) = (fil.node(nodes[3] as usize), fil.node(nodes[24] as usize));
+        let mut pts: Vec<[f64; 3]> = vec![p0, [2.0 * p1[0] - p0[0], 2.0 * p1[1] - p0[1], 2.0 * p1[2] - p0[2]]];
+        pts.push([p0[0] + 2e-4, p0[1], p0[2]]);
+        while pts.len() < LANES32 {
+            pts.push([4.0 * rng() - 0.5, 3.0 * rng() - 0.5, rng() - 0.25]);
+        }
+        fn run<const N: usize>(isa: Isa, fil: &Filaments, c: &Filaments32, pts: &[[f64; 3]]) -> [[f64; N]; 3] {
+            let p = [0, 1, 2].map(|q| std::array::from_fn(|l| pts[l][q]));
+            let (mut blk, mut u) = (Block32::<N>::default(), [[0.0; N]; 3]);
+            add_lanes_on(isa, fil, c, &p, &mut blk, &mut u);
+            u
+        }
+        let (wide, narrow) = (run::<LANES32>(Isa::Generic, &fil, &c, &pts), run::<8>(Isa::Generic, &fil, &c, &pts));
+        assert!(wide.iter().flatten().all(|v| v.is_finite() && *v != 0.0));
+        for isa in isas {
+            assert_eq!(run::<LANES32>(isa, &fil, &c, &pts), wide, "{isa:?}, {LANES32} lanes");
+            assert_eq!(run::<8>(isa, &fil, &c, &pts), narrow, "{isa:?}, 8 lanes");
+        }
     }
 
     /// The paper's wing's far wake after 120 steps (25 m/s, dt 0.01 s, 5°, folding, closure legs,
