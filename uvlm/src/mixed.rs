@@ -101,11 +101,15 @@ impl Filaments32 {
 #[derive(Debug, Clone)]
 pub(crate) struct Block32<const N: usize> {
     r: Vec<[[f32; N]; 4]>,
+    /// Eight lanes of it at a time, where the kernel runs on eight (AVX2): a node's record in
+    /// two cache lines, so that the records of a long wake stay in the core's cache between
+    /// the fill and the kernel.
+    eight: Vec<[[f32; 8]; 4]>,
 }
 
 impl<const N: usize> Default for Block32<N> {
     fn default() -> Self {
-        Self { r: Vec::new() }
+        Self { r: Vec::new(), eight: Vec::new() }
     }
 }
 
@@ -153,13 +157,13 @@ fn leg32(r: [f32; 3], rn: f32, d: [f32; 3], core2: f32, cut2: f32) -> ([f32; 3],
 macro_rules! fill32 {
     ($($attr:meta)?; $fill:ident) => {
         $(#[$attr])?
-        fn $fill<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block32<N>) {
+        fn $fill<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
             let n = c.x.len();
-            if blk.r.len() < n {
-                blk.r.resize(n, [[0.0; N]; 4]);
+            if rec.len() < n {
+                rec.resize(n, [[0.0; N]; 4]);
             }
             let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in blk.r[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
+            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
                 for l in 0..N {
                     r[0][l] = (p[0][l] - x) as f32;
                     r[1][l] = (p[1][l] - y) as f32;
@@ -189,7 +193,7 @@ macro_rules! velocity32 {
         fn $vel<const N: usize, const W: usize>(
             fil: &Filaments,
             c: &Filaments32,
-            blk: &Block32<N>,
+            rec: &[[[f32; N]; 4]],
             u: &mut [[f64; N]; 3],
         ) {
             const { assert!(W > 0 && N.is_multiple_of(W)) };
@@ -204,8 +208,8 @@ macro_rules! velocity32 {
                     let mut uy = [0.0f32; W];
                     let mut uz = [0.0f32; W];
                     for s in s0..s1 {
-                        let r1 = blk.r[sa[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
-                        let r2 = blk.r[sb[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                        let r1 = rec[sa[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                        let r2 = rec[sb[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
                         let (g, core2, cut2) = (sg[s], sc[s], st[s]);
                         for l in 0..W {
                             let (cr, k) = pair32(
@@ -234,7 +238,7 @@ macro_rules! velocity32 {
                 let mut uy = [0.0f32; W];
                 let mut uz = [0.0f32; W];
                 for j in 0..nl {
-                    let r = blk.r[fil.leg_a[j] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
+                    let r = rec[fil.leg_a[j] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
                     let (d, g, core2, cut2) = (c.leg_d[j], c.leg_g[j], c.leg_core2[j], c.leg_cut2[j]);
                     for l in 0..W {
                         let (cr, k) = leg32([r[0][l], r[1][l], r[2][l]], r[3][l], d, core2, cut2);
@@ -268,12 +272,12 @@ velocity32!(target_feature(enable = "avx512f,avx2,fma"); velocity_avx512);
 /// products, so the lanes are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
-fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block32<N>) {
+fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
     use std::arch::x86_64::*;
     const { assert!(N.is_multiple_of(8)) };
     let n = c.x.len();
-    if blk.r.len() < n {
-        blk.r.resize(n, [[0.0; N]; 4]);
+    if rec.len() < n {
+        rec.resize(n, [[0.0; N]; 4]);
     }
     // SAFETY: unaligned loads of 8 f64 at offsets h, h + 8 ≤ N of [f64; N] arrays, and stores
     // of 8 f32 at the same offsets of [f32; N] arrays.
@@ -283,7 +287,7 @@ fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Blo
             let vy = _mm512_loadu_pd(p[1].as_ptr().add(h));
             let vz = _mm512_loadu_pd(p[2].as_ptr().add(h));
             let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in blk.r[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
+            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
                 let dx = _mm512_cvtpd_ps(_mm512_sub_pd(vx, _mm512_set1_pd(x)));
                 let dy = _mm512_cvtpd_ps(_mm512_sub_pd(vy, _mm512_set1_pd(y)));
                 let dz = _mm512_cvtpd_ps(_mm512_sub_pd(vz, _mm512_set1_pd(z)));
@@ -301,12 +305,12 @@ fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Blo
 /// [`fill_avx512`] on AVX2: eight lanes per pass, each from two four-lane f64 differences.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block32<N>) {
+fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
     use std::arch::x86_64::*;
     const { assert!(N.is_multiple_of(8)) };
     let n = c.x.len();
-    if blk.r.len() < n {
-        blk.r.resize(n, [[0.0; N]; 4]);
+    if rec.len() < n {
+        rec.resize(n, [[0.0; N]; 4]);
     }
     // SAFETY: unaligned loads of 4 f64 at offsets h, h + 4 (h + 8 ≤ N) of [f64; N] arrays, and
     // stores of 8 f32 at offset h of [f32; N] arrays.
@@ -327,7 +331,7 @@ fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], blk: &mut Block
                 _mm256_set_m128(_mm256_cvtpd_ps(_mm256_sub_pd(hi[q], x)), _mm256_cvtpd_ps(_mm256_sub_pd(lo[q], x)))
             };
             let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in blk.r[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
+            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
                 let (dx, dy, dz) = (diff(0, x), diff(1, y), diff(2, z));
                 let n2 =
                     _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
@@ -377,20 +381,28 @@ fn add_lanes_on<const N: usize>(
     let p = &p.map(|q| q.map(|x| x * c.inv_len));
     match isa {
         Isa::Generic => {
-            fill_generic(c, p, blk);
-            velocity_generic::<N, N>(fil, c, blk, &mut v);
+            fill_generic(c, p, &mut blk.r);
+            velocity_generic::<N, N>(fil, c, &blk.r, &mut v);
         }
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe {
-            fill_avx2(c, p, blk);
-            velocity_avx2::<N, 8>(fil, c, blk, &mut v);
+            const { assert!(N.is_multiple_of(8)) };
+            for h in (0..N).step_by(8) {
+                let p8 = p.each_ref().map(|q| std::array::from_fn::<f64, 8, _>(|l| q[h + l]));
+                let mut v8 = [[0.0; 8]; 3];
+                fill_avx2(c, &p8, &mut blk.eight);
+                velocity_avx2::<8, 8>(fil, c, &blk.eight, &mut v8);
+                for q in 0..3 {
+                    v[q][h..h + 8].copy_from_slice(&v8[q]);
+                }
+            }
         },
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
-            fill_avx512(c, p, blk);
-            velocity_avx512::<N, N>(fil, c, blk, &mut v);
+            fill_avx512(c, p, &mut blk.r);
+            velocity_avx512::<N, N>(fil, c, &blk.r, &mut v);
         },
     }
     // (P − X)/ℓ gives the velocity times ℓ.
