@@ -169,6 +169,10 @@ fn lock(_file: &File, _dir: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
+/// The prefixes of the files the analysis commands (`static`, `stability`, `gust` and `trim`)
+/// write into a case's folder beside its runs' files: a run does not remove them.
+const ANALYSIS_PREFIXES: [&str; 4] = ["static_", "stability_", "gust_", "trim_"];
+
 /// Remove what a run writes into its folder (CSV, JSON, SVG, Markdown, HTML, leftover temporary
 /// files, the `vtk/` folder), so that no file of an earlier run stays beside the new run's.
 /// Call it holding the folder's [`DirLock`]; the files named in `keep` stay.
@@ -180,8 +184,8 @@ pub fn clear_outputs(lock: &DirLock, keep: &[&str]) -> Result<(), Error> {
         let p = e.path();
         let name = e.file_name().to_string_lossy().into_owned();
         let is_dir = e.file_type().map(|t| t.is_dir()).unwrap_or(false);
-        // `static_*` files belong to `harness static`, another command writing into the folder.
-        if keep.contains(&name.as_str()) || name.starts_with("static_") {
+        // The analyses' files belong to other commands writing into the folder.
+        if keep.contains(&name.as_str()) || ANALYSIS_PREFIXES.iter().any(|a| name.starts_with(a)) {
             continue;
         }
         if is_dir && name == "vtk" {
@@ -210,10 +214,17 @@ mod tests {
         assert_eq!(std::fs::read(&p).unwrap(), b"new");
         let names: Vec<_> = std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(names.len(), 1, "{names:?}");
+        let analyses = ["static_ancf.csv", "stability_gebf.json", "gust_history_ancf.csv", "trim_gebf.json"];
+        for a in analyses {
+            write(&d.join(a), b"an analysis").unwrap();
+        }
         let lock = claim_dir(&d).unwrap();
         clear_outputs(&lock, &[]).unwrap();
         assert!(!p.exists());
         assert!(d.join(".lock").exists());
+        for a in analyses {
+            assert!(d.join(a).exists(), "{a}: an analysis' file removed by a run");
+        }
         let _ = std::fs::remove_dir_all(&d);
     }
 

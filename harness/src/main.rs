@@ -1130,14 +1130,18 @@ fn cmd_all(a: &AllArgs) -> Result<ExitCode> {
     // Every run keeps one thread while the phases go side by side (the UVLM threads a run only
     // while it is the one run registered): the pool's threads are the only ones computing.
     let _one_thread_each = harness::aero::register_runs(2);
-    let (cases, studies, gusts) = std::thread::scope(|s| {
+    // The gust sweeps first, with the machine to themselves: each is one study whose user waits
+    // for the whole of it, while the other lanes' many short units pack the cores after it as
+    // well as beside it.
+    let gusts = all_gusts(a, &p, &progress);
+    let (cases, studies, readings) = std::thread::scope(|s| {
         let studies = s.spawn(|| all_studies(a, &p, &progress));
-        let gusts = s.spawn(|| all_gusts(a, &p, &progress));
+        let readings = s.spawn(|| all_readings(a, &p, &progress));
         let sweeps = s.spawn(|| all_sweeps(&p, &progress));
         let cases = all_cases(a, &p, &progress, sweeps);
-        (cases, joined(studies), joined(gusts))
+        (cases, joined(studies), joined(readings))
     });
-    let (cases, studies, gusts) = (cases?, studies?, gusts?);
+    let (cases, studies, gusts) = (cases?, studies?, gusts?.and(readings?));
     let interrupted = cases.interrupted || harness::signal::interrupted();
     let (ladders, bench) = if a.quick || interrupted { Default::default() } else { all_timed(a, &p, &progress)? };
     // The manifest's units: the cases, the ladders, the stress matrix, the energy study, the benchmark.
@@ -1295,10 +1299,9 @@ fn all_studies(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<Vec<Stri
     Ok(done)
 }
 
-/// The lane of `harness all` with Healy's readings (where the three cases are) and the gust
-/// sweeps, several minutes of CPU: not with --quick, and not on a shard (on a cluster the gust
-/// sweeps are their own array, `harness gust --shard`).
-fn all_gusts(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<AnalysisFailures> {
+/// The lane of `harness all` with Healy's readings (where the three cases are): not with
+/// --quick, and not on a shard.
+fn all_readings(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<AnalysisFailures> {
     let mut n = AnalysisFailures::default();
     if a.quick || p.plan.is_some() {
         return Ok(n);
@@ -1311,6 +1314,17 @@ fn all_gusts(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<AnalysisFa
         n.static_failed += usize::from(healy_readings(cases, out, Formulation::Gebf, &mut lines)?);
         lines.print(progress);
     }
+    Ok(n)
+}
+
+/// The gust sweeps of `harness all`, several minutes of CPU: not with --quick, and not on a
+/// shard (on a cluster the gust sweeps are their own array, `harness gust --shard`).
+fn all_gusts(a: &AllArgs, p: &AllPlan, progress: &Progress) -> Result<AnalysisFailures> {
+    let mut n = AnalysisFailures::default();
+    if a.quick || p.plan.is_some() {
+        return Ok(n);
+    }
+    let out = &a.out.out;
     for spec in p.runs.iter().filter(|r| r.ancf.gust.is_some()) {
         if stopping() {
             break;

@@ -110,7 +110,8 @@ fn fma_avx2(n: usize) -> f64 {
     }
     let mut lanes = [0.0; 4];
     x.iter().fold(0.0, |s, v| {
-        _mm256_storeu_pd(lanes.as_mut_ptr(), *v);
+        // SAFETY: `lanes` holds the four f64 stored.
+        unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), *v) };
         s + lanes.iter().sum::<f64>()
     })
 }
