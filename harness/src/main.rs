@@ -1134,6 +1134,12 @@ fn cmd_all(a: &AllArgs) -> Result<ExitCode> {
     // for the whole of it, while the other lanes' many short units pack the cores after it as
     // well as beside it.
     let gusts = all_gusts(a, &p, &progress);
+    if stopping() {
+        // Nothing of the lanes has begun: the folders keep what an earlier run wrote.
+        gusts?;
+        eprintln!("interrupted during the gust sweeps: the cases, sweeps and studies were not begun");
+        return Ok(ExitCode::from(harness::signal::EXIT_INTERRUPTED));
+    }
     let (cases, studies, readings) = std::thread::scope(|s| {
         let studies = s.spawn(|| all_studies(a, &p, &progress));
         let readings = s.spawn(|| all_readings(a, &p, &progress));
