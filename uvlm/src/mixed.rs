@@ -177,82 +177,65 @@ macro_rules! fill32 {
     };
 }
 
-/// The lanes `h..h + W` of a node's row.
-#[inline(always)]
-fn sub_lanes<const N: usize, const W: usize>(row: &[f32; N], h: usize) -> &[f32; W] {
-    row[h..h + W].first_chunk::<W>().expect("a sub-block lies within the block")
-}
-
-/// The kernel body, compiled once per instruction set. The `N` lanes go through the filaments
-/// `W` at a time: one register of f32 per quantity (with AVX2's sixteen registers, two per
-/// quantity spilled the partial sums to the stack at every filament). Each lane's arithmetic
-/// and order of summation do not depend on `W`.
+/// The kernel body, compiled once per instruction set.
 macro_rules! velocity32 {
     ($($attr:meta)?; $vel:ident) => {
         $(#[$attr])?
-        fn $vel<const N: usize, const W: usize>(
-            fil: &Filaments,
-            c: &Filaments32,
-            rec: &[[[f32; N]; 4]],
-            u: &mut [[f64; N]; 3],
-        ) {
-            const { assert!(W > 0 && N.is_multiple_of(W)) };
+        fn $vel<const N: usize>(fil: &Filaments, c: &Filaments32, rec: &[[[f32; N]; 4]], u: &mut [[f64; N]; 3]) {
             let ns = fil.n_segments();
             let (sa, sb) = (&fil.seg_a[..ns], &fil.seg_b[..ns]);
             let (sg, sc, st) = (&c.seg_g[..ns], &c.seg_core2[..ns], &c.seg_cut2[..ns]);
-            for h in (0..N).step_by(W) {
-                let mut s0 = 0;
-                while s0 < ns {
-                    let s1 = (s0 + FLUSH).min(ns);
-                    let mut ux = [0.0f32; W];
-                    let mut uy = [0.0f32; W];
-                    let mut uz = [0.0f32; W];
-                    for s in s0..s1 {
-                        let r1 = rec[sa[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
-                        let r2 = rec[sb[s] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
-                        let (g, core2, cut2) = (sg[s], sc[s], st[s]);
-                        for l in 0..W {
-                            let (cr, k) = pair32(
-                                [r1[0][l], r1[1][l], r1[2][l]],
-                                r1[3][l],
-                                [r2[0][l], r2[1][l], r2[2][l]],
-                                r2[3][l],
-                                core2,
-                                cut2,
-                            );
-                            let gk = g * k;
-                            ux[l] = gk.mul_add(cr[0], ux[l]);
-                            uy[l] = gk.mul_add(cr[1], uy[l]);
-                            uz[l] = gk.mul_add(cr[2], uz[l]);
-                        }
-                    }
-                    for l in 0..W {
-                        u[0][h + l] += ux[l] as f64;
-                        u[1][h + l] += uy[l] as f64;
-                        u[2][h + l] += uz[l] as f64;
-                    }
-                    s0 = s1;
-                }
-                let nl = fil.n_legs();
-                let mut ux = [0.0f32; W];
-                let mut uy = [0.0f32; W];
-                let mut uz = [0.0f32; W];
-                for j in 0..nl {
-                    let r = rec[fil.leg_a[j] as usize].each_ref().map(|row| sub_lanes::<N, W>(row, h));
-                    let (d, g, core2, cut2) = (c.leg_d[j], c.leg_g[j], c.leg_core2[j], c.leg_cut2[j]);
-                    for l in 0..W {
-                        let (cr, k) = leg32([r[0][l], r[1][l], r[2][l]], r[3][l], d, core2, cut2);
+            let mut s0 = 0;
+            while s0 < ns {
+                let s1 = (s0 + FLUSH).min(ns);
+                let mut ux = [0.0f32; N];
+                let mut uy = [0.0f32; N];
+                let mut uz = [0.0f32; N];
+                for s in s0..s1 {
+                    let r1 = &rec[sa[s] as usize];
+                    let r2 = &rec[sb[s] as usize];
+                    let (g, core2, cut2) = (sg[s], sc[s], st[s]);
+                    for l in 0..N {
+                        let (cr, k) = pair32(
+                            [r1[0][l], r1[1][l], r1[2][l]],
+                            r1[3][l],
+                            [r2[0][l], r2[1][l], r2[2][l]],
+                            r2[3][l],
+                            core2,
+                            cut2,
+                        );
                         let gk = g * k;
-                        ux[l] += gk * cr[0];
-                        uy[l] += gk * cr[1];
-                        uz[l] += gk * cr[2];
+                        ux[l] = gk.mul_add(cr[0], ux[l]);
+                        uy[l] = gk.mul_add(cr[1], uy[l]);
+                        uz[l] = gk.mul_add(cr[2], uz[l]);
                     }
                 }
-                for l in 0..W {
-                    u[0][h + l] += ux[l] as f64;
-                    u[1][h + l] += uy[l] as f64;
-                    u[2][h + l] += uz[l] as f64;
+                for l in 0..N {
+                    u[0][l] += ux[l] as f64;
+                    u[1][l] += uy[l] as f64;
+                    u[2][l] += uz[l] as f64;
                 }
+                s0 = s1;
+            }
+            let nl = fil.n_legs();
+            let mut ux = [0.0f32; N];
+            let mut uy = [0.0f32; N];
+            let mut uz = [0.0f32; N];
+            for j in 0..nl {
+                let r = &rec[fil.leg_a[j] as usize];
+                let (d, g, core2, cut2) = (c.leg_d[j], c.leg_g[j], c.leg_core2[j], c.leg_cut2[j]);
+                for l in 0..N {
+                    let (cr, k) = leg32([r[0][l], r[1][l], r[2][l]], r[3][l], d, core2, cut2);
+                    let gk = g * k;
+                    ux[l] += gk * cr[0];
+                    uy[l] += gk * cr[1];
+                    uz[l] += gk * cr[2];
+                }
+            }
+            for l in 0..N {
+                u[0][l] += ux[l] as f64;
+                u[1][l] += uy[l] as f64;
+                u[2][l] += uz[l] as f64;
             }
         }
     };
@@ -302,7 +285,7 @@ fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec
     }
 }
 
-/// [`fill_avx512`] on AVX2: eight lanes per pass, each from two four-lane f64 differences.
+/// [`fill_avx512`] on AVX2: eight lanes a pass, each pass from two four-lane f64 differences.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
@@ -382,17 +365,20 @@ fn add_lanes_on<const N: usize>(
     match isa {
         Isa::Generic => {
             fill_generic(c, p, &mut blk.r);
-            velocity_generic::<N, N>(fil, c, &blk.r, &mut v);
+            velocity_generic(fil, c, &blk.r, &mut v);
         }
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
+        // Eight points at a time: with AVX2's sixteen registers, sixteen lanes (two registers per
+        // quantity) spill the partial sums to the stack at every filament. Each lane's operations
+        // are those of the whole block's.
         Isa::Avx2 => unsafe {
             const { assert!(N.is_multiple_of(8)) };
             for h in (0..N).step_by(8) {
                 let p8 = p.each_ref().map(|q| std::array::from_fn::<f64, 8, _>(|l| q[h + l]));
                 let mut v8 = [[0.0; 8]; 3];
                 fill_avx2(c, &p8, &mut blk.eight);
-                velocity_avx2::<8, 8>(fil, c, &blk.eight, &mut v8);
+                velocity_avx2::<8>(fil, c, &blk.eight, &mut v8);
                 for q in 0..3 {
                     v[q][h..h + 8].copy_from_slice(&v8[q]);
                 }
@@ -402,7 +388,7 @@ fn add_lanes_on<const N: usize>(
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
             fill_avx512(c, p, &mut blk.r);
-            velocity_avx512::<N, N>(fil, c, &blk.r, &mut v);
+            velocity_avx512(fil, c, &blk.r, &mut v);
         },
     }
     // (P − X)/ℓ gives the velocity times ℓ.
