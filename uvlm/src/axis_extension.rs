@@ -304,6 +304,11 @@ pub(crate) fn correct_wake_columns(
 /// rows at a time (their strengths and cores computed once for the column's points), corrected
 /// at each of the column's load points only where the point lies in the filament's cut-off
 /// cylinder (`|r₁×r₂|² + core2 ≤ cut2`, the kernel's own test).
+///
+/// The rows go in chunks of [`RUN`] across all the columns, so that the chunk's node rows, one
+/// cache line per two or three nodes, are read from memory once for the columns that share them
+/// rather than once per column. Each point still takes its filaments in row order, one at a
+/// time ([`flush_run`]), so the chunking does not change its sums.
 fn cutoff_columns(
     sl: &SurfaceLayout,
     p0: usize,
@@ -318,12 +323,14 @@ fn cutoff_columns(
     let pos = |k: usize, j: usize| if k == 0 { w.te[j] } else { wake.node(k - 1, j) };
     let g = |r: usize, j: isize| if j >= 0 && (j as usize) < n { wake.gamma(r, j as usize) } else { 0.0 };
     let mut legs = [([0.0; 3], [0.0; 3], (0.0, 0.0, 0.0)); RUN];
-    for j in 0..nc {
-        let mut b = pos(rows.start() - 1, j);
-        let mut k = *rows.start();
-        while k <= *rows.end() {
+    let (first, last) = (*rows.start(), *rows.end());
+    let mut k0 = first;
+    while k0 <= last {
+        let k1 = (k0 + RUN - 1).min(last);
+        for j in 0..nc {
+            let mut b = pos(k0 - 1, j);
             let mut count = 0;
-            while count < RUN && k <= *rows.end() {
+            for k in k0..=k1 {
                 let a = b;
                 b = pos(k, j);
                 let gamma = g(k - 1, j as isize - 1) - g(k - 1, j as isize);
@@ -333,7 +340,6 @@ fn cutoff_columns(
                     legs[count] = (a, b, (gamma * INV_FOUR_PI, core2, cut2));
                     count += 1;
                 }
-                k += 1;
             }
             for row in 0..m {
                 let i = p0 + m * n + row * nc + j;
@@ -343,6 +349,7 @@ fn cutoff_columns(
                 fix_run(&mut ch, inside.copied(), x, &mut u[i]);
             }
         }
+        k0 = k1 + 1;
     }
 }
 

@@ -6,9 +6,14 @@
 //! far wake (rows one and on) is where most point–segment pairs of a step are, and its
 //! induction needs about six digits (the aggregation's 1e-6 |V∞|), not sixteen.
 //!
-//! **Accuracy.** `P/ℓ − X/ℓ` is formed in f64 and rounded once (ℓ the set's mean segment length,
-//! so that the products below stay far from f32's range limits), so each relative vector
-//! carries a relative error of ε₃₂ ≈ 6e-8 whatever its distance from the origin. The kernel's factor `(|r₁|+|r₂|)(|r₁||r₂| − r₁·r₂)` cancels near a segment's axis
+//! **Accuracy.** `P/ℓ` and `X/ℓ` (ℓ the set's mean segment length, so that the products below
+//! stay far from f32's range limits) are each held as two f32, the value rounded and what the
+//! rounding left, and `P/ℓ − X/ℓ` is formed as `(Pₕ − Xₕ) + (Pₗ − Xₗ)`: the first difference is
+//! exact when the two coordinates are within a factor of two of each other (Sterbenz), else
+//! rounded by ε₃₂ of itself, so each relative vector carries a relative error of about 2ε₃₂
+//! (ε₃₂ ≈ 6e-8) plus ε₃₂² of the coordinates' size, whatever its distance from the origin, from
+//! eight-lane f32 operations alone (no f64 differences and conversions per point and node).
+//! The kernel's factor `(|r₁|+|r₂|)(|r₁||r₂| − r₁·r₂)` cancels near a segment's axis
 //! extension (`r₁·r₂ > 0`), which in f32 would lose every digit: there it takes the same law's
 //! regular form `(|r₁|+|r₂|)|r₁×r₂|²/(|r₁||r₂| + r₁·r₂)` (as axis_extension.rs does in f64), and
 //! a semi-infinite leg upstream of its start (`d·r < 0`) likewise takes
@@ -34,10 +39,9 @@ const FLUSH: usize = 256;
 pub(crate) struct Filaments32 {
     /// 1/ℓ, ℓ the mean segment length (1 without segments).
     inv_len: f64,
-    /// The nodes' coordinates over ℓ.
-    x: Vec<f64>,
-    y: Vec<f64>,
-    z: Vec<f64>,
+    /// The nodes' coordinates over ℓ, each as the sum of two f32 ([`split`]): x, y, z rounded,
+    /// then what the rounding left of each.
+    nodes: Vec<[f32; 6]>,
     seg_g: Vec<f32>,
     seg_core2: Vec<f32>,
     seg_cut2: Vec<f32>,
@@ -62,10 +66,11 @@ impl Filaments32 {
         let len = if total > 0.0 { total / count as f64 } else { 1.0 };
         let s = 1.0 / len;
         self.inv_len = s;
-        for (to, from) in [(&mut self.x, &fil.x), (&mut self.y, &fil.y), (&mut self.z, &fil.z)] {
-            to.clear();
-            to.extend(from.iter().map(|v| v * s));
-        }
+        self.nodes.clear();
+        self.nodes.extend((0..fil.x.len()).map(|i| {
+            let ([xh, xl], [yh, yl], [zh, zl]) = (split(fil.x[i] * s), split(fil.y[i] * s), split(fil.z[i] * s));
+            [xh, yh, zh, xl, yl, zl]
+        }));
         // A segment's core and cut-off constants scale as length⁴, a leg's as length²; the
         // strengths (Γ/4π) are not lengths: the velocity is scaled back by 1/ℓ at the end.
         let (s2, s4) = (s * s, s * s * s * s);
@@ -95,6 +100,14 @@ impl Filaments32 {
         self.seg_core2[s] = (core2 * s4) as f32;
         self.seg_cut2[s] = (cut2 * s4) as f32;
     }
+}
+
+/// `v` as `hi + lo` in f32: `hi` is `v` rounded, `lo` what the rounding left, rounded (so
+/// `hi + lo` is within about ε₃₂² |v| of `v`).
+#[inline]
+fn split(v: f64) -> [f32; 2] {
+    let hi = v as f32;
+    [hi, (v - hi as f64) as f32]
 }
 
 /// Per-block scratch: for each node, the `N` lanes of (P − X)/ℓ (x, y, z) and its norm, in f32.
@@ -153,28 +166,24 @@ fn leg32(r: [f32; 3], rn: f32, d: [f32; 3], core2: f32, cut2: f32) -> ([f32; 3],
     ([cx, cy, cz], k)
 }
 
-/// The node fill, compiled once per instruction set (AVX-512 has its own, [`fill_avx512`]).
-macro_rules! fill32 {
-    ($($attr:meta)?; $fill:ident) => {
-        $(#[$attr])?
-        fn $fill<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
-            let n = c.x.len();
-            if rec.len() < n {
-                rec.resize(n, [[0.0; N]; 4]);
-            }
-            let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
-                for l in 0..N {
-                    r[0][l] = (p[0][l] - x) as f32;
-                    r[1][l] = (p[1][l] - y) as f32;
-                    r[2][l] = (p[2][l] - z) as f32;
-                }
-                for l in 0..N {
-                    r[3][l] = (r[0][l] * r[0][l] + r[1][l] * r[1][l] + r[2][l] * r[2][l]).sqrt();
-                }
+/// The node fill, portable: `(P − X)/ℓ` lane by lane from the two halves of each ([`split`]),
+/// `(Pₕ − Xₕ) + (Pₗ − Xₗ)` in f32, and its norm from `(x² + y²) + z²`.
+fn fill_generic<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut Vec<[[f32; N]; 4]>) {
+    let n = c.nodes.len();
+    if rec.len() < n {
+        rec.resize(n, [[0.0; N]; 4]);
+    }
+    let [ph, pl] = p;
+    for (r, x) in rec[..n].iter_mut().zip(&c.nodes) {
+        for q in 0..3 {
+            for l in 0..N {
+                r[q][l] = (ph[q][l] - x[q]) + (pl[q][l] - x[q + 3]);
             }
         }
-    };
+        for l in 0..N {
+            r[3][l] = (r[0][l] * r[0][l] + r[1][l] * r[1][l] + r[2][l] * r[2][l]).sqrt();
+        }
+    }
 }
 
 /// The kernel body, compiled once per instruction set.
@@ -241,81 +250,38 @@ macro_rules! velocity32 {
     };
 }
 
-fill32!(; fill_generic);
 velocity32!(; velocity_generic);
 #[cfg(target_arch = "x86_64")]
 velocity32!(target_feature(enable = "avx2,fma"); velocity_avx2);
 #[cfg(target_arch = "x86_64")]
 velocity32!(target_feature(enable = "avx512f,avx2,fma"); velocity_avx512);
 
-/// The node fill written with intrinsics, here and in [`fill_avx2`]: auto-vectorisation of the
-/// portable version runs across nodes with gathers and scatters, or on AVX2 with four-lane
-/// shuffles (measured slower than the kernel itself). The same operations in the same order as
-/// [`fill_generic`]: the difference in f64 rounded to f32, then `(x² + y²) + z²` without fused
-/// products, so the lanes are bit-identical to it.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx2,fma")]
-fn fill_avx512<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
-    use std::arch::x86_64::*;
-    const { assert!(N.is_multiple_of(8)) };
-    let n = c.x.len();
-    if rec.len() < n {
-        rec.resize(n, [[0.0; N]; 4]);
-    }
-    // SAFETY: unaligned loads of 8 f64 at offsets h, h + 8 ≤ N of [f64; N] arrays, and stores
-    // of 8 f32 at the same offsets of [f32; N] arrays.
-    unsafe {
-        for h in (0..N).step_by(8) {
-            let vx = _mm512_loadu_pd(p[0].as_ptr().add(h));
-            let vy = _mm512_loadu_pd(p[1].as_ptr().add(h));
-            let vz = _mm512_loadu_pd(p[2].as_ptr().add(h));
-            let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
-                let dx = _mm512_cvtpd_ps(_mm512_sub_pd(vx, _mm512_set1_pd(x)));
-                let dy = _mm512_cvtpd_ps(_mm512_sub_pd(vy, _mm512_set1_pd(y)));
-                let dz = _mm512_cvtpd_ps(_mm512_sub_pd(vz, _mm512_set1_pd(z)));
-                let n2 =
-                    _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
-                _mm256_storeu_ps(r[0].as_mut_ptr().add(h), dx);
-                _mm256_storeu_ps(r[1].as_mut_ptr().add(h), dy);
-                _mm256_storeu_ps(r[2].as_mut_ptr().add(h), dz);
-                _mm256_storeu_ps(r[3].as_mut_ptr().add(h), _mm256_sqrt_ps(n2));
-            }
-        }
-    }
-}
-
-/// [`fill_avx512`] on AVX2: eight lanes a pass, each pass from two four-lane f64 differences.
+/// [`fill_generic`] written with intrinsics, eight lanes a pass, for AVX2 and AVX-512 alike:
+/// auto-vectorisation of the portable version runs across nodes with gathers and scatters, or
+/// with four-lane shuffles. The same operations in the same order, without fused products, so
+/// the lanes are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn fill_avx2<const N: usize>(c: &Filaments32, p: &[[f64; N]; 3], rec: &mut Vec<[[f32; N]; 4]>) {
+fn fill_x86<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut Vec<[[f32; N]; 4]>) {
     use std::arch::x86_64::*;
     const { assert!(N.is_multiple_of(8)) };
-    let n = c.x.len();
+    let n = c.nodes.len();
     if rec.len() < n {
         rec.resize(n, [[0.0; N]; 4]);
     }
-    // SAFETY: unaligned loads of 4 f64 at offsets h, h + 4 (h + 8 ≤ N) of [f64; N] arrays, and
-    // stores of 8 f32 at offset h of [f32; N] arrays.
+    // SAFETY: unaligned loads and stores of 8 f32 at offset h (h + 8 ≤ N) of [f32; N] arrays.
     unsafe {
         for h in (0..N).step_by(8) {
-            let lo = [
-                _mm256_loadu_pd(p[0].as_ptr().add(h)),
-                _mm256_loadu_pd(p[1].as_ptr().add(h)),
-                _mm256_loadu_pd(p[2].as_ptr().add(h)),
-            ];
-            let hi = [
-                _mm256_loadu_pd(p[0].as_ptr().add(h + 4)),
-                _mm256_loadu_pd(p[1].as_ptr().add(h + 4)),
-                _mm256_loadu_pd(p[2].as_ptr().add(h + 4)),
-            ];
-            let diff = |q: usize, x: f64| {
-                let x = _mm256_set1_pd(x);
-                _mm256_set_m128(_mm256_cvtpd_ps(_mm256_sub_pd(hi[q], x)), _mm256_cvtpd_ps(_mm256_sub_pd(lo[q], x)))
-            };
-            let (xs, ys, zs) = (&c.x[..n], &c.y[..n], &c.z[..n]);
-            for (((r, &x), &y), &z) in rec[..n].iter_mut().zip(xs).zip(ys).zip(zs) {
-                let (dx, dy, dz) = (diff(0, x), diff(1, y), diff(2, z));
+            let ph = p[0].each_ref().map(|q| _mm256_loadu_ps(q.as_ptr().add(h)));
+            let pl = p[1].each_ref().map(|q| _mm256_loadu_ps(q.as_ptr().add(h)));
+            for (r, x) in rec[..n].iter_mut().zip(&c.nodes) {
+                let d = |q: usize| {
+                    _mm256_add_ps(
+                        _mm256_sub_ps(ph[q], _mm256_set1_ps(x[q])),
+                        _mm256_sub_ps(pl[q], _mm256_set1_ps(x[q + 3])),
+                    )
+                };
+                let (dx, dy, dz) = (d(0), d(1), d(2));
                 let n2 =
                     _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
                 _mm256_storeu_ps(r[0].as_mut_ptr().add(h), dx);
@@ -360,8 +326,9 @@ fn add_lanes_on<const N: usize>(
     u: &mut [[f64; N]; 3],
 ) {
     let mut v = [[0.0; N]; 3];
-    // The points over ℓ, as the nodes.
-    let p = &p.map(|q| q.map(|x| x * c.inv_len));
+    // The points over ℓ, split as the nodes.
+    let sp = p.map(|q| q.map(|x| split(x * c.inv_len)));
+    let p = &[0, 1].map(|k| sp.map(|q| q.map(|x| x[k])));
     match isa {
         Isa::Generic => {
             fill_generic(c, p, &mut blk.r);
@@ -375,9 +342,9 @@ fn add_lanes_on<const N: usize>(
         Isa::Avx2 => unsafe {
             const { assert!(N.is_multiple_of(8)) };
             for h in (0..N).step_by(8) {
-                let p8 = p.each_ref().map(|q| std::array::from_fn::<f64, 8, _>(|l| q[h + l]));
+                let p8 = p.each_ref().map(|k| k.each_ref().map(|q| std::array::from_fn::<f32, 8, _>(|l| q[h + l])));
                 let mut v8 = [[0.0; 8]; 3];
-                fill_avx2(c, &p8, &mut blk.eight);
+                fill_x86(c, &p8, &mut blk.eight);
                 velocity_avx2::<8>(fil, c, &blk.eight, &mut v8);
                 for q in 0..3 {
                     v[q][h..h + 8].copy_from_slice(&v8[q]);
@@ -387,7 +354,7 @@ fn add_lanes_on<const N: usize>(
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
-            fill_avx512(c, p, &mut blk.r);
+            fill_x86(c, p, &mut blk.r);
             velocity_avx512(fil, c, &blk.r, &mut v);
         },
     }

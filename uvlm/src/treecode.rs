@@ -27,8 +27,10 @@
 //!
 //! A cluster is used at a block of points when `S(ρ/d)/(4π d²) ≤ ε / A_total` at the block's
 //! nearest point (ε the absolute tolerance, `A_total` the strength of all segments), so the
-//! errors of all the clusters used at a point add up to at most ε. Otherwise its children are
-//! visited, and a leaf is summed directly with the block kernels. The expansion is that of the
+//! errors of all the clusters used at a point add up to at most ε. It is then evaluated at the
+//! lowest order `q ≤ p` whose series `S` still passes that test: the order-`q` expansion is the
+//! order-`p` one truncated to its terms of degree `≤ q`, so the same bound holds with `q`.
+//! Otherwise its children are visited, and a leaf is summed directly with the block kernels. The expansion is that of the
 //! singular line vortex: a vortex core or cut-off changes a far segment's induction only where
 //! a point lies within the core radius of the segment's axis line, where the singular induction
 //! is itself of the order of the core radius.
@@ -761,15 +763,18 @@ impl Treecode {
                 d2min = d2min.min(d2);
             }
             let d = d2min.sqrt();
-            let accept = d > c.radius && {
-                let t = c.radius / d;
-                let s = t.powi(p + 1) * ((2 * p + 3) as f64 - (2 * p + 1) as f64 * t) / ((1.0 - t) * (1.0 - t));
-                s <= budget * d2min
-            };
-            if accept {
+            let t = c.radius / d;
+            let allowed = budget * d2min;
+            if d > c.radius && tail_bound(t, p) <= allowed {
+                // The lowest order whose bound still holds: its expansion is the order-p one
+                // truncated to `|k| ≤ q + 1` (`B_k` holds the moments of degree `|k| − 1`).
+                let mut q = p;
+                while q > 0 && tail_bound(t, q - 1) <= allowed {
+                    q -= 1;
+                }
                 let nt = self.taylor_idx.k.len();
                 let (ci, c) = (ci as usize, c.center);
-                let curl = &self.curl[ci * nt..(ci + 1) * nt];
+                let curl = &self.curl[ci * nt..ci * nt + n_coefficients(q as usize + 1)];
                 let (idx, rec, a) = (&self.taylor_idx, &self.rec[..], &mut sc.taylor[..]);
                 match isa() {
                     Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
@@ -799,6 +804,17 @@ impl Treecode {
         }
         pairs
     }
+}
+
+/// `S(t) = Σ_{n>p} (2n+1) tⁿ`, the error bound's series of the order-`p` expansion of a cluster
+/// of radius `t d` at distance `d` (module documentation), for `0 ≤ t < 1`.
+fn tail_bound(t: f64, p: i32) -> f64 {
+    t.powi(p + 1) * ((2 * p + 3) as f64 - (2 * p + 1) as f64 * t) / ((1.0 - t) * (1.0 - t))
+}
+
+/// Number of Taylor coefficients `a_k` with `|k| ≤ degree` ([`Indices`] lists them by degree).
+fn n_coefficients(degree: usize) -> usize {
+    (degree + 1) * (degree + 2) * (degree + 3) / 6
 }
 
 /// The points of block `b` of `order` (the last point repeated past the end).
@@ -869,7 +885,8 @@ fn expansion_lanes(
         inv_r2[l] = 1.0 / r2;
         a[0][l] = inv_r2[l].sqrt();
     }
-    for k in 1..idx.k.len() {
+    // The coefficients of `curl` only: those of degree ≤ q + 1, listed by degree.
+    for k in 1..curl.len() {
         let (c1, c2) = rec[k];
         let (d1, d2) = (idx.down1[k], idx.down2[k]);
         let mut acc1 = [0.0; LANES];

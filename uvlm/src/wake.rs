@@ -54,7 +54,10 @@ impl Wake {
     #[inline]
     fn phys(&self, r: usize) -> usize {
         debug_assert!(r < self.len);
-        (self.head + r) % self.capacity
+        // `head < capacity` and `r < len ≤ capacity`: one conditional subtraction, not the
+        // integer division of `%` (tens of cycles, on every node the Biot–Savart sets read).
+        let p = self.head + r;
+        if p >= self.capacity { p - self.capacity } else { p }
     }
 
     /// Downstream node `j` of ring row `r` (the detached node row `r`), m.
