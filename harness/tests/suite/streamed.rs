@@ -5,6 +5,7 @@
 //! moment leaves CSVs whose rows are whole and consecutive output steps from t = 0, and a
 //! `summary.json` that parses and is either complete or says `"interrupted"`. Concurrency test:
 //! pairs of identical runs started together into one output root leave whole, consistent folders.
+//! `harness all` interrupted during its gust sweeps exits 130 without beginning its other phases.
 //! The counts are small here; `HARNESS_KILLS=50 HARNESS_PAIRS=100 cargo test --release -p harness
 //! --test suite streamed -- --nocapture` runs the larger campaign and prints its figures.
 
@@ -197,5 +198,50 @@ fn variants_write_to_their_own_folders() {
     );
     let single = out.join("double_pendulum_c1_beta45__only-ancf__set_t_end=0.02");
     assert!(single.join("ancf.csv").exists() && !single.join("gebf.csv").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `harness all` stopped by SIGINT during its gust sweeps, which run first and alone: exit 130,
+/// the cases, sweeps and studies not begun, and nothing in the output folder (the sweep's
+/// results are written after the sweep, a run's folder by the lanes that never started).
+#[test]
+fn sigint_during_the_gust_sweeps_skips_the_lanes_and_writes_nothing() {
+    use std::io::{BufRead, BufReader};
+    let cases = tmp("all-sigint-cases");
+    std::fs::create_dir_all(&cases).unwrap();
+    std::fs::copy(root().join("cases/wing_gust.json"), cases.join("wing_gust.json")).unwrap();
+    let out = tmp("all-sigint-out");
+    let (c, o) = (cases.to_str().unwrap(), out.to_str().unwrap());
+    // Three gradients: 18 runs of a few CPU seconds each, far longer than the wait below.
+    let mut child = spawn(&["all", "--cases", c, "--out", o, "--set", "gust.gradients_m=[9,15,25]"]);
+    let stderr = child.stderr.take().unwrap();
+    let (started, began) = std::sync::mpsc::channel();
+    let log = std::thread::spawn(move || {
+        let mut log = String::new();
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            if line.contains("== gust sweep of wing_gust") {
+                let _ = started.send(());
+            }
+            log.push_str(&line);
+            log.push('\n');
+        }
+        log
+    });
+    let sweeping = began.recv_timeout(Duration::from_secs(300));
+    std::thread::sleep(Duration::from_millis(1500));
+    // SAFETY: signalling our own child by its id.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let st = child.wait().unwrap();
+    let log = log.join().unwrap();
+    assert!(sweeping.is_ok(), "the gust sweep did not start:\n{log}");
+    assert_eq!(st.code(), Some(130), "{log}");
+    assert!(log.contains("interrupted during the gust sweeps"), "{log}");
+    assert!(!log.contains("== cases"), "{log}");
+    let written: Vec<_> = match std::fs::read_dir(&out) {
+        Ok(d) => d.map(|e| e.unwrap().file_name()).collect(),
+        Err(_) => Vec::new(),
+    };
+    assert!(written.is_empty(), "{written:?}\n{log}");
+    let _ = std::fs::remove_dir_all(&cases);
     let _ = std::fs::remove_dir_all(&out);
 }
