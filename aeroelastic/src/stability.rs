@@ -230,9 +230,7 @@ impl Reduced {
             rhs.zip_apply(wr, |a, b| *a += e * (r * b));
             wake_g.zip_apply(wg, |a, b| *a += e * (r * r * b));
         }
-        let x = n
-            .lu()
-            .solve(&rhs)
+        let x = uvlm::solve_complex(&n, &rhs)
             .unwrap_or_else(|| DMatrix::from_element(rhs.nrows(), rhs.ncols(), C64::new(f64::NAN, 0.0)));
         self.m.map(|x| s * s * x)
             + (&self.c + &self.gv * r).map(|x| s * x)

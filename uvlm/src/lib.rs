@@ -144,6 +144,7 @@ mod wake_nodes;
 mod wake_tree;
 
 pub use biot_savart::{CoreModel, Filaments, segment_velocity, semi_infinite_velocity};
+pub use dense_lu::solve_complex;
 pub use error::{Result, UvlmError};
 pub use flap::{ColumnFlap, hinge_moment, hinge_row};
 pub use flow::{Flow, FlowField, Uniform};
