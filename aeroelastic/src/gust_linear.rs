@@ -597,7 +597,6 @@ fn transfer(
 ) -> Result<[C64; N_OUT], String> {
     let nb = p.rx.ncols();
     let (nr, nf) = (p.rx.nrows(), p.fx.nrows());
-    let nw = la.normalwash_matrix(s);
     // Wake nodes following the trailing edge: extra residual and forces per mode.
     let r_w = delayed_sum(s, &p.row_delays, &p.rw, nr, nb);
     let f_w = delayed_sum(s, &p.row_delays, &p.fw, nf, nb);
@@ -610,7 +609,8 @@ fn transfer(
         f_g += delayed_columns(s, &p.drift_delays, &p.drift_f);
     }
     rhs.set_column(nb, &r_g);
-    let x = uvlm::solve_complex(&nw, &rhs).ok_or("the linear UVLM's normalwash matrix is singular")?;
+    let x =
+        uvlm::solve_complex(&la.normalwash_matrix(s), &rhs).ok_or("the linear UVLM's normalwash matrix is singular")?;
     // Nodal forces of the circulations (δΓ = −N⁻¹ r) per η and per ŵ.
     let fgam = -(la.force_matrix(s) * &x);
     let f_eta_circ = fgam.columns(0, nb).into_owned();

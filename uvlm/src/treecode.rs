@@ -30,10 +30,10 @@
 //! errors of all the clusters used at a point add up to at most ε. It is then evaluated at the
 //! lowest order `q ≤ p` whose series `S` still passes that test: the order-`q` expansion is the
 //! order-`p` one truncated to its terms of degree `≤ q`, so the same bound holds with `q`.
-//! Otherwise its children are visited, and a leaf is summed directly with the block kernels. The expansion is that of the
-//! singular line vortex: a vortex core or cut-off changes a far segment's induction only where
-//! a point lies within the core radius of the segment's axis line, where the singular induction
-//! is itself of the order of the core radius.
+//! Otherwise its children are visited, and a leaf is summed directly with the block kernels.
+//! The expansion is that of the singular line vortex: a vortex core or cut-off changes a far
+//! segment's induction only where a point lies within the core radius of the segment's axis
+//! line, where the singular induction is itself of the order of the core radius.
 
 use crate::biot_savart::{Filaments, Isa, LANES, NodeBlock, fill_block, isa, velocity_block};
 use crate::induce::{Points, use_threads};
