@@ -18,6 +18,9 @@ fn wing(nc: usize, n_half: usize, ar: f64, spacing: SpanSpacing) -> (Lattice, Uv
     let lat = Lattice::from_stations(LatticeSpec::new(nc), &st).unwrap();
     let mut p = UvlmParams::new(1.0, [1.0, 0.0, 0.0]);
     p.images = vec![ImagePlane::through_origin([0.0, 1.0, 0.0])];
+    // The harness's default: the treecode (1e-6 |V∞|) once the far wake reaches its size.
+    p.wake_aggregation =
+        WakeAggregation { min_segments: WakeAggregation::AUTO_MIN_SEGMENTS, ..WakeAggregation::treecode() };
     (lat, p)
 }
 
