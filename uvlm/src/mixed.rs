@@ -23,6 +23,8 @@
 //! differs from f64's only for a point within about 1e-3 of the cut-off radius of a filament's
 //! cylinder surface. Measured against the f64 sum: uvlm/tests/suite/mixed.rs.
 
+use std::ops::Range;
+
 use crate::biot_savart::{Filaments, Isa, isa};
 use crate::induce::{Points, use_threads};
 use crate::params::Parallel;
@@ -49,6 +51,9 @@ pub(crate) struct Filaments32 {
     leg_g: Vec<f32>,
     leg_core2: Vec<f32>,
     leg_cut2: Vec<f32>,
+    /// For each run of [`FLUSH`] segments, one past the highest node index its segments and
+    /// those before it use: the nodes the fill must have reached before the run's kernel.
+    reach: Vec<u32>,
 }
 
 impl Filaments32 {
@@ -88,6 +93,12 @@ impl Filaments32 {
         self.leg_core2.extend(fil.leg_core2.iter().map(|&c| (c * s2) as f32));
         self.leg_cut2.clear();
         self.leg_cut2.extend(fil.leg_cut2.iter().map(|&c| (c * s2) as f32));
+        self.reach.clear();
+        let mut hi = 0;
+        for (a, b) in fil.seg_a[..ns].chunks(FLUSH).zip(fil.seg_b[..ns].chunks(FLUSH)) {
+            hi = a.iter().chain(b).fold(hi, |h, &i| h.max(i + 1));
+            self.reach.push(hi);
+        }
     }
 }
 
@@ -168,13 +179,14 @@ fn leg32(r: [f32; 3], rn: f32, d: [f32; 3], core2: f32, cut2: f32) -> ([f32; 3],
 
 /// The node fill, portable: `(P − X)/ℓ` lane by lane from the two halves of each ([`split`]),
 /// `(Pₕ − Xₕ) + (Pₗ − Xₗ)` in f32, and its norm from `(x² + y²) + z²`.
-fn fill_generic<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut Vec<[[f32; N]; 4]>) {
-    let n = c.nodes.len();
-    if rec.len() < n {
-        rec.resize(n, [[0.0; N]; 4]);
-    }
+fn fill_generic<const N: usize>(
+    c: &Filaments32,
+    p: &[[[f32; N]; 3]; 2],
+    rec: &mut [[[f32; N]; 4]],
+    nodes: Range<usize>,
+) {
     let [ph, pl] = p;
-    for (r, x) in rec[..n].iter_mut().zip(&c.nodes) {
+    for (r, x) in rec[nodes.clone()].iter_mut().zip(&c.nodes[nodes]) {
         for q in 0..3 {
             for l in 0..N {
                 r[q][l] = (ph[q][l] - x[q]) + (pl[q][l] - x[q + 3]);
@@ -190,11 +202,18 @@ fn fill_generic<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &m
 macro_rules! velocity32 {
     ($($attr:meta)?; $vel:ident) => {
         $(#[$attr])?
-        fn $vel<const N: usize>(fil: &Filaments, c: &Filaments32, rec: &[[[f32; N]; 4]], u: &mut [[f64; N]; 3]) {
-            let ns = fil.n_segments();
+        fn $vel<const N: usize>(
+            fil: &Filaments,
+            c: &Filaments32,
+            rec: &[[[f32; N]; 4]],
+            segs: Range<usize>,
+            legs: bool,
+            u: &mut [[f64; N]; 3],
+        ) {
+            let ns = segs.end;
             let (sa, sb) = (&fil.seg_a[..ns], &fil.seg_b[..ns]);
             let (sg, sc, st) = (&c.seg_g[..ns], &c.seg_core2[..ns], &c.seg_cut2[..ns]);
-            let mut s0 = 0;
+            let mut s0 = segs.start;
             while s0 < ns {
                 let s1 = (s0 + FLUSH).min(ns);
                 let mut ux = [0.0f32; N];
@@ -225,6 +244,9 @@ macro_rules! velocity32 {
                     u[2][l] += uz[l] as f64;
                 }
                 s0 = s1;
+            }
+            if !legs {
+                return;
             }
             let nl = fil.n_legs();
             let mut ux = [0.0f32; N];
@@ -262,19 +284,15 @@ velocity32!(target_feature(enable = "avx512f,avx2,fma"); velocity_avx512);
 /// the lanes are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn fill_x86<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut Vec<[[f32; N]; 4]>) {
+fn fill_x86<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut [[[f32; N]; 4]], nodes: Range<usize>) {
     use std::arch::x86_64::*;
     const { assert!(N.is_multiple_of(8)) };
-    let n = c.nodes.len();
-    if rec.len() < n {
-        rec.resize(n, [[0.0; N]; 4]);
-    }
     // SAFETY: unaligned loads and stores of 8 f32 at offset h (h + 8 ≤ N) of [f32; N] arrays.
     unsafe {
         for h in (0..N).step_by(8) {
             let ph = p[0].each_ref().map(|q| _mm256_loadu_ps(q.as_ptr().add(h)));
             let pl = p[1].each_ref().map(|q| _mm256_loadu_ps(q.as_ptr().add(h)));
-            for (r, x) in rec[..n].iter_mut().zip(&c.nodes) {
+            for (r, x) in rec[nodes.clone()].iter_mut().zip(&c.nodes[nodes.clone()]) {
                 let d = |q: usize| {
                     _mm256_add_ps(
                         _mm256_sub_ps(ph[q], _mm256_set1_ps(x[q])),
@@ -291,6 +309,75 @@ fn fill_x86<const N: usize>(c: &Filaments32, p: &[[[f32; N]; 3]; 2], rec: &mut V
             }
         }
     }
+}
+
+/// [`fill_x86`] sixteen lanes a pass, for AVX-512 and `N` a multiple of 16 (the same
+/// operations in the same order, so the lanes are bit-identical to [`fill_generic`]'s): half the
+/// instructions of eight-lane passes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn fill_x86_512<const N: usize>(
+    c: &Filaments32,
+    p: &[[[f32; N]; 3]; 2],
+    rec: &mut [[[f32; N]; 4]],
+    nodes: Range<usize>,
+) {
+    use std::arch::x86_64::*;
+    assert!(N.is_multiple_of(16), "fill_x86_512: {N} lanes");
+    // SAFETY: unaligned loads and stores of 16 f32 at offset h (h + 16 ≤ N) of [f32; N] arrays.
+    unsafe {
+        for h in (0..N).step_by(16) {
+            let ph = p[0].each_ref().map(|q| _mm512_loadu_ps(q.as_ptr().add(h)));
+            let pl = p[1].each_ref().map(|q| _mm512_loadu_ps(q.as_ptr().add(h)));
+            for (r, x) in rec[nodes.clone()].iter_mut().zip(&c.nodes[nodes.clone()]) {
+                let d = |q: usize| {
+                    _mm512_add_ps(
+                        _mm512_sub_ps(ph[q], _mm512_set1_ps(x[q])),
+                        _mm512_sub_ps(pl[q], _mm512_set1_ps(x[q + 3])),
+                    )
+                };
+                let (dx, dy, dz) = (d(0), d(1), d(2));
+                let n2 =
+                    _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+                _mm512_storeu_ps(r[0].as_mut_ptr().add(h), dx);
+                _mm512_storeu_ps(r[1].as_mut_ptr().add(h), dy);
+                _mm512_storeu_ps(r[2].as_mut_ptr().add(h), dz);
+                _mm512_storeu_ps(r[3].as_mut_ptr().add(h), _mm512_sqrt_ps(n2));
+            }
+        }
+    }
+}
+
+/// Run the node fill and the kernel alternately, [`FLUSH`] segments at a time: each run's kernel
+/// finds the nodes the fill just wrote in the core's first-level cache (a wake's segments
+/// follow its nodes row by row), where one fill of the whole set would have left them in the
+/// second level. The values and the order of the sums are those of one fill followed by one
+/// kernel pass.
+#[inline(always)]
+fn interleave<const N: usize>(
+    fil: &Filaments,
+    c: &Filaments32,
+    rec: &mut Vec<[[f32; N]; 4]>,
+    mut fill: impl FnMut(&mut [[[f32; N]; 4]], Range<usize>),
+    mut kernel: impl FnMut(&[[[f32; N]; 4]], Range<usize>, bool),
+) {
+    let n = c.nodes.len();
+    if rec.len() < n {
+        rec.resize(n, [[0.0; N]; 4]);
+    }
+    let (ns, mut filled) = (fil.n_segments(), 0);
+    for (k, &hi) in c.reach.iter().enumerate() {
+        let hi = hi as usize;
+        if hi > filled {
+            fill(rec, filled..hi);
+            filled = hi;
+        }
+        kernel(rec, k * FLUSH..((k + 1) * FLUSH).min(ns), false);
+    }
+    if filled < n {
+        fill(rec, filled..n);
+    }
+    kernel(rec, ns..ns, true);
 }
 
 /// The lanes of block `b` of `v` (the last point repeated past the end).
@@ -330,10 +417,13 @@ fn add_lanes_on<const N: usize>(
     let sp = p.map(|q| q.map(|x| split(x * c.inv_len)));
     let p = &[0, 1].map(|k| sp.map(|q| q.map(|x| x[k])));
     match isa {
-        Isa::Generic => {
-            fill_generic(c, p, &mut blk.r);
-            velocity_generic(fil, c, &blk.r, &mut v);
-        }
+        Isa::Generic => interleave(
+            fil,
+            c,
+            &mut blk.r,
+            |rec, nodes| fill_generic(c, p, rec, nodes),
+            |rec, segs, legs| velocity_generic(fil, c, rec, segs, legs, &mut v),
+        ),
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         // Eight points at a time: with AVX2's sixteen registers, sixteen lanes (two registers per
@@ -344,8 +434,13 @@ fn add_lanes_on<const N: usize>(
             for h in (0..N).step_by(8) {
                 let p8 = p.each_ref().map(|k| k.each_ref().map(|q| std::array::from_fn::<f32, 8, _>(|l| q[h + l])));
                 let mut v8 = [[0.0; 8]; 3];
-                fill_x86(c, &p8, &mut blk.eight);
-                velocity_avx2::<8>(fil, c, &blk.eight, &mut v8);
+                interleave(
+                    fil,
+                    c,
+                    &mut blk.eight,
+                    |rec, nodes| fill_x86(c, &p8, rec, nodes),
+                    |rec, segs, legs| velocity_avx2::<8>(fil, c, rec, segs, legs, &mut v8),
+                );
                 for q in 0..3 {
                     v[q][h..h + 8].copy_from_slice(&v8[q]);
                 }
@@ -354,8 +449,10 @@ fn add_lanes_on<const N: usize>(
         // SAFETY: the features were detected at run time.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
-            fill_x86(c, p, &mut blk.r);
-            velocity_avx512(fil, c, &blk.r, &mut v);
+            let fill = |rec: &mut [[[f32; N]; 4]], nodes| {
+                if N.is_multiple_of(16) { fill_x86_512(c, p, rec, nodes) } else { fill_x86(c, p, rec, nodes) }
+            };
+            interleave(fil, c, &mut blk.r, fill, |rec, segs, legs| velocity_avx512(fil, c, rec, segs, legs, &mut v));
         },
     }
     // (P − X)/ℓ gives the velocity times ℓ.
