@@ -1,8 +1,8 @@
 //! The generalized-α stepper (Arnold–Brüls or Chung–Hulbert form, with scaled constraint rows).
 
 use crate::{
-    Assembled, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Error, Form, IntegratorParams, IterationRecord,
-    LinearSolver, MatView, Predictor, Stats, StepStats,
+    Assembled, AssemblyTarget, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Entries, Error, Form,
+    IntegratorParams, IterationRecord, LinearSolver, MatView, Predictor, Stats, StepStats,
 };
 
 /// The integrator's state at one instant.
@@ -91,6 +91,8 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     hdelta_alpha: Vec<f64>,
     v_n: Vec<f64>,
     have_factorization: bool,
+    /// Matrices assembled densely ([`GenAlpha::dense_assemblies`]).
+    n_dense_assemblies: usize,
     /// The last assembly went to the solver's storage.
     assembled_direct: bool,
     /// Steps left during which the factorisation is refreshed at each step's predictor, because
@@ -214,6 +216,58 @@ fn eval_b<S: ConstrainedSystem + ?Sized>(sys: &S, t: f64, q: &[f64], b: &mut Den
     nz_cols.extend((0..n).filter(|&j| data[j * n_v..(j + 1) * n_v].iter().fold(false, |a, x| a | (*x != 0.0))));
 }
 
+/// The constraint Jacobians at the start (one Φ_q and B for both sides: the weighted state is
+/// the state itself), for assembling the initial mass system.
+struct MassBorder<'a> {
+    n: usize,
+    n_h: usize,
+    n_v: usize,
+    phi_q: &'a DenseMatrix,
+    phi_q_cols: &'a [usize],
+    b: &'a DenseMatrix,
+    b_cols: &'a [usize],
+}
+
+impl<'a> MassBorder<'a> {
+    fn of<L: LinearSolver>(g: &'a GenAlpha<L>) -> Self {
+        MassBorder {
+            n: g.n,
+            n_h: g.n_h,
+            n_v: g.n_v,
+            phi_q: &g.phi_q,
+            phi_q_cols: &g.phi_q_cols,
+            b: &g.b_mat,
+            b_cols: &g.b_nz_cols,
+        }
+    }
+
+    /// `[M Φ_qᵀ Bᵀ; Φ_q 0 0; B 0 0]` at `s` into `target` (cleared first).
+    fn assemble<S: ConstrainedSystem + ?Sized>(&self, sys: &S, s: &State, target: &mut dyn AssemblyTarget) {
+        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
+        target.clear();
+        {
+            let mut k = MatView::direct(&mut *target, 0, 0, n, n);
+            sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut k);
+        }
+        for &j in self.phi_q_cols {
+            for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
+                let x = self.phi_q.get(i, j);
+                target.add(n + i, j, x);
+                target.add(j, n + i, x);
+            }
+        }
+        if n_v > 0 {
+            for &j in self.b_cols {
+                let col = &self.b.as_slice()[j * n_v..(j + 1) * n_v];
+                for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+                    target.add(n + n_h + i, j, x);
+                    target.add(j, n + n_h + i, x);
+                }
+            }
+        }
+    }
+}
+
 /// One unknown's weighted increment against its tolerance, `|Δx w| / (atol + rtol |h δ w|)`.
 #[inline]
 fn increment_ratio(dx: f64, w: f64, hdelta: f64, atol: f64, rtol: f64) -> f64 {
@@ -306,6 +360,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             hdelta_alpha: vec![0.0; n_w],
             v_n: vec![0.0; n_w],
             have_factorization: false,
+            n_dense_assemblies: 0,
             assembled_direct: false,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
@@ -439,8 +494,9 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// Allocate the dense matrix at its first use (zero, as the constraint blocks' bookkeeping
-    /// assumes).
+    /// assumes), before a dense assembly.
     fn ensure_dense(&mut self) {
+        self.n_dense_assemblies += 1;
         if self.matrix.n_rows() != self.n_all {
             self.matrix = DenseMatrix::zeros(self.n_all, self.n_all);
         }
@@ -452,6 +508,12 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.matrix = DenseMatrix::zeros(0, 0);
             self.b_cols_written.iter_mut().for_each(|w| *w = false);
         }
+    }
+
+    /// How many matrices (the start's included) have been assembled into the dense
+    /// `n_all × n_all` matrix: a solver without its own storage, or a fallback.
+    pub fn dense_assemblies(&self) -> usize {
+        self.n_dense_assemblies
     }
 
     /// Whether the dense `n_all × n_all` matrix has been allocated (it is only on a dense
@@ -510,7 +572,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             self.q_alpha.copy_from_slice(&s.q);
         }
         self.update_jacobians(sys, s.t, &s.q, true);
-        if !self.factorize_mass_direct(sys, s)? {
+        if !self.factorize_mass_direct(sys, s)? && !self.factorize_mass_entries(sys, s)? {
             self.ensure_dense();
             self.matrix.fill_zero();
             sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut self.matrix.block(0, 0, n, n));
@@ -556,34 +618,25 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// solver's own storage and factorised there; false when the solver has no such storage or
     /// asks for the dense path.
     fn factorize_mass_direct<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &State) -> Result<bool, Error> {
-        let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
-        let Some(target) = self.solver.assembly_target() else { return Ok(false) };
-        target.clear();
-        {
-            let mut k = MatView::direct(&mut *target, 0, 0, n, n);
-            sys.iteration_matrix_inplace(s.t, &s.q, &s.v, &s.v_dot, 1.0, 0.0, 0.0, &mut k);
-        }
-        // At the start the weighted state is the state itself: one Φ_q and B for both sides.
-        for &j in &self.phi_q_cols {
-            for i in (0..n_h).filter(|&i| self.phi_q.get(i, j) != 0.0) {
-                let x = self.phi_q.get(i, j);
-                target.add(n + i, j, x);
-                target.add(j, n + i, x);
-            }
-        }
-        if n_v > 0 {
-            for &j in &self.b_nz_cols {
-                let col = &self.b_mat.as_slice()[j * n_v..(j + 1) * n_v];
-                for (i, &x) in col.iter().enumerate().filter(|(_, x)| **x != 0.0) {
-                    target.add(n + n_h + i, j, x);
-                    target.add(j, n + n_h + i, x);
-                }
-            }
-        }
+        let Self { solver, n, n_h, n_v, phi_q, phi_q_cols, b_mat, b_nz_cols, .. } = self;
+        let jac = MassBorder { n: *n, n_h: *n_h, n_v: *n_v, phi_q, phi_q_cols, b: b_mat, b_cols: b_nz_cols };
+        let Some(target) = solver.assembly_target() else { return Ok(false) };
+        jac.assemble(sys, s, target);
         match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })? {
             Assembled::Factorized => Ok(true),
             Assembled::UseDense => Ok(false),
         }
+    }
+
+    /// The same matrix as [`factorize_mass_direct`](Self::factorize_mass_direct) assembled as
+    /// entries and factorised by the solver's sparse LU with pivoting (when it has one): the
+    /// fallback when the structured factorisation meets a tiny pivot, in memory proportional to
+    /// the non-zeros. A floating frame's rotation is one: with the mass alone the nodes can
+    /// follow it, so its Schur complement is only the share of the clamped nodes (docs/genalpha.md).
+    fn factorize_mass_entries<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &State) -> Result<bool, Error> {
+        let mut entries = Entries::new(self.n_all);
+        MassBorder::of(self).assemble(sys, s, &mut entries);
+        self.solver.factorize_entries(&entries).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })
     }
 
     /// Advance `s` by one step `dt`. If Newton fails, the step is retried as two half steps

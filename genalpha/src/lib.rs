@@ -56,7 +56,7 @@ mod system;
 pub use banded::BandedBorder;
 pub use error::Error;
 pub use integrator::{GenAlpha, State};
-pub use linear_solver::{Assembled, DENSE_FALLBACK_MAX, DenseLu, LinearSolver};
+pub use linear_solver::{Assembled, DENSE_FALLBACK_MAX, DenseLu, Entries, LinearSolver};
 pub use matrix::{AssemblyTarget, DenseMatrix, MatView};
 pub use params::{Coefficients, Form, IntegratorParams, NewtonParams, Predictor};
 pub use stats::{IterationRecord, Stats, StepStats};

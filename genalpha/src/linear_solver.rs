@@ -33,6 +33,61 @@ pub trait LinearSolver {
     fn factorize_assembled(&mut self) -> Result<Assembled, usize> {
         Ok(Assembled::UseDense)
     }
+    /// Factorise the matrix held as entries (with pivoting, in memory proportional to its
+    /// non-zeros): the fallback of a structured factorisation that met a tiny pivot, without
+    /// an `n × n` matrix. Returns false when the solver has no such factorisation (then the
+    /// integrator assembles the matrix densely). Default: false.
+    fn factorize_entries(&mut self, _entries: &Entries) -> Result<bool, usize> {
+        Ok(false)
+    }
+}
+
+/// A square matrix as a list of entries (row, column, value; repeated positions add up), filled
+/// through [`AssemblyTarget`]: the assembly of a fallback factorisation without `n²` storage.
+#[derive(Debug, Clone, Default)]
+pub struct Entries {
+    n: usize,
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    vals: Vec<f64>,
+}
+
+impl Entries {
+    /// An empty `n × n` matrix.
+    pub fn new(n: usize) -> Self {
+        Self { n, ..Self::default() }
+    }
+    /// Its dimension.
+    pub fn dimension(&self) -> usize {
+        self.n
+    }
+    /// The number of entries held (repeated positions counted each time).
+    pub fn len(&self) -> usize {
+        self.vals.len()
+    }
+    /// True when no entry is held.
+    pub fn is_empty(&self) -> bool {
+        self.vals.is_empty()
+    }
+}
+
+impl AssemblyTarget for Entries {
+    fn clear(&mut self) {
+        self.rows.clear();
+        self.cols.clear();
+        self.vals.clear();
+    }
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        debug_assert!(i < self.n && j < self.n, "Entries::add: ({i}, {j}) outside {0} × {0}", self.n);
+        if v != 0.0 {
+            self.rows.push(i);
+            self.cols.push(j);
+            self.vals.push(v);
+        }
+    }
+    fn get(&self, i: usize, j: usize) -> f64 {
+        (0..self.vals.len()).filter(|&k| self.rows[k] == i && self.cols[k] == j).map(|k| self.vals[k]).sum()
+    }
 }
 
 /// Outcome of [`LinearSolver::factorize_assembled`].
@@ -127,8 +182,7 @@ impl Default for DenseLu {
 impl DenseLu {
     /// faer's sparse LU of the non-zeros of `a`; `Err(row)` when it is singular.
     fn factorize_sparse(&mut self, a: &DenseMatrix) -> Result<(), usize> {
-        use faer::sparse::linalg::LuError;
-        use faer::sparse::{SparseColMat, Triplet};
+        use faer::sparse::Triplet;
         let n = self.n;
         let data = a.as_slice();
         let mut entries = Vec::new();
@@ -139,7 +193,15 @@ impl DenseLu {
                 }
             }
         }
-        let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &entries).map_err(|_| 0_usize)?;
+        self.factorize_triplets(&entries)
+    }
+
+    /// faer's sparse LU of the `n × n` matrix with these entries (repeated positions add up).
+    fn factorize_triplets(&mut self, entries: &[faer::sparse::Triplet<usize, usize, f64>]) -> Result<(), usize> {
+        use faer::sparse::SparseColMat;
+        use faer::sparse::linalg::LuError;
+        let n = self.n;
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, entries).map_err(|_| 0_usize)?;
         match m.sp_lu() {
             Ok(lu) => {
                 self.sparse = Some(lu);
@@ -245,6 +307,20 @@ impl LinearSolver for DenseLu {
             self.sparse = None;
         }
         Ok(Assembled::Factorized)
+    }
+
+    fn factorize_entries(&mut self, entries: &Entries) -> Result<bool, usize> {
+        use faer::sparse::Triplet;
+        assert!(entries.n == self.n, "factorize_entries: dimension mismatch");
+        self.use_structured = false;
+        self.sparse = None;
+        // A dense fallback's storage is not kept beside the sparse factors.
+        self.lu = Mat::zeros(0, 0);
+        let triplets: Vec<_> = (0..entries.len())
+            .map(|k| Triplet { row: entries.rows[k], col: entries.cols[k], val: entries.vals[k] })
+            .collect();
+        self.factorize_triplets(&triplets)?;
+        Ok(true)
     }
 
     fn solve_in_place(&mut self, b: &mut [f64]) {
