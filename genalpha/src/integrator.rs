@@ -228,19 +228,7 @@ struct MassBorder<'a> {
     b_cols: &'a [usize],
 }
 
-impl<'a> MassBorder<'a> {
-    fn of<L: LinearSolver>(g: &'a GenAlpha<L>) -> Self {
-        MassBorder {
-            n: g.n,
-            n_h: g.n_h,
-            n_v: g.n_v,
-            phi_q: &g.phi_q,
-            phi_q_cols: &g.phi_q_cols,
-            b: &g.b_mat,
-            b_cols: &g.b_nz_cols,
-        }
-    }
-
+impl MassBorder<'_> {
     /// `[M Φ_qᵀ Bᵀ; Φ_q 0 0; B 0 0]` at `s` into `target` (cleared first).
     fn assemble<S: ConstrainedSystem + ?Sized>(&self, sys: &S, s: &State, target: &mut dyn AssemblyTarget) {
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
@@ -618,8 +606,7 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// solver's own storage and factorised there; false when the solver has no such storage or
     /// asks for the dense path.
     fn factorize_mass_direct<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &State) -> Result<bool, Error> {
-        let Self { solver, n, n_h, n_v, phi_q, phi_q_cols, b_mat, b_nz_cols, .. } = self;
-        let jac = MassBorder { n: *n, n_h: *n_h, n_v: *n_v, phi_q, phi_q_cols, b: b_mat, b_cols: b_nz_cols };
+        let (jac, solver) = self.mass_border();
         let Some(target) = solver.assembly_target() else { return Ok(false) };
         jac.assemble(sys, s, target);
         match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })? {
@@ -632,11 +619,20 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// entries and factorised by the solver's sparse LU with pivoting (when it has one): the
     /// fallback when the structured factorisation meets a tiny pivot, in memory proportional to
     /// the non-zeros. A floating frame's rotation is one: with the mass alone the nodes can
-    /// follow it, so its Schur complement is only the share of the clamped nodes (docs/genalpha.md).
+    /// follow it, so its Schur complement is only the share of the clamped nodes
+    /// (docs/integrator.md §8.1).
     fn factorize_mass_entries<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, s: &State) -> Result<bool, Error> {
         let mut entries = Entries::new(self.n_all);
-        MassBorder::of(self).assemble(sys, s, &mut entries);
-        self.solver.factorize_entries(&entries).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })
+        let (jac, solver) = self.mass_border();
+        jac.assemble(sys, s, &mut entries);
+        solver.factorize_entries(&entries).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })
+    }
+
+    /// The start's constraint Jacobians beside the solver (borrowed apart, so that the matrix
+    /// can be assembled into the solver's own storage).
+    fn mass_border(&mut self) -> (MassBorder<'_>, &mut L) {
+        let Self { solver, n, n_h, n_v, phi_q, phi_q_cols, b_mat, b_nz_cols, .. } = self;
+        (MassBorder { n: *n, n_h: *n_h, n_v: *n_v, phi_q, phi_q_cols, b: b_mat, b_cols: b_nz_cols }, solver)
     }
 
     /// Advance `s` by one step `dt`. If Newton fails, the step is retried as two half steps

@@ -47,46 +47,36 @@ pub trait LinearSolver {
 #[derive(Debug, Clone, Default)]
 pub struct Entries {
     n: usize,
-    rows: Vec<usize>,
-    cols: Vec<usize>,
-    vals: Vec<f64>,
+    triplets: Vec<faer::sparse::Triplet<usize, usize, f64>>,
 }
 
 impl Entries {
     /// An empty `n × n` matrix.
     pub fn new(n: usize) -> Self {
-        Self { n, ..Self::default() }
-    }
-    /// Its dimension.
-    pub fn dimension(&self) -> usize {
-        self.n
+        Self { n, triplets: Vec::new() }
     }
     /// The number of entries held (repeated positions counted each time).
     pub fn len(&self) -> usize {
-        self.vals.len()
+        self.triplets.len()
     }
     /// True when no entry is held.
     pub fn is_empty(&self) -> bool {
-        self.vals.is_empty()
+        self.triplets.is_empty()
     }
 }
 
 impl AssemblyTarget for Entries {
     fn clear(&mut self) {
-        self.rows.clear();
-        self.cols.clear();
-        self.vals.clear();
+        self.triplets.clear();
     }
     fn add(&mut self, i: usize, j: usize, v: f64) {
         debug_assert!(i < self.n && j < self.n, "Entries::add: ({i}, {j}) outside {0} × {0}", self.n);
         if v != 0.0 {
-            self.rows.push(i);
-            self.cols.push(j);
-            self.vals.push(v);
+            self.triplets.push(faer::sparse::Triplet { row: i, col: j, val: v });
         }
     }
     fn get(&self, i: usize, j: usize) -> f64 {
-        (0..self.vals.len()).filter(|&k| self.rows[k] == i && self.cols[k] == j).map(|k| self.vals[k]).sum()
+        self.triplets.iter().filter(|t| t.row == i && t.col == j).map(|t| t.val).sum()
     }
 }
 
@@ -310,16 +300,12 @@ impl LinearSolver for DenseLu {
     }
 
     fn factorize_entries(&mut self, entries: &Entries) -> Result<bool, usize> {
-        use faer::sparse::Triplet;
         assert!(entries.n == self.n, "factorize_entries: dimension mismatch");
         self.use_structured = false;
         self.sparse = None;
         // A dense fallback's storage is not kept beside the sparse factors.
         self.lu = Mat::zeros(0, 0);
-        let triplets: Vec<_> = (0..entries.len())
-            .map(|k| Triplet { row: entries.rows[k], col: entries.cols[k], val: entries.vals[k] })
-            .collect();
-        self.factorize_triplets(&triplets)?;
+        self.factorize_triplets(&entries.triplets)?;
         Ok(true)
     }
 
