@@ -18,7 +18,7 @@
 //! (its length, never `n²`); the dense fallback's `n × n` storage only if it is used. After the
 //! first factorisation of a given profile, factorising and solving do not allocate.
 
-use genalpha::{Assembled, AssemblyTarget, DenseLu, DenseMatrix, LinearSolver};
+use genalpha::{Assembled, AssemblyTarget, DenseLu, DenseMatrix, Entries, LinearSolver};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -964,6 +964,16 @@ impl LinearSolver for SkylineLu {
 
     fn assembly_target(&mut self) -> Option<&mut dyn AssemblyTarget> {
         if self.direct_ok { Some(self) } else { None }
+    }
+
+    /// The fallback's sparse LU with pivoting (large matrices the skyline cannot take).
+    fn factorize_entries(&mut self, entries: &Entries) -> Result<bool, usize> {
+        let done = self.dense.factorize_entries(entries)?;
+        if done {
+            self.use_dense = true;
+            self.n_dense += 1;
+        }
+        Ok(done)
     }
 
     fn factorize_assembled(&mut self) -> Result<Assembled, usize> {

@@ -3,12 +3,14 @@
 //!
 //! The estimate counts what grows with the input: the unknowns `n` of each formulation (ANCF:
 //! 12 per node plus at most 12 constraint rows per joint; GEBF: 12 per element plus 6 per body
-//! and at most 6 rows per joint), the integrator's dense iteration matrix (`8 n²` bytes) and the
-//! dense fallback LU where one is allowed ([`genalpha::DENSE_FALLBACK_MAX`]), the band storage,
+//! and at most 6 rows per joint), the fallback factorisation of a matrix the band storage cannot
+//! take (up to [`genalpha::DENSE_FALLBACK_MAX`] unknowns a dense matrix and
+//! its LU, `16 n²` bytes; above it a sparse LU, `n²` bytes), the band storage,
 //! the Broyden history (`n × (max_iter + 1)`), the recorded rows, and with aerodynamics the
 //! influence matrix and its LU (`2 × 8 N_b²` for `N_b` bound rings) and the wake. The time is
-//! a per-step cost (a few Newton iterations over a band, the influence matrix, its LU and the
-//! wake's induced velocities) times the steps, with the coupling sub-iterations.
+//! a per-step cost (a few Newton iterations over a band, linear in `n`, the influence matrix, its
+//! LU and the wake's induced velocities) times the steps, with the coupling sub-iterations, plus
+//! a sparse consistent start.
 //! Constants are deliberately generous: the estimate refuses what cannot fit, it does not
 //! predict a run's wall time.
 //!
@@ -148,8 +150,7 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
     }
     let every = case.output_dt.map_or(1.0, |o| (o / dt).round().max(1.0));
     let rows = steps / every + 2.0;
-    let dense_lu = if n <= genalpha::DENSE_FALLBACK_MAX as f64 { 1.0 } else { 0.0 };
-    let structure_bytes = 8.0 * n * n * (1.0 + dense_lu)
+    let structure_bytes = fallback_bytes(n)
         + 8.0 * n * 600.0
         + 8.0 * n * (newton.max_iter as f64 + 1.0)
         + rows * std::mem::size_of::<Row>() as f64;
@@ -162,12 +163,15 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
         aero_step = 2e-8 * bound * bound + 1e-9 * bound * bound * bound / 3.0 + 3e-8 * bound * wake;
         sub = 1.0 + a.coupling.max_sub_iterations as f64;
     }
-    // A band solve per Newton iteration, plus the dense iteration matrix the integrator clears
-    // and scans (n² per iteration; measured: 3 steps of a 14,500-unknown ANCF wing take 15 s);
-    // the consistent start costs about two steps more.
-    let structure_step = 5.0 * (2e-6 * n + 4e-9 * n * n);
-    let seconds = (steps + 2.0) * sub * (structure_step + aero_step);
-    let structure_seconds = (steps + 2.0) * sub * structure_step;
+    // A band solve and the element loops per Newton iteration, linear in n (measured on the
+    // paper's pendulum with 1,000 and 2,000 elements per body: ANCF 1.3e-6 n s a step, GEBF
+    // 0.6e-6 n). The consistent start costs about two steps more, and GEBF's sparse LU of its
+    // start, whose fill grows as n², in time as n³ (1.7 s at 48,000 unknowns, 15 s at 96,000:
+    // 1.7e-14 n³ s).
+    let structure_step = 5.0 * 2e-6 * n;
+    let start = 4e-14 * n * n * n;
+    let seconds = start + (steps + 2.0) * sub * (structure_step + aero_step);
+    let structure_seconds = start + (steps + 2.0) * sub * structure_step;
     Estimate {
         unknowns: n,
         steps,
@@ -179,6 +183,16 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
         aero_bytes,
         structure_seconds,
     }
+}
+
+/// Bytes of the fallback factorisation of an `n`-unknown matrix that the band storage cannot
+/// take (a tiny band pivot, or an entry outside the declared structure; GEBF's consistent start
+/// with a floating frame): up to [`genalpha::DENSE_FALLBACK_MAX`] unknowns the dense matrix and
+/// its LU (`2 × 8 n²`), above it entries and faer's sparse LU, whose fill is counted as `n²`
+/// bytes (measured: GEBF's pendulum start 0.45–0.5 n² at 24,000 to 96,000 unknowns, ANCF's
+/// none).
+fn fallback_bytes(n: f64) -> f64 {
+    if n <= genalpha::DENSE_FALLBACK_MAX as f64 { 16.0 * n * n } else { n * n }
 }
 
 fn gb(x: f64) -> String {
@@ -224,7 +238,7 @@ pub fn check_formulations(
         if e.bytes > lim.memory_bytes {
             let field = if e.aero_bytes > e.structure_bytes {
                 "aero.panels_per_body / aero.n_chordwise / aero.n_wake_rows".to_string()
-            } else if 8.0 * e.unknowns * e.unknowns > 0.5 * e.structure_bytes {
+            } else if fallback_bytes(e.unknowns) > 0.5 * e.structure_bytes {
                 format!("{f}.elements_per_body")
             } else {
                 format!("t_end / {f}.dt / output_dt ({:.3e} steps)", e.steps)

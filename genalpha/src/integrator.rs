@@ -1,9 +1,20 @@
 //! The generalized-α stepper (Arnold–Brüls or Chung–Hulbert form, with scaled constraint rows).
 
 use crate::{
-    Assembled, AssemblyTarget, Coefficients, ConstrainedSystem, DenseLu, DenseMatrix, Entries, Error, Form,
-    IntegratorParams, IterationRecord, LinearSolver, MatView, Predictor, Stats, StepStats,
+    Assembled, AssemblyTarget, Coefficients, ConstrainedSystem, DENSE_FALLBACK_MAX, DenseLu, DenseMatrix, Entries,
+    Error, Form, IntegratorParams, IterationRecord, LinearSolver, MatView, Predictor, Stats, StepStats,
 };
+
+/// Where [`GenAlpha::assemble_with_residual`] puts the iteration matrix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum AssembleInto {
+    /// The solver's own storage, when it offers one (else the dense matrix).
+    Solver,
+    /// A list of entries, for the solver's sparse fallback.
+    Entries,
+    /// The dense `n_all × n_all` matrix.
+    Dense,
+}
 
 /// The integrator's state at one instant.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,8 +104,13 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     have_factorization: bool,
     /// Matrices assembled densely ([`GenAlpha::dense_assemblies`]).
     n_dense_assemblies: usize,
-    /// The last assembly went to the solver's storage.
-    assembled_direct: bool,
+    /// Where the last iteration matrix was assembled.
+    assembled: AssembleInto,
+    /// The iteration matrix as entries, for the sparse fallback above [`DENSE_FALLBACK_MAX`].
+    fallback_entries: Entries,
+    /// Iteration matrices handed to the solver's sparse fallback as entries
+    /// ([`GenAlpha::sparse_fallbacks`]).
+    n_sparse_fallbacks: usize,
     /// Steps left during which the factorisation is refreshed at each step's predictor, because
     /// a factorisation reused from an earlier step recently failed to contract.
     refresh_steps_left: usize,
@@ -349,7 +365,9 @@ impl<L: LinearSolver> GenAlpha<L> {
             v_n: vec![0.0; n_w],
             have_factorization: false,
             n_dense_assemblies: 0,
-            assembled_direct: false,
+            assembled: AssembleInto::Dense,
+            fallback_entries: Entries::default(),
+            n_sparse_fallbacks: 0,
             refresh_steps_left: 0,
             rhs: vec![0.0; n_all],
             r: vec![0.0; n],
@@ -502,6 +520,13 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// `n_all × n_all` matrix: a solver without its own storage, or a fallback.
     pub fn dense_assemblies(&self) -> usize {
         self.n_dense_assemblies
+    }
+
+    /// How many iteration matrices went to the solver's sparse LU as entries: the fallback,
+    /// above [`DENSE_FALLBACK_MAX`] unknowns, when the solver's structured storage cannot take a
+    /// matrix (no `n²` storage is allocated for it).
+    pub fn sparse_fallbacks(&self) -> usize {
+        self.n_sparse_fallbacks
     }
 
     /// Whether the dense `n_all × n_all` matrix has been allocated (it is only on a dense
@@ -936,7 +961,7 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
         self.update_jacobians(sys, t1, &s.q, need);
         if need {
-            self.assemble_with_residual(sys, t1, s, true);
+            self.assemble_with_residual(sys, t1, s, AssembleInto::Solver);
         } else if weighted {
             sys.residual_inplace(self.t_alpha, &self.q_alpha, &self.v_alpha, &s.v_dot, &mut self.r);
         } else {
@@ -1132,7 +1157,13 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// there into `self.r` (without constraint forces): into the solver's own storage when
     /// `direct` is allowed and the solver offers one ([`LinearSolver::assembly_target`]), else into
     /// the dense matrix.
-    fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(&mut self, sys: &S, t1: f64, s: &State, direct: bool) {
+    fn assemble_with_residual<S: ConstrainedSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t1: f64,
+        s: &State,
+        into: AssembleInto,
+    ) {
         let c = self.c;
         let (n, n_h, n_v) = (self.n, self.n_h, self.n_v);
         let (c_m, c_c, c_k) = (1.0, c.gamma_prime / c.beta_prime, 1.0 / c.beta_prime);
@@ -1144,7 +1175,20 @@ impl<L: LinearSolver> GenAlpha<L> {
         } else {
             (&self.phi_q, &self.phi_q_cols, &self.b_mat, &self.b_nz_cols)
         };
-        if direct && let Some(target) = self.solver.assembly_target() {
+        // A solver without storage of its own takes the dense matrix, or entries above the
+        // dense fallback's size.
+        let into = match into {
+            AssembleInto::Solver if self.solver.assembly_target().is_none() => self.fallback_form(),
+            into => into,
+        };
+        self.assembled = into;
+        let mut entries = (into == AssembleInto::Entries).then(|| Entries::new(self.n_all));
+        let target: Option<&mut dyn AssemblyTarget> = match (&mut entries, into) {
+            (Some(e), _) => Some(e),
+            (None, AssembleInto::Solver) => self.solver.assembly_target(),
+            _ => None,
+        };
+        if let Some(target) = target {
             target.clear();
             {
                 let mut k = MatView::direct(&mut *target, 0, 0, n, n);
@@ -1192,10 +1236,12 @@ impl<L: LinearSolver> GenAlpha<L> {
                     }
                 }
             }
-            self.assembled_direct = true;
+            if let Some(e) = entries {
+                self.fallback_entries = e;
+            }
             return;
         }
-        self.assembled_direct = false;
+        self.assembled = AssembleInto::Dense;
         self.ensure_dense();
         self.clear_added_blocks();
         let (t_f, q_f, v_f) =
@@ -1214,28 +1260,48 @@ impl<L: LinearSolver> GenAlpha<L> {
 
     /// Factorise the matrix of the last [`assemble_with_residual`](Self::assemble_with_residual).
     /// When the solver's own storage asks for the dense path, the same matrix is assembled
-    /// densely (the residual is recomputed with the same values, and the constraint forces added
+    /// again (the residual is recomputed with the same values, and the constraint forces added
     /// to it again) and factorised (a solver whose storage met an entry outside its structure
-    /// stops offering it).
+    /// stops offering it): densely, or above [`DENSE_FALLBACK_MAX`] unknowns as entries for the
+    /// solver's sparse LU with pivoting (densely only for a solver without one).
     fn factorize_iteration_matrix<S: ConstrainedSystem + ?Sized>(
         &mut self,
         sys: &S,
         t1: f64,
         s: &State,
     ) -> Result<(), Error> {
-        if self.assembled_direct {
-            match self.solver.factorize_assembled().map_err(|pivot| Error::SingularMatrix { t: t1, pivot })? {
+        let singular = |pivot| Error::SingularMatrix { t: t1, pivot };
+        if self.assembled == AssembleInto::Solver {
+            match self.solver.factorize_assembled().map_err(singular)? {
                 Assembled::Factorized => return Ok(()),
                 Assembled::UseDense => {
                     // The storage met an entry outside the declared structure (or could not
                     // factorise). The residual is recomputed on the way: add the constraint
                     // forces again.
-                    self.assemble_with_residual(sys, t1, s, false);
+                    let into = self.fallback_form();
+                    self.assemble_with_residual(sys, t1, s, into);
                     self.add_constraint_forces(&s.lambda, &s.mu);
                 }
             }
         }
-        self.solver.factorize(&self.matrix).map_err(|pivot| Error::SingularMatrix { t: t1, pivot })
+        if self.assembled == AssembleInto::Entries {
+            let entries = std::mem::take(&mut self.fallback_entries);
+            self.n_sparse_fallbacks += 1;
+            if self.solver.factorize_entries(&entries).map_err(singular)? {
+                return Ok(());
+            }
+            // A solver without a sparse LU: the dense matrix after all.
+            self.assemble_with_residual(sys, t1, s, AssembleInto::Dense);
+            self.add_constraint_forces(&s.lambda, &s.mu);
+        }
+        self.solver.factorize(&self.matrix).map_err(singular)
+    }
+
+    /// Where a matrix the solver's storage cannot take is assembled: the dense matrix, or
+    /// entries for the solver's sparse LU above [`DENSE_FALLBACK_MAX`] unknowns (no `n²`
+    /// storage).
+    fn fallback_form(&self) -> AssembleInto {
+        if self.n_all > DENSE_FALLBACK_MAX { AssembleInto::Entries } else { AssembleInto::Dense }
     }
 }
 

@@ -892,3 +892,107 @@ fn entries_outside_a_declared_structure_do_not_pile_up() {
         }
     }
 }
+
+/// [`CoupledPendulum`] beside `extra` uncoupled oscillators `ẍ + 4 x = 0` (at rest), so that the
+/// matrix is larger than [`DENSE_FALLBACK_MAX`]; the structure declares every coordinate its own
+/// diagonal block.
+struct PaddedPendulum {
+    inner: CoupledPendulum,
+    extra: usize,
+}
+
+impl ConstrainedSystem for PaddedPendulum {
+    fn n_coords(&self) -> usize {
+        2 + self.extra
+    }
+    fn n_dof(&self) -> usize {
+        2 + self.extra
+    }
+    fn n_holonomic(&self) -> usize {
+        1
+    }
+    fn residual_inplace(&self, t: f64, q: &[f64], v: &[f64], v_dot: &[f64], r: &mut [f64]) {
+        self.inner.residual_inplace(t, &q[..2], &v[..2], &v_dot[..2], &mut r[..2]);
+        for i in 2..r.len() {
+            r[i] = v_dot[i] + 4.0 * q[i];
+        }
+    }
+    fn iteration_matrix_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        v_dot: &[f64],
+        c_m: f64,
+        c_c: f64,
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        self.inner.iteration_matrix_inplace(t, &q[..2], &v[..2], &v_dot[..2], c_m, c_c, c_k, k);
+        for i in 2..self.n_coords() {
+            k.add(i, i, c_m + 4.0 * c_k);
+        }
+    }
+    fn phi_inplace(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+        self.inner.phi_inplace(t, &q[..2], phi);
+    }
+    fn phi_q_inplace(&self, t: f64, q: &[f64], j: &mut MatView<'_>) {
+        self.inner.phi_q_inplace(t, &q[..2], j);
+    }
+    fn phi_qq_vv_inplace(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.inner.phi_qq_vv_inplace(t, &q[..2], &v[..2], out);
+    }
+    fn constraint_force_tangent_inplace(
+        &self,
+        t: f64,
+        q: &[f64],
+        lambda: &[f64],
+        mu: &[f64],
+        c_k: f64,
+        k: &mut MatView<'_>,
+    ) {
+        self.inner.constraint_force_tangent_inplace(t, &q[..2], lambda, mu, c_k, k);
+    }
+    fn matrix_structure(&self) -> Option<BandedBorder> {
+        Some(BandedBorder { blocks: vec![(0, self.n_coords(), 0)], node_bandwidth: None })
+    }
+}
+
+/// Above [`DENSE_FALLBACK_MAX`] unknowns, a matrix the structured storage cannot take (here the
+/// coupling spring, outside the declared structure, from t = 0.1 s on) goes to the sparse LU as
+/// entries: no `n × n` matrix is ever allocated, and the pendulum takes the same iterations to
+/// the same states as the small system's dense fallback.
+#[test]
+fn large_fallback_goes_to_the_sparse_lu_without_a_dense_matrix() {
+    let run = |extra: usize| {
+        let inner = CoupledPendulum {
+            p: Pendulum { m: 1.0, g: 9.81, l: 1.0, velocity_level: false },
+            k_c: 50.0,
+            t_on: 0.1,
+            structured: true,
+            m_c: 0.0,
+        };
+        let mut sys = PaddedPendulum { inner, extra };
+        let mut p = IntegratorParams::new(0.8, 1e-2);
+        p.newton.reuse_factorization = false;
+        let mut ga = GenAlpha::new(p, &sys).unwrap();
+        let mut q0 = vec![0.0; 2 + extra];
+        q0[0] = 1.0;
+        let mut s = State::at_rest(&sys, 0.0, q0);
+        ga.initialize(&sys, &mut s).unwrap();
+        for _ in 0..30 {
+            ga.step(&mut sys, &mut s).unwrap();
+        }
+        (s, *ga.stats(), ga.holds_dense_matrix(), ga.sparse_fallbacks(), ga.dense_assemblies())
+    };
+    let (small, s_small, dense_small, sparse_small, _) = run(0);
+    let (large, s_large, dense_large, sparse_large, assemblies_large) = run(DENSE_FALLBACK_MAX);
+    assert!(dense_small && sparse_small == 0, "the small system falls back densely");
+    assert!(!dense_large && assemblies_large == 0, "no dense matrix above the fallback's size");
+    assert!(sparse_large >= 20, "{sparse_large} sparse fallbacks");
+    assert_eq!(s_small.n_newton_iters, s_large.n_newton_iters);
+    for (x, y) in small.q.iter().chain(&small.lambda).zip(large.q[..2].iter().chain(&large.lambda)) {
+        assert!((x - y).abs() < 1e-12 * (1.0 + x.abs()), "{x} vs {y}");
+    }
+    assert!(large.q[2..].iter().all(|&x| x == 0.0));
+}
