@@ -165,9 +165,9 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
     }
     // A band solve and the element loops per Newton iteration, linear in n (measured on the
     // paper's pendulum with 1,000 and 2,000 elements per body: ANCF 1.3e-6 n s a step, GEBF
-    // 0.6e-6 n). The consistent start costs about two steps more, and GEBF's sparse LU of its
-    // start, whose fill grows as n², in time as n³ (1.7 s at 48,000 unknowns, 15 s at 96,000:
-    // 1.7e-14 n³ s).
+    // 0.6e-6 n). The consistent start costs about two steps more, and a sparse fallback's time
+    // can grow as n³ (GEBF's pendulum start through faer's sparse LU: 1.7 s at 48,000
+    // unknowns, 15 s at 96,000, 1.7e-14 n³ s).
     let structure_step = 5.0 * 2e-6 * n;
     let start = 4e-14 * n * n * n;
     let seconds = start + (steps + 2.0) * sub * (structure_step + aero_step);
@@ -186,11 +186,10 @@ pub fn estimate(case: &Case, f: Formulation, max_steps: Option<usize>) -> Estima
 }
 
 /// Bytes of the fallback factorisation of an `n`-unknown matrix that the band storage cannot
-/// take (a tiny band pivot, or an entry outside the declared structure; GEBF's consistent start
-/// with a floating frame): up to [`genalpha::DENSE_FALLBACK_MAX`] unknowns the dense matrix and
-/// its LU (`2 × 8 n²`), above it entries and faer's sparse LU, whose fill is counted as `n²`
-/// bytes (measured: GEBF's pendulum start 0.45–0.5 n² at 24,000 to 96,000 unknowns, ANCF's
-/// none).
+/// take (a tiny band pivot, or an entry outside the declared structure): up to
+/// [`genalpha::DENSE_FALLBACK_MAX`] unknowns the dense matrix and its LU (`2 × 8 n²`), above it
+/// entries and faer's sparse LU, whose fill is counted as `n²` bytes (GEBF's pendulum start
+/// through it: 0.45–0.5 n² at 24,000 to 96,000 unknowns).
 fn fallback_bytes(n: f64) -> f64 {
     if n <= genalpha::DENSE_FALLBACK_MAX as f64 { 16.0 * n * n } else { n * n }
 }

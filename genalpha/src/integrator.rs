@@ -522,9 +522,10 @@ impl<L: LinearSolver> GenAlpha<L> {
         self.n_dense_assemblies
     }
 
-    /// How many iteration matrices went to the solver's sparse LU as entries: the fallback,
-    /// above [`DENSE_FALLBACK_MAX`] unknowns, when the solver's structured storage cannot take a
-    /// matrix (no `n²` storage is allocated for it).
+    /// How many matrices went to the solver's sparse LU as entries: the start's mass matrix when
+    /// the structured factorisation cannot take it, and iteration matrices above
+    /// [`DENSE_FALLBACK_MAX`] unknowns that the solver's storage cannot take (no `n²` storage is
+    /// allocated for them).
     pub fn sparse_fallbacks(&self) -> usize {
         self.n_sparse_fallbacks
     }
@@ -650,7 +651,9 @@ impl<L: LinearSolver> GenAlpha<L> {
         let mut entries = Entries::new(self.n_all);
         let (jac, solver) = self.mass_border();
         jac.assemble(sys, s, &mut entries);
-        solver.factorize_entries(&entries).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })
+        let done = solver.factorize_entries(&entries).map_err(|pivot| Error::SingularMatrix { t: s.t, pivot })?;
+        self.n_sparse_fallbacks += usize::from(done);
+        Ok(done)
     }
 
     /// The start's constraint Jacobians beside the solver (borrowed apart, so that the matrix
