@@ -277,8 +277,9 @@ fn reference_frames(case: &Problem) -> Vec<Matrix3<f64>> {
         .collect()
 }
 
-/// Reused buffers of the stations' poses and velocities: the probe states `q ⊕ ±ε v` and the
-/// poses at `q` and at both probes.
+/// Reused buffers of the stations' poses and velocities: the exact states where the
+/// formulation gives them, else the probe states `q ⊕ ±ε v` and the poses at `q` and at both
+/// probes.
 #[derive(Debug, Clone, Default)]
 pub struct StationScratch {
     dq: Vec<f64>,
@@ -286,12 +287,14 @@ pub struct StationScratch {
     qm: Vec<f64>,
     at: Vec<(usize, f64)>,
     poses: [Vec<(Vector3<f64>, Matrix3<f64>)>; 3],
+    states: Vec<SectionKinematics>,
 }
 
 /// A section's pose and velocity: point, frame, linear and angular velocity.
-pub type SectionKinematics = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
+pub type SectionKinematics = formulation::SectionState;
 
-/// Pose and velocity of a section by central differences along the retraction.
+/// Pose and velocity of a section: exact where the formulation gives them
+/// ([`Structure::section_states`]), else by central differences along the retraction.
 pub fn section_state<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
@@ -304,9 +307,10 @@ pub fn section_state<S: Structure + ?Sized>(
     out.unwrap_or_else(|| unreachable!("one station in, one out"))
 }
 
-/// [`section_state`] of every station of `map`, handed to `each` with its index: the probe
-/// states `q ⊕ ±ε v` depend on the state only, so one pair serves every station (a retraction
-/// costs the whole structure), and the poses go through [`Structure::section_poses`].
+/// [`section_state`] of every station of `map`, handed to `each` with its index. Without exact
+/// rates the probe states `q ⊕ ±ε v` depend on the state only, so one pair serves every station
+/// (a retraction costs the whole structure), and the poses go through
+/// [`Structure::section_poses`].
 pub fn station_states<S: Structure + ?Sized>(
     model: &S,
     q: &[f64],
@@ -317,9 +321,15 @@ pub fn station_states<S: Structure + ?Sized>(
 ) {
     let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let eps = (vmax != 0.0).then(|| 1e-6 / vmax.max(1.0));
-    let StationScratch { dq, qp, qm, at, poses } = scratch;
+    let StationScratch { dq, qp, qm, at, poses, states } = scratch;
     at.clear();
     at.extend(map.iter().map(|st| (st.body, st.s)));
+    if model.section_states(q, v, at, states) {
+        for (i, &k) in states.iter().enumerate() {
+            each(i, k);
+        }
+        return;
+    }
     model.section_poses(q, at, &mut poses[0]);
     let Some(eps) = eps else {
         for (i, &(p, r)) in poses[0].iter().enumerate() {

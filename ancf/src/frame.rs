@@ -14,6 +14,33 @@ pub fn section_frame(r_y: &Vector3<f64>, r_z: &Vector3<f64>) -> Matrix3<f64> {
     polar_rotation(&Matrix3::from_columns(&[n, *r_y, *r_z]))
 }
 
+/// [`section_frame`] and its angular velocity (global, rad/s) while the slopes change at rates
+/// `dr_y`, `dr_z`. With `F = [n, r_y, r_z] = R U` (polar) and the body rate `Ω = Rᵀ Ṙ = [w]×`,
+/// `Rᵀ Ḟ = Ω U + U̇` with `U̇` symmetric, so `Rᵀ Ḟ − Ḟᵀ R = Ω U + U Ω = [(tr U − U) w]×`: `w`
+/// solves a 3 × 3 system whose matrix is `2 I` for orthonormal slopes (symmetric positive
+/// definite while `U` is), and the global rate is `R w`. A degenerate section gives NaN.
+pub fn section_frame_rate(
+    r_y: &Vector3<f64>,
+    r_z: &Vector3<f64>,
+    dr_y: &Vector3<f64>,
+    dr_z: &Vector3<f64>,
+) -> (Matrix3<f64>, Vector3<f64>) {
+    let c = r_y.cross(r_z);
+    let len = c.norm().max(f64::MIN_POSITIVE);
+    let n = c / len;
+    let dc = dr_y.cross(r_z) + r_y.cross(dr_z);
+    let dn = (dc - n * n.dot(&dc)) / len;
+    let f = Matrix3::from_columns(&[n, *r_y, *r_z]);
+    let r = polar_rotation(&f);
+    let u = r.transpose() * f;
+    let u = (u + u.transpose()) * 0.5;
+    let w = r.transpose() * Matrix3::from_columns(&[dn, *dr_y, *dr_z]);
+    let x = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]);
+    let a = Matrix3::identity() * u.trace() - u;
+    let body = a.cholesky().map_or(Vector3::from_element(f64::NAN), |ch| ch.solve(&x));
+    (r, r * body)
+}
+
 /// The rotation factor of the polar decomposition `F = R U` (the rotation closest to `F`).
 ///
 /// For `det F > 0` (every section frame: `det [n, r_y, r_z] = |r_y × r_z|`) by Higham's Newton

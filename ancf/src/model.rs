@@ -4,7 +4,7 @@
 use crate::Energies;
 use crate::elastic_force::{ElementMatrix, LaneMatrix, mirror_upper_inplace};
 use crate::element::Element;
-use crate::frame::{fold_angle, section_frame};
+use crate::frame::{fold_angle, section_frame, section_frame_rate};
 use crate::hinge_spring::{Hessian, HingeSpring, Kinematics};
 use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
@@ -709,6 +709,39 @@ impl Model {
             let rz = v(3) * (1.0 - st.xi) + v(7) * st.xi;
             (r, section_frame(&ry, &rz))
         }))
+    }
+
+    /// Axis point, section frame, the point's velocity and the frame's angular velocity (global)
+    /// of each `(body, s)` of `at` at coordinates `q` and velocities `v`, into `out` (cleared
+    /// first): the point and the slopes interpolate the nodal vectors linearly, so their rates
+    /// interpolate the nodal velocities (both paths' full coordinates are linear in the model's),
+    /// and the frame's rate is that of its polar factor ([`section_frame_rate`]).
+    pub fn section_states(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        at: &[(usize, f64)],
+        out: &mut Vec<formulation::SectionState>,
+    ) -> Result<(), Error> {
+        out.clear();
+        let mut guard = scratch(&self.sensor);
+        let (qf, vf) = &mut *guard;
+        let (qf, vf) = (&mut qf[..self.n_full], &mut vf[..self.n_full]);
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, vf);
+        for (i, &(body, s)) in at.iter().enumerate() {
+            let b = self.check_station(|| format!("station {i}"), body, s)?;
+            let st = locate(b, s);
+            let w = point_weights(st.xi, st.l, 0.0, 0.0);
+            let at = |x: &[f64], k: usize| {
+                Vector3::new(x[st.first + 3 * k], x[st.first + 3 * k + 1], x[st.first + 3 * k + 2])
+            };
+            let point = |x: &[f64]| -> Vector3<f64> { (0..8).map(|k| at(x, k) * w[k]).sum() };
+            let slope = |x: &[f64], k: usize| at(x, k) * (1.0 - st.xi) + at(x, k + 4) * st.xi;
+            let (r, omega) = section_frame_rate(&slope(qf, 2), &slope(qf, 3), &slope(vf, 2), &slope(vf, 3));
+            out.push((point(qf), r, point(vf), omega));
+        }
+        Ok(())
     }
 
     /// Replace the point loads. Forces are dead loads at material points (constant generalized

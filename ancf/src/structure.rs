@@ -1,6 +1,6 @@
 //! [`formulation::Structure`] for the ANCF model: what the analyses need from it.
 
-use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, Structure};
+use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, SectionState, Structure};
 use genalpha::{GenAlpha, IntegratorParams, State};
 use nalgebra::{Matrix3, Vector3};
 
@@ -64,6 +64,10 @@ impl Structure for Model {
                 out.push(s, p, r);
             }
         }
+    }
+    /// Exact rates: ANCF's points and slopes are linear in the coordinates.
+    fn section_states(&self, q: &[f64], v: &[f64], at: &[(usize, f64)], out: &mut Vec<SectionState>) -> bool {
+        Model::section_states(self, q, v, at, out).is_ok()
     }
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
         self.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))

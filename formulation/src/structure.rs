@@ -5,6 +5,10 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, check_section_loads};
 
+/// A section's pose and rates: axis point (m), section frame (columns x, y, z), the point's
+/// velocity (m/s) and the frame's angular velocity (rad/s), all global.
+pub type SectionState = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
+
 /// What the analyses need from a structural model beyond the integrator's trait: the integrator
 /// it runs with, its state at rest, its sensors, the pose of a section and the section loads of
 /// the aerodynamic coupling, its geometry for output, and the statics hook. Implemented by
@@ -151,6 +155,15 @@ pub trait Structure: ConstrainedSystem {
     fn section_poses(&self, q: &[f64], at: &[(usize, f64)], out: &mut Vec<(Vector3<f64>, Matrix3<f64>)>) {
         out.clear();
         out.extend(at.iter().map(|&(body, s)| self.section_pose(q, body, s)));
+    }
+    /// Pose and rates of each `(body, s)` of `at`, in order, into `out` (cleared first): axis
+    /// point (m), section frame, the point's velocity (m/s) and the frame's angular velocity
+    /// (rad/s, global), at coordinates `q` and velocities `v`. Returns false when the
+    /// formulation has no exact rates (the default) or cannot give them (a station outside the
+    /// model), and `out` is then not to be read: the caller differences
+    /// [`section_poses`](Self::section_poses) along the retraction.
+    fn section_states(&self, _q: &[f64], _v: &[f64], _at: &[(usize, f64)], _out: &mut Vec<SectionState>) -> bool {
+        false
     }
     /// Replace all external section loads by `loads`, which [`check_section_loads`] has
     /// accepted; an error here ([`LoadError::Model`]) is the model's own refusal of a value
