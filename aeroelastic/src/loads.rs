@@ -20,7 +20,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use formulation::Structure;
+use formulation::{SectionMotion, Structure};
 
 use crate::problem::{Formulation, Joint, Problem};
 use formulation::SectionLoad;
@@ -224,6 +224,19 @@ struct Kinematics {
 }
 
 impl Kinematics {
+    /// From a model's exact motion: `R̈ = (ω̃² + α̃) R`.
+    fn from_motion(m: &SectionMotion) -> Self {
+        let w = m.omega.cross_matrix();
+        Kinematics {
+            p: m.p,
+            r: m.r,
+            acc: m.acc,
+            r_dd: (w * w + m.alpha.cross_matrix()) * m.r,
+            omega: m.omega,
+            alpha: m.alpha,
+        }
+    }
+
     /// Position and acceleration of the point at `offset` (section frame) from the axis point.
     fn offset_point(&self, offset: Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         (self.p + self.r * offset, self.acc + self.r_dd * offset)
@@ -254,6 +267,14 @@ pub struct LoadScratch {
     aero_ready: bool,
     /// Per body, the kinematics at its Gauss points in (element, point) order; empty until used.
     gauss: Vec<Vec<Kinematics>>,
+    /// The velocities and accelerations of a moving state.
+    v: Vec<f64>,
+    a: Vec<f64>,
+    /// The model gives the sections' motions exactly ([`Structure::section_motions`]), so the
+    /// states `q(±ε)`, `q(±2ε)` are made only if a station needs them (`probes`: made).
+    exact: bool,
+    probes: bool,
+    motions: Vec<SectionMotion>,
 }
 
 /// Multiples of ε of the states `q[1..]` of [`LoadScratch`].
@@ -272,23 +293,50 @@ impl LoadScratch {
             return;
         }
         self.moving = true;
+        self.v.clear();
+        self.v.extend_from_slice(v);
+        self.a.clear();
+        self.a.extend_from_slice(a);
+        self.probes = false;
+        self.exact = model.section_motions(q, v, a, &[], &mut self.motions);
+        if !self.exact {
+            self.make_probes(model);
+        }
+    }
+
+    /// The states `q(±ε)`, `q(±2ε)` along the trajectory of the moving state.
+    fn make_probes<S: Structure + ?Sized>(&mut self, model: &S) {
+        self.probes = true;
+        let (q, v, a) = (&self.q[0], &self.v, &self.a);
+        let vmax = v.iter().chain(a).fold(0.0_f64, |m, x| m.max(x.abs()));
         // Fourth-order differences along the curve q ∘ exp(h v + ½ h² v̇), h = kε: the
         // states move by about d = ε² max|v̇| ≈ 6e-6, so that the truncation, O(d²), and the
         // round-off of the positions, about 5e-16 / d, are both near 1e-10 of the
         // accelerations. Second differences at d = 1e-8 had round-off near 1e-8, which the
         // root loads' inertial terms carried into every time history.
         self.eps = 2.5e-3 / vmax.sqrt().max(1.0);
-        let eps = self.eps;
+        let (eps, n) = (self.eps, q.len());
         for (k, h) in STEPS.iter().map(|m| m * eps).enumerate() {
             self.dq.clear();
             self.dq.extend(v.iter().zip(a).map(|(v, a)| h * v + 0.5 * h * h * a));
-            self.q[k + 1].resize(q.len(), 0.0);
+            self.q[k + 1].resize(n, 0.0);
             let (head, tail) = self.q.split_at_mut(1);
             model.retract_inplace(&head[0], &self.dq, &mut tail[k]);
         }
     }
 
-    fn kinematics<S: Structure + ?Sized>(&self, model: &S, body: usize, s: f64) -> Kinematics {
+    /// The exact motions of the stations `at` into `motions`, when the model gives them.
+    fn exact_motions<S: Structure + ?Sized>(&mut self, model: &S, at: &[(usize, f64)]) -> bool {
+        self.moving && self.exact && model.section_motions(&self.q[0], &self.v, &self.a, at, &mut self.motions)
+    }
+
+    fn kinematics<S: Structure + ?Sized>(&mut self, model: &S, body: usize, s: f64) -> Kinematics {
+        if self.exact_motions(model, &[(body, s)]) {
+            return Kinematics::from_motion(&self.motions[0]);
+        }
+        if self.moving && !self.probes {
+            self.make_probes(model);
+        }
         let n = if self.moving { 5 } else { 1 };
         let mut poses = [(Vector3::zeros(), Matrix3::zeros()); 5];
         for (pose, q) in poses.iter_mut().zip(&self.q).take(n) {
@@ -345,8 +393,20 @@ impl LoadScratch {
             return;
         }
         let h = bm.length / bm.n_elements as f64;
-        self.at.clear();
-        self.at.extend((0..bm.n_elements).flat_map(|e| GAUSS3.map(|(xi, _)| (b, h * (e as f64 + xi)))));
+        let mut at = std::mem::take(&mut self.at);
+        at.clear();
+        at.extend((0..bm.n_elements).flat_map(|e| GAUSS3.map(|(xi, _)| (b, h * (e as f64 + xi)))));
+        let exact = self.exact_motions(model, &at);
+        self.at = at;
+        if exact {
+            let mut gauss = std::mem::take(&mut self.gauss[b]);
+            gauss.extend(self.motions.iter().map(Kinematics::from_motion));
+            self.gauss[b] = gauss;
+            return;
+        }
+        if self.moving && !self.probes {
+            self.make_probes(model);
+        }
         let n = if self.moving { 5 } else { 1 };
         for k in 0..n {
             model.section_poses(&self.q[k], &self.at, &mut self.poses[k]);

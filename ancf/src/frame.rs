@@ -41,6 +41,46 @@ pub fn section_frame_rate(
     (r, r * body)
 }
 
+/// [`section_frame_rate`] one derivative further: the frame, its angular velocity `ω` and its
+/// angular acceleration `α` (global) while the slopes move with rates `dr_*` and accelerations
+/// `ddr_*`. Differentiating `A w = x` (`A = tr U − U`, `x` the axial vector of `W − Wᵀ`,
+/// `W = Rᵀ Ḟ`): `A ẇ = ẋ − Ȧ w` with `U̇ = W − Ω U` and `Ẇ = Rᵀ F̈ − Ω W`; then `α = R ẇ`
+/// (`Ṙ w = R (w × w) = 0`). `n̈` is that of the unit normal `n = c/|c|`, `c = r_y × r_z`.
+pub fn section_frame_motion(
+    r_y: &Vector3<f64>,
+    r_z: &Vector3<f64>,
+    dr_y: &Vector3<f64>,
+    dr_z: &Vector3<f64>,
+    ddr_y: &Vector3<f64>,
+    ddr_z: &Vector3<f64>,
+) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+    let c = r_y.cross(r_z);
+    let len = c.norm().max(f64::MIN_POSITIVE);
+    let n = c / len;
+    let dc = dr_y.cross(r_z) + r_y.cross(dr_z);
+    let ddc = ddr_y.cross(r_z) + dr_y.cross(dr_z) * 2.0 + r_y.cross(ddr_z);
+    let dn = (dc - n * n.dot(&dc)) / len;
+    let ddn = (ddc - n * n.dot(&ddc) - n * dn.dot(&dc) - dn * (2.0 * n.dot(&dc))) / len;
+    let f = Matrix3::from_columns(&[n, *r_y, *r_z]);
+    let r = polar_rotation(&f);
+    let u = r.transpose() * f;
+    let u = (u + u.transpose()) * 0.5;
+    let w = r.transpose() * Matrix3::from_columns(&[dn, *dr_y, *dr_z]);
+    let axial = |m: &Matrix3<f64>| Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]);
+    let a = Matrix3::identity() * u.trace() - u;
+    let Some(ch) = a.cholesky() else {
+        return (r, Vector3::from_element(f64::NAN), Vector3::from_element(f64::NAN));
+    };
+    let body = ch.solve(&axial(&w));
+    let omega_b = body.cross_matrix();
+    let du = w - omega_b * u;
+    let du = (du + du.transpose()) * 0.5;
+    let dw = r.transpose() * Matrix3::from_columns(&[ddn, *ddr_y, *ddr_z]) - omega_b * w;
+    let da = Matrix3::identity() * du.trace() - du;
+    let body_acc = ch.solve(&(axial(&dw) - da * body));
+    (r, r * body, r * body_acc)
+}
+
 /// The rotation factor of the polar decomposition `F = R U` (the rotation closest to `F`).
 ///
 /// For `det F > 0` (every section frame: `det [n, r_y, r_z] = |r_y × r_z|`) by Higham's Newton

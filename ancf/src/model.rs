@@ -4,7 +4,7 @@
 use crate::Energies;
 use crate::elastic_force::{ElementMatrix, LaneMatrix, mirror_upper_inplace};
 use crate::element::Element;
-use crate::frame::{fold_angle, section_frame, section_frame_rate};
+use crate::frame::{fold_angle, section_frame, section_frame_motion, section_frame_rate};
 use crate::hinge_spring::{Hessian, HingeSpring, Kinematics};
 use crate::joint::{ConstraintRow, Joint, node_vector};
 use crate::loads::{PointLoad, Station, add_moment_force, add_point_force, locate, moment_tangent};
@@ -106,8 +106,8 @@ pub struct Model {
     reduced_block: Mutex<Vec<f64>>,
     /// Full-coordinate buffers of the ODE path's residual and matrix.
     work: Mutex<Workspace>,
-    /// Full coordinates and velocities of the sensors on the ODE path.
-    sensor: Mutex<(Vec<f64>, Vec<f64>)>,
+    /// Full coordinates, velocities and accelerations of the sensors on the ODE path.
+    sensor: Mutex<(Vec<f64>, Vec<f64>, Vec<f64>)>,
     /// Whether the iteration matrix is symmetric (no follower moments; a hinge damper's
     /// unsymmetric term is left out of Newton's matrix and vanishes at rest), shared with the
     /// [`SkylineLu`](crate::SkylineLu)s of [`linear_solver`](Self::linear_solver).
@@ -272,7 +272,7 @@ impl Model {
                 r: vec![0.0; n_full],
                 rate: vec![0.0; if damped { n_full } else { 0 }],
             }),
-            sensor: Mutex::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)])),
+            sensor: Mutex::new((vec![0.0; n_full], vec![0.0; n_full.max(n_red)], vec![0.0; n_full])),
             // a follower force's tangent is unsymmetric
             symmetric: Arc::new(AtomicBool::new(thrusts.is_empty())),
             springs,
@@ -472,7 +472,7 @@ impl Model {
     /// Kinetic, elastic and gravitational potential energy.
     pub fn energies(&self, q: &[f64], v: &[f64]) -> Energies {
         let mut s = scratch(&self.sensor);
-        let (qf, vf) = &mut *s;
+        let (qf, vf, _) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
         let mut e = Energies::default();
@@ -510,7 +510,7 @@ impl Model {
     /// and over the point masses: the momenta the discrete equations of motion balance.
     pub fn momentum(&self, q: &[f64], v: &[f64]) -> formulation::Momentum {
         let mut s = scratch(&self.sensor);
-        let (qf, vf) = &mut *s;
+        let (qf, vf, _) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
         let mut out = formulation::Momentum::default();
@@ -565,7 +565,7 @@ impl Model {
             return 0.0;
         }
         let mut s = scratch(&self.sensor);
-        let (qf, vf) = &mut *s;
+        let (qf, vf, _) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
         self.springs
@@ -605,7 +605,7 @@ impl Model {
         }
         let hinge = HingeSpring::new(joint, jt, &self.bodies, 0.0, 0.0, 0.0);
         let mut s = scratch(&self.sensor);
-        let (qf, vf) = &mut *s;
+        let (qf, vf, _) = &mut *s;
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, &mut vf[..self.n_full]);
         Ok(HingeSpring::rate(&hinge.kinematics(qf, false), vf))
@@ -725,7 +725,7 @@ impl Model {
     ) -> Result<(), Error> {
         out.clear();
         let mut guard = scratch(&self.sensor);
-        let (qf, vf) = &mut *guard;
+        let (qf, vf, _) = &mut *guard;
         let (qf, vf) = (&mut qf[..self.n_full], &mut vf[..self.n_full]);
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, vf);
@@ -740,6 +740,47 @@ impl Model {
             let slope = |x: &[f64], k: usize| at(x, k) * (1.0 - st.xi) + at(x, k + 4) * st.xi;
             let (r, omega) = section_frame_rate(&slope(qf, 2), &slope(qf, 3), &slope(vf, 2), &slope(vf, 3));
             out.push((point(qf), r, point(vf), omega));
+        }
+        Ok(())
+    }
+
+    /// [`section_states`](Self::section_states) with the accelerations: at coordinates `q`,
+    /// velocities `v` and accelerations `a` (`v̇`; on both paths the full accelerations are
+    /// linear in them), the axis point's acceleration interpolates the nodal accelerations and
+    /// the frame's angular acceleration is its polar factor's ([`section_frame_motion`]).
+    pub fn section_motions(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        at: &[(usize, f64)],
+        out: &mut Vec<formulation::SectionMotion>,
+    ) -> Result<(), Error> {
+        out.clear();
+        let mut guard = scratch(&self.sensor);
+        let (qf, vf, af) = &mut *guard;
+        let (qf, vf, af) = (&mut qf[..self.n_full], &mut vf[..self.n_full], &mut af[..self.n_full]);
+        self.full_coordinates_inplace(q, qf);
+        self.full_velocities_inplace(v, vf);
+        self.full_velocities_inplace(a, af);
+        for (i, &(body, s)) in at.iter().enumerate() {
+            let b = self.check_station(|| format!("station {i}"), body, s)?;
+            let st = locate(b, s);
+            let w = point_weights(st.xi, st.l, 0.0, 0.0);
+            let at = |x: &[f64], k: usize| {
+                Vector3::new(x[st.first + 3 * k], x[st.first + 3 * k + 1], x[st.first + 3 * k + 2])
+            };
+            let point = |x: &[f64]| -> Vector3<f64> { (0..8).map(|k| at(x, k) * w[k]).sum() };
+            let slope = |x: &[f64], k: usize| at(x, k) * (1.0 - st.xi) + at(x, k + 4) * st.xi;
+            let (r, omega, alpha) = section_frame_motion(
+                &slope(qf, 2),
+                &slope(qf, 3),
+                &slope(vf, 2),
+                &slope(vf, 3),
+                &slope(af, 2),
+                &slope(af, 3),
+            );
+            out.push(formulation::SectionMotion { p: point(qf), r, vel: point(vf), omega, acc: point(af), alpha });
         }
         Ok(())
     }
@@ -1364,7 +1405,7 @@ impl Model {
             return 0.0;
         }
         let mut sens = scratch(&self.sensor);
-        let (qf, vf) = &mut *sens;
+        let (qf, vf, _) = &mut *sens;
         let (qf, vf) = (&mut qf[..self.n_full], &mut vf[..self.n_full]);
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, vf);

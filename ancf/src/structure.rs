@@ -1,6 +1,6 @@
 //! [`formulation::Structure`] for the ANCF model: what the analyses need from it.
 
-use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, SectionState, Structure};
+use formulation::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, SectionMotion, SectionState, Structure};
 use genalpha::{GenAlpha, IntegratorParams, State};
 use nalgebra::{Matrix3, Vector3};
 
@@ -68,6 +68,17 @@ impl Structure for Model {
     /// Exact rates: ANCF's points and slopes are linear in the coordinates.
     fn section_states(&self, q: &[f64], v: &[f64], at: &[(usize, f64)], out: &mut Vec<SectionState>) -> bool {
         Model::section_states(self, q, v, at, out).is_ok()
+    }
+    /// Exact accelerations, for the same reason.
+    fn section_motions(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        at: &[(usize, f64)],
+        out: &mut Vec<SectionMotion>,
+    ) -> bool {
+        Model::section_motions(self, q, v, a, at, out).is_ok()
     }
     fn section_pose(&self, q: &[f64], body: usize, s: f64) -> (Vector3<f64>, Matrix3<f64>) {
         self.section_frame(q, body, s).unwrap_or((Vector3::from_element(f64::NAN), Matrix3::identity()))

@@ -33,4 +33,4 @@ pub use energies::Energies;
 pub use geometry::BeamGeometry;
 pub use load::{LoadError, SectionLoad, check_section_loads};
 pub use momentum::Momentum;
-pub use structure::{SectionState, Structure};
+pub use structure::{SectionMotion, SectionState, Structure};

@@ -9,6 +9,23 @@ use crate::{BeamGeometry, Energies, LoadError, Momentum, SectionLoad, check_sect
 /// velocity (m/s) and the frame's angular velocity (rad/s), all global.
 pub type SectionState = (Vector3<f64>, Matrix3<f64>, Vector3<f64>, Vector3<f64>);
 
+/// A section's pose, rates and accelerations, all global.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SectionMotion {
+    /// Axis point, m.
+    pub p: Vector3<f64>,
+    /// Section frame (columns x, y, z).
+    pub r: Matrix3<f64>,
+    /// Velocity of the axis point, m/s.
+    pub vel: Vector3<f64>,
+    /// Angular velocity of the frame, rad/s.
+    pub omega: Vector3<f64>,
+    /// Acceleration of the axis point, m/s².
+    pub acc: Vector3<f64>,
+    /// Angular acceleration of the frame, rad/s².
+    pub alpha: Vector3<f64>,
+}
+
 /// What the analyses need from a structural model beyond the integrator's trait: the integrator
 /// it runs with, its state at rest, its sensors, the pose of a section and the section loads of
 /// the aerodynamic coupling, its geometry for output, and the statics hook. Implemented by
@@ -163,6 +180,20 @@ pub trait Structure: ConstrainedSystem {
     /// model), and `out` is then not to be read: the caller differences
     /// [`section_poses`](Self::section_poses) along the retraction.
     fn section_states(&self, _q: &[f64], _v: &[f64], _at: &[(usize, f64)], _out: &mut Vec<SectionState>) -> bool {
+        false
+    }
+    /// Pose, rates and accelerations of each `(body, s)` of `at`, in order, into `out` (cleared
+    /// first), at coordinates `q`, velocities `v` and their rates `a` (`v̇`). Returns false when
+    /// the formulation has none exact (the default) or cannot give them, and `out` is then not to
+    /// be read: the caller differences poses along the trajectory.
+    fn section_motions(
+        &self,
+        _q: &[f64],
+        _v: &[f64],
+        _a: &[f64],
+        _at: &[(usize, f64)],
+        _out: &mut Vec<SectionMotion>,
+    ) -> bool {
         false
     }
     /// Replace all external section loads by `loads`, which [`check_section_loads`] has
