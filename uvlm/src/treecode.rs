@@ -37,12 +37,16 @@
 
 use crate::biot_savart::{Filaments, Isa, LANES, NodeBlock, fill_block, isa, velocity_block};
 use crate::induce::{Points, use_threads};
-use crate::mixed::{Block32, Filaments32, add_lanes};
+use crate::mixed::{Block32, Filaments32, LANES32, add_lanes};
 use crate::params::Parallel;
 use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
+
+/// Points per traversal block: the mixed kernel's width, so that a near leaf is summed sixteen
+/// points at a time; the f64 expansions and legs take the block in two halves of [`LANES`].
+const BLOCK: usize = LANES32;
 
 /// A multi-index table: every `k` with `|k| ≤ degree`, sorted by degree.
 #[derive(Debug, Clone, Default)]
@@ -255,7 +259,7 @@ struct Edits {
 }
 
 /// The velocities at one block's points and the point–filament pairs summed directly.
-type BlockOut = ([[f64; LANES]; 3], u64);
+type BlockOut = ([[f64; BLOCK]; 3], u64);
 
 /// Scratch of a traversal (one per chunk of point blocks).
 #[derive(Debug, Clone, Default)]
@@ -264,7 +268,7 @@ struct Scratch {
     taylor: Vec<[f64; LANES]>,
     stats: TreeStats,
     blk: NodeBlock,
-    blk32: Block32<LANES>,
+    blk32: Block32<BLOCK>,
 }
 
 impl Treecode {
@@ -660,7 +664,7 @@ impl Treecode {
     }
 
     /// Velocity induced by the set at every point of `pts`, added to `out`, to within `tol`
-    /// (m/s, absolute) at each point. `order` lists the points in blocks of [`LANES`] that are
+    /// (m/s, absolute) at each point. `order` lists the points in blocks of sixteen that are
     /// close together ([`block_order`]). Returns the point–filament pairs summed directly.
     pub(crate) fn add_velocity_inplace(
         &mut self,
@@ -672,7 +676,7 @@ impl Treecode {
     ) -> u64 {
         assert_eq!(out.len(), pts.len(), "treecode: output length");
         assert_eq!(order.len(), pts.len(), "treecode: order length");
-        let n_blocks = pts.len().div_ceil(LANES);
+        let n_blocks = pts.len().div_ceil(BLOCK);
         // Rough work: every point against a leaf's worth of segments per level.
         let work = pts.len() * self.leaf_size * self.clusters.len().max(1).ilog2() as usize * 16;
         if use_threads(parallel, work) && n_blocks > 1 {
@@ -683,7 +687,7 @@ impl Treecode {
         let sc = pool.first();
         for b in 0..n_blocks {
             let (bx, by, bz) = gather(pts, order, b);
-            let mut u = [[0.0; LANES]; 3];
+            let mut u = [[0.0; BLOCK]; 3];
             pairs += self.block(&bx, &by, &bz, tol, &mut u, sc);
             scatter(order, b, &u, out);
         }
@@ -695,13 +699,13 @@ impl Treecode {
     /// write disjoint points of `out` (through `order`), so compute into `block_out`, then
     /// scatter in block order. Returns the pairs summed directly.
     fn add_blocks_threaded(&mut self, pts: &Points, order: &[u32], tol: f64, out: &mut [[f64; 3]]) -> u64 {
-        let n_blocks = pts.len().div_ceil(LANES);
+        let n_blocks = pts.len().div_ceil(BLOCK);
         let (mut pool, mut res) = (std::mem::take(&mut self.scratch), std::mem::take(&mut self.block_out));
-        res.resize(n_blocks, ([[0.0; LANES]; 3], 0));
+        res.resize(n_blocks, ([[0.0; BLOCK]; 3], 0));
         pool.for_each_chunk(&mut res, 1, TREE_CHUNKS_PER_THREAD, |first, chunk, sc| {
             for (i, (u, pairs)) in chunk.iter_mut().enumerate() {
                 let (bx, by, bz) = gather(pts, order, first + i);
-                *u = [[0.0; LANES]; 3];
+                *u = [[0.0; BLOCK]; 3];
                 *pairs = self.block(&bx, &by, &bz, tol, u, sc);
             }
         });
@@ -731,18 +735,20 @@ impl Treecode {
     /// One block of points: traverse the tree.
     fn block(
         &self,
-        px: &[f64; LANES],
-        py: &[f64; LANES],
-        pz: &[f64; LANES],
+        px: &[f64; BLOCK],
+        py: &[f64; BLOCK],
+        pz: &[f64; BLOCK],
         tol: f64,
-        u: &mut [[f64; LANES]; 3],
+        u: &mut [[f64; BLOCK]; 3],
         sc: &mut Scratch,
     ) -> u64 {
         let mut pairs = 0u64;
         if self.legs.n_legs() > 0 {
-            fill_block(&self.legs, px, py, pz, &mut sc.blk);
-            velocity_block(&self.legs, &sc.blk, u);
-            pairs += (LANES * self.legs.n_legs()) as u64;
+            for_halves(px, py, pz, u, |hx, hy, hz, uh| {
+                fill_block(&self.legs, hx, hy, hz, &mut sc.blk);
+                velocity_block(&self.legs, &sc.blk, uh);
+            });
+            pairs += (BLOCK * self.legs.n_legs()) as u64;
         }
         if self.clusters.is_empty() {
             return pairs;
@@ -758,7 +764,7 @@ impl Treecode {
         while let Some(ci) = sc.stack.pop() {
             let c = self.clusters[ci as usize];
             let mut d2min = f64::INFINITY;
-            for l in 0..LANES {
+            for l in 0..BLOCK {
                 let d2 = (px[l] - c.center[0]).powi(2) + (py[l] - c.center[1]).powi(2) + (pz[l] - c.center[2]).powi(2);
                 d2min = d2min.min(d2);
             }
@@ -776,7 +782,8 @@ impl Treecode {
                 let (ci, c) = (ci as usize, c.center);
                 let curl = &self.curl[ci * nt..ci * nt + n_coefficients(q as usize + 1)];
                 let (idx, rec, a) = (&self.taylor_idx, &self.rec[..], &mut sc.taylor[..]);
-                match isa() {
+                let isa = isa();
+                for_halves(px, py, pz, u, |px, py, pz, u| match isa {
                     Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
                     // SAFETY: the features were detected at run time.
                     #[cfg(target_arch = "x86_64")]
@@ -784,17 +791,19 @@ impl Treecode {
                     // SAFETY: the features were detected at run time.
                     #[cfg(target_arch = "x86_64")]
                     Isa::Avx512 => unsafe { expansion_avx512(idx, rec, curl, c, px, py, pz, a, u) },
-                }
-                sc.stats.n_expansions += LANES as u64;
+                });
+                sc.stats.n_expansions += BLOCK as u64;
             } else if c.leaf != NONE {
                 let leaf = &self.leaves[c.leaf as usize];
                 if self.mixed {
                     add_lanes(leaf, &self.leaves32[c.leaf as usize], &[*px, *py, *pz], &mut sc.blk32, u);
                 } else {
-                    fill_block(leaf, px, py, pz, &mut sc.blk);
-                    velocity_block(leaf, &sc.blk, u);
+                    for_halves(px, py, pz, u, |hx, hy, hz, uh| {
+                        fill_block(leaf, hx, hy, hz, &mut sc.blk);
+                        velocity_block(leaf, &sc.blk, uh);
+                    });
                 }
-                let n = (LANES * leaf.n_segments()) as u64;
+                let n = (BLOCK * leaf.n_segments()) as u64;
                 pairs += n;
                 sc.stats.n_direct_pairs += n;
             } else {
@@ -817,11 +826,33 @@ fn n_coefficients(degree: usize) -> usize {
     (degree + 1) * (degree + 2) * (degree + 3) / 6
 }
 
+/// `f` on each half of a block, [`LANES`] points each, with that half's velocities (added to
+/// `u`'s).
+#[inline(always)]
+fn for_halves(
+    px: &[f64; BLOCK],
+    py: &[f64; BLOCK],
+    pz: &[f64; BLOCK],
+    u: &mut [[f64; BLOCK]; 3],
+    mut f: impl FnMut(&[f64; LANES], &[f64; LANES], &[f64; LANES], &mut [[f64; LANES]; 3]),
+) {
+    for h in (0..BLOCK).step_by(LANES) {
+        let half = |p: &[f64; BLOCK]| -> [f64; LANES] { std::array::from_fn(|l| p[h + l]) };
+        let mut uh = [[0.0; LANES]; 3];
+        f(&half(px), &half(py), &half(pz), &mut uh);
+        for (uq, hq) in u.iter_mut().zip(&uh) {
+            for l in 0..LANES {
+                uq[h + l] += hq[l];
+            }
+        }
+    }
+}
+
 /// The points of block `b` of `order` (the last point repeated past the end).
-fn gather(pts: &Points, order: &[u32], b: usize) -> ([f64; LANES], [f64; LANES], [f64; LANES]) {
-    let (mut bx, mut by, mut bz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-    for l in 0..LANES {
-        let i = order[(b * LANES + l).min(order.len() - 1)] as usize;
+fn gather(pts: &Points, order: &[u32], b: usize) -> ([f64; BLOCK], [f64; BLOCK], [f64; BLOCK]) {
+    let (mut bx, mut by, mut bz) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+    for l in 0..BLOCK {
+        let i = order[(b * BLOCK + l).min(order.len() - 1)] as usize;
         bx[l] = pts.x[i];
         by[l] = pts.y[i];
         bz[l] = pts.z[i];
@@ -830,9 +861,9 @@ fn gather(pts: &Points, order: &[u32], b: usize) -> ([f64; LANES], [f64; LANES],
 }
 
 /// Add block `b`'s velocities to its points in `out`.
-fn scatter(order: &[u32], b: usize, u: &[[f64; LANES]; 3], out: &mut [[f64; 3]]) {
-    for l in 0..LANES.min(order.len() - b * LANES) {
-        let o = &mut out[order[b * LANES + l] as usize];
+fn scatter(order: &[u32], b: usize, u: &[[f64; BLOCK]; 3], out: &mut [[f64; 3]]) {
+    for l in 0..BLOCK.min(order.len() - b * BLOCK) {
+        let o = &mut out[order[b * BLOCK + l] as usize];
         o[0] += u[0][l];
         o[1] += u[1][l];
         o[2] += u[2][l];
@@ -1054,15 +1085,15 @@ fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     out
 }
 
-/// An order of the points in which consecutive blocks of [`LANES`] are close together: median
-/// splits along the longest side, at multiples of [`LANES`].
+/// An order of the points in which consecutive blocks of sixteen (the traversal's blocks) are
+/// close together: median splits along the longest side, at multiples of sixteen.
 pub(crate) fn block_order(pts: &Points, order: &mut Vec<u32>, stack: &mut Vec<(usize, usize)>) {
     order.clear();
     order.extend(0..pts.len() as u32);
     stack.clear();
     stack.push((0, pts.len()));
     while let Some((start, end)) = stack.pop() {
-        if end - start <= LANES {
+        if end - start <= BLOCK {
             continue;
         }
         let mut lo = [f64::INFINITY; 3];
@@ -1079,8 +1110,8 @@ pub(crate) fn block_order(pts: &Points, order: &mut Vec<u32>, stack: &mut Vec<(u
             }
         }
         let axis = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b]))).unwrap_or(0);
-        let n_blocks = (end - start).div_ceil(LANES);
-        let k = (n_blocks / 2) * LANES;
+        let n_blocks = (end - start).div_ceil(BLOCK);
+        let k = (n_blocks / 2) * BLOCK;
         order[start..end].select_nth_unstable_by(k, |&a, &b| coord(a, axis).total_cmp(&coord(b, axis)));
         stack.push((start, start + k));
         stack.push((start + k, end));
