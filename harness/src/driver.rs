@@ -201,19 +201,13 @@ pub fn any_interrupted(results: &[CaseResult]) -> bool {
         .any(|r| r.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)))
 }
 
-/// Write a case's files ([`write_case`]: CSV, `summary.json`, plots, each atomically) and put the
-/// run's `"status"` (`"complete"` or `"interrupted"`) at the top of its `summary.json`.
+/// Write a case's files ([`write_case`]: CSV, `summary.json`, plots, each atomically), the run's
+/// `"status"` (`"complete"` or `"interrupted"`) at the top of its `summary.json`, in the same
+/// write: a kill at any moment leaves either the summary that says "interrupted" from
+/// [`claim_outputs`] or this one, never one without a status.
 pub fn finish_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
-    write_case(dir, r)?;
     let interrupted = r.runs.iter().any(|x| x.error.as_deref().is_some_and(|e| e.starts_with(crate::run::INTERRUPTED)));
-    let status = if interrupted { "interrupted" } else { "complete" };
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-    let marked = match text.strip_prefix('{') {
-        Some(rest) => format!("{{\n  \"status\": \"{status}\",{rest}"),
-        None => text,
-    };
-    crate::atomic::write(&path, marked.as_bytes())
+    write_case(dir, r, if interrupted { "interrupted" } else { "complete" })
 }
 
 /// Write `index.html` and `summary.md` under `out` (the cases' own files are written already).

@@ -130,6 +130,9 @@ impl CaseResult {
 
 #[derive(Serialize)]
 struct Summary<'a> {
+    /// `"complete"` or `"interrupted"`, first, in the same write as the rest: a run killed
+    /// between two writes must not leave a summary without it.
+    status: &'a str,
     case: &'a str,
     description: &'a str,
     span_m: f64,
@@ -141,8 +144,9 @@ struct Summary<'a> {
     gate_pass: Option<bool>,
 }
 
-/// Write `<dir>/<formulation>.csv`, `summary.json` and the plots of one case.
-pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
+/// Write `<dir>/<formulation>.csv`, `summary.json` (its `"status"` first) and the plots of one
+/// case.
+pub fn write_case(dir: &Path, r: &CaseResult, status: &str) -> Result<(), Error> {
     for run in &r.runs {
         write_file(&dir.join(format!("{}.csv", run.formulation)), &to_csv(&run.rows, &r.control_surfaces))?;
         if !run.events.is_empty() {
@@ -151,6 +155,7 @@ pub fn write_case(dir: &Path, r: &CaseResult) -> Result<(), Error> {
         }
     }
     let summary = Summary {
+        status,
         case: &r.name,
         description: &r.description,
         span_m: r.span,
