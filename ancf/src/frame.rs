@@ -30,15 +30,8 @@ pub fn section_frame_rate(
     let n = c / len;
     let dc = dr_y.cross(r_z) + r_y.cross(dr_z);
     let dn = (dc - n * n.dot(&dc)) / len;
-    let f = Matrix3::from_columns(&[n, *r_y, *r_z]);
-    let r = polar_rotation(&f);
-    let u = r.transpose() * f;
-    let u = (u + u.transpose()) * 0.5;
-    let w = r.transpose() * Matrix3::from_columns(&[dn, *dr_y, *dr_z]);
-    let x = Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]);
-    let a = Matrix3::identity() * u.trace() - u;
-    let body = a.cholesky().map_or(Vector3::from_element(f64::NAN), |ch| ch.solve(&x));
-    (r, r * body)
+    let p = PolarRate::new(&Matrix3::from_columns(&[n, *r_y, *r_z]), &Matrix3::from_columns(&[dn, *dr_y, *dr_z]));
+    (p.r, p.r * p.body)
 }
 
 /// [`section_frame_rate`] one derivative further: the frame, its angular velocity `ω` and its
@@ -61,24 +54,45 @@ pub fn section_frame_motion(
     let ddc = ddr_y.cross(r_z) + dr_y.cross(dr_z) * 2.0 + r_y.cross(ddr_z);
     let dn = (dc - n * n.dot(&dc)) / len;
     let ddn = (ddc - n * n.dot(&ddc) - n * dn.dot(&dc) - dn * (2.0 * n.dot(&dc))) / len;
-    let f = Matrix3::from_columns(&[n, *r_y, *r_z]);
-    let r = polar_rotation(&f);
-    let u = r.transpose() * f;
-    let u = (u + u.transpose()) * 0.5;
-    let w = r.transpose() * Matrix3::from_columns(&[dn, *dr_y, *dr_z]);
-    let axial = |m: &Matrix3<f64>| Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]);
-    let a = Matrix3::identity() * u.trace() - u;
-    let Some(ch) = a.cholesky() else {
-        return (r, Vector3::from_element(f64::NAN), Vector3::from_element(f64::NAN));
+    let p = PolarRate::new(&Matrix3::from_columns(&[n, *r_y, *r_z]), &Matrix3::from_columns(&[dn, *dr_y, *dr_z]));
+    let Some(ch) = p.a.cholesky() else {
+        return (p.r, Vector3::from_element(f64::NAN), Vector3::from_element(f64::NAN));
     };
-    let body = ch.solve(&axial(&w));
-    let omega_b = body.cross_matrix();
-    let du = w - omega_b * u;
+    let omega_b = p.body.cross_matrix();
+    let du = p.w - omega_b * p.u;
     let du = (du + du.transpose()) * 0.5;
-    let dw = r.transpose() * Matrix3::from_columns(&[ddn, *ddr_y, *ddr_z]) - omega_b * w;
+    let dw = p.r.transpose() * Matrix3::from_columns(&[ddn, *ddr_y, *ddr_z]) - omega_b * p.w;
     let da = Matrix3::identity() * du.trace() - du;
-    let body_acc = ch.solve(&(axial(&dw) - da * body));
-    (r, r * body, r * body_acc)
+    let body_acc = ch.solve(&(axial(&dw) - da * p.body));
+    (p.r, p.r * p.body, p.r * body_acc)
+}
+
+/// The polar factor `R` of `F = R U` and the body rate `w` of `Ω = Rᵀ Ṙ = [w]×` while `F`
+/// changes at `Ḟ`: `(tr U − U) w = axial(W − Wᵀ)`, `W = Rᵀ Ḟ` (NaN for a degenerate `F`).
+struct PolarRate {
+    r: Matrix3<f64>,
+    /// `U`'s symmetric part, `W`, and `A = tr U − U`.
+    u: Matrix3<f64>,
+    w: Matrix3<f64>,
+    a: Matrix3<f64>,
+    body: Vector3<f64>,
+}
+
+impl PolarRate {
+    fn new(f: &Matrix3<f64>, df: &Matrix3<f64>) -> Self {
+        let r = polar_rotation(f);
+        let u = r.transpose() * f;
+        let u = (u + u.transpose()) * 0.5;
+        let w = r.transpose() * df;
+        let a = Matrix3::identity() * u.trace() - u;
+        let body = a.cholesky().map_or(Vector3::from_element(f64::NAN), |ch| ch.solve(&axial(&w)));
+        Self { r, u, w, a, body }
+    }
+}
+
+/// `(m₂₁ − m₁₂, m₀₂ − m₂₀, m₁₀ − m₀₁)`: twice the axial vector of `m`'s skew part.
+fn axial(m: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)])
 }
 
 /// The rotation factor of the polar decomposition `F = R U` (the rotation closest to `F`).

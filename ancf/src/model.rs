@@ -729,19 +729,10 @@ impl Model {
         let (qf, vf) = (&mut qf[..self.n_full], &mut vf[..self.n_full]);
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, vf);
-        for (i, &(body, s)) in at.iter().enumerate() {
-            let b = self.check_station(|| format!("station {i}"), body, s)?;
-            let st = locate(b, s);
-            let w = point_weights(st.xi, st.l, 0.0, 0.0);
-            let at = |x: &[f64], k: usize| {
-                Vector3::new(x[st.first + 3 * k], x[st.first + 3 * k + 1], x[st.first + 3 * k + 2])
-            };
-            let point = |x: &[f64]| -> Vector3<f64> { (0..8).map(|k| at(x, k) * w[k]).sum() };
-            let slope = |x: &[f64], k: usize| at(x, k) * (1.0 - st.xi) + at(x, k + 4) * st.xi;
-            let (r, omega) = section_frame_rate(&slope(qf, 2), &slope(qf, 3), &slope(vf, 2), &slope(vf, 3));
-            out.push((point(qf), r, point(vf), omega));
-        }
-        Ok(())
+        self.each_station(at, [qf, vf], |[(p, ry, rz), (dp, dry, drz)]| {
+            let (r, omega) = section_frame_rate(&ry, &rz, &dry, &drz);
+            out.push((p, r, dp, omega));
+        })
     }
 
     /// [`section_states`](Self::section_states) with the accelerations: at coordinates `q`,
@@ -763,6 +754,21 @@ impl Model {
         self.full_coordinates_inplace(q, qf);
         self.full_velocities_inplace(v, vf);
         self.full_velocities_inplace(a, af);
+        self.each_station(at, [qf, vf, af], |[(p, ry, rz), (dp, dry, drz), (ddp, ddry, ddrz)]| {
+            let (r, omega, alpha) = section_frame_motion(&ry, &rz, &dry, &drz, &ddry, &ddrz);
+            out.push(formulation::SectionMotion { p, r, vel: dp, omega, acc: ddp, alpha });
+        })
+    }
+
+    /// For each station of `at`, the axis point and the two section slopes interpolated from
+    /// each full vector of `xs` (coordinates or their rates: both interpolate alike), handed to
+    /// `each`; a station outside the model is an error naming it.
+    fn each_station<const N: usize>(
+        &self,
+        at: &[(usize, f64)],
+        xs: [&[f64]; N],
+        mut each: impl FnMut([(Vector3<f64>, Vector3<f64>, Vector3<f64>); N]),
+    ) -> Result<(), Error> {
         for (i, &(body, s)) in at.iter().enumerate() {
             let b = self.check_station(|| format!("station {i}"), body, s)?;
             let st = locate(b, s);
@@ -770,17 +776,8 @@ impl Model {
             let at = |x: &[f64], k: usize| {
                 Vector3::new(x[st.first + 3 * k], x[st.first + 3 * k + 1], x[st.first + 3 * k + 2])
             };
-            let point = |x: &[f64]| -> Vector3<f64> { (0..8).map(|k| at(x, k) * w[k]).sum() };
             let slope = |x: &[f64], k: usize| at(x, k) * (1.0 - st.xi) + at(x, k + 4) * st.xi;
-            let (r, omega, alpha) = section_frame_motion(
-                &slope(qf, 2),
-                &slope(qf, 3),
-                &slope(vf, 2),
-                &slope(vf, 3),
-                &slope(af, 2),
-                &slope(af, 3),
-            );
-            out.push(formulation::SectionMotion { p: point(qf), r, vel: point(vf), omega, acc: point(af), alpha });
+            each(xs.map(|x| ((0..8).map(|k| at(x, k) * w[k]).sum(), slope(x, 2), slope(x, 3))));
         }
         Ok(())
     }
