@@ -319,8 +319,6 @@ pub fn station_states<S: Structure + ?Sized>(
     scratch: &mut StationScratch,
     mut each: impl FnMut(usize, SectionKinematics),
 ) {
-    let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let eps = (vmax != 0.0).then(|| 1e-6 / vmax.max(1.0));
     let StationScratch { dq, qp, qm, at, poses, states } = scratch;
     at.clear();
     at.extend(map.iter().map(|st| (st.body, st.s)));
@@ -330,6 +328,8 @@ pub fn station_states<S: Structure + ?Sized>(
         }
         return;
     }
+    let vmax = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let eps = (vmax != 0.0).then(|| 1e-6 / vmax.max(1.0));
     model.section_poses(q, at, &mut poses[0]);
     let Some(eps) = eps else {
         for (i, &(p, r)) in poses[0].iter().enumerate() {

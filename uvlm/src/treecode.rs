@@ -47,6 +47,7 @@ pub const MAX_ORDER: usize = 12;
 /// Points per traversal block: the mixed kernel's width, so that a near leaf is summed sixteen
 /// points at a time; the f64 expansions and legs take the block in two halves of [`LANES`].
 const BLOCK: usize = LANES32;
+const _: () = assert!(BLOCK == 2 * LANES, "a block is two halves of the f64 lanes");
 
 /// A multi-index table: every `k` with `|k| ≤ degree`, sorted by degree.
 #[derive(Debug, Clone, Default)]
@@ -743,8 +744,9 @@ impl Treecode {
         sc: &mut Scratch,
     ) -> u64 {
         let mut pairs = 0u64;
+        let halves = Halves::of(px, py, pz);
         if self.legs.n_legs() > 0 {
-            for_halves(px, py, pz, u, |hx, hy, hz, uh| {
+            halves.each(u, |hx, hy, hz, uh| {
                 fill_block(&self.legs, hx, hy, hz, &mut sc.blk);
                 velocity_block(&self.legs, &sc.blk, uh);
             });
@@ -783,7 +785,7 @@ impl Treecode {
                 let curl = &self.curl[ci * nt..ci * nt + n_coefficients(q as usize + 1)];
                 let (idx, rec, a) = (&self.taylor_idx, &self.rec[..], &mut sc.taylor[..]);
                 let isa = isa();
-                for_halves(px, py, pz, u, |px, py, pz, u| match isa {
+                halves.each(u, |px, py, pz, u| match isa {
                     Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
                     // SAFETY: the features were detected at run time.
                     #[cfg(target_arch = "x86_64")]
@@ -798,7 +800,7 @@ impl Treecode {
                 if self.mixed {
                     add_lanes(leaf, &self.leaves32[c.leaf as usize], &[*px, *py, *pz], &mut sc.blk32, u);
                 } else {
-                    for_halves(px, py, pz, u, |hx, hy, hz, uh| {
+                    halves.each(u, |hx, hy, hz, uh| {
                         fill_block(leaf, hx, hy, hz, &mut sc.blk);
                         velocity_block(leaf, &sc.blk, uh);
                     });
@@ -826,23 +828,28 @@ fn n_coefficients(degree: usize) -> usize {
     (degree + 1) * (degree + 2) * (degree + 3) / 6
 }
 
-/// `f` on each half of a block, [`LANES`] points each, with that half's velocities (added to
-/// `u`'s).
-#[inline(always)]
-fn for_halves(
-    px: &[f64; BLOCK],
-    py: &[f64; BLOCK],
-    pz: &[f64; BLOCK],
-    u: &mut [[f64; BLOCK]; 3],
-    mut f: impl FnMut(&[f64; LANES], &[f64; LANES], &[f64; LANES], &mut [[f64; LANES]; 3]),
-) {
-    for h in (0..BLOCK).step_by(LANES) {
-        let half = |p: &[f64; BLOCK]| -> [f64; LANES] { std::array::from_fn(|l| p[h + l]) };
-        let mut uh = [[0.0; LANES]; 3];
-        f(&half(px), &half(py), &half(pz), &mut uh);
-        for (uq, hq) in u.iter_mut().zip(&uh) {
-            for l in 0..LANES {
-                uq[h + l] += hq[l];
+/// A block's points as two halves of [`LANES`], split once per block for the f64 kernels.
+struct Halves([[[f64; LANES]; 3]; 2]);
+
+impl Halves {
+    fn of(px: &[f64; BLOCK], py: &[f64; BLOCK], pz: &[f64; BLOCK]) -> Self {
+        Self(std::array::from_fn(|h| [px, py, pz].map(|p| std::array::from_fn(|l| p[h * LANES + l]))))
+    }
+
+    /// `f` on each half with that half's velocities, added to `u`'s.
+    #[inline(always)]
+    fn each(
+        &self,
+        u: &mut [[f64; BLOCK]; 3],
+        mut f: impl FnMut(&[f64; LANES], &[f64; LANES], &[f64; LANES], &mut [[f64; LANES]; 3]),
+    ) {
+        for (h, [hx, hy, hz]) in self.0.iter().enumerate() {
+            let mut uh = [[0.0; LANES]; 3];
+            f(hx, hy, hz, &mut uh);
+            for (uq, hq) in u.iter_mut().zip(&uh) {
+                for l in 0..LANES {
+                    uq[h * LANES + l] += hq[l];
+                }
             }
         }
     }

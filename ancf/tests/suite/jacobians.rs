@@ -116,23 +116,16 @@ fn constraint_jacobian_equals_finite_differences() {
 #[test]
 fn section_rates_equal_finite_differences_of_the_poses() {
     use formulation::Structure;
-    for (path, twisted) in
-        [(SolvePath::Dae, false), (SolvePath::Ode, false), (SolvePath::Dae, true), (SolvePath::Ode, true)]
-    {
-        let model = pendulum(45.0, 3, twisted, Options { path, ..Default::default() });
-        let n = model.n_dof();
-        let q = deformed_state(&model);
-        let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
-        let at: Vec<(usize, f64)> = [(0, 0.0), (0, 0.13), (0, 0.5), (1, 0.0), (1, 0.31), (1, 0.5)].to_vec();
+    for_section_cases(|path, twisted, model, q, v, at| {
         let mut exact = Vec::new();
-        assert!(Structure::section_states(&model, &q, &v, &at, &mut exact));
+        assert!(Structure::section_states(model, q, v, at, &mut exact));
         let eps = 1e-6;
         let probe = |sign: f64| {
             let dq: Vec<f64> = v.iter().map(|x| sign * eps * x).collect();
             let mut qp = vec![0.0; q.len()];
-            model.retract_inplace(&q, &dq, &mut qp);
+            model.retract_inplace(q, &dq, &mut qp);
             let mut poses = Vec::new();
-            model.section_poses(&qp, &at, &mut poses);
+            model.section_poses(&qp, at, &mut poses);
             poses
         };
         let (plus, minus) = (probe(1.0), probe(-1.0));
@@ -147,6 +140,20 @@ fn section_rates_equal_finite_differences_of_the_poses() {
         }
         println!("{path:?} twisted {twisted}: rates up to {scale:.3e}, exact - differences {err:.2e}");
         assert!(err <= 1e-8 * scale, "{path:?}: {err:e} against {scale:e}");
+    });
+}
+
+/// `f` on the pendulum of both solve paths, plain and twisted, at a deformed state with
+/// velocities, and six stations (both bodies' ends and interior points).
+fn for_section_cases(mut f: impl FnMut(SolvePath, bool, &Model, &[f64], &[f64], &[(usize, f64)])) {
+    for (path, twisted) in
+        [(SolvePath::Dae, false), (SolvePath::Ode, false), (SolvePath::Dae, true), (SolvePath::Ode, true)]
+    {
+        let model = pendulum(45.0, 3, twisted, Options { path, ..Default::default() });
+        let q = deformed_state(&model);
+        let v: Vec<f64> = (0..model.n_dof()).map(|i| (i as f64 * 0.7).cos()).collect();
+        let at = [(0, 0.0), (0, 0.13), (0, 0.5), (1, 0.0), (1, 0.31), (1, 0.5)];
+        f(path, twisted, &model, &q, &v, &at);
     }
 }
 
@@ -158,27 +165,20 @@ fn section_rates_equal_finite_differences_of_the_poses() {
 #[test]
 fn section_accelerations_equal_finite_differences_of_the_rates() {
     use formulation::Structure;
-    for (path, twisted) in
-        [(SolvePath::Dae, false), (SolvePath::Ode, false), (SolvePath::Dae, true), (SolvePath::Ode, true)]
-    {
-        let model = pendulum(45.0, 3, twisted, Options { path, ..Default::default() });
-        let n = model.n_dof();
-        let q = deformed_state(&model);
-        let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
-        let a: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).sin() * 3.0).collect();
-        let at: Vec<(usize, f64)> = [(0, 0.0), (0, 0.13), (0, 0.5), (1, 0.0), (1, 0.31), (1, 0.5)].to_vec();
+    for_section_cases(|path, twisted, model, q, v, at| {
+        let a: Vec<f64> = (0..model.n_dof()).map(|i| (i as f64 * 1.3).sin() * 3.0).collect();
         let mut exact = Vec::new();
-        assert!(Structure::section_motions(&model, &q, &v, &a, &at, &mut exact));
+        assert!(Structure::section_motions(model, q, v, &a, at, &mut exact));
         let mut rates = Vec::new();
-        assert!(Structure::section_states(&model, &q, &v, &at, &mut rates));
+        assert!(Structure::section_states(model, q, v, at, &mut rates));
         let h = 1e-5;
         let probe = |t: f64| {
             let dq: Vec<f64> = v.iter().zip(&a).map(|(v, a)| t * v + 0.5 * t * t * a).collect();
             let mut qt = vec![0.0; q.len()];
-            model.retract_inplace(&q, &dq, &mut qt);
+            model.retract_inplace(q, &dq, &mut qt);
             let vt: Vec<f64> = v.iter().zip(&a).map(|(v, a)| v + t * a).collect();
             let mut out = Vec::new();
-            assert!(Structure::section_states(&model, &qt, &vt, &at, &mut out));
+            assert!(Structure::section_states(model, &qt, &vt, at, &mut out));
             out
         };
         let (plus, minus) = (probe(h), probe(-h));
@@ -192,5 +192,5 @@ fn section_accelerations_equal_finite_differences_of_the_rates() {
         }
         println!("{path:?} twisted {twisted}: accelerations up to {scale:.3e}, exact - differences {err:.2e}");
         assert!(err <= 1e-8 * scale, "{path:?}: {err:e} against {scale:e}");
-    }
+    });
 }
