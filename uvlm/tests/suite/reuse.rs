@@ -95,6 +95,7 @@ fn a_kept_wake_tree_matches_the_direct_sum() {
         let gd = a.gamma().iter().zip(b.gamma()).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
         dg = dg.max(gd / gmax);
     }
+    println!("kept tree: gamma {dg:.3e}");
     assert!(dg < 1e-5, "gamma {dg:e}");
     assert!(dg > 0.0, "the tree changed nothing: did it aggregate?");
     assert!(b.stats().n_pair_evaluations < a.stats().n_pair_evaluations);
