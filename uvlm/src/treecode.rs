@@ -175,6 +175,9 @@ pub struct Treecode {
     /// bound derived from them.
     radial: Vec<f64>,
     shape: Vec<f64>,
+    /// The segments' ends and absolute strengths times lengths in tree order, for the radial
+    /// moments' vectorised sums.
+    ends: SegmentEnds,
     /// `clusters.len() × n_taylor` coefficients `B_k` of the Taylor coefficients in the
     /// expansion, `u = Σ_k a_k B_k` ([`curl_coefficients`]), derived from the moments.
     curl: Vec<[f64; 3]>,
@@ -525,19 +528,27 @@ impl Treecode {
         }
     }
 
-    /// Every cluster's radial strength moments and shape factors (see `radial`).
+    /// Every cluster's radial strength moments and shape factors (see `radial`): the segments'
+    /// ends are laid out in tree order once, so that each cluster's are one contiguous run.
     fn compute_radial(&mut self, fil: &Filaments) {
         let np = self.order + 2;
         self.radial.clear();
         self.radial.resize(self.clusters.len() * np, 0.0);
         self.shape.resize(self.clusters.len() * np, 0.0);
+        self.ends.load(fil, &self.perm);
+        let isa = isa();
         for ci in 0..self.clusters.len() {
             let c = self.clusters[ci];
             let out = &mut self.radial[ci * np..(ci + 1) * np];
-            for &s in &self.perm[c.start as usize..c.end as usize] {
-                let (a, b) = fil.segment_nodes(s as usize);
-                let (pa, pb) = (fil.node(a as usize), fil.node(b as usize));
-                add_radial(out, pa, pb, c.center, fil.seg_g[s as usize].abs());
+            let run = c.start as usize..c.end as usize;
+            match isa {
+                Isa::Generic => radial_generic(&self.ends, run, c.center, out),
+                // SAFETY: the features were detected at run time.
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => unsafe { radial_avx2(&self.ends, run, c.center, out) },
+                // SAFETY: the features were detected at run time.
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 => unsafe { radial_avx512(&self.ends, run, c.center, out) },
             }
             self.update_shape(ci);
         }
@@ -1107,6 +1118,84 @@ fn moments_avx2(up: &[(u32, u8)], sm: &mut MomentSamples) {
 #[target_feature(enable = "avx512f,avx2,fma")]
 fn moments_avx512(up: &[(u32, u8)], sm: &mut MomentSamples) {
     moments_body(up, sm);
+}
+
+/// Segments' ends (`a`, `b`) and absolute strengths times lengths (`w`), structure of arrays.
+#[derive(Debug, Clone, Default)]
+struct SegmentEnds {
+    a: [Vec<f64>; 3],
+    b: [Vec<f64>; 3],
+    w: Vec<f64>,
+}
+
+impl SegmentEnds {
+    /// The segments of `fil` in the order `perm`.
+    fn load(&mut self, fil: &Filaments, perm: &[u32]) {
+        for v in self.a.iter_mut().chain(self.b.iter_mut()) {
+            v.clear();
+        }
+        self.w.clear();
+        for &s in perm {
+            let (a, b) = fil.segment_nodes(s as usize);
+            let (pa, pb) = (fil.node(a as usize), fil.node(b as usize));
+            for q in 0..3 {
+                self.a[q].push(pa[q]);
+                self.b[q].push(pb[q]);
+            }
+            let l = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt();
+            self.w.push(fil.seg_g[s as usize].abs() * l);
+        }
+    }
+}
+
+/// `out[m] = Σ w rᵐ` over the segments `run` of `e` (r the farther end's distance from `c`),
+/// [`LANES`] segments at a time (the remainder in the first lanes), summed over the lanes at
+/// the end: the same order of operations on every instruction set.
+#[inline(always)]
+fn radial_body(e: &SegmentEnds, run: std::ops::Range<usize>, c: [f64; 3], out: &mut [f64]) {
+    let np = out.len();
+    let mut acc = [[0.0f64; LANES]; MAX_ORDER + 2];
+    let (a, b, w) = (&e.a, &e.b, &e.w[run.clone()]);
+    let (ax, ay, az) = (&a[0][run.clone()], &a[1][run.clone()], &a[2][run.clone()]);
+    let (bx, by, bz) = (&b[0][run.clone()], &b[1][run.clone()], &b[2][run]);
+    let n = w.len();
+    for i in (0..n).step_by(LANES) {
+        let k = LANES.min(n - i);
+        let mut t = [0.0; LANES];
+        let mut r = [0.0; LANES];
+        for l in 0..k {
+            let j = i + l;
+            let da = (ax[j] - c[0]).powi(2) + (ay[j] - c[1]).powi(2) + (az[j] - c[2]).powi(2);
+            let db = (bx[j] - c[0]).powi(2) + (by[j] - c[1]).powi(2) + (bz[j] - c[2]).powi(2);
+            r[l] = if da > db { da } else { db }.sqrt();
+            t[l] = w[j];
+        }
+        for am in acc[..np].iter_mut() {
+            for l in 0..LANES {
+                am[l] += t[l];
+                t[l] *= r[l];
+            }
+        }
+    }
+    for (o, am) in out.iter_mut().zip(&acc) {
+        *o = am.iter().sum();
+    }
+}
+
+fn radial_generic(e: &SegmentEnds, run: std::ops::Range<usize>, c: [f64; 3], out: &mut [f64]) {
+    radial_body(e, run, c, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn radial_avx2(e: &SegmentEnds, run: std::ops::Range<usize>, c: [f64; 3], out: &mut [f64]) {
+    radial_body(e, run, c, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx2,fma")]
+fn radial_avx512(e: &SegmentEnds, run: std::ops::Range<usize>, c: [f64; 3], out: &mut [f64]) {
+    radial_body(e, run, c, out);
 }
 
 /// Centre of the bounding box of the segments' ends, the largest distance of an end from it,
