@@ -84,7 +84,8 @@ pub struct WakeAggregation {
     /// Order p of the clusters' Cartesian expansions, ≤ 12. Default 5 (the fastest of 4–6 on
     /// the paper's wing at 160–320 wake rows, docs/uvlm.md §14; the bound holds at any order).
     pub order: usize,
-    /// Most segments in a leaf cluster (summed directly when near), ≥ 1. Default 128.
+    /// Most segments in a leaf cluster (summed directly when near), ≥ 1. Default 384, the
+    /// fastest of 64–1024 on the paper's wing at 320 rows (512 within 2 %; docs/uvlm.md §14).
     pub leaf_size: usize,
     /// Sum the far wake (rows one and on) directly in mixed precision where the treecode does
     /// not apply: positions in f64, the kernel in f32, sums in f64 (mixed.rs, docs/uvlm.md
@@ -94,11 +95,11 @@ pub struct WakeAggregation {
 
 impl WakeAggregation {
     /// The wake size from which the harness aggregates (`aero.wake_aggregation`): segments of
-    /// the far wake, images included. The treecode kept across steps (p = 5, leaves of 128,
+    /// the far wake, images included. The treecode kept across steps (p = 5, leaves of 384,
     /// 1e-6 |V∞|, near leaves in mixed precision) breaks even with the mixed-precision direct
-    /// sum at about 120 rows of the paper's wing (65 segments a row, 420 points; 7800
-    /// segments), docs/uvlm.md §14. The shipped cases' wakes (2600 and 5300 segments) are
-    /// summed directly.
+    /// sum at about 80 rows of the paper's wing (65 segments a row, 420 points; 5200 segments)
+    /// and gains under 10 % up to 120 rows (7800 segments), docs/uvlm.md §14. The shipped
+    /// cases' wakes (2600 and 5300 segments) are summed directly.
     pub const AUTO_MIN_SEGMENTS: usize = 8000;
 
     /// Aggregation switched off: every wake filament summed directly (the default).
@@ -119,7 +120,7 @@ impl WakeAggregation {
 
 impl Default for WakeAggregation {
     fn default() -> Self {
-        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 5, leaf_size: 128, mixed_precision: true }
+        Self { enabled: false, min_segments: 0, tolerance: 1e-6, order: 5, leaf_size: 384, mixed_precision: true }
     }
 }
 
