@@ -468,7 +468,18 @@ impl SegmentKeys {
     pub(crate) fn representable(n_surfaces: usize, n_spanwise: usize) -> bool {
         n_surfaces < 64 && n_spanwise < (1 << 20)
     }
+
+    /// The surface and the push number of the row a key names.
+    pub(crate) fn surface_and_row(key: u64) -> (usize, u64) {
+        (((key >> 56) & 0x3f) as usize, KEY_ROW_MAX - ((key >> 21) & KEY_ROW_MAX))
+    }
 }
+
+/// Node rows of the far wake to build (`head`, `tail`): the spanwise edges at node rows
+/// `1..=head` and `tail..`, the chordwise legs ending there, the closure legs, and only the
+/// nodes these use. The rows between are left out: a tree kept across steps holds them
+/// unchanged (wake_tree.rs). `head + 2 ≤ tail − 1`, so that at least one node row is left out.
+pub(crate) type FarRows = (usize, usize);
 
 /// Append one surface's known wake (as [`build_known_wake`], without images) to `fil`, after
 /// what it holds: the wakes of several surfaces go into one set, then the images of all.
@@ -481,6 +492,22 @@ pub(crate) fn append_known_wake(
     core: &CoreModel,
     te_core: &CoreModel,
     part: WakePart,
+    keys: Option<&mut SegmentKeys>,
+) {
+    append_wake_rows(fil, te, wake, closure_dir, core, te_core, part, None, keys);
+}
+
+/// [`append_known_wake`], of the far part only the node rows `rows` when given ([`FarRows`]).
+#[allow(clippy::too_many_arguments)] // as append_known_wake, and the rows
+pub(crate) fn append_wake_rows(
+    fil: &mut Filaments,
+    te: &[[f64; 3]],
+    wake: &Wake,
+    closure_dir: Option<[f64; 3]>,
+    core: &CoreModel,
+    te_core: &CoreModel,
+    part: WakePart,
+    rows: Option<FarRows>,
     mut keys: Option<&mut SegmentKeys>,
 ) {
     let len = wake.n_rows();
@@ -497,13 +524,23 @@ pub(crate) fn append_known_wake(
     };
     // Position of node (k, j): 0 = trailing edge, k ≥ 1 = detached row k − 1.
     let pos = |k: usize, j: usize| if k == 0 { te[j] } else { wake.node(k - 1, j) };
+    // The node rows kept: all, or `k_first..=head` and `tail − 1..=k_last` (legs ending at
+    // `tail` start at `tail − 1`), packed.
+    let rows = rows.filter(|&(head, tail)| part == WakePart::Far && head + 2 < tail && tail <= len);
+    let kept = |k: usize| rows.is_none_or(|(head, tail)| k <= head || k >= tail);
+    let slot = |k: usize| match rows {
+        Some((head, tail)) if k > head => head + 1 - k_first + (k - (tail - 1)),
+        _ => k - k_first,
+    };
     let node0 = fil.n_nodes();
     for k in k_first..=k_last {
-        for j in 0..nc {
-            fil.push_node(pos(k, j));
+        if rows.is_none_or(|(head, tail)| k <= head || k + 1 >= tail) {
+            for j in 0..nc {
+                fil.push_node(pos(k, j));
+            }
         }
     }
-    let node = |k: usize, j: usize| (node0 + (k - k_first) * nc + j) as u32;
+    let node = |k: usize, j: usize| (node0 + slot(k) * nc + j) as u32;
     let dist = |a: (usize, usize), b: (usize, usize)| {
         let (p, q) = (pos(a.0, a.1), pos(b.0, b.1));
         ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
@@ -525,7 +562,7 @@ pub(crate) fn append_known_wake(
     for k in 0..=len {
         // Spanwise edge at node row k: upstream edge of ring k (+Γ_k), downstream edge of ring k − 1 (−Γ_{k−1}).
         let r = k as isize;
-        if s_range.contains(&k) {
+        if s_range.contains(&k) && kept(k) {
             for j in 0..n {
                 let up = if closed && k == len { 0.0 } else { g(r - 1, j as isize) };
                 let s = g(r, j as isize) - up;
@@ -545,7 +582,7 @@ pub(crate) fn append_known_wake(
             }
         }
         // Chordwise legs of ring k − 1: (k−1, j)→(k, j).
-        if c_range.contains(&k) {
+        if c_range.contains(&k) && kept(k) {
             for j in 0..nc {
                 let s = g(r - 1, j as isize - 1) - g(r - 1, j as isize);
                 if s != 0.0 {

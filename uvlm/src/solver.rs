@@ -1,7 +1,7 @@
 //! The UVLM solver: steady solve and unsteady time steps on one or several lattices (surfaces),
 //! each with its wake, in one influence system.
 
-use crate::aic::{AicLayout, BoundSystem, SegmentKeys, TrailingEdge, WakePart, append_known_wake};
+use crate::aic::{AicLayout, BoundSystem, FarRows, SegmentKeys, TrailingEdge, WakePart, append_wake_rows};
 use crate::axis_extension::{
     ExtensionLayout, SurfaceLayout, WakeColumns, correct_axis_extensions, correct_wake_columns,
 };
@@ -78,6 +78,11 @@ pub struct Uvlm {
     far_tree: WakeTree,
     /// The names of `far`'s segments, for the persistent tree (wake_tree.rs).
     far_keys: SegmentKeys,
+    /// Whether `far` holds only the rows the kept tree needs ([`WakeTree::rows_needed`]); the
+    /// tree holds the rest. Per surface: those rows and the push numbers of the rows left out.
+    far_partial: bool,
+    far_rows: Vec<(FarRows, (u64, u64))>,
+    far_omitted: Vec<(u64, u64)>,
     lu: DenseLu,
     aic: Vec<f64>,
     rhs: Vec<f64>,
@@ -148,6 +153,9 @@ impl Uvlm {
             known_tree: WakeTree::new(&params.wake_aggregation),
             far_tree: WakeTree::far(&params.wake_aggregation),
             far_keys: SegmentKeys::default(),
+            far_partial: false,
+            far_rows: Vec::new(),
+            far_omitted: Vec::new(),
             lu: DenseLu::new(nr),
             aic: vec![0.0; AicLayout::BlockRings.len(nr)],
             rhs: vec![0.0; nr],
@@ -286,7 +294,15 @@ impl Uvlm {
             add(self.bound.fil.velocity_at(p));
             if self.bound_mode == Some(Mode::Unsteady) {
                 add(self.known.velocity_at(p));
-                add(self.far.velocity_at(p));
+                if self.far_partial {
+                    // `far` holds part of the far wake (the kept tree the rest): build it whole.
+                    let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+                    let mut far = Filaments::default();
+                    build_wakes(&mut far, &self.surfaces, closure, &self.params, WakePart::Far, None, None);
+                    add(far.velocity_at(p));
+                } else {
+                    add(self.far.velocity_at(p));
+                }
             }
         }
         v
@@ -715,6 +731,7 @@ impl Uvlm {
             return;
         }
         self.far_tree.break_persistence();
+        self.far_whole();
         self.load_wake_points();
         self.v_wake.resize(self.wpts.len(), [0.0; 3]);
         self.flow.velocity_inplace(&self.wpts, t, &mut self.v_wake);
@@ -812,7 +829,7 @@ impl Uvlm {
         let closure = if self.params.wake_closure { Some(self.stream_dir()?) } else { None };
         let frozen = self.params.wake_reuse == WakeReuse::Frozen;
         let part = if frozen { WakePart::Near } else { WakePart::All };
-        build_wakes(&mut self.known, &self.surfaces, closure, &self.params, part, None);
+        build_wakes(&mut self.known, &self.surfaces, closure, &self.params, part, None, None);
         self.known_tree.invalidate();
         if frozen && !self.far_ready {
             // The far wake's segments are named when a tree can be kept across steps.
@@ -821,9 +838,12 @@ impl Uvlm {
                     self.surfaces.len(),
                     self.surfaces.iter().map(|s| s.wake.n_spanwise()).max().unwrap_or(0),
                 );
-            let keys = if named { Some(&mut self.far_keys) } else { None };
-            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far, keys);
-            self.far_tree.sync(&self.far, named.then_some(&self.far_keys.keys[..]));
+            self.far_partial = named && self.sync_far_rows(closure);
+            if !self.far_partial {
+                let keys = if named { Some(&mut self.far_keys) } else { None };
+                build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far, keys, None);
+                self.far_tree.sync(&self.far, named.then_some(&self.far_keys.keys[..]));
+            }
         }
         let t = self.time + dt;
         self.solve_gamma(true, t)?;
@@ -839,6 +859,45 @@ impl Uvlm {
         self.solved_pending = true;
         self.stats.wall_time += t0.elapsed().as_secs_f64();
         Ok(self.loads())
+    }
+
+    /// Build `far` from the rows the kept far tree needs and update the tree from them
+    /// (wake_tree.rs), when it can be: the rows between are the tree's, translated and
+    /// unchanged, so they are neither built nor merged. Returns false (`far` to be built whole)
+    /// otherwise.
+    fn sync_far_rows(&mut self, closure: Option<[f64; 3]>) -> bool {
+        self.far_rows.clear();
+        self.far_omitted.clear();
+        for s in &self.surfaces {
+            let Some((head, tail)) = self.far_tree.rows_needed(s.wake.n_rows()) else {
+                return false;
+            };
+            let n = s.wake.n_pushed();
+            let omitted = (n - (tail - 1) as u64, n - (head + 1) as u64);
+            self.far_rows.push(((head, tail), omitted));
+            self.far_omitted.push(omitted);
+        }
+        build_wakes(
+            &mut self.far,
+            &self.surfaces,
+            closure,
+            &self.params,
+            WakePart::Far,
+            Some(&mut self.far_keys),
+            Some(&self.far_rows),
+        );
+        self.far_tree.sync_rows(&self.far, &self.far_keys.keys, &self.far_omitted)
+    }
+
+    /// Make `far` hold the whole far wake again where it holds part of it (the kept tree is then
+    /// rebuilt from it at its next use).
+    fn far_whole(&mut self) {
+        if self.far_partial {
+            let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far, None, None);
+            self.far_tree.invalidate();
+            self.far_partial = false;
+        }
     }
 
     /// Third phase: accept the last [`Uvlm::solve_step`] as the state at the new time (history
@@ -875,6 +934,7 @@ fn build_wakes(
     p: &UvlmParams,
     part: WakePart,
     mut keys: Option<&mut SegmentKeys>,
+    rows: Option<&[(FarRows, (u64, u64))]>,
 ) {
     fil.clear();
     if let Some(k) = keys.as_deref_mut() {
@@ -886,7 +946,8 @@ fn build_wakes(
         if let Some(k) = keys.as_deref_mut() {
             k.surface = i as u64;
         }
-        append_known_wake(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part, keys.as_deref_mut());
+        let r = rows.and_then(|r| r.get(i)).map(|r| r.0);
+        append_wake_rows(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part, r, keys.as_deref_mut());
     }
     append_images(fil, &p.images);
     if let Some(k) = keys {

@@ -18,6 +18,7 @@
 //! what changed. The tree is rebuilt every [`REBUILD_PERIOD`] steps, when the wake did not move
 //! rigidly ([`WakeTree::break_persistence`]), and when most of the set is new.
 
+use crate::aic::{FarRows, SegmentKeys};
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, load_lanes, velocity_block};
 use crate::induce::{Points, induced_velocity_inplace};
 use crate::mixed::{MixedScratch, add_velocity_mixed};
@@ -47,6 +48,9 @@ pub(crate) struct WakeTree {
     persist: Persist,
     /// The workspace of the mixed-precision direct sum, when this tree's set may use it.
     mixed: Option<MixedScratch>,
+    /// Whether the last sync saw part of the set only ([`WakeTree::sync_rows`]): the tree
+    /// applies whatever that part's size.
+    partial: bool,
 }
 
 /// The state of a tree kept across steps.
@@ -95,6 +99,7 @@ impl WakeTree {
             stack: Vec::new(),
             persist: Persist::default(),
             mixed: mixed.then(MixedScratch::default),
+            partial: false,
         }
     }
 
@@ -102,6 +107,7 @@ impl WakeTree {
     pub(crate) fn invalidate(&mut self) {
         self.ready = false;
         self.persist.valid = false;
+        self.partial = false;
     }
 
     /// The wake moved other than rigidly (or was replaced): the next [`WakeTree::sync`] rebuilds.
@@ -119,13 +125,25 @@ impl WakeTree {
     }
 
     pub(crate) fn applies(&self, set: &Filaments) -> bool {
-        self.settings.applies(set.n_segments())
+        self.partial || self.settings.applies(set.n_segments())
     }
 
     /// Whether `set`'s induction comes from the crate's f64 kernel throughout (not from a
     /// treecode's expansions, nor from the mixed-precision kernel's regular forms).
     pub(crate) fn kernel_exact(&self, set: &Filaments) -> bool {
         self.mixed.is_none() && !self.applies(set)
+    }
+
+    /// The node rows of a wake of `len` rows the next [`WakeTree::sync_rows`] needs, when the
+    /// tree is kept and will be updated in place: the rows shed since its build (`1..=age + 1`,
+    /// whose segments it does not hold) and the last (`len`, whose edge changes strength as the
+    /// buffer drops rows). The rows between are the tree's, translated and unchanged. `None`
+    /// when the next sync rebuilds, or when nothing would be left out.
+    pub(crate) fn rows_needed(&self, len: usize) -> Option<FarRows> {
+        let p = &self.persist;
+        let kept = self.ready && p.valid && p.age < REBUILD_PERIOD;
+        let (head, tail) = (p.age + 1, len);
+        (kept && head + 2 < tail).then_some((head, tail))
     }
 
     /// Make the tree hold `set`, whose segments are named by `keys` (or `None` when they cannot
@@ -137,7 +155,8 @@ impl WakeTree {
             return;
         };
         debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "segment keys ascend");
-        if self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD && self.update(set, keys) {
+        self.partial = false;
+        if self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD && self.update(set, keys, None) {
             return;
         }
         self.tree.build(set);
@@ -155,15 +174,40 @@ impl WakeTree {
         self.ready = true;
     }
 
+    /// Update the kept tree from part of the set: `set` holds the node rows of
+    /// [`WakeTree::rows_needed`] only, named by `keys`, and `omitted[surface]` is the range of
+    /// push numbers of the rows left out (inclusive), whose segments the tree holds unchanged.
+    /// Returns false, changing nothing the next full sync needs, when the tree cannot be updated
+    /// (it is not kept, or most of the set is new): then sync the whole set.
+    pub(crate) fn sync_rows(&mut self, set: &Filaments, keys: &[u64], omitted: &[(u64, u64)]) -> bool {
+        if keys.len() != set.n_segments() || !(self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD) {
+            return false;
+        }
+        debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "segment keys ascend");
+        self.partial = self.update(set, keys, Some(omitted));
+        if !self.partial {
+            // The merge may have recorded strengths it did not apply: rebuild at the next sync.
+            self.persist.valid = false;
+        }
+        self.partial
+    }
+
     /// Merge the tree's keys with the set's: a segment in both takes the set's strength and
-    /// core, a segment only in the tree strength 0, a segment only in the set goes to the
-    /// direct sum. Returns false (nothing usable) when more than half the set is new.
-    fn update(&mut self, set: &Filaments, keys: &[u64]) -> bool {
+    /// core, a segment only in the tree strength 0 (unless its row is `omitted`: the set holds
+    /// part of the wake, [`WakeTree::sync_rows`]), a segment only in the set goes to the direct
+    /// sum. Returns false (nothing usable) when more than half the set is new.
+    fn update(&mut self, set: &Filaments, keys: &[u64], omitted: Option<&[(u64, u64)]>) -> bool {
         let p = &mut self.persist;
         p.direct.clear();
         p.changes.clear();
         let (mut i, mut s) = (0, 0);
-        let mut n_new = 0;
+        let (mut n_new, mut n_omitted) = (0, 0);
+        let left_out = |k: u64| {
+            omitted.is_some_and(|o| {
+                let (surface, row) = SegmentKeys::surface_and_row(k);
+                o.get(surface).is_some_and(|&(lo, hi)| (lo..=hi).contains(&row))
+            })
+        };
         loop {
             let (kt, ks) = (p.keys.get(i), keys.get(s));
             match (kt, ks) {
@@ -180,8 +224,10 @@ impl WakeTree {
                     }
                     (i, s) = (i + 1, s + 1);
                 }
-                (Some(a), b) if b.is_none_or(|b| a < b) => {
-                    if p.held[i] != [0.0; 3] {
+                (Some(&a), b) if b.is_none_or(|&b| a < b) => {
+                    if left_out(a) {
+                        n_omitted += 1;
+                    } else if p.held[i] != [0.0; 3] {
                         p.changes.push((i as u32, 0.0, 0.0, 0.0));
                         p.held[i] = [0.0; 3];
                     }
@@ -194,7 +240,7 @@ impl WakeTree {
                 }
             }
         }
-        if 2 * n_new > keys.len() {
+        if 2 * n_new > keys.len() + n_omitted {
             return false;
         }
         self.tree.set_segments(&p.changes);
@@ -214,7 +260,7 @@ impl WakeTree {
         parallel: Parallel,
         scratch: &mut ScratchPool<NodeBlock>,
     ) -> u64 {
-        if pts.is_empty() || set.n_filaments() == 0 {
+        if pts.is_empty() || (set.n_filaments() == 0 && !self.partial) {
             return 0;
         }
         // A tree built for this use alone pays its build: it breaks even at a larger wake.
@@ -314,7 +360,7 @@ fn copy_legs(set: &Filaments, out: &mut Filaments) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::aic::{SegmentKeys, WakePart, append_known_wake};
+    use crate::aic::{SegmentKeys, WakePart, append_known_wake, append_wake_rows};
     use crate::biot_savart::CoreModel;
     use crate::images::{ImagePlane, append_images};
     use crate::induce::induced_velocity;
@@ -325,7 +371,9 @@ mod tests {
     /// At every step the persistent tree's induction is within its tolerance (1e-6 |V∞|) of the
     /// direct sum at points over the wing and the near wake: through the rebuilds, the rows
     /// the full buffer drops and the last edge's change of strength. The tree was kept across
-    /// steps and aggregated (the check can fail).
+    /// steps and aggregated (the check can fail). A second tree synchronised from the rows it
+    /// needs only ([`WakeTree::sync_rows`], whenever it can) gives the same velocities bit for
+    /// bit.
     #[test]
     fn a_persistent_tree_follows_a_translating_wake() {
         let (n, rows, dt) = (16, 40, 0.01);
@@ -336,6 +384,8 @@ mod tests {
         let core = CoreModel::CutOff { radius: 1e-6 };
         let settings = WakeAggregation { leaf_size: 16, ..WakeAggregation::treecode() };
         let mut tree = WakeTree::new(&settings);
+        let mut by_rows = WakeTree::new(&settings);
+        let mut n_by_rows = 0;
         let mut wake = Wake::new(n, rows);
         let y = |j: usize| 0.05 + 1.2 * (1.0 - (std::f64::consts::FRAC_PI_2 * j as f64 / n as f64).cos());
         let te: Vec<[f64; 3]> = (0..=n).map(|j| [0.0, y(j), 0.02 * y(j) * y(j)]).collect();
@@ -351,6 +401,7 @@ mod tests {
         for step in 0..80 {
             wake.translate(d);
             tree.translate(d);
+            by_rows.translate(d);
             let row: Vec<[f64; 3]> = te.iter().map(|p| [p[0] + d[0], p[1], p[2]]).collect();
             let t = step as f64 * dt;
             let gamma: Vec<f64> = (0..n)
@@ -379,6 +430,34 @@ mod tests {
             }
             let mut u = vec![[0.0; 3]; pts.len()];
             tree.add_velocity(&fil, &pts, tol, &mut u, Parallel::Off, &mut scratch);
+            let synced = by_rows.rows_needed(wake.n_rows()).is_some_and(|r| {
+                let (mut part, mut keys) = (Filaments::default(), SegmentKeys::default());
+                append_wake_rows(
+                    &mut part,
+                    &te,
+                    &wake,
+                    Some([1.0, 0.0, 0.0]),
+                    &core,
+                    &core,
+                    WakePart::Far,
+                    Some(r),
+                    Some(&mut keys),
+                );
+                append_images(&mut part, &planes);
+                keys.append_images(planes.len());
+                let np = wake.n_pushed();
+                let omitted = [(np - (r.1 - 1) as u64, np - (r.0 + 1) as u64)];
+                assert!(part.n_segments() < fil.n_segments(), "step {step}: rows left out");
+                by_rows.sync_rows(&part, &keys.keys, &omitted)
+            });
+            if synced {
+                n_by_rows += 1;
+            } else {
+                by_rows.sync(&fil, Some(&keys.keys));
+            }
+            let mut v = vec![[0.0; 3]; pts.len()];
+            by_rows.add_velocity(&fil, &pts, tol, &mut v, Parallel::Off, &mut scratch);
+            assert_eq!(u, v, "step {step}: the tree synchronised from rows differs");
             aggregated |= tree.tree.stats().n_expansions > 0;
             let points: Vec<[f64; 3]> = (0..pts.len()).map(|k| [pts.x[k], pts.y[k], pts.z[k]]).collect();
             let direct = induced_velocity(&[&fil], &points);
@@ -390,6 +469,7 @@ mod tests {
             assert!(err <= tol, "step {step}: error {err:e} > {tol:e}");
         }
         assert!(kept >= 60, "the tree was kept at {kept} of 80 steps");
+        assert!(n_by_rows >= 50, "synchronised from rows at {n_by_rows} of 80 steps");
         assert!(aggregated, "nothing aggregated");
     }
 }
