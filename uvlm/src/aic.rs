@@ -473,6 +473,12 @@ impl SegmentKeys {
     pub(crate) fn surface_and_row(key: u64) -> (usize, u64) {
         (((key >> 56) & 0x3f) as usize, KEY_ROW_MAX - ((key >> 21) & KEY_ROW_MAX))
     }
+
+    /// The largest key of `key`'s surface and image copy whose row's push number is at least
+    /// `oldest` (newer rows have smaller keys).
+    pub(crate) fn last_key_from(key: u64, oldest: u64) -> u64 {
+        (key & (0xff << 56)) | ((KEY_ROW_MAX - oldest.min(KEY_ROW_MAX)) << 21) | 0x1f_ffff
+    }
 }
 
 /// Node rows of the far wake to build (`head`, `tail`): the spanwise edges at node rows

@@ -202,10 +202,12 @@ impl WakeTree {
         p.changes.clear();
         let (mut i, mut s) = (0, 0);
         let (mut n_new, mut n_omitted) = (0, 0);
+        // The rows left out of the set, per surface: a held key in them starts a run of held
+        // keys (that surface and image copy, down to the oldest row left out) passed over at once.
         let left_out = |k: u64| {
-            omitted.is_some_and(|o| {
+            omitted.and_then(|o| {
                 let (surface, row) = SegmentKeys::surface_and_row(k);
-                o.get(surface).is_some_and(|&(lo, hi)| (lo..=hi).contains(&row))
+                o.get(surface).filter(|&&(lo, hi)| (lo..=hi).contains(&row)).map(|&(lo, _)| lo)
             })
         };
         loop {
@@ -225,9 +227,14 @@ impl WakeTree {
                     (i, s) = (i + 1, s + 1);
                 }
                 (Some(&a), b) if b.is_none_or(|&b| a < b) => {
-                    if left_out(a) {
-                        n_omitted += 1;
-                    } else if p.held[i] != [0.0; 3] {
+                    if let Some(oldest) = left_out(a) {
+                        let last = SegmentKeys::last_key_from(a, oldest);
+                        let run = p.keys[i..].partition_point(|&k| k <= last);
+                        n_omitted += run;
+                        i += run;
+                        continue;
+                    }
+                    if p.held[i] != [0.0; 3] {
                         p.changes.push((i as u32, 0.0, 0.0, 0.0));
                         p.held[i] = [0.0; 3];
                     }
