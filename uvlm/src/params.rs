@@ -89,7 +89,8 @@ pub struct WakeAggregation {
     pub leaf_size: usize,
     /// Sum the far wake (rows one and on) directly in mixed precision where the treecode does
     /// not apply: positions in f64, the kernel in f32, sums in f64 (mixed.rs, docs/uvlm.md
-    /// §14). Default true; only when `enabled`.
+    /// §14); where it applies, its near leaves and its expansions likewise. Default true; only
+    /// when `enabled`.
     pub mixed_precision: bool,
 }
 
