@@ -2,8 +2,8 @@
 //! (40 to 320 rows), direct (f64, and mixed precision) and through the treecode at 1e-6 |V∞|
 //! (orders 4, 5, 6), and the direct kernels' throughput against an FMA loop: the figures of docs/uvlm.md §9 and §14 on a
 //! shared machine, where the wall time of `cargo bench -p perf --bench uvlm_wake_scaling` / `--bench
-//! uvlm_kernel` is inflated by other load. Medians of three runs of 20 steps after the wake is full;
-//! the last line is the 8×-wake ratio at p = 5 (interleaved medians of seven runs of 64 steps).
+//! uvlm_kernel` is inflated by other load. Medians of three runs of 100 steps after the wake is full;
+//! the last line is the 8×-wake ratio at p = 5 (interleaved medians of seven runs of 400 steps).
 //! Run: `cargo run --release -p perf --example uvlm_wake_scaling [-- kernel]` (with `kernel`, the
 //! throughputs only).
 use uvlm::samples::FlaredWing;
@@ -53,19 +53,19 @@ fn steps_ms(u: &mut Uvlm, st: &[SpanStation], n: usize) -> f64 {
 
 fn step_ms(rows: usize, agg: WakeAggregation) -> f64 {
     let (mut u, st) = solver(rows, agg);
-    median((0..3).map(|_| steps_ms(&mut u, &st, 20)).collect())
+    median((0..3).map(|_| steps_ms(&mut u, &st, 100)).collect())
 }
 
 /// The performance issue's "a wake 8× longer costs at most 2.5× per step": the treecode's step
 /// at 320 rows over the faster of the direct and the treecode's at 40 rows, interleaved, medians
-/// of seven runs of 64 steps.
+/// of seven runs of 400 steps (the thread clock ticks every few milliseconds).
 fn ratio(order: usize) {
     let tree = WakeAggregation { order, min_segments: 0, ..WakeAggregation::treecode() };
     let mut runs = [solver(40, WakeAggregation::off()), solver(40, mixed()), solver(40, tree), solver(320, tree)];
     let mut times = [vec![], vec![], vec![], vec![]];
     for _ in 0..7 {
         for ((u, st), t) in runs.iter_mut().zip(&mut times) {
-            t.push(steps_ms(u, st, 64));
+            t.push(steps_ms(u, st, 400));
         }
     }
     let [d40, m40, t40, t320] = times.map(median);
@@ -207,7 +207,7 @@ fn main() {
     if std::env::args().nth(1).as_deref() == Some("kernel") {
         return;
     }
-    println!("rows  direct_ms  mixed_ms  tree4_ms  tree5_ms  tree6_ms   (CPU time per step, median of 3 × 20 steps)");
+    println!("rows  direct_ms  mixed_ms  tree4_ms  tree5_ms  tree6_ms   (CPU time per step, median of 3 × 100 steps)");
     let tree = |order| WakeAggregation { order, ..WakeAggregation::treecode() };
     for rows in [40usize, 80, 160, 320] {
         let d = step_ms(rows, WakeAggregation::off());

@@ -28,7 +28,7 @@ use crate::treecode::{Treecode, block_order};
 
 /// Steps between rebuilds of a persistent tree: the rows shed since the build are summed
 /// directly, so a longer period trades build time for direct sums.
-pub(crate) const REBUILD_PERIOD: usize = 16;
+pub(crate) const REBUILD_PERIOD: usize = 32;
 
 /// A tree built for one set (not kept across steps) applies from this many times the
 /// aggregation's `min_segments`: on the paper's wing it breaks even at about twice the wake of a
