@@ -36,7 +36,7 @@ use aeroelastic::run::{Observer, Row, Snapshot};
 pub const WAKE_ROWS: [usize; 5] = [20, 40, 80, 160, 320];
 /// Steps timed once the wake is full: two rebuild periods of a kept tree, so that every window
 /// holds the same number of rebuilds.
-const TIMED_STEPS: usize = 32;
+const TIMED_STEPS: usize = 64;
 /// Timed runs of each step configuration, interleaved (every configuration once, then again);
 /// the figure is their median.
 const STEP_REPEATS: usize = 3;

@@ -58,6 +58,12 @@ use crate::scratch::{ScratchPool, TREE_CHUNKS_PER_THREAD};
 /// Largest expansion order supported.
 pub const MAX_ORDER: usize = 12;
 
+/// Distance from a cluster's centre, m, below which a mixed-precision traversal evaluates the
+/// expansion in f64: the Taylor coefficients grow as `|R|^-(p+2)`, which leaves f32's range
+/// (3.4e38) below about 3e-6 m at `p = 5` and 2e-3 m at [`MAX_ORDER`]; at 1 cm they stay below
+/// 1e28 at every order.
+const F32_MIN_DISTANCE: f64 = 1e-2;
+
 /// Points per traversal block: the mixed kernel's width, so that a near leaf is summed sixteen
 /// points at a time; the f64 expansions and legs take the block in two halves of [`LANES`].
 const BLOCK: usize = LANES32;
@@ -859,7 +865,8 @@ impl Treecode {
                 let nt = self.taylor_idx.k.len();
                 let (ci, c) = (ci as usize, c.center);
                 let ncf = n_coefficients(q as usize + 1);
-                if self.mixed {
+                // Closer than F32_MIN_DISTANCE the coefficients could leave f32's range.
+                if self.mixed && d2min >= F32_MIN_DISTANCE * F32_MIN_DISTANCE {
                     let curl = &self.curl32[ci * nt..ci * nt + ncf];
                     let (idx, rec, a) = (&self.taylor_idx, &self.rec32[..], &mut sc.taylor32[..]);
                     match isa() {
