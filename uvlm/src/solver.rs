@@ -79,9 +79,9 @@ pub struct Uvlm {
     /// The names of `far`'s segments, for the persistent tree (wake_tree.rs).
     far_keys: SegmentKeys,
     /// Whether `far` holds only the rows the kept tree needs ([`WakeTree::rows_needed`]); the
-    /// tree holds the rest. Per surface: those rows and the push numbers of the rows left out.
+    /// tree holds the rest. Per surface: those rows, and the push numbers of the rows left out.
     far_partial: bool,
-    far_rows: Vec<(FarRows, (u64, u64))>,
+    far_rows: Vec<FarRows>,
     far_omitted: Vec<(u64, u64)>,
     lu: DenseLu,
     aic: Vec<f64>,
@@ -296,9 +296,8 @@ impl Uvlm {
                 add(self.known.velocity_at(p));
                 if self.far_partial {
                     // `far` holds part of the far wake (the kept tree the rest): build it whole.
-                    let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
                     let mut far = Filaments::default();
-                    build_wakes(&mut far, &self.surfaces, closure, &self.params, WakePart::Far, None, None);
+                    self.build_far_whole(&mut far);
                     add(far.velocity_at(p));
                 } else {
                     add(self.far.velocity_at(p));
@@ -873,9 +872,8 @@ impl Uvlm {
                 return false;
             };
             let n = s.wake.n_pushed();
-            let omitted = (n - (tail - 1) as u64, n - (head + 1) as u64);
-            self.far_rows.push(((head, tail), omitted));
-            self.far_omitted.push(omitted);
+            self.far_rows.push((head, tail));
+            self.far_omitted.push((n - (tail - 1) as u64, n - (head + 1) as u64));
         }
         build_wakes(
             &mut self.far,
@@ -893,11 +891,19 @@ impl Uvlm {
     /// rebuilt from it at its next use).
     fn far_whole(&mut self) {
         if self.far_partial {
-            let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
-            build_wakes(&mut self.far, &self.surfaces, closure, &self.params, WakePart::Far, None, None);
+            let mut far = std::mem::take(&mut self.far);
+            self.build_far_whole(&mut far);
+            self.far = far;
             self.far_tree.invalidate();
             self.far_partial = false;
         }
+    }
+
+    /// The whole far wake of the last solve into `fil` (unnamed).
+    fn build_far_whole(&self, fil: &mut Filaments) {
+        // The stream's direction was checked by the solve that built the partial set.
+        let closure = if self.params.wake_closure { self.stream_dir().ok() } else { None };
+        build_wakes(fil, &self.surfaces, closure, &self.params, WakePart::Far, None, None);
     }
 
     /// Third phase: accept the last [`Uvlm::solve_step`] as the state at the new time (history
@@ -934,7 +940,7 @@ fn build_wakes(
     p: &UvlmParams,
     part: WakePart,
     mut keys: Option<&mut SegmentKeys>,
-    rows: Option<&[(FarRows, (u64, u64))]>,
+    rows: Option<&[FarRows]>,
 ) {
     fil.clear();
     if let Some(k) = keys.as_deref_mut() {
@@ -946,7 +952,7 @@ fn build_wakes(
         if let Some(k) = keys.as_deref_mut() {
             k.surface = i as u64;
         }
-        let r = rows.and_then(|r| r.get(i)).map(|r| r.0);
+        let r = rows.and_then(|r| r.get(i)).copied();
         append_wake_rows(fil, te, &s.wake, closure, &p.wake_core, &p.bound_core, part, r, keys.as_deref_mut());
     }
     append_images(fil, &p.images);

@@ -49,6 +49,8 @@
 //! segment's induction only where a point lies within the core radius of the segment's axis
 //! line, where the singular induction is itself of the order of the core radius.
 
+use std::ops::{Add, AddAssign, Div, Mul, Sub};
+
 use crate::biot_savart::{Filaments, Isa, LANES, NodeBlock, fill_block, isa, velocity_block};
 use crate::induce::{Points, use_threads};
 use crate::mixed::{Block32, Filaments32, LANES32, add_lanes};
@@ -866,33 +868,15 @@ impl Treecode {
                 let (ci, c) = (ci as usize, c.center);
                 let ncf = n_coefficients(q as usize + 1);
                 // Closer than F32_MIN_DISTANCE the coefficients could leave f32's range.
+                let isa = isa();
+                let idx = &self.taylor_idx;
                 if self.mixed && d2min >= F32_MIN_DISTANCE * F32_MIN_DISTANCE {
                     let curl = &self.curl32[ci * nt..ci * nt + ncf];
-                    let (idx, rec, a) = (&self.taylor_idx, &self.rec32[..], &mut sc.taylor32[..]);
-                    match isa() {
-                        Isa::Generic => expansion32_generic(idx, rec, curl, c, px, py, pz, a, u),
-                        // SAFETY: the features were detected at run time.
-                        #[cfg(target_arch = "x86_64")]
-                        Isa::Avx2 => unsafe { expansion32_avx2(idx, rec, curl, c, px, py, pz, a, u) },
-                        // SAFETY: the features were detected at run time.
-                        #[cfg(target_arch = "x86_64")]
-                        Isa::Avx512 => unsafe { expansion32_avx512(idx, rec, curl, c, px, py, pz, a, u) },
-                    }
-                    sc.stats.n_expansions += BLOCK as u64;
-                    continue;
+                    expansion_on(isa, idx, &self.rec32, curl, c, px, py, pz, &mut sc.taylor32, u);
+                } else {
+                    let (curl, a) = (&self.curl[ci * nt..ci * nt + ncf], &mut sc.taylor[..]);
+                    halves.each(u, |px, py, pz, u| expansion_on(isa, idx, &self.rec, curl, c, px, py, pz, a, u));
                 }
-                let curl = &self.curl[ci * nt..ci * nt + ncf];
-                let (idx, rec, a) = (&self.taylor_idx, &self.rec[..], &mut sc.taylor[..]);
-                let isa = isa();
-                halves.each(u, |px, py, pz, u| match isa {
-                    Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
-                    // SAFETY: the features were detected at run time.
-                    #[cfg(target_arch = "x86_64")]
-                    Isa::Avx2 => unsafe { expansion_avx2(idx, rec, curl, c, px, py, pz, a, u) },
-                    // SAFETY: the features were detected at run time.
-                    #[cfg(target_arch = "x86_64")]
-                    Isa::Avx512 => unsafe { expansion_avx512(idx, rec, curl, c, px, py, pz, a, u) },
-                });
                 sc.stats.n_expansions += BLOCK as u64;
             } else if c.leaf != NONE {
                 let leaf = &self.leaves[c.leaf as usize];
@@ -1001,20 +985,66 @@ fn scatter(order: &[u32], b: usize, u: &[[f64; BLOCK]; 3], out: &mut [[f64; 3]])
 }
 
 /// [`expansion_lanes`] compiled for each instruction set, chosen at run time.
+/// The number type of an expansion's recurrence and sum: f64, or f32 in mixed precision. Only
+/// IEEE additions, multiplications, divisions and square roots (no fused operations), so every
+/// instruction set gives the same bits.
+trait Lane: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + AddAssign {
+    const ZERO: Self;
+    const ONE: Self;
+    /// `x` rounded to this type.
+    fn of(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+    fn sqrt(self) -> Self;
+}
+
+impl Lane for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+}
+
+impl Lane for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn of(x: f64) -> Self {
+        x as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+}
+
 macro_rules! expansion_variants {
     ($($name:ident $(, $feat:literal)?);*) => {$(
         $(#[cfg(target_arch = "x86_64")] #[target_feature(enable = $feat)])?
         #[allow(clippy::too_many_arguments)] // as expansion_lanes
-        fn $name(
+        fn $name<T: Lane, const N: usize>(
             idx: &Indices,
-            rec: &[(f64, f64)],
-            curl: &[[f64; 3]],
+            rec: &[(T, T)],
+            curl: &[[T; 3]],
             c: [f64; 3],
-            px: &[f64; LANES],
-            py: &[f64; LANES],
-            pz: &[f64; LANES],
-            a: &mut [[f64; LANES]],
-            u: &mut [[f64; LANES]; 3],
+            px: &[f64; N],
+            py: &[f64; N],
+            pz: &[f64; N],
+            a: &mut [[T; N]],
+            u: &mut [[f64; N]; 3],
         ) {
             expansion_lanes(idx, rec, curl, c, px, py, pz, a, u);
         }
@@ -1022,154 +1052,97 @@ macro_rules! expansion_variants {
 }
 expansion_variants!(expansion_generic; expansion_avx2, "avx2,fma"; expansion_avx512, "avx512f,avx2,fma");
 
-macro_rules! expansion32_variants {
-    ($($name:ident $(, $feat:literal)?);*) => {$(
-        $(#[cfg(target_arch = "x86_64")] #[target_feature(enable = $feat)])?
-        #[allow(clippy::too_many_arguments)] // as expansion32_lanes
-        fn $name(
-            idx: &Indices,
-            rec: &[(f32, f32)],
-            curl: &[[f32; 3]],
-            c: [f64; 3],
-            px: &[f64; BLOCK],
-            py: &[f64; BLOCK],
-            pz: &[f64; BLOCK],
-            a: &mut [[f32; BLOCK]],
-            u: &mut [[f64; BLOCK]; 3],
-        ) {
-            expansion32_lanes(idx, rec, curl, c, px, py, pz, a, u);
-        }
-    )*};
-}
-expansion32_variants!(expansion32_generic; expansion32_avx2, "avx2,fma"; expansion32_avx512, "avx512f,avx2,fma");
-
-/// [`expansion_lanes`] in f32 on a whole block of sixteen points: `R = P − c` formed in f64 and
-/// rounded, the recurrence and the sum in f32 (no fused operations, so every instruction set
-/// gives the same bits), the sum added to the f64 velocities.
+/// [`expansion_lanes`] compiled for the instruction set `isa`.
 #[allow(clippy::too_many_arguments)] // as expansion_lanes
 #[inline(always)]
-fn expansion32_lanes(
+fn expansion_on<T: Lane, const N: usize>(
+    isa: Isa,
     idx: &Indices,
-    rec: &[(f32, f32)],
-    curl: &[[f32; 3]],
+    rec: &[(T, T)],
+    curl: &[[T; 3]],
     c: [f64; 3],
-    px: &[f64; BLOCK],
-    py: &[f64; BLOCK],
-    pz: &[f64; BLOCK],
-    a: &mut [[f32; BLOCK]],
-    u: &mut [[f64; BLOCK]; 3],
+    px: &[f64; N],
+    py: &[f64; N],
+    pz: &[f64; N],
+    a: &mut [[T; N]],
+    u: &mut [[f64; N]; 3],
 ) {
-    let mut r = [[0.0f32; BLOCK]; 3];
-    let mut inv_r2 = [0.0f32; BLOCK];
-    for l in 0..BLOCK {
-        r[0][l] = (px[l] - c[0]) as f32;
-        r[1][l] = (py[l] - c[1]) as f32;
-        r[2][l] = (pz[l] - c[2]) as f32;
-        let r2 = r[0][l] * r[0][l] + r[1][l] * r[1][l] + r[2][l] * r[2][l];
-        inv_r2[l] = 1.0 / r2;
-        a[0][l] = inv_r2[l].sqrt();
-    }
-    for k in 1..curl.len() {
-        let (c1, c2) = rec[k];
-        let (d1, d2) = (idx.down1[k], idx.down2[k]);
-        let mut acc1 = [0.0f32; BLOCK];
-        let mut acc2 = [0.0f32; BLOCK];
-        for i in 0..3 {
-            if d1[i] != NONE {
-                let prev = a[d1[i] as usize];
-                for l in 0..BLOCK {
-                    acc1[l] += r[i][l] * prev[l];
-                }
-            }
-            if d2[i] != NONE {
-                let prev = a[d2[i] as usize];
-                for l in 0..BLOCK {
-                    acc2[l] += prev[l];
-                }
-            }
-        }
-        let out = &mut a[k];
-        for l in 0..BLOCK {
-            out[l] = (c1 * acc1[l] - c2 * acc2[l]) * inv_r2[l];
-        }
-    }
-    let mut acc = [[0.0f32; BLOCK]; 3];
-    for (b, ak) in curl.iter().zip(&a[..curl.len()]).skip(1) {
-        for l in 0..BLOCK {
-            acc[0][l] += ak[l] * b[0];
-            acc[1][l] += ak[l] * b[1];
-            acc[2][l] += ak[l] * b[2];
-        }
-    }
-    for (uq, aq) in u.iter_mut().zip(&acc) {
-        for l in 0..BLOCK {
-            uq[l] += aq[l] as f64;
-        }
+    match isa {
+        Isa::Generic => expansion_generic(idx, rec, curl, c, px, py, pz, a, u),
+        // SAFETY: the features were detected at run time.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { expansion_avx2(idx, rec, curl, c, px, py, pz, a, u) },
+        // SAFETY: the features were detected at run time.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { expansion_avx512(idx, rec, curl, c, px, py, pz, a, u) },
     }
 }
 
-/// Taylor coefficients at the block's points and the sum over the moments, lane by lane.
+/// Taylor coefficients at `N` points and the sum over the moments, lane by lane, in the number
+/// type `T`: `R = P − c` formed in f64 and rounded to `T`, the recurrence and the sum in `T`,
+/// the sum added to the f64 velocities. In f64 on halves of a block ([`LANES`]); in f32 on
+/// whole blocks ([`BLOCK`]).
 #[allow(clippy::too_many_arguments)] // tables, coefficients, centre, points, scratch and output
 #[inline(always)]
-fn expansion_lanes(
+fn expansion_lanes<T: Lane, const N: usize>(
     idx: &Indices,
-    rec: &[(f64, f64)],
-    curl: &[[f64; 3]],
+    rec: &[(T, T)],
+    curl: &[[T; 3]],
     c: [f64; 3],
-    px: &[f64; LANES],
-    py: &[f64; LANES],
-    pz: &[f64; LANES],
-    a: &mut [[f64; LANES]],
-    u: &mut [[f64; LANES]; 3],
+    px: &[f64; N],
+    py: &[f64; N],
+    pz: &[f64; N],
+    a: &mut [[T; N]],
+    u: &mut [[f64; N]; 3],
 ) {
-    let mut r = [[0.0; LANES]; 3];
-    let mut inv_r2 = [0.0; LANES];
-    for l in 0..LANES {
-        r[0][l] = px[l] - c[0];
-        r[1][l] = py[l] - c[1];
-        r[2][l] = pz[l] - c[2];
+    let mut r = [[T::ZERO; N]; 3];
+    let mut inv_r2 = [T::ZERO; N];
+    for l in 0..N {
+        r[0][l] = T::of(px[l] - c[0]);
+        r[1][l] = T::of(py[l] - c[1]);
+        r[2][l] = T::of(pz[l] - c[2]);
         let r2 = r[0][l] * r[0][l] + r[1][l] * r[1][l] + r[2][l] * r[2][l];
-        inv_r2[l] = 1.0 / r2;
+        inv_r2[l] = T::ONE / r2;
         a[0][l] = inv_r2[l].sqrt();
     }
     // The coefficients of `curl` only: those of degree ≤ q + 1, listed by degree.
     for k in 1..curl.len() {
         let (c1, c2) = rec[k];
         let (d1, d2) = (idx.down1[k], idx.down2[k]);
-        let mut acc1 = [0.0; LANES];
-        let mut acc2 = [0.0; LANES];
+        let mut acc1 = [T::ZERO; N];
+        let mut acc2 = [T::ZERO; N];
         for i in 0..3 {
             if d1[i] != NONE {
                 let prev = a[d1[i] as usize];
-                for l in 0..LANES {
+                for l in 0..N {
                     acc1[l] += r[i][l] * prev[l];
                 }
             }
             if d2[i] != NONE {
                 let prev = a[d2[i] as usize];
-                for l in 0..LANES {
+                for l in 0..N {
                     acc2[l] += prev[l];
                 }
             }
         }
         let out = &mut a[k];
-        for l in 0..LANES {
+        for l in 0..N {
             out[l] = (c1 * acc1[l] - c2 * acc2[l]) * inv_r2[l];
         }
     }
     // a_0 (|k| = 0) has no coefficient: the velocity is a gradient's curl. Summed in registers,
     // then added to `u`.
-    let mut acc = [[0.0; LANES]; 3];
+    let mut acc = [[T::ZERO; N]; 3];
     for (b, ak) in curl.iter().zip(&a[..curl.len()]).skip(1) {
-        for l in 0..LANES {
+        for l in 0..N {
             acc[0][l] += ak[l] * b[0];
             acc[1][l] += ak[l] * b[1];
             acc[2][l] += ak[l] * b[2];
         }
     }
     for (uq, aq) in u.iter_mut().zip(&acc) {
-        for l in 0..LANES {
-            uq[l] += aq[l];
+        for l in 0..N {
+            uq[l] += aq[l].to_f64();
         }
     }
 }
@@ -1607,16 +1580,8 @@ mod tests {
         let run = |isa: Isa| {
             let mut a = vec![[0.0f32; BLOCK]; nt];
             let mut u = [[0.0; BLOCK]; 3];
-            let (idx, rec) = (&tree.taylor_idx, &tree.rec32[..]);
-            match isa {
-                Isa::Generic => expansion32_generic(idx, rec, curl32, c, &p[0], &p[1], &p[2], &mut a, &mut u),
-                // SAFETY: called only when detected below.
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => unsafe { expansion32_avx2(idx, rec, curl32, c, &p[0], &p[1], &p[2], &mut a, &mut u) },
-                // SAFETY: called only when detected below.
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => unsafe { expansion32_avx512(idx, rec, curl32, c, &p[0], &p[1], &p[2], &mut a, &mut u) },
-            }
+            // Called with an instruction set only when it is detected below.
+            expansion_on(isa, &tree.taylor_idx, &tree.rec32, curl32, c, &p[0], &p[1], &p[2], &mut a, &mut u);
             u
         };
         let generic = run(Isa::Generic);

@@ -140,10 +140,13 @@ impl WakeTree {
     /// buffer drops rows). The rows between are the tree's, translated and unchanged. `None`
     /// when the next sync rebuilds, or when nothing would be left out.
     pub(crate) fn rows_needed(&self, len: usize) -> Option<FarRows> {
-        let p = &self.persist;
-        let kept = self.ready && p.valid && p.age < REBUILD_PERIOD;
-        let (head, tail) = (p.age + 1, len);
-        (kept && head + 2 < tail).then_some((head, tail))
+        let (head, tail) = (self.persist.age + 1, len);
+        (self.updatable() && head + 2 < tail).then_some((head, tail))
+    }
+
+    /// Whether the next sync may update the kept tree in place rather than rebuild it.
+    fn updatable(&self) -> bool {
+        self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD
     }
 
     /// Make the tree hold `set`, whose segments are named by `keys` (or `None` when they cannot
@@ -156,7 +159,7 @@ impl WakeTree {
         };
         debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "segment keys ascend");
         self.partial = false;
-        if self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD && self.update(set, keys, None) {
+        if self.updatable() && self.update(set, keys, None) {
             return;
         }
         self.tree.build(set);
@@ -180,7 +183,7 @@ impl WakeTree {
     /// Returns false, changing nothing the next full sync needs, when the tree cannot be updated
     /// (it is not kept, or most of the set is new): then sync the whole set.
     pub(crate) fn sync_rows(&mut self, set: &Filaments, keys: &[u64], omitted: &[(u64, u64)]) -> bool {
-        if keys.len() != set.n_segments() || !(self.ready && self.persist.valid && self.persist.age < REBUILD_PERIOD) {
+        if keys.len() != set.n_segments() || !self.updatable() {
             return false;
         }
         debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "segment keys ascend");
@@ -367,7 +370,7 @@ fn copy_legs(set: &Filaments, out: &mut Filaments) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::aic::{SegmentKeys, WakePart, append_known_wake, append_wake_rows};
+    use crate::aic::{SegmentKeys, WakePart, append_wake_rows};
     use crate::biot_savart::CoreModel;
     use crate::images::{ImagePlane, append_images};
     use crate::induce::induced_velocity;
@@ -418,19 +421,16 @@ mod tests {
                 })
                 .collect();
             wake.push_front(&row, &gamma);
-            let (mut fil, mut keys) = (Filaments::default(), SegmentKeys::default());
-            append_known_wake(
-                &mut fil,
-                &te,
-                &wake,
-                Some([1.0, 0.0, 0.0]),
-                &core,
-                &core,
-                WakePart::Far,
-                Some(&mut keys),
-            );
-            append_images(&mut fil, &planes);
-            keys.append_images(planes.len());
+            // The far wake with its images and names: whole, or only the node rows `rows`.
+            let far = |rows: Option<FarRows>| {
+                let (mut fil, mut keys) = (Filaments::default(), SegmentKeys::default());
+                let (closure, part) = (Some([1.0, 0.0, 0.0]), WakePart::Far);
+                append_wake_rows(&mut fil, &te, &wake, closure, &core, &core, part, rows, Some(&mut keys));
+                append_images(&mut fil, &planes);
+                keys.append_images(planes.len());
+                (fil, keys)
+            };
+            let (fil, keys) = far(None);
             tree.sync(&fil, Some(&keys.keys));
             if tree.persist.age > 0 {
                 kept += 1;
@@ -438,20 +438,7 @@ mod tests {
             let mut u = vec![[0.0; 3]; pts.len()];
             tree.add_velocity(&fil, &pts, tol, &mut u, Parallel::Off, &mut scratch);
             let synced = by_rows.rows_needed(wake.n_rows()).is_some_and(|r| {
-                let (mut part, mut keys) = (Filaments::default(), SegmentKeys::default());
-                append_wake_rows(
-                    &mut part,
-                    &te,
-                    &wake,
-                    Some([1.0, 0.0, 0.0]),
-                    &core,
-                    &core,
-                    WakePart::Far,
-                    Some(r),
-                    Some(&mut keys),
-                );
-                append_images(&mut part, &planes);
-                keys.append_images(planes.len());
+                let (part, keys) = far(Some(r));
                 let np = wake.n_pushed();
                 let omitted = [(np - (r.1 - 1) as u64, np - (r.0 + 1) as u64)];
                 assert!(part.n_segments() < fil.n_segments(), "step {step}: rows left out");
