@@ -841,6 +841,9 @@ impl BorderedBandLu {
             }
         }
         self.active_known = true;
+        if nb == 0 {
+            return Ok(()); // no border: the band's factors are the whole factorisation
+        }
         // Dense LU of S with partial pivoting. A pivot is tested against its own column's
         // largest entry before the elimination, not against all of S: the border mixes units
         // (frame velocities, rotation rates, multipliers), and a column that is small throughout
@@ -1035,6 +1038,25 @@ mod tests {
         let mut a = a;
         *a.get_mut(2, 12) = 1.0;
         assert!(!lu.fits(&a));
+    }
+
+    /// Blocks that cover every unknown leave no border: the band factors alone solve it (an
+    /// unconstrained model's ODE path).
+    #[test]
+    fn a_structure_without_border_solves() {
+        let n = 33;
+        let st = BandedBorder { blocks: vec![(0, 15, 3), (15, 18, 4)], node_bandwidth: None };
+        assert!(st.is_valid(n));
+        let a = random_bordered(n, &st, 11);
+        let mut lu = BorderedBandLu::new(n, &st);
+        lu.factorize(&a).unwrap();
+        let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.61).cos()).collect();
+        let mut b = vec![0.0; n];
+        a.mul_vec_inplace(&x_true, &mut b);
+        lu.solve_in_place(&mut b);
+        for (x, y) in b.iter().zip(&x_true) {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
     }
 
     /// Direct assembly (entry by entry, by slices and by strided sub-blocks, twice with a clear
