@@ -103,6 +103,13 @@ pub struct AeroSettings {
     /// free-stream speed, docs/uvlm.md §14); default true. `false` sums it in f64.
     #[cfg_attr(feature = "serde", serde(default = "default_true"))]
     pub wake_mixed_precision: bool,
+    /// Solve for the circulations of a moving lattice on the factorisation of an earlier
+    /// influence matrix, refined against the current one to 1e-12 of the largest circulation,
+    /// and factorise again only when the refinement slows (docs/uvlm.md §9); default true.
+    /// `false` factorises every change of the matrix (with `wake_aggregation: false`, bit for bit
+    /// the exact f64 path).
+    #[cfg_attr(feature = "serde", serde(default = "default_true"))]
+    pub aic_refinement: bool,
     /// Section polars (issue 37, docs/section_aero.md): the lattice's loads on the strips of
     /// these bodies are corrected by the polar (lift, profile drag, moment); default none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
@@ -211,6 +218,7 @@ impl AeroSettings {
         } else {
             uvlm::WakeAggregation::off()
         };
+        params.aic_refinement = self.aic_refinement;
         params
     }
 }

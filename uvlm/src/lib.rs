@@ -132,6 +132,7 @@ mod load_derivative;
 mod loads;
 mod mixed;
 mod params;
+mod refine;
 pub mod samples;
 mod scratch;
 mod solver;

@@ -187,6 +187,12 @@ pub struct UvlmParams {
     /// directly).
     #[serde(default)]
     pub wake_aggregation: WakeAggregation,
+    /// Solve for Γ with the factorisation of an earlier influence matrix, corrected by iterative
+    /// refinement against the current one to 1e-12 of the largest Γ, while that converges fast
+    /// (refine.rs, docs/uvlm.md §9); the matrix is factorised again when it does not. Default
+    /// false: every change of the matrix is factorised, bit for bit as without the option.
+    #[serde(default)]
+    pub aic_refinement: bool,
 }
 
 fn default_wake_rows() -> usize {
@@ -215,6 +221,7 @@ impl UvlmParams {
             steady_wake: SteadyWake::SemiInfinite,
             wake_reuse: WakeReuse::Recompute,
             wake_aggregation: WakeAggregation::default(),
+            aic_refinement: false,
         }
     }
 

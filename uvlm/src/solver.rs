@@ -15,6 +15,7 @@ use crate::lattice::Lattice;
 use crate::loads::{Loads, compute_loads, concatenate_loads};
 use crate::mixed::{MixedScratch, add_velocity_mixed};
 use crate::params::{SteadyWake, UvlmParams, WakeConvection, WakeReuse};
+use crate::refine;
 use crate::scratch::ScratchPool;
 use crate::station::{SpanStation, StationVelocity};
 use crate::stats::Stats;
@@ -86,9 +87,17 @@ pub struct Uvlm {
     lu: DenseLu,
     aic: Vec<f64>,
     rhs: Vec<f64>,
-    /// The mode the current influence matrix was built and factorised for (with the lattice
-    /// versions of [`Surface::aic_version`]); `None` when it must be rebuilt.
+    /// The mode the current influence matrix was built for (with the lattice versions of
+    /// [`Surface::aic_version`]); `None` when it must be rebuilt.
     aic_mode: Option<Mode>,
+    /// The mode of the matrix `lu` factorised (`None`: no factorisation), and whether that matrix
+    /// is an earlier one than `aic` ([`UvlmParams::aic_refinement`]: solves refine on it).
+    lu_mode: Option<Mode>,
+    lu_stale: bool,
+    /// The last refined solve was slow: factorise at the next change of the matrix.
+    refactor_next: bool,
+    /// Scratch of the refined solves.
+    refine_work: Vec<f64>,
     col: Points,
     nrm: Points,
     mid: Points,
@@ -160,6 +169,10 @@ impl Uvlm {
             aic: vec![0.0; AicLayout::BlockRings.len(nr)],
             rhs: vec![0.0; nr],
             aic_mode: None,
+            lu_mode: None,
+            lu_stale: false,
+            refactor_next: false,
+            refine_work: vec![0.0; nr],
             col: Points::default(),
             nrm: Points::default(),
             mid: Points::default(),
@@ -239,7 +252,7 @@ impl Uvlm {
         p.validate()?;
         if self.params.steady_wake != wake {
             self.params.steady_wake = wake;
-            self.aic_mode = None;
+            (self.aic_mode, self.lu_mode) = (None, None);
         }
         Ok(())
     }
@@ -393,14 +406,48 @@ impl Uvlm {
         );
         self.stats.n_aic_builds += 1;
         self.aic_mode = None;
-        self.lu
-            .factorize_block_rings(&self.aic, crate::biot_savart::LANES)
-            .map_err(|pivot| UvlmError::SingularAic { pivot })?;
-        self.stats.n_factorizations += 1;
+        if self.params.aic_refinement && self.lu_mode == Some(mode) && !self.refactor_next {
+            // Solves refine on the factorisation in hand (refine.rs).
+            self.lu_stale = true;
+        } else {
+            self.factorize_aic(mode)?;
+        }
         self.aic_mode = Some(mode);
         for s in &mut self.surfaces {
             s.aic_version = Some(s.lattice.version());
         }
+        Ok(())
+    }
+
+    /// Factorise the current influence matrix, built for `mode`.
+    fn factorize_aic(&mut self, mode: Mode) -> Result<()> {
+        self.lu_mode = None;
+        self.lu
+            .factorize_block_rings(&self.aic, crate::biot_savart::LANES)
+            .map_err(|pivot| UvlmError::SingularAic { pivot })?;
+        self.stats.n_factorizations += 1;
+        (self.lu_mode, self.lu_stale, self.refactor_next) = (Some(mode), false, false);
+        Ok(())
+    }
+
+    /// `gamma ← A⁻¹ rhs` with the current influence matrix: with its factors, or refined on the
+    /// factors of an earlier one, factorising it when the refinement does not converge.
+    fn solve_aic(&mut self) -> Result<()> {
+        self.gamma.copy_from_slice(&self.rhs);
+        if self.lu_stale {
+            let refined =
+                refine::solve_refined(&mut self.lu, &self.aic, &self.rhs, &mut self.gamma, &mut self.refine_work);
+            if let Some(k) = refined {
+                self.stats.n_refined_solves += 1;
+                self.stats.n_refinement_corrections += k;
+                self.refactor_next = k > refine::REFACTOR_ABOVE;
+                return Ok(());
+            }
+            let mode = self.aic_mode.expect("a stale factorisation implies a current matrix");
+            self.factorize_aic(mode)?;
+            self.gamma.copy_from_slice(&self.rhs);
+        }
+        self.lu.solve_in_place(&mut self.gamma);
         Ok(())
     }
 
@@ -448,8 +495,7 @@ impl Uvlm {
                 self.rhs[rg] = -s;
             }
         }
-        self.gamma.copy_from_slice(&self.rhs);
-        self.lu.solve_in_place(&mut self.gamma);
+        self.solve_aic()?;
         if !self.gamma.iter().all(|g| g.is_finite()) {
             return Err(UvlmError::NonFiniteSolution { step: self.stats.n_steps });
         }
