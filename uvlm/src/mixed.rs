@@ -487,6 +487,36 @@ fn add_block(
 pub(crate) struct MixedScratch {
     consts: Filaments32,
     blocks: ScratchPool<Block32<LANES32>>,
+    /// Whether `consts` are those of the set of the last [`add_velocity_mixed_kept`], which its
+    /// owner has not changed since ([`MixedScratch::forget`]), and that set's node, segment and
+    /// leg counts (a set of other counts is loaded whatever the flag says).
+    kept: bool,
+    kept_counts: [usize; 3],
+}
+
+impl MixedScratch {
+    /// The set of [`add_velocity_mixed_kept`] changed: load its constants at the next call.
+    pub(crate) fn forget(&mut self) {
+        self.kept = false;
+    }
+}
+
+/// [`add_velocity_mixed`] for a set whose owner calls [`MixedScratch::forget`] whenever it
+/// changes: the f32 constants are loaded once per change, not once per call (the far wake is
+/// summed at the collocation points, then at the segment midpoints, of each step).
+pub(crate) fn add_velocity_mixed_kept(
+    fil: &Filaments,
+    pts: &Points,
+    out: &mut [[f64; 3]],
+    parallel: Parallel,
+    scratch: &mut MixedScratch,
+) -> u64 {
+    let counts = [fil.n_nodes(), fil.n_segments(), fil.n_legs()];
+    if !scratch.kept || scratch.kept_counts != counts {
+        scratch.consts.load(fil);
+        (scratch.kept, scratch.kept_counts) = (true, counts);
+    }
+    add_loaded(fil, pts, out, parallel, scratch)
 }
 
 /// Add the velocity induced by `fil` at every point of `pts` to `out`, in mixed precision.
@@ -502,11 +532,23 @@ pub(crate) fn add_velocity_mixed(
     parallel: Parallel,
     scratch: &mut MixedScratch,
 ) -> u64 {
+    scratch.consts.load(fil);
+    scratch.kept = false;
+    add_loaded(fil, pts, out, parallel, scratch)
+}
+
+/// [`add_velocity_mixed`] with `fil`'s constants in `scratch`.
+fn add_loaded(
+    fil: &Filaments,
+    pts: &Points,
+    out: &mut [[f64; 3]],
+    parallel: Parallel,
+    scratch: &mut MixedScratch,
+) -> u64 {
     assert_eq!(out.len(), pts.len(), "add_velocity_mixed: output length");
     if pts.is_empty() || fil.n_filaments() == 0 {
         return 0;
     }
-    scratch.consts.load(fil);
     let c = &scratch.consts;
     let n_blocks = pts.len().div_ceil(LANES32);
     let pairs = n_blocks * LANES32 * fil.n_filaments();

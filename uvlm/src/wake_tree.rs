@@ -21,7 +21,7 @@
 use crate::aic::{FarRows, SegmentKeys};
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, load_lanes, velocity_block};
 use crate::induce::{Points, induced_velocity_inplace};
-use crate::mixed::{MixedScratch, add_velocity_mixed};
+use crate::mixed::{MixedScratch, add_velocity_mixed, add_velocity_mixed_kept};
 use crate::params::{Parallel, WakeAggregation};
 use crate::scratch::ScratchPool;
 use crate::treecode::{Treecode, block_order};
@@ -105,6 +105,7 @@ impl WakeTree {
 
     /// The set changed in a way the tree cannot follow: rebuild at the next use.
     pub(crate) fn invalidate(&mut self) {
+        self.forget_mixed();
         self.ready = false;
         self.persist.valid = false;
         self.partial = false;
@@ -112,7 +113,15 @@ impl WakeTree {
 
     /// The wake moved other than rigidly (or was replaced): the next [`WakeTree::sync`] rebuilds.
     pub(crate) fn break_persistence(&mut self) {
+        self.forget_mixed();
         self.persist.valid = false;
+    }
+
+    /// The set changed: the mixed-precision sum loads its constants again.
+    fn forget_mixed(&mut self) {
+        if let Some(m) = &mut self.mixed {
+            m.forget();
+        }
     }
 
     /// Every node of the set's wake moved by `d`, m (a rigid convection step).
@@ -153,6 +162,7 @@ impl WakeTree {
     /// be): update the persistent tree when it is valid, young and holds most of the set,
     /// else rebuild it.
     pub(crate) fn sync(&mut self, set: &Filaments, keys: Option<&[u64]>) {
+        self.forget_mixed();
         let Some(keys) = keys.filter(|k| k.len() == set.n_segments() && self.applies(set)) else {
             self.invalidate();
             return;
@@ -183,6 +193,7 @@ impl WakeTree {
     /// Returns false, changing nothing the next full sync needs, when the tree cannot be updated
     /// (it is not kept, or most of the set is new): then sync the whole set.
     pub(crate) fn sync_rows(&mut self, set: &Filaments, keys: &[u64], omitted: &[(u64, u64)]) -> bool {
+        self.forget_mixed();
         if keys.len() != set.n_segments() || !self.updatable() {
             return false;
         }
@@ -279,7 +290,8 @@ impl WakeTree {
             || (rebuilt && set.n_segments() < REBUILT_FACTOR.saturating_mul(self.settings.min_segments))
         {
             return match &mut self.mixed {
-                Some(m) => add_velocity_mixed(set, pts, out, parallel, m),
+                // The set is the one of the last sync (every change of it goes through one).
+                Some(m) => add_velocity_mixed_kept(set, pts, out, parallel, m),
                 None => add_direct(set, pts, out, parallel, scratch),
             };
         }
