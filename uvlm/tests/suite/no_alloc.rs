@@ -1,7 +1,7 @@
 //! The time loop does not allocate: once the wake buffer is full and every work buffer has
 //! reached its size, `update_stations` + `step` perform no heap allocation (counting allocator;
-//! prescribed and free wake, with a symmetry plane, without and with a disturbance field; single
-//! thread, and threaded on a rayon pool of two with the wake summed directly and through the
+//! prescribed and free wake, with a symmetry plane, without and with a disturbance field, with the
+//! refined solves of the influence matrix; single thread, and threaded on a rayon pool of two with the wake summed directly and through the
 //! treecode).
 
 use uvlm::samples::FlaredWing;
@@ -9,11 +9,12 @@ use uvlm::*;
 
 #[test]
 fn step_does_not_allocate() {
-    for (convection, disturbed) in [
-        (WakeConvection::Prescribed, false),
-        (WakeConvection::Free, false),
-        (WakeConvection::Prescribed, true),
-        (WakeConvection::Free, true),
+    for (convection, disturbed, refined) in [
+        (WakeConvection::Prescribed, false, false),
+        (WakeConvection::Free, false, false),
+        (WakeConvection::Prescribed, true, false),
+        (WakeConvection::Free, true, false),
+        (WakeConvection::Prescribed, false, true),
     ] {
         let wing = FlaredWing { aoa: 5f64.to_radians(), ..FlaredWing::default() };
         let stations: Vec<Vec<SpanStation>> = (0..8).map(|k| wing.stations(0.02 * k as f64)).collect();
@@ -25,6 +26,7 @@ fn step_does_not_allocate() {
         p.wake_convection = convection;
         p.wake_core = CoreModel::Scully { fraction: 0.1 };
         p.images = vec![ImagePlane::through_origin([1.0, 0.0, 0.0])];
+        p.aic_refinement = refined;
         let mut u = Uvlm::new(lat, p).unwrap();
         if disturbed {
             // A travelling vertical gust: evaluated at every point, every step.
@@ -40,7 +42,13 @@ fn step_does_not_allocate() {
                 u.step(0.01).unwrap();
             }
         });
-        assert_eq!(allocations, 0, "{convection:?}, disturbed {disturbed}: {allocations} allocations in 8 steps");
+        assert_eq!(
+            allocations, 0,
+            "{convection:?}, disturbed {disturbed}, refined {refined}: {allocations} allocations in 8 steps"
+        );
+        if refined {
+            assert!(u.stats().n_refined_solves > 0, "{:?}", u.stats());
+        }
     }
 }
 
