@@ -26,6 +26,10 @@ pub(crate) const MAX_CORRECTIONS: usize = 8;
 /// A correction larger than this fraction of the one before ends the refinement as failed.
 pub(crate) const MAX_CONTRACTION: f64 = 0.25;
 
+/// Refined solves on one unchanged matrix after which the caller factorises it: a lattice that
+/// stopped moving then solves with its own factors.
+pub(crate) const MAX_STALE_SOLVES: usize = 8;
+
 /// Corrections above which the caller refactorises at its next change of the matrix. On the
 /// paper's wing (128 rings, 2000 steps) the solves took 3.9 corrections on average and the
 /// matrix was factorised 16 times; on Healy's (176 rings, 1000 steps of a gust) 3.7 and 14.

@@ -96,6 +96,8 @@ pub struct Uvlm {
     lu_stale: bool,
     /// The last refined solve was slow: factorise at the next change of the matrix.
     refactor_next: bool,
+    /// Solves refined on the current matrix (which has not changed since).
+    stale_solves: usize,
     /// Scratch of the refined solves.
     refine_work: Vec<f64>,
     col: Points,
@@ -172,6 +174,7 @@ impl Uvlm {
             lu_mode: None,
             lu_stale: false,
             refactor_next: false,
+            stale_solves: 0,
             refine_work: vec![0.0; nr],
             col: Points::default(),
             nrm: Points::default(),
@@ -408,7 +411,7 @@ impl Uvlm {
         self.aic_mode = None;
         if self.params.aic_refinement && self.lu_mode == Some(mode) && !self.refactor_next {
             // Solves refine on the factorisation in hand (refine.rs).
-            self.lu_stale = true;
+            (self.lu_stale, self.stale_solves) = (true, 0);
         } else {
             self.factorize_aic(mode)?;
         }
@@ -434,16 +437,20 @@ impl Uvlm {
     /// factors of an earlier one, factorising it when the refinement does not converge.
     fn solve_aic(&mut self) -> Result<()> {
         self.gamma.copy_from_slice(&self.rhs);
-        if self.lu_stale {
-            let refined =
-                refine::solve_refined(&mut self.lu, &self.aic, &self.rhs, &mut self.gamma, &mut self.refine_work);
+        // A stale factorisation is of the current matrix's mode (prepare_aic).
+        if let (true, Some(mode)) = (self.lu_stale, self.lu_mode) {
+            self.stale_solves += 1;
+            let refined = if self.stale_solves > refine::MAX_STALE_SOLVES {
+                None // the matrix stopped changing: its own factors pay
+            } else {
+                refine::solve_refined(&mut self.lu, &self.aic, &self.rhs, &mut self.gamma, &mut self.refine_work)
+            };
             if let Some(k) = refined {
                 self.stats.n_refined_solves += 1;
                 self.stats.n_refinement_corrections += k;
                 self.refactor_next = k > refine::REFACTOR_ABOVE;
                 return Ok(());
             }
-            let mode = self.aic_mode.expect("a stale factorisation implies a current matrix");
             self.factorize_aic(mode)?;
             self.gamma.copy_from_slice(&self.rhs);
         }

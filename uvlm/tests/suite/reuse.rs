@@ -182,3 +182,31 @@ fn refined_solves_match_a_factorisation_of_every_matrix() {
     assert!(sb.n_refined_solves > 0 && 5 * sb.n_factorizations < sb.n_aic_builds, "{sb:?}");
     assert_eq!(sb.n_refined_solves + sb.n_factorizations, sb.n_aic_builds);
 }
+
+/// Refined solves on a matrix that stops changing: the first eight solves on it refine on the
+/// earlier factors, the ninth factorises it, and later ones use its own factors.
+#[test]
+fn a_matrix_that_stops_changing_is_factorised_after_eight_refined_solves() {
+    let (u, wing) = solver(WakeReuse::Frozen);
+    let mut params = u.params().clone();
+    params.aic_refinement = true;
+    let mut u = Uvlm::new(u.lattice().clone(), params).unwrap();
+    for k in 1..=3 {
+        u.advance_wake(0.01).unwrap();
+        u.update_stations(&wing.stations(fold(k)), None).unwrap();
+        u.solve_step().unwrap();
+        u.commit_step().unwrap();
+    }
+    let before = *u.stats();
+    assert_eq!(before.n_factorizations, 1, "{before:?}");
+    u.advance_wake(0.01).unwrap();
+    u.update_stations(&wing.stations(fold(4)), None).unwrap();
+    for _ in 0..12 {
+        u.solve_step().unwrap();
+    }
+    u.commit_step().unwrap();
+    let after = *u.stats();
+    assert_eq!(after.n_aic_builds - before.n_aic_builds, 1, "{after:?}");
+    assert_eq!(after.n_refined_solves - before.n_refined_solves, 8, "{after:?}");
+    assert_eq!(after.n_factorizations - before.n_factorizations, 1, "{after:?}");
+}
