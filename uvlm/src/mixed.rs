@@ -487,7 +487,7 @@ fn add_block(
 pub(crate) struct MixedScratch {
     consts: Filaments32,
     blocks: ScratchPool<Block32<LANES32>>,
-    /// Whether `consts` are those of the set of the last [`add_velocity_mixed_kept`], which its
+    /// Whether `consts` are those of the set of the last [`MixedScratch::load_once`], which its
     /// owner has not changed since ([`MixedScratch::forget`]), and that set's node, segment and
     /// leg counts (a set of other counts is loaded whatever the flag says).
     kept: bool,
@@ -495,28 +495,58 @@ pub(crate) struct MixedScratch {
 }
 
 impl MixedScratch {
-    /// The set of [`add_velocity_mixed_kept`] changed: load its constants at the next call.
+    /// Take `fil`'s f32 constants.
+    fn load(&mut self, fil: &Filaments) {
+        self.consts.load(fil);
+        self.kept = false;
+    }
+
+    /// Take `fil`'s f32 constants unless they are held already: for a set whose owner calls
+    /// [`MixedScratch::forget`] whenever it changes, so that they are loaded once per change,
+    /// not once per sum (the far wake is summed at the collocation points, then at the segment
+    /// midpoints, of each step).
+    pub(crate) fn load_once(&mut self, fil: &Filaments) {
+        let counts = [fil.n_nodes(), fil.n_segments(), fil.n_legs()];
+        if !self.kept || self.kept_counts != counts {
+            self.consts.load(fil);
+            (self.kept, self.kept_counts) = (true, counts);
+        }
+    }
+
+    /// The set of [`MixedScratch::load_once`] changed: load its constants at the next call.
     pub(crate) fn forget(&mut self) {
         self.kept = false;
     }
-}
 
-/// [`add_velocity_mixed`] for a set whose owner calls [`MixedScratch::forget`] whenever it
-/// changes: the f32 constants are loaded once per change, not once per call (the far wake is
-/// summed at the collocation points, then at the segment midpoints, of each step).
-pub(crate) fn add_velocity_mixed_kept(
-    fil: &Filaments,
-    pts: &Points,
-    out: &mut [[f64; 3]],
-    parallel: Parallel,
-    scratch: &mut MixedScratch,
-) -> u64 {
-    let counts = [fil.n_nodes(), fil.n_segments(), fil.n_legs()];
-    if !scratch.kept || scratch.kept_counts != counts {
-        scratch.consts.load(fil);
-        (scratch.kept, scratch.kept_counts) = (true, counts);
+    /// [`add_velocity_mixed`] with `fil`'s constants loaded.
+    pub(crate) fn add_velocity(
+        &mut self,
+        fil: &Filaments,
+        pts: &Points,
+        out: &mut [[f64; 3]],
+        parallel: Parallel,
+    ) -> u64 {
+        assert_eq!(out.len(), pts.len(), "add_velocity_mixed: output length");
+        if pts.is_empty() || fil.n_filaments() == 0 {
+            return 0;
+        }
+        let c = &self.consts;
+        let n_blocks = pts.len().div_ceil(LANES32);
+        let pairs = n_blocks * LANES32 * fil.n_filaments();
+        if use_threads(parallel, pairs) {
+            self.blocks.for_each_chunk(out, LANES32, DIRECT_CHUNKS_PER_THREAD, |first, chunk, blk| {
+                for (i, block) in chunk.chunks_mut(LANES32).enumerate() {
+                    add_block(fil, c, pts, first + i, blk, block);
+                }
+            });
+        } else {
+            let blk = self.blocks.first();
+            for (b, block) in out.chunks_mut(LANES32).enumerate() {
+                add_block(fil, c, pts, b, blk, block);
+            }
+        }
+        pairs as u64
     }
-    add_loaded(fil, pts, out, parallel, scratch)
 }
 
 /// Add the velocity induced by `fil` at every point of `pts` to `out`, in mixed precision.
@@ -532,39 +562,8 @@ pub(crate) fn add_velocity_mixed(
     parallel: Parallel,
     scratch: &mut MixedScratch,
 ) -> u64 {
-    scratch.consts.load(fil);
-    scratch.kept = false;
-    add_loaded(fil, pts, out, parallel, scratch)
-}
-
-/// [`add_velocity_mixed`] with `fil`'s constants in `scratch`.
-fn add_loaded(
-    fil: &Filaments,
-    pts: &Points,
-    out: &mut [[f64; 3]],
-    parallel: Parallel,
-    scratch: &mut MixedScratch,
-) -> u64 {
-    assert_eq!(out.len(), pts.len(), "add_velocity_mixed: output length");
-    if pts.is_empty() || fil.n_filaments() == 0 {
-        return 0;
-    }
-    let c = &scratch.consts;
-    let n_blocks = pts.len().div_ceil(LANES32);
-    let pairs = n_blocks * LANES32 * fil.n_filaments();
-    if use_threads(parallel, pairs) {
-        scratch.blocks.for_each_chunk(out, LANES32, DIRECT_CHUNKS_PER_THREAD, |first, chunk, blk| {
-            for (i, block) in chunk.chunks_mut(LANES32).enumerate() {
-                add_block(fil, c, pts, first + i, blk, block);
-            }
-        });
-    } else {
-        let blk = scratch.blocks.first();
-        for (b, block) in out.chunks_mut(LANES32).enumerate() {
-            add_block(fil, c, pts, b, blk, block);
-        }
-    }
-    pairs as u64
+    scratch.load(fil);
+    scratch.add_velocity(fil, pts, out, parallel)
 }
 
 /// Velocity induced by `fil` at `points` in mixed precision (allocating convenience for checks

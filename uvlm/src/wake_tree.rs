@@ -21,7 +21,7 @@
 use crate::aic::{FarRows, SegmentKeys};
 use crate::biot_savart::{Filaments, LANES, NodeBlock, fill_block, load_lanes, velocity_block};
 use crate::induce::{Points, induced_velocity_inplace};
-use crate::mixed::{MixedScratch, add_velocity_mixed, add_velocity_mixed_kept};
+use crate::mixed::{MixedScratch, add_velocity_mixed};
 use crate::params::{Parallel, WakeAggregation};
 use crate::scratch::ScratchPool;
 use crate::treecode::{Treecode, block_order};
@@ -291,7 +291,10 @@ impl WakeTree {
         {
             return match &mut self.mixed {
                 // The set is the one of the last sync (every change of it goes through one).
-                Some(m) => add_velocity_mixed_kept(set, pts, out, parallel, m),
+                Some(m) => {
+                    m.load_once(set);
+                    m.add_velocity(set, pts, out, parallel)
+                }
                 None => add_direct(set, pts, out, parallel, scratch),
             };
         }

@@ -28,9 +28,16 @@ fn fold(k: usize) -> f64 {
 fn frozen_against_recompute(delta: f64) -> (f64, f64) {
     let (mut a, wing) = solver(WakeReuse::Recompute);
     let (mut b, _) = solver(WakeReuse::Frozen);
+    march_both(&mut a, &mut b, &wing, delta, 30)
+}
+
+/// March `a` and `b` side by side over `steps` steps of two solves (at the fold off by `delta`,
+/// then at the true fold); the largest relative differences of the total force and of Γ
+/// (relative to max |Γ|) over the steps.
+fn march_both(a: &mut Uvlm, b: &mut Uvlm, wing: &FlaredWing, delta: f64, steps: usize) -> (f64, f64) {
     let (mut df, mut dg) = (0.0_f64, 0.0_f64);
-    for k in 1..=30 {
-        for u in [&mut a, &mut b] {
+    for k in 1..=steps {
+        for u in [&mut *a, &mut *b] {
             u.advance_wake(0.01).unwrap();
             u.update_stations(&wing.stations(fold(k) + delta), None).unwrap();
             u.solve_step().unwrap();
@@ -139,6 +146,13 @@ fn mixed_precision_loads_match_f64() {
     assert!(df > 0.0, "the mixed path was not taken");
 }
 
+/// A solver as `u` was built, with the refined solves of the influence matrix.
+fn refined(u: &Uvlm) -> Uvlm {
+    let mut params = u.params().clone();
+    params.aic_refinement = true;
+    Uvlm::new(u.lattice().clone(), params).unwrap()
+}
+
 /// Γ solved on the factorisation of an earlier influence matrix and refined against the current
 /// one (`aic_refinement`, uvlm/src/refine.rs) against a factorisation of every matrix, on the
 /// folding wing of [`solver`] over 60 steps with two solves a step (the second at the step's
@@ -149,28 +163,8 @@ fn mixed_precision_loads_match_f64() {
 #[test]
 fn refined_solves_match_a_factorisation_of_every_matrix() {
     let (mut a, wing) = solver(WakeReuse::Frozen);
-    let (b, _) = solver(WakeReuse::Frozen);
-    let mut params = b.params().clone();
-    params.aic_refinement = true;
-    let mut b = Uvlm::new(b.lattice().clone(), params).unwrap();
-    let (mut df, mut dg) = (0.0_f64, 0.0_f64);
-    for k in 1..=60 {
-        for u in [&mut a, &mut b] {
-            u.advance_wake(0.01).unwrap();
-            u.update_stations(&wing.stations(fold(k) + 1e-3), None).unwrap();
-            u.solve_step().unwrap();
-            u.update_stations(&wing.stations(fold(k)), None).unwrap();
-            u.solve_step().unwrap();
-            u.commit_step().unwrap();
-        }
-        let (fa, fb) = (a.loads().total_force(), b.loads().total_force());
-        let norm = (fa[0] * fa[0] + fa[1] * fa[1] + fa[2] * fa[2]).sqrt();
-        let diff = ((fa[0] - fb[0]).powi(2) + (fa[1] - fb[1]).powi(2) + (fa[2] - fb[2]).powi(2)).sqrt();
-        df = df.max(diff / norm);
-        let gmax = a.gamma().iter().fold(0.0_f64, |m, g| m.max(g.abs()));
-        let gd = a.gamma().iter().zip(b.gamma()).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-        dg = dg.max(gd / gmax);
-    }
+    let mut b = refined(&a);
+    let (df, dg) = march_both(&mut a, &mut b, &wing, 1e-3, 60);
     let (sa, sb) = (a.stats(), b.stats());
     println!(
         "force {df:.2e}, gamma {dg:.2e}; factorisations {} against {}, refined solves {}, corrections {}",
@@ -188,9 +182,7 @@ fn refined_solves_match_a_factorisation_of_every_matrix() {
 #[test]
 fn a_matrix_that_stops_changing_is_factorised_after_eight_refined_solves() {
     let (u, wing) = solver(WakeReuse::Frozen);
-    let mut params = u.params().clone();
-    params.aic_refinement = true;
-    let mut u = Uvlm::new(u.lattice().clone(), params).unwrap();
+    let mut u = refined(&u);
     for k in 1..=3 {
         u.advance_wake(0.01).unwrap();
         u.update_stations(&wing.stations(fold(k)), None).unwrap();
