@@ -86,7 +86,7 @@ impl DenseLu {
 
 impl DenseLu {
     /// Overwrite `b` with `A⁻¹ b` by substitution column by column (the solves of a refinement,
-    /// refine.rs): faer's solve, made for many right-hand sides, took about three times as long
+    /// refine.rs): faer's solve, made for many right-hand sides, took twice as long
     /// for one at the lattices' sizes. Within rounding of [`DenseLu::solve_in_place`], not bit for
     /// bit; one instruction set's sums are every other's (no fused products).
     pub(crate) fn solve_vector(&mut self, b: &mut [f64]) {

@@ -7,7 +7,7 @@
 //! `A x = b` by the classical refinement `x ← x + A₀⁻¹ (b − A x)`, which contracts by
 //! `ρ ≈ ‖A₀⁻¹ (A − A₀)‖` per correction. Each correction costs a product with `A` and a solve with
 //! the LU (`4n²` flops, [`DenseLu::solve_vector`]), the factorisation `⅔n³` at a lower rate than
-//! its flop count says: on 128 rings a factorisation took as long as about ten corrections.
+//! its flop count says: on 128 rings a factorisation took as long as about fourteen corrections.
 //!
 //! The iteration stops when a correction is at most [`TOLERANCE`] of the solution's largest
 //! entry (the residual left is then about `ρ` times that); it gives up, so that the caller
