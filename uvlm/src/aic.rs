@@ -75,6 +75,9 @@ pub(crate) struct BoundSystem {
     /// Ring incidences of the base segments, then (`inc_leg`) of the base legs.
     inc: Vec<[(u32, f64); 2]>,
     inc_leg: Vec<[(u32, f64); 2]>,
+    /// The incidences of every filament, image copies included, in the filaments' order (the
+    /// AIC's ring sums read them per block of points: no index arithmetic per filament).
+    inc_all: Vec<[(u32, f64); 2]>,
     n_base_seg: usize,
     n_base_leg: usize,
     /// Per surface: where its filaments and rings are.
@@ -117,6 +120,11 @@ impl BoundSystem {
         self.n_planes = planes.len();
         self.n_copies = copy_signs(planes.len()).len();
         append_images(&mut self.fil, planes);
+        self.inc_all.clear();
+        for f in 0..self.n_filaments() {
+            let (b, _) = self.base_of(f);
+            self.inc_all.push(*self.incidences(b));
+        }
     }
 
     /// Where surface `k`'s filaments and rings are.
@@ -313,9 +321,8 @@ impl BoundSystem {
             let NodeBlock { infl, rings, .. } = blk;
             let sum_rings = |rings: &mut [[f64; LANES]]| {
                 rings.fill([0.0; LANES]);
-                for (f, v) in infl.iter().enumerate().take(nf) {
-                    let (b, _) = self.base_of(f);
-                    for &(r, s) in self.incidences(b) {
+                for (v, inc) in infl.iter().zip(&self.inc_all[..nf]) {
+                    for &(r, s) in inc {
                         if r == NONE {
                             continue;
                         }
