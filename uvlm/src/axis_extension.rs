@@ -151,7 +151,9 @@ const AXIS_CHUNK: usize = 48;
 /// [`use_threads`].
 const AXIS_PAIR_COST: usize = 4;
 
-/// [`correct_axis_extensions`] at the load points `p0..p0 + out.len()`, into `out`.
+/// [`correct_axis_extensions`] at the load points `p0..p0 + out.len()`, into `out`. Copy by
+/// copy, then point by point (each point takes its corrections in the same order as point by
+/// point, copy by copy); the segments of a spanwise row are gathered once for the row's points.
 fn correct_axis_points(
     fil: &Filaments,
     layout: &ExtensionLayout,
@@ -162,22 +164,26 @@ fn correct_axis_points(
 ) {
     let mut ch = RunChunk::new();
     ch.cutoff_only = cutoff_only;
-    let mut base = 0;
-    for sl in &layout.surfaces {
-        let (m, n) = (sl.m, sl.n);
-        let nc = n + 1;
-        let (lo, hi) = (p0.max(base), (p0 + out.len()).min(base + sl.n_load));
-        for p in lo..hi {
-            let s = p - base;
-            let x = [pts.x[p], pts.y[p], pts.z[p]];
-            let o = &mut out[p - p0];
-            for c in 0..layout.n_copies {
-                let seg = |b: usize| c * layout.n_base_seg + b;
+    let mut row = RowCache::new();
+    for c in 0..layout.n_copies {
+        let seg = |b: usize| c * layout.n_base_seg + b;
+        let mut base = 0;
+        for sl in &layout.surfaces {
+            let (m, n) = (sl.m, sl.n);
+            let nc = n + 1;
+            let (lo, hi) = (p0.max(base), (p0 + out.len()).min(base + sl.n_load));
+            for p in lo..hi {
+                let s = p - base;
+                let x = [pts.x[p], pts.y[p], pts.z[p]];
+                let o = &mut out[p - p0];
                 if s < m * n || s >= m * n + m * nc {
                     // A spanwise point: the segments of its row.
                     let i = if s < m * n { s / n } else { m };
                     let first = if i < m { sl.seg0 + i * n } else { sl.seg0 + m * n + m * nc };
-                    fix_run(&mut ch, (first..first + n).map(|b| filament(fil, seg(b))), x, o);
+                    match row.segments(fil, (seg(first), n)) {
+                        Some(segs) => fix_run(&mut ch, segs.iter().copied(), x, o),
+                        None => fix_run(&mut ch, (first..first + n).map(|b| filament(fil, seg(b))), x, o),
+                    }
                 } else {
                     // A chordwise point: the segments of its column and its trailing leg.
                     let j = (s - m * n) % nc;
@@ -189,8 +195,40 @@ fn correct_axis_points(
                     }
                 }
             }
+            base += sl.n_load;
         }
-        base += sl.n_load;
+    }
+}
+
+/// Segments a [`RowCache`] holds (longer rows are gathered point by point).
+const ROW_CACHE: usize = 256;
+
+/// The consecutive segments of one spanwise row of the bound system, gathered once for the
+/// row's load points rather than once per point (a fixed array: the loop does not allocate).
+struct RowCache {
+    /// The first filament and the count held.
+    held: Option<(usize, usize)>,
+    segs: [Segment; ROW_CACHE],
+}
+
+impl RowCache {
+    fn new() -> Self {
+        Self { held: None, segs: [([0.0; 3], [0.0; 3], (0.0, 0.0, 0.0)); ROW_CACHE] }
+    }
+
+    /// The `len` filaments of `fil` from `first`, gathered if they are not held; `None` for a
+    /// row longer than the cache.
+    fn segments(&mut self, fil: &Filaments, (first, len): (usize, usize)) -> Option<&[Segment]> {
+        if len > ROW_CACHE {
+            return None;
+        }
+        if self.held != Some((first, len)) {
+            for (s, f) in self.segs.iter_mut().zip(first..first + len) {
+                *s = filament(fil, f);
+            }
+            self.held = Some((first, len));
+        }
+        Some(&self.segs[..len])
     }
 }
 
