@@ -425,7 +425,7 @@ pub(crate) fn build_known_wake(
     part: WakePart,
 ) {
     fil.clear();
-    append_known_wake(fil, te, wake, closure_dir, core, te_core, part, None);
+    append_known_wake(fil, te, wake, closure_dir, (core, te_core), part);
     append_images(fil, planes);
 }
 
@@ -494,24 +494,23 @@ impl SegmentKeys {
 /// unchanged (wake_tree.rs). `head + 2 ≤ tail − 1`, so that at least one node row is left out.
 pub(crate) type FarRows = (usize, usize);
 
-/// Append one surface's known wake (as [`build_known_wake`], without images) to `fil`, after
-/// what it holds: the wakes of several surfaces go into one set, then the images of all.
-#[allow(clippy::too_many_arguments)] // the wake, its two cores, closure, part and the keys' sink
+/// Append one surface's known wake (as [`build_known_wake`], without images, its segments
+/// unnamed) to `fil`, after what it holds: the wakes of several surfaces go into one set, then
+/// the images of all.
 pub(crate) fn append_known_wake(
     fil: &mut Filaments,
     te: &[[f64; 3]],
     wake: &Wake,
     closure_dir: Option<[f64; 3]>,
-    core: &CoreModel,
-    te_core: &CoreModel,
+    (core, te_core): (&CoreModel, &CoreModel),
     part: WakePart,
-    keys: Option<&mut SegmentKeys>,
 ) {
-    append_wake_rows(fil, te, wake, closure_dir, core, te_core, part, None, keys);
+    append_wake_rows(fil, te, wake, closure_dir, core, te_core, part, None, None);
 }
 
-/// [`append_known_wake`], of the far part only the node rows `rows` when given ([`FarRows`]).
-#[allow(clippy::too_many_arguments)] // as append_known_wake, and the rows
+/// [`append_known_wake`], of the far part only the node rows `rows` when given ([`FarRows`]),
+/// each segment's name pushed to `keys` when given.
+#[allow(clippy::too_many_arguments)] // the wake, its two cores, closure, part, rows and the keys' sink
 pub(crate) fn append_wake_rows(
     fil: &mut Filaments,
     te: &[[f64; 3]],

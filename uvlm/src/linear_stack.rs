@@ -127,7 +127,7 @@ impl Frozen {
         self.known.clear();
         for (lat, wake) in lats.iter().zip(wakes) {
             let te = lat.trailing_edge_nodes();
-            append_known_wake(&mut self.known, te, wake, closure, &p.wake_core, &p.bound_core, WakePart::All, None);
+            append_known_wake(&mut self.known, te, wake, closure, (&p.wake_core, &p.bound_core), WakePart::All);
         }
         append_images(&mut self.known, &p.images);
         self.col.clear();
