@@ -448,6 +448,9 @@ pub struct NewtonSettings {
     pub estimate_convergence: bool,
     /// Broyden rank-one corrections of the steps made with a reused factorisation.
     pub broyden: bool,
+    /// Turn a factorisation reused from an earlier step with the nodes' rotations (ANCF's DAE
+    /// path; a no-op elsewhere).
+    pub corotate: bool,
     /// Retry a failed step as two half steps, at most this deep.
     pub max_step_halvings: usize,
     /// Local error control: halve a converged step whose error estimate
@@ -525,6 +528,7 @@ impl Default for NewtonSettings {
             reuse_factorization: d.reuse_factorization,
             estimate_convergence: d.estimate_convergence,
             broyden: d.broyden,
+            corotate: d.corotate,
             max_step_halvings: d.max_step_halvings,
             local_error_tol: d.local_error_tol,
             predictor: None,
@@ -549,6 +553,7 @@ impl NewtonSettings {
             reuse_factorization: self.reuse_factorization,
             estimate_convergence: self.estimate_convergence,
             broyden: self.broyden,
+            corotate: self.corotate,
             max_step_halvings: self.max_step_halvings,
             local_error_tol: self.local_error_tol,
             ..Default::default()

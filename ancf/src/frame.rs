@@ -152,6 +152,17 @@ fn polar_rotation_svd(f: &Matrix3<f64>) -> Matrix3<f64> {
     r
 }
 
+/// The rotation that turns a node from the slopes `from` to the slopes `to` (each
+/// `[r_x, r_y, r_z]`, nine values column after column): the rotation factor of
+/// `F_to F_from⁻¹`, identity when `F_from` is singular.
+pub fn node_turn(from: &[f64], to: &[f64]) -> Matrix3<f64> {
+    let (f0, f1) = (Matrix3::from_column_slice(&from[..9]), Matrix3::from_column_slice(&to[..9]));
+    match f0.try_inverse() {
+        Some(inv) => polar_rotation(&(f1 * inv)),
+        None => Matrix3::identity(),
+    }
+}
+
 /// Rotation angle of a rotation matrix, rad in [0, π] (accurate for small angles).
 pub fn rotation_angle(r: &Matrix3<f64>) -> f64 {
     let s = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]).norm() * 0.5;

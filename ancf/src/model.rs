@@ -1341,6 +1341,40 @@ impl ConstrainedSystem for Model {
             SolvePath::Ode => self.weights[self.reduction.full_of(i)],
         }
     }
+
+    /// DAE: one rotation per node, the rotation part of `F F_ref⁻¹` with `F = [r_x r_y r_z]`
+    /// (docs/ancf.md §8). ODE: none (the reduced coordinates mix nodes' frames).
+    fn corotation_inplace(&self, q_ref: &[f64], q: &[f64], rotations: &mut Vec<f64>) -> bool {
+        if self.options.path != SolvePath::Dae {
+            return false;
+        }
+        rotations.clear();
+        for b in &self.bodies {
+            for k in 0..b.n_nodes {
+                let o = b.offset + NODE_DOF * k;
+                let turn = crate::frame::node_turn(&q_ref[o + 3..o + 12], &q[o + 3..o + 12]);
+                rotations.extend_from_slice(turn.as_slice());
+            }
+        }
+        true
+    }
+
+    /// The node's four vectors `r, r_x, r_y, r_z` turned by the node's rotation.
+    fn corotate_inplace(&self, rotations: &[f64], x: &mut [f64], transpose: bool) {
+        let mut turns = rotations.chunks_exact(9);
+        for b in &self.bodies {
+            for k in 0..b.n_nodes {
+                let Some(r) = turns.next() else { return };
+                let r = Matrix3::from_column_slice(r);
+                let o = b.offset + NODE_DOF * k;
+                for v in x[o..o + NODE_DOF].chunks_exact_mut(3) {
+                    let y = Vector3::new(v[0], v[1], v[2]);
+                    let z = if transpose { r.tr_mul(&y) } else { r * y };
+                    v.copy_from_slice(z.as_slice());
+                }
+            }
+        }
+    }
 }
 
 impl Model {

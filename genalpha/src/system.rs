@@ -162,4 +162,20 @@ pub trait ConstrainedSystem {
     fn increment_weight(&self, _i: usize) -> f64 {
         1.0
     }
+
+    /// Rotations `R` that carry an iteration matrix made at `q_ref` to the configuration `q`,
+    /// `A(q) ≈ R A(q_ref) Rᵀ`, written into `rotations` in the system's own layout; false (the
+    /// default) when the system has none. The integrator reserves room for `n_dof` values, so a
+    /// layout within that allocates nothing. A formulation in absolute coordinates turns its
+    /// stiffness with the body: the matrix of an earlier step, reused for Newton's iteration,
+    /// then contracts poorly on a body that turns, while the co-rotated one
+    /// (`x = R A(q_ref)⁻¹ Rᵀ r`) contracts as on a body at rest. Only a preconditioner: the
+    /// iteration converges to the same solution with or without it.
+    fn corotation_inplace(&self, _q_ref: &[f64], _q: &[f64], _rotations: &mut Vec<f64>) -> bool {
+        false
+    }
+
+    /// `x ← R x`, or `x ← Rᵀ x` if `transpose`, on the Newton unknowns (`n_dof` tangent
+    /// components) with rotations from [`corotation_inplace`](Self::corotation_inplace).
+    fn corotate_inplace(&self, _rotations: &[f64], _x: &mut [f64], _transpose: bool) {}
 }

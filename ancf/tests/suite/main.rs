@@ -6,6 +6,7 @@
 mod allocation;
 mod bad_input;
 mod common;
+mod corotation;
 mod energy;
 mod generic_analysis;
 mod inertia;
