@@ -108,11 +108,14 @@ pub struct GenAlpha<L: LinearSolver = DenseLu> {
     q_factorized: Vec<f64>,
     rotations: Vec<f64>,
     corotated: bool,
-    /// The Cholesky factor of `Φ_q Φ_qᵀ` (lower, row-major), built once for a constant `Φ_q`:
-    /// a co-rotated increment is projected back onto the linearised constraints with it.
-    /// `projection_ok`: built and positive definite; `constraint_target`: the constraint rows'
-    /// right-hand side of the solve in hand.
-    projection: Vec<f64>,
+    /// A co-rotated increment is projected back onto the linearised constraints with
+    /// `P = Φ_q` on its non-zero columns (`n_h × n_c`, row-major) and `Q = Pᵀ (P Pᵀ)⁻¹`
+    /// (`n_c × n_h`, row-major), both built once for a constant `Φ_q`; `projection_x` gathers
+    /// the increment on those columns. `projection_ok`: built, `P Pᵀ` positive definite;
+    /// `constraint_target`: the constraint rows' right-hand side of the solve in hand.
+    projection_rows: Vec<f64>,
+    projection_op: Vec<f64>,
+    projection_x: Vec<f64>,
     projection_ok: Option<bool>,
     constraint_target: Vec<f64>,
     /// Matrices assembled densely ([`GenAlpha::dense_assemblies`]).
@@ -385,7 +388,9 @@ impl<L: LinearSolver> GenAlpha<L> {
             q_factorized: vec![0.0; n_q],
             rotations: Vec::with_capacity(n),
             corotated: false,
-            projection: vec![0.0; n_h * n_h],
+            projection_rows: Vec::new(),
+            projection_op: Vec::new(),
+            projection_x: Vec::new(),
             projection_ok: None,
             constraint_target: vec![0.0; n_h],
             rhs: vec![0.0; n_all],
@@ -918,16 +923,40 @@ impl<L: LinearSolver> GenAlpha<L> {
         if !(self.phi_q_ready && sys.phi_q_is_constant()) {
             return false;
         }
-        *self.projection_ok.get_or_insert_with(|| {
-            let n_h = self.n_h;
-            let g = &mut self.projection;
-            for i in 0..n_h {
-                for j in 0..=i {
-                    g[i * n_h + j] = self.phi_q_cols.iter().map(|&c| self.phi_q.get(i, c) * self.phi_q.get(j, c)).sum();
-                }
+        if self.projection_ok.is_none() {
+            self.projection_ok = Some(self.build_projection());
+        }
+        self.projection_ok == Some(true)
+    }
+
+    /// `P` and `Q` of the projection onto the constraints (see the fields); false if `P Pᵀ` is
+    /// not positive definite (dependent constraint rows). Once per run.
+    fn build_projection(&mut self) -> bool {
+        let (n_h, n_c) = (self.n_h, self.phi_q_cols.len());
+        let p: Vec<f64> = (0..n_h)
+            .flat_map(|i| self.phi_q_cols.iter().map(move |&c| (i, c)))
+            .map(|(i, c)| self.phi_q.get(i, c))
+            .collect();
+        let row = |i: usize| &p[i * n_c..(i + 1) * n_c];
+        let mut g = vec![0.0; n_h * n_h];
+        for i in 0..n_h {
+            for j in 0..=i {
+                g[i * n_h + j] = row(i).iter().zip(row(j)).map(|(a, b)| a * b).sum();
             }
-            cholesky_in_place(g, n_h)
-        })
+        }
+        if !cholesky_in_place(&mut g, n_h) {
+            return false;
+        }
+        // Q's row k is (P Pᵀ)⁻¹ times P's column k.
+        let mut q = vec![0.0; n_c * n_h];
+        for (k, qk) in q.chunks_exact_mut(n_h).enumerate() {
+            for (i, x) in qk.iter_mut().enumerate() {
+                *x = p[i * n_c + k];
+            }
+            cholesky_solve(&g, n_h, qk);
+        }
+        (self.projection_rows, self.projection_op, self.projection_x) = (p, q, vec![0.0; n_c]);
+        true
     }
 
     /// `x += Φ_qᵀ (Φ_q Φ_qᵀ)⁻¹ (g − Φ_q x)` on the increment in `rhs` (`g` its constraint rows'
@@ -938,13 +967,16 @@ impl<L: LinearSolver> GenAlpha<L> {
         if n_h == 0 {
             return;
         }
-        let e = &mut self.constraint_target;
-        for (i, ei) in e.iter_mut().enumerate() {
-            *ei -= self.phi_q_cols.iter().map(|&c| self.phi_q.get(i, c) * self.rhs[c]).sum::<f64>();
+        let x = &mut self.projection_x;
+        for (xk, &c) in x.iter_mut().zip(&self.phi_q_cols) {
+            *xk = self.rhs[c];
         }
-        cholesky_solve(&self.projection, n_h, e);
-        for &c in &self.phi_q_cols {
-            self.rhs[c] += (0..n_h).map(|i| self.phi_q.get(i, c) * e[i]).sum::<f64>();
+        let e = &mut self.constraint_target;
+        for (ei, p) in e.iter_mut().zip(self.projection_rows.chunks_exact(x.len())) {
+            *ei -= p.iter().zip(x.iter()).map(|(a, b)| a * b).sum::<f64>();
+        }
+        for (&c, q) in self.phi_q_cols.iter().zip(self.projection_op.chunks_exact(n_h)) {
+            self.rhs[c] += q.iter().zip(e.iter()).map(|(a, b)| a * b).sum::<f64>();
         }
     }
 
