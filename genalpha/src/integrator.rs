@@ -649,6 +649,11 @@ impl<L: LinearSolver> GenAlpha<L> {
             // matrix is not kept (it is allocated again, zero, if a fallback needs it).
             self.discard_dense();
         }
+        let np = &self.params.newton;
+        if np.corotate && np.reuse_factorization && self.projection_ok.is_none() {
+            // Set up the co-rotated solves' projection here, so that no step allocates.
+            self.can_corotate(sys);
+        }
         Ok(())
     }
 
