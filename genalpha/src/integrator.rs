@@ -935,32 +935,22 @@ impl<L: LinearSolver> GenAlpha<L> {
     }
 
     /// `P` and `Q` of the projection onto the constraints (see the fields); false if `P Pᵀ` is
-    /// not positive definite (dependent constraint rows). Once per run.
+    /// not positive definite to 1e-12 of its diagonal (dependent constraint rows). Once per run.
     fn build_projection(&mut self) -> bool {
         let (n_h, n_c) = (self.n_h, self.phi_q_cols.len());
-        let p: Vec<f64> = (0..n_h)
-            .flat_map(|i| self.phi_q_cols.iter().map(move |&c| (i, c)))
-            .map(|(i, c)| self.phi_q.get(i, c))
-            .collect();
-        let row = |i: usize| &p[i * n_c..(i + 1) * n_c];
-        let mut g = vec![0.0; n_h * n_h];
-        for i in 0..n_h {
-            for j in 0..=i {
-                g[i * n_h + j] = row(i).iter().zip(row(j)).map(|(a, b)| a * b).sum();
-            }
-        }
-        if !cholesky_in_place(&mut g, n_h) {
+        let p = nalgebra::DMatrix::from_fn(n_h, n_c, |i, k| self.phi_q.get(i, self.phi_q_cols[k]));
+        let g = &p * p.transpose();
+        let Some(chol) = g.clone().cholesky() else { return false };
+        // The pivots are the squared diagonal of the factor.
+        let independent = (0..n_h).all(|j| chol.l_dirty()[(j, j)].powi(2) > 1e-12 * g[(j, j)].abs());
+        if !independent {
             return false;
         }
-        // Q's row k is (P Pᵀ)⁻¹ times P's column k.
-        let mut q = vec![0.0; n_c * n_h];
-        for (k, qk) in q.chunks_exact_mut(n_h).enumerate() {
-            for (i, x) in qk.iter_mut().enumerate() {
-                *x = p[i * n_c + k];
-            }
-            cholesky_solve(&g, n_h, qk);
-        }
-        (self.projection_rows, self.projection_op, self.projection_x) = (p, q, vec![0.0; n_c]);
+        // Q = Pᵀ (P Pᵀ)⁻¹ row-major is (P Pᵀ)⁻¹ P column-major: Q's row k is its column k.
+        let q = chol.solve(&p);
+        self.projection_rows = p.transpose().as_slice().to_vec(); // P row-major
+        self.projection_op = q.as_slice().to_vec();
+        self.projection_x = vec![0.0; n_c];
         true
     }
 
@@ -1431,38 +1421,6 @@ impl<L: LinearSolver> GenAlpha<L> {
     /// storage).
     fn fallback_form(&self) -> AssembleInto {
         if self.n_all > DENSE_FALLBACK_MAX { AssembleInto::Entries } else { AssembleInto::Dense }
-    }
-}
-
-/// `G = L Lᵀ` in place (lower triangle, row-major `n × n`); false unless `G` is positive
-/// definite (to 1e-12 of its diagonal). Written by hand: a handful of constraint rows, factorised
-/// once per run.
-fn cholesky_in_place(g: &mut [f64], n: usize) -> bool {
-    for j in 0..n {
-        let d = g[j * n + j] - (0..j).map(|k| g[j * n + k] * g[j * n + k]).sum::<f64>();
-        let positive = d.is_finite() && d > 1e-12 * g[j * n + j].abs(); // false for NaN too
-        if !positive {
-            return false;
-        }
-        let l = d.sqrt();
-        g[j * n + j] = l;
-        for i in j + 1..n {
-            let s = g[i * n + j] - (0..j).map(|k| g[i * n + k] * g[j * n + k]).sum::<f64>();
-            g[i * n + j] = s / l;
-        }
-    }
-    true
-}
-
-/// Solve `L Lᵀ x = b` in place with the factor of [`cholesky_in_place`].
-fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
-    for i in 0..n {
-        let s = b[i] - (0..i).map(|k| l[i * n + k] * b[k]).sum::<f64>();
-        b[i] = s / l[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let s = b[i] - (i + 1..n).map(|k| l[k * n + i] * b[k]).sum::<f64>();
-        b[i] = s / l[i * n + i];
     }
 }
 
