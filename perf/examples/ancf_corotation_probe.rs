@@ -2,9 +2,11 @@
 //! bring its contraction on the current one down? Spectral radius of I − K_old⁻¹ K_new, against
 //! I − (R K_old Rᵀ)⁻¹ K_new with R = diag(I₄ ⊗ ΔR_node, I on multipliers), on the c = 1, β = 45°
 //! pendulum (DAE), by power iteration.
+use ancf::frame::{node_turn, rotation_angle};
 use ancf::{Model, Options, SolvePath, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix, IntegratorParams};
-use nalgebra::{DMatrix, DVector, Matrix3};
+use nalgebra::DMatrix;
+use perf::reuse_radius;
 
 fn kkt(model: &Model, q: &[f64], ck: f64) -> DMatrix<f64> {
     let (n, nh) = (model.n_dof(), model.n_holonomic());
@@ -19,29 +21,6 @@ fn kkt(model: &Model, q: &[f64], ck: f64) -> DMatrix<f64> {
         }
     }
     DMatrix::from_column_slice(n + nh, n + nh, m.as_slice())
-}
-
-fn frame(q: &[f64], node: usize) -> Matrix3<f64> {
-    let o = 12 * node;
-    Matrix3::from_column_slice(&q[o + 3..o + 12])
-}
-
-fn polar(g: Matrix3<f64>) -> Matrix3<f64> {
-    let svd = g.svd(true, true);
-    svd.u.unwrap() * svd.v_t.unwrap()
-}
-
-fn radius(p: &DMatrix<f64>, k_new: &DMatrix<f64>) -> f64 {
-    let lu = p.clone().lu();
-    let n = p.nrows();
-    let mut x = DVector::from_fn(n, |i, _| ((i * 7 + 3) as f64).sin());
-    let mut rho = 0.0;
-    for _ in 0..200 {
-        let y = &x - lu.solve(&(k_new * &x)).unwrap();
-        rho = y.norm() / x.norm();
-        x = y / rho.max(1e-300);
-    }
-    rho
 }
 
 fn main() {
@@ -64,8 +43,9 @@ fn main() {
         let mut r = DMatrix::<f64>::identity(n + nh, n + nh);
         let mut worst = 0.0_f64;
         for node in 0..nodes {
-            let dr = polar(frame(&s.q, node) * frame(&q_old, node).try_inverse().unwrap());
-            worst = worst.max(((dr.trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos());
+            let o = 12 * node;
+            let dr = node_turn(&q_old[o + 3..o + 12], &s.q[o + 3..o + 12]);
+            worst = worst.max(rotation_angle(&dr));
             for b in 0..4 {
                 let o = 12 * node + 3 * b;
                 r.view_mut((o, o), (3, 3)).copy_from(&dr);
@@ -76,8 +56,8 @@ fn main() {
             "t = {:.3}  largest node turn {:.4} rad  rho(old) {:.3}  rho(co-rotated) {:.3}",
             s.t,
             worst,
-            radius(&k_old, &k_new),
-            radius(&k_co, &k_new)
+            reuse_radius(&k_old, &k_new, 200),
+            reuse_radius(&k_co, &k_new, 200)
         );
     }
 }

@@ -8,7 +8,8 @@
 //! could take out, as ANCF's (`ancf_corotation_probe`): GEBF's unknowns already follow the frame.
 use gebf::{Model, Options, samples};
 use genalpha::{ConstrainedSystem, DenseMatrix, GenAlpha, IntegratorParams, State};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
+use perf::reuse_radius;
 
 struct Parts {
     m: DMatrix<f64>,
@@ -44,19 +45,6 @@ fn assemble(p: [&Parts; 4], bp: f64, gp: f64) -> DMatrix<f64> {
     &p[0].m + &p[1].c * (gp / bp) + &p[2].k * (1.0 / bp) + &p[3].joints
 }
 
-fn radius(p: &DMatrix<f64>, k_new: &DMatrix<f64>) -> f64 {
-    let lu = p.clone().lu();
-    let n = p.nrows();
-    let mut x = DVector::from_fn(n, |i, _| ((i * 7 + 3) as f64).sin());
-    let mut rho = 0.0;
-    for _ in 0..300 {
-        let y = &x - lu.solve(&(k_new * &x)).unwrap();
-        rho = y.norm() / x.norm();
-        x = y / rho.max(1e-300);
-    }
-    rho
-}
-
 fn main() {
     let (b, j, g) = samples::double_pendulum(1.0, 45.0, 5);
     let mut model = Model::new(&b, &j, g, Options::default()).unwrap();
@@ -74,7 +62,7 @@ fn main() {
         }
         let (po, pn) = (parts(&model, &old, gp), parts(&model, &s, gp));
         let a_new = assemble([&pn, &pn, &pn, &pn], bp, gp);
-        let rho = |p: [&Parts; 4]| radius(&assemble(p, bp, gp), &a_new);
+        let rho = |p: [&Parts; 4]| reuse_radius(&assemble(p, bp, gp), &a_new, 300);
         println!(
             "t = {:.3}  |psi|max {:.3}  rho(old) {:.3}  old M only {:.3}  old C only {:.3}  old K only {:.3}  old joints only {:.3}",
             s.t,

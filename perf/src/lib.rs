@@ -8,4 +8,23 @@
 //!   crate they time: `ancf_*`, `gebf_*`, `uvlm_*`, and `newton_trace` (the Newton iterations of a
 //!   case's run).
 //!
-//! The library itself is empty.
+//! The library holds what several examples share: [`reuse_radius`], the probes' measure of how
+//! well an earlier iteration matrix serves the current one.
+
+use nalgebra::{DMatrix, DVector};
+
+/// The spectral radius of `I − A_old⁻¹ A_new` (the linear contraction of Newton's iteration with
+/// the matrix `A_old` on a problem whose matrix is `A_new`), by `iterations` steps of power
+/// iteration from a fixed start.
+pub fn reuse_radius(a_old: &DMatrix<f64>, a_new: &DMatrix<f64>, iterations: usize) -> f64 {
+    let lu = a_old.clone().lu();
+    let n = a_old.nrows();
+    let mut x = DVector::from_fn(n, |i, _| ((i * 7 + 3) as f64).sin());
+    let mut rho = 0.0;
+    for _ in 0..iterations {
+        let y = &x - lu.solve(&(a_new * &x)).expect("the old matrix is invertible");
+        rho = y.norm() / x.norm();
+        x = y / rho.max(1e-300);
+    }
+    rho
+}
