@@ -34,6 +34,7 @@
 
 use crate::DenseMatrix;
 use crate::node_lu::NodeBand;
+use crate::vecops::{dot, first_nonzero, last_nonzero, sub_scaled};
 
 /// The declared structure: diagonal blocks `(first, len, half_bandwidth)` of the unknowns
 /// (tangent indices); every index in no block belongs to the border, and so do all constraint
@@ -64,63 +65,6 @@ impl BandedBorder {
             end = first + len;
         }
         true
-    }
-}
-
-/// `Σ a_i b_i` with four partial sums: independent chains that pipeline and vectorise, where a
-/// single running sum would wait for every addition in turn.
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    let mut acc = [0.0; 4];
-    for (x, y) in ca.zip(cb) {
-        for i in 0..4 {
-            acc[i] += x[i] * y[i];
-        }
-    }
-    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
-}
-
-/// Index of the first non-zero of `x`. Tested eight at a time without an early exit inside a
-/// group (a comparison and an `or` that vectorise), since most scanned rows and columns of the
-/// border are entirely zero.
-#[inline(always)]
-fn first_nonzero(x: &[f64]) -> Option<usize> {
-    let chunks = x.chunks_exact(8);
-    let tail = x.len() - chunks.remainder().len();
-    for (g, c) in chunks.enumerate() {
-        if c.iter().fold(false, |a, v| a | (*v != 0.0)) {
-            return c.iter().position(|v| *v != 0.0).map(|o| 8 * g + o);
-        }
-    }
-    x[tail..].iter().position(|v| *v != 0.0).map(|o| tail + o)
-}
-
-/// Index of the last non-zero of `x`, eight at a time from the end (see [`first_nonzero`]).
-#[inline(always)]
-fn last_nonzero(x: &[f64]) -> Option<usize> {
-    let chunks = x.rchunks_exact(8);
-    let head = chunks.remainder().len();
-    for (g, c) in chunks.enumerate() {
-        if c.iter().fold(false, |a, v| a | (*v != 0.0)) {
-            return c.iter().rposition(|v| *v != 0.0).map(|o| x.len() - 8 * (g + 1) + o);
-        }
-    }
-    x[..head].iter().rposition(|v| *v != 0.0)
-}
-
-/// `y −= s x`.
-#[inline(always)]
-fn sub_scaled(y: &mut [f64], s: f64, x: &[f64]) {
-    for (a, b) in y.iter_mut().zip(x) {
-        *a -= s * b;
     }
 }
 

@@ -1,5 +1,6 @@
 //! The generalized-α stepper (Arnold–Brüls or Chung–Hulbert form, with scaled constraint rows).
 
+use crate::vecops::{dot, first_nonzero};
 use crate::{
     Assembled, AssemblyTarget, Coefficients, ConstrainedSystem, DENSE_FALLBACK_MAX, DenseLu, DenseMatrix, Entries,
     Error, Form, IntegratorParams, IterationRecord, LinearSolver, MatView, Predictor, Stats, StepStats,
@@ -243,9 +244,16 @@ fn eval_b<S: ConstrainedSystem + ?Sized>(sys: &S, t: f64, q: &[f64], b: &mut Den
         data[j * n_v..(j + 1) * n_v].fill(0.0);
     }
     sys.psi_v_inplace(t, q, &mut b.view());
-    let data = b.as_slice();
+    // Most columns are zero: skip them eight entries at a time, and after a non-zero the rest of
+    // its column.
     nz_cols.clear();
-    nz_cols.extend((0..n).filter(|&j| data[j * n_v..(j + 1) * n_v].iter().fold(false, |a, x| a | (*x != 0.0))));
+    let data = &b.as_slice()[..n * n_v];
+    let mut p = 0;
+    while let Some(o) = first_nonzero(&data[p..]) {
+        let j = (p + o) / n_v;
+        nz_cols.push(j);
+        p = (j + 1) * n_v;
+    }
 }
 
 /// The constraint Jacobians at the start (one Φ_q and B for both sides: the weighted state is
@@ -587,13 +595,15 @@ impl<L: LinearSolver> GenAlpha<L> {
         } else {
             (&self.phi_q, &self.phi_q_cols, &self.b_mat, &self.b_nz_cols)
         };
+        // Φ_q and B are stored by columns: column j's entries are contiguous.
+        let phi = phi_f.as_slice();
         for &j in phi_f_cols {
-            self.r[j] += (0..n_h).map(|i| phi_f.get(i, j) * lambda[i]).sum::<f64>();
+            self.r[j] += dot(&phi[j * n_h..(j + 1) * n_h], lambda);
         }
         if n_v > 0 {
             let data = b_f.as_slice();
             for &j in b_f_cols {
-                self.r[j] += data[j * n_v..(j + 1) * n_v].iter().zip(mu).map(|(a, b)| a * b).sum::<f64>();
+                self.r[j] += dot(&data[j * n_v..(j + 1) * n_v], mu);
             }
         }
     }
@@ -839,7 +849,6 @@ impl<L: LinearSolver> GenAlpha<L> {
         let k = self.broyden_norms.len();
         if k > 0 {
             self.broyden_plain.copy_from_slice(&self.rhs);
-            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
             for j in 0..k - 1 {
                 let c = dot(&self.broyden_steps[j * m..(j + 1) * m], &self.rhs) / self.broyden_norms[j];
                 for (z, s) in self.rhs.iter_mut().zip(&self.broyden_steps[(j + 1) * m..(j + 2) * m]) {
@@ -857,7 +866,7 @@ impl<L: LinearSolver> GenAlpha<L> {
             }
         }
         if k <= self.params.newton.max_iter {
-            let norm2 = self.rhs.iter().map(|x| x * x).sum::<f64>();
+            let norm2 = dot(&self.rhs, &self.rhs);
             if norm2 > 0.0 && norm2.is_finite() {
                 self.broyden_steps.extend_from_slice(&self.rhs);
                 self.broyden_norms.push(norm2);
@@ -968,10 +977,10 @@ impl<L: LinearSolver> GenAlpha<L> {
         }
         let e = &mut self.constraint_target;
         for (ei, p) in e.iter_mut().zip(self.projection_rows.chunks_exact(x.len())) {
-            *ei -= p.iter().zip(x.iter()).map(|(a, b)| a * b).sum::<f64>();
+            *ei -= dot(p, x);
         }
         for (&c, q) in self.phi_q_cols.iter().zip(self.projection_op.chunks_exact(n_h)) {
-            self.rhs[c] += q.iter().zip(e.iter()).map(|(a, b)| a * b).sum::<f64>();
+            self.rhs[c] += dot(q, e);
         }
     }
 
@@ -1227,8 +1236,12 @@ impl<L: LinearSolver> GenAlpha<L> {
                     rotations_known = true;
                 }
                 fresh = false;
-                copy_state(s, &mut self.previous);
-                self.previous_delta.copy_from_slice(&self.delta);
+                if factorized_this_step {
+                    // The iterate a diverging update steps back to (only after this step's own
+                    // factorisation: with an earlier step's matrix it restarts from the predictor).
+                    copy_state(s, &mut self.previous);
+                    self.previous_delta.copy_from_slice(&self.delta);
+                }
             }
             step_back = false;
             self.solve_increment(sys, c_vdot);

@@ -52,6 +52,7 @@ mod node_lu;
 mod params;
 mod stats;
 mod system;
+mod vecops;
 
 pub use banded::BandedBorder;
 pub use error::Error;

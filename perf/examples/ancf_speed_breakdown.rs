@@ -8,7 +8,8 @@
 //! `NOEST=1` switches the convergence estimate off; `MAXC` sets the contraction rate above which a
 //! reused factorisation is refreshed; `PRED=ext` extrapolates the acceleration in the predictor; `FULL=1` refactorises at every Newton iteration; `OUT=dir` writes every step's tip as
 //! `dir/<case>.csv`; `REF=dir` compares the tip with such files and prints the largest
-//! distance relative to the largest tip excursion from its start.
+//! distance relative to the largest tip excursion from its start; `ONLY=<name>` (e.g.
+//! `c1_beta45_Dae`) runs one case on one path, for a profile.
 use ancf::{Model, Options, SolvePath, samples};
 use genalpha::{GenAlpha, IntegratorParams, LinearSolver, State, Stats};
 use nalgebra::Vector3;
@@ -40,6 +41,9 @@ fn main() {
     for (c, beta) in samples::PAPER_CASES {
         for path in [SolvePath::Dae, SolvePath::Ode] {
             let name = format!("c{c}_beta{beta}_{path:?}");
+            if env("ONLY").is_some_and(|only| only != name) {
+                continue;
+            }
             let (bodies, joints, g) = samples::double_pendulum(c, beta, 5);
             let mut model =
                 Model::new(&bodies, &joints, g, Options { path, ..Default::default() }).expect("valid case");
