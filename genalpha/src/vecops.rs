@@ -35,12 +35,12 @@ pub(crate) fn sub_scaled(y: &mut [f64], s: f64, x: &[f64]) {
 /// the sign bit shifted out (−0.0 is zero). Integer operations without branches, which
 /// vectorise where eight floating-point comparisons would not.
 #[inline(always)]
-pub(crate) fn any_nonzero(x: &[f64]) -> bool {
+fn any_nonzero(x: &[f64]) -> bool {
     x.iter().fold(0u64, |a, v| a | v.to_bits()) << 1 != 0
 }
 
 /// Index of the first non-zero of `x`. Tested eight at a time without an early exit inside a
-/// group (a comparison and an `or` that vectorise), since most scanned rows and columns of a
+/// group ([`any_nonzero`]), since most scanned rows and columns of a
 /// bordered matrix's border, and of a constraint Jacobian, are entirely zero.
 #[inline(always)]
 pub(crate) fn first_nonzero(x: &[f64]) -> Option<usize> {
