@@ -11,10 +11,7 @@ use genalpha::IntegratorParams;
 
 /// CPU time of the calling thread, s (less sensitive to other processes than wall time).
 fn thread_cpu() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(f64::NAN, |ns| ns * 1e-9)
+    perf::thread_cpu_ns() as f64 * 1e-9
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

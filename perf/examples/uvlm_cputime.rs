@@ -2,14 +2,9 @@
 //! shared machines where criterion's wall time is inflated by other load. With rayon the CPU
 //! figure only counts the main thread: read the wall time there.
 //! Run: `cargo run --release -p perf --example uvlm_cputime`.
+use perf::thread_cpu_ns as cpu_ns;
 use uvlm::samples::FlaredWing;
 use uvlm::*;
-fn cpu_ns() -> u64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse().ok()))
-        .unwrap_or(0)
-}
 fn main() {
     let cases = [
         ("flexible", false, true, Parallel::Off),

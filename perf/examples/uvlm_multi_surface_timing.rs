@@ -8,12 +8,7 @@
 use uvlm::samples::{SpanSpacing, rectangular_wing};
 use uvlm::*;
 
-fn cpu_ns() -> u64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse().ok()))
-        .unwrap_or(0)
-}
+use perf::thread_cpu_ns as cpu_ns;
 
 fn shifted(st: &[SpanStation], dx: f64, dz: f64) -> Vec<SpanStation> {
     st.iter().map(|s| SpanStation { origin: s.origin + nalgebra::Vector3::new(dx, 0.0, dz), ..*s }).collect()

@@ -9,9 +9,23 @@
 //!   case's run).
 //!
 //! The library holds what several examples share: [`reuse_radius`], the probes' measure of how
-//! well an earlier iteration matrix serves the current one.
+//! well an earlier iteration matrix serves the current one, and [`thread_cpu_ns`], their clock.
 
 use nalgebra::{DMatrix, DVector};
+
+/// CPU time of the calling thread, ns, to the nanosecond (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`;
+/// wall time since the first call where the platform has no per-thread clock).
+///
+/// Not `/proc/thread-self/schedstat`: on a kernel with tick-based accounting its figure moves
+/// only at the scheduler's ticks (4 ms steps at 250 Hz), so a timed interval of tens of
+/// milliseconds came out as a whole number of ticks.
+pub fn thread_cpu_ns() -> u64 {
+    static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    match aeroelastic::clock::thread_cpu_s() {
+        Some(s) => (s * 1e9) as u64,
+        None => START.get_or_init(std::time::Instant::now).elapsed().as_nanos() as u64,
+    }
+}
 
 /// The spectral radius of `I − A_old⁻¹ A_new` (the linear contraction of Newton's iteration with
 /// the matrix `A_old` on a problem whose matrix is `A_new`), by `iterations` steps of power
