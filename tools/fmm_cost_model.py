@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Cost model of a dual-tree (fast-multipole-like) far-wake sum against the direct sum
-(docs/uvlm.md §14, "Clusters of targets as well").
+(docs/uvlm.md §9, "Clusters of targets as well").
 
 It answers one question before any code is written: with the evaluation points (collocation
 points and segment midpoints) grouped into clusters as well as the wake's segments, how much of
